@@ -1,0 +1,155 @@
+"""The Motion: a skeleton animated over time.
+
+A Motion holds, for T frames, the local rotation of every joint, the root's world position and
+the frame rate. Joints that translate on their own (BVH position channels on a non-root joint)
+keep per-frame translations in ``local_pos``; otherwise their rest offsets are used.
+
+Taught in ``notebooks/00_quaternions_and_fk.ipynb`` and ``01_preprocessing.ipynb``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from motionlab.core import fk as _fk
+from motionlab.core import quat
+from motionlab.core.skeleton import Skeleton
+
+__all__ = ["Motion"]
+
+
+@dataclass(eq=False)
+class Motion:
+    """A skeleton's animation.
+
+    Attributes
+    ----------
+    skeleton  : Skeleton with J joints
+    local_rot : ndarray, shape (T, J, 4)   unit quaternions (w, x, y, z) relative to the parent
+    root_pos  : ndarray, shape (T, 3)      world position of the root joint, metres
+    fps       : float                      frames per second (required: no silent default)
+    local_pos : ndarray, shape (T, J, 3), or None
+        Per-frame translation of every joint relative to its parent, for rigs whose non-root
+        joints are animated in position; ``None`` means the skeleton's rest offsets.
+    name      : str                        a label (file stem when loaded from BVH)
+    """
+
+    skeleton: Skeleton
+    local_rot: np.ndarray
+    root_pos: np.ndarray
+    fps: float
+    local_pos: np.ndarray | None = None
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        self.local_rot = quat.check(self.local_rot, "local_rot")
+        self.root_pos = np.asarray(self.root_pos, dtype=self.local_rot.dtype)
+        J = self.skeleton.num_joints
+        if self.local_rot.ndim != 3 or self.local_rot.shape[1] != J:
+            raise ValueError(
+                f"expected local_rot of shape (T, {J}, 4) for a {J}-joint skeleton, got {self.local_rot.shape}"
+            )
+        T = self.local_rot.shape[0]
+        if self.root_pos.shape != (T, 3):
+            raise ValueError(f"expected root_pos of shape ({T}, 3), got {self.root_pos.shape}")
+        if self.local_pos is not None:
+            self.local_pos = np.asarray(self.local_pos, dtype=self.local_rot.dtype)
+            if self.local_pos.shape != (T, J, 3):
+                raise ValueError(f"expected local_pos of shape ({T}, {J}, 3), got {self.local_pos.shape}")
+        if not (np.isfinite(self.fps) and self.fps > 0):
+            raise ValueError(f"fps must be a positive number, got {self.fps}")
+        self.fps = float(self.fps)
+
+    # ------------------------------------------------------------------ basics
+    @property
+    def num_frames(self) -> int:
+        """Number of frames T."""
+        return int(self.local_rot.shape[0])
+
+    def __len__(self) -> int:
+        return self.num_frames
+
+    @property
+    def duration(self) -> float:
+        """Length in seconds, ``(T - 1) / fps``."""
+        return max(self.num_frames - 1, 0) / self.fps
+
+    def __repr__(self) -> str:
+        label = f"{self.name!r}, " if self.name else ""
+        return f"Motion({label}{self.num_frames} frames @ {self.fps:g} fps, {self.skeleton.num_joints} joints)"
+
+    def __getitem__(self, frames) -> Motion:
+        """Frames ``frames`` (a slice or index array) as a new Motion."""
+        if isinstance(frames, (int, np.integer)):
+            frames = slice(int(frames), int(frames) + 1 if frames != -1 else None)
+        return Motion(
+            self.skeleton,
+            self.local_rot[frames].copy(),
+            self.root_pos[frames].copy(),
+            self.fps,
+            None if self.local_pos is None else self.local_pos[frames].copy(),
+            self.name,
+        )
+
+    def copy(self, **changes) -> Motion:
+        """A deep copy, with any field replaced by ``changes``."""
+        fields = dict(
+            skeleton=self.skeleton,
+            local_rot=self.local_rot.copy(),
+            root_pos=self.root_pos.copy(),
+            fps=self.fps,
+            local_pos=None if self.local_pos is None else self.local_pos.copy(),
+            name=self.name,
+        )
+        fields.update(changes)
+        return Motion(**fields)
+
+    # ------------------------------------------------------------------ kinematics
+    def translations(self) -> np.ndarray:
+        """Local translations (T, J, 3): the root's world position, then each joint's offset."""
+        if self.local_pos is not None:
+            t = self.local_pos.copy()
+        else:
+            t = np.broadcast_to(self.skeleton.offsets.astype(self.local_rot.dtype), (self.num_frames, self.skeleton.num_joints, 3)).copy()
+        t[:, 0] = self.root_pos
+        return t
+
+    def fk(self) -> tuple[np.ndarray, np.ndarray]:
+        """Global rotations (T, J, 4) and positions (T, J, 3)."""
+        return _fk.fk(self.local_rot, self.translations(), self.skeleton.parents)
+
+    def global_positions(self) -> np.ndarray:
+        """World joint positions (T, J, 3), metres."""
+        return self.fk()[1]
+
+    def global_rotations(self) -> np.ndarray:
+        """World joint rotations (T, J, 4)."""
+        return _fk.local_to_global(self.local_rot, self.skeleton.parents)
+
+    # ------------------------------------------------------------------ time
+    def resample(self, fps: float) -> Motion:
+        """The motion at another frame rate: SLERP for rotations, linear for positions.
+
+        The first frame is kept; the last new frame is the last one at or before the end.
+        """
+        if not (np.isfinite(fps) and fps > 0):
+            raise ValueError(f"fps must be a positive number, got {fps}")
+        if abs(fps - self.fps) < 1e-9 * self.fps or self.num_frames < 2:
+            return self.copy(fps=float(fps))
+        n_new = int(np.floor(self.duration * fps + 1e-6)) + 1
+        t = np.arange(n_new) * (self.fps / fps)  # in source frames
+        i0 = np.clip(np.floor(t).astype(np.int64), 0, self.num_frames - 1)
+        i1 = np.clip(i0 + 1, 0, self.num_frames - 1)
+        alpha = t - i0
+        rot = quat.slerp(self.local_rot[i0], self.local_rot[i1], alpha[:, None])
+        lerp = lambda x: x[i0] + (x[i1] - x[i0]) * alpha.reshape((-1,) + (1,) * (x.ndim - 1))  # noqa: E731
+        return Motion(
+            self.skeleton,
+            rot,
+            lerp(self.root_pos),
+            float(fps),
+            None if self.local_pos is None else lerp(self.local_pos),
+            self.name,
+        )
