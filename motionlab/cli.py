@@ -1,0 +1,67 @@
+"""The ``motionlab`` command line.
+
+Each part of the package registers its own sub-commands through a ``register(subparsers)``
+function in its ``cli`` module; this file only gathers them, so ``motionlab --help`` lists
+everything and a part that fails to import does not break the others.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+__all__ = ["main", "build_parser", "CLIError"]
+
+_PARTS = (
+    "motionlab.core.cli",
+    "motionlab.retargeting.cli",
+    "motionlab.motion_graphs.cli",
+    "motionlab.interpolation.cli",
+    "motionlab.viz.cli",
+)
+
+
+class CLIError(Exception):
+    """A user-facing error: printed as ``motionlab: error: …`` with exit status 2, no traceback."""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="motionlab",
+        description="Skeletal character animation: BVH tools, retargeting by latent iteration, "
+        "motion graphs, key-pose in-betweening and 3D playback.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name in _PARTS:
+        try:
+            module = importlib.import_module(name)
+        except ModuleNotFoundError as e:
+            if e.name == name:
+                continue  # that part has no commands (yet)
+            raise
+        module.register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if not getattr(args, "func", None):
+        parser.print_help()
+        return 0
+    try:
+        return int(args.func(args) or 0)
+    except CLIError as e:
+        print(f"motionlab: error: {e}", file=sys.stderr)
+        return 2
+    except (FileNotFoundError, FileExistsError, ValueError) as e:
+        print(f"motionlab: error: {e}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("motionlab: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,123 @@
+"""Motion quality metrics, each with its unit stated.
+
+All functions take world joint positions ``pos`` of shape (..., T, J, 3) in metres (or any unit:
+results are in that unit), Y up, ground at y = 0. Errors compare two motions frame by frame.
+
+========================  ==========================================================  ==========
+metric                    formula                                                     unit
+========================  ==========================================================  ==========
+``mse``                   mean over frames, joints and axes of (p - p̂)²               m²
+``mpjpe``                 mean over frames and joints of ‖p - p̂‖                      m
+``mse / height²``         :func:`mse` with ``height=h``                               unitless
+``smoothness``            mean over frames, joints of ‖p[t+1] - 2 p[t] + p[t-1]‖      m/frame²
+``foot_penetration``      mean over frames and foot joints of max(0, -y)              m
+``foot_skating``          mean horizontal foot speed over frames in ground contact    m/s
+``bone_length_error``     mean over bones of std_t(length) / mean_t(length)           unitless
+========================  ==========================================================  ==========
+
+Taught in ``notebooks/01_preprocessing.ipynb``; used by the retargeting evaluation (Table 1).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = [
+    "mse",
+    "mpjpe",
+    "smoothness",
+    "foot_penetration",
+    "foot_contacts",
+    "foot_skating",
+    "bone_length_error",
+]
+
+
+def _pair(pred, target) -> tuple[np.ndarray, np.ndarray]:
+    pred, target = np.asarray(pred, dtype=np.float64), np.asarray(target, dtype=np.float64)
+    if pred.shape != target.shape or pred.shape[-1:] != (3,):
+        raise ValueError(f"expected two (..., T, J, 3) position arrays of equal shape, got {pred.shape} and {target.shape}")
+    return pred, target
+
+
+def _pos(pos, name: str = "pos") -> np.ndarray:
+    pos = np.asarray(pos, dtype=np.float64)
+    if pos.ndim < 3 or pos.shape[-1] != 3:
+        raise ValueError(f"expected {name} of shape (..., T, J, 3), got {pos.shape}")
+    return pos
+
+
+def mse(pred, target, height: float | None = None) -> float:
+    """Mean squared joint-position error over frames, joints and axes.
+
+    With ``height``, the error is divided by ``height²`` (the unitless retargeting-literature
+    metric). Unit: (position unit)², or none when normalised.
+    """
+    pred, target = _pair(pred, target)
+    err = float(np.mean((pred - target) ** 2))
+    return err / height**2 if height else err
+
+
+def mpjpe(pred, target, height: float | None = None) -> float:
+    """Mean per-joint position error: mean Euclidean distance (position unit; ÷ height if given)."""
+    pred, target = _pair(pred, target)
+    err = float(np.mean(np.linalg.norm(pred - target, axis=-1)))
+    return err / height if height else err
+
+
+def smoothness(pos) -> float:
+    """Mean acceleration magnitude ``‖p[t+1] − 2p[t] + p[t−1]‖`` over frames and joints.
+
+    Unit: position unit per frame² (lower is smoother). Needs at least 3 frames.
+    """
+    pos = _pos(pos)
+    if pos.shape[-3] < 3:
+        raise ValueError(f"smoothness needs at least 3 frames, got {pos.shape[-3]}")
+    acc = pos[..., 2:, :, :] - 2 * pos[..., 1:-1, :, :] + pos[..., :-2, :, :]
+    return float(np.mean(np.linalg.norm(acc, axis=-1)))
+
+
+def foot_penetration(pos, feet, ground: float = 0.0) -> float:
+    """Mean depth below the ground, ``max(0, ground − y)``, over frames and the ``feet`` joints.
+
+    ``feet``: joint indices (e.g. both feet and toes). Unit: position unit.
+    """
+    pos = _pos(pos)
+    y = pos[..., list(feet), 1]
+    return float(np.mean(np.maximum(0.0, ground - y)))
+
+
+def foot_contacts(pos, feet, fps: float, height_threshold: float = 0.05, speed_threshold: float = 0.5) -> np.ndarray:
+    """Boolean ground-contact labels (..., T, F) for the ``feet`` joints: below
+    ``height_threshold`` (position unit) and slower than ``speed_threshold`` (units/s).
+    """
+    pos = _pos(pos)
+    p = pos[..., list(feet), :]
+    vel = np.gradient(p, axis=-3) * fps if p.shape[-3] > 1 else np.zeros_like(p)
+    return (p[..., 1] < height_threshold) & (np.linalg.norm(vel, axis=-1) < speed_threshold)
+
+
+def foot_skating(pos, feet, fps: float, height_threshold: float = 0.05) -> float:
+    """Mean horizontal speed (units/s) of the ``feet`` joints over the frames where they touch
+    the ground (height below ``height_threshold``); 0 when no foot ever touches it.
+    """
+    pos = _pos(pos)
+    p = pos[..., list(feet), :]
+    if p.shape[-3] < 2:
+        return 0.0
+    speed = np.linalg.norm(np.diff(p[..., [0, 2]], axis=-3), axis=-1) * fps  # (..., T-1, F)
+    contact = (p[..., 1:, :, 1] < height_threshold) & (p[..., :-1, :, 1] < height_threshold)
+    if not np.any(contact):
+        return 0.0
+    return float(np.mean(speed[contact]))
+
+
+def bone_length_error(pos, parents) -> float:
+    """How much bones stretch over time: mean over bones of std_t(length) / mean_t(length)."""
+    pos = _pos(pos)
+    parents = np.asarray(parents)
+    child = np.flatnonzero(parents >= 0)
+    lengths = np.linalg.norm(pos[..., child, :] - pos[..., parents[child], :], axis=-1)
+    mean = lengths.mean(axis=-2)
+    ok = mean > 1e-9
+    return float(np.mean(lengths.std(axis=-2)[ok] / mean[ok])) if np.any(ok) else 0.0

@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Create .venv/ with motionlab and everything its tests and notebooks need.
+# torch is installed first at a pinned version: on machines that keep its CPU wheel locally
+# this avoids downloading the multi-GB CUDA build. Elsewhere, set MOTIONLAB_TORCH_INDEX to
+# https://download.pytorch.org/whl/cpu to fetch the CPU build from PyTorch's own index.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+VENV=${MOTIONLAB_VENV:-.venv}
+[ -x "$VENV/bin/python" ] || python3 -m venv "$VENV"
+PY="$VENV/bin/python"
+"$PY" -m pip install -q --upgrade pip
+if ! "$PY" -c "import torch" >/dev/null 2>&1; then
+  if [ -n "${MOTIONLAB_TORCH_INDEX:-}" ]; then
+    "$PY" -m pip install -q torch --index-url "$MOTIONLAB_TORCH_INDEX"
+  else
+    "$PY" -m pip install -q torch==2.13.0
+  fi
+fi
+"$PY" -m pip install -q -e ".[dev,notebooks,bench]"
+"$PY" -m ipykernel install --sys-prefix --name python3 >/dev/null 2>&1 || true
+echo "motionlab is installed in $VENV (activate with: source $VENV/bin/activate)"
