@@ -1,0 +1,126 @@
+"""Foundation commands: ``motionlab info``, ``motionlab convert``, ``motionlab synth``, ``motionlab demo``."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+__all__ = ["register"]
+
+
+def _load(path: str):
+    from motionlab.core import bvh
+
+    p = Path(path)
+    if not p.is_file():
+        raise FileNotFoundError(f"{path}: no such file")
+    return bvh.load(p)
+
+
+def _check_output(path: str, force: bool) -> Path:
+    from motionlab.cli import CLIError
+
+    out = Path(path)
+    if out.exists() and not force:
+        raise CLIError(f"{out} exists; pass --force to overwrite it")
+    if not out.parent.exists():
+        raise CLIError(f"{out.parent} does not exist")
+    return out
+
+
+def _info(args) -> int:
+    from motionlab.core import humanoid
+
+    m = _load(args.file)
+    sk = m.skeleton
+    print(f"file      {args.file}")
+    print(f"frames    {m.num_frames} at {m.fps:g} fps ({m.duration:.2f} s)")
+    print(f"joints    {sk.num_joints} (root {sk.names[0]!r}, {len(sk.end_sites)} end sites)")
+    print(f"height    {sk.height():.4f} m (rest pose, all joints)")
+    try:
+        mapping = humanoid.find_mapping(sk)
+        canon = humanoid.to_canonical_skeleton(sk)
+        print(f"humanoid  maps onto the 22 joints (profile {mapping.profile!r}); 22-joint height {canon.height():.4f} m, "
+              f"leg length {humanoid.leg_length(canon):.4f} m")
+    except humanoid.RigMappingError as e:
+        print(f"humanoid  {e}")
+    if args.joints:
+        depth = sk.depth()
+        for j, name in enumerate(sk.names):
+            chans = " ".join(sk.channels[j]) if sk.channels else ""
+            print(f"  {'  ' * depth[j]}{name}  [{chans}]")
+    return 0
+
+
+def _convert(args) -> int:
+    from motionlab.core import bvh, humanoid
+
+    m = _load(args.input)
+    out = _check_output(args.output, args.force)
+    if args.canonical:
+        m = humanoid.to_canonical(m)
+    if args.fps:
+        m = m.resample(args.fps)
+    bvh.save(out, m, overwrite=args.force)
+    print(f"wrote {out}: {m.num_frames} frames at {m.fps:g} fps, {m.skeleton.num_joints} joints")
+    return 0
+
+
+def _synth(args) -> int:
+    from motionlab import synthetic
+    from motionlab.core import bvh, humanoid
+
+    out = _check_output(args.output, args.force)
+    skeleton = humanoid.canonical_skeleton(args.height)
+    skeleton = humanoid.scale_bones(skeleton, legs=args.legs, arms=args.arms)
+    if args.behaviour == "mix":
+        segments = [("idle", 60), ("walk", 150), ("run", 120), ("jump", 70), ("walk", 90), ("squat", 100), ("idle", 60)]
+        motion = synthetic.sequence(segments, skeleton, fps=args.fps, seed=args.seed)
+    else:
+        motion = synthetic.generate(args.behaviour, skeleton, num_frames=int(args.seconds * args.fps), fps=args.fps, seed=args.seed)
+    motion.name = args.behaviour
+    bvh.save(out, motion, overwrite=args.force)
+    print(f"wrote {out}: {motion.num_frames} frames of {args.behaviour} at {motion.fps:g} fps")
+    return 0
+
+
+def _demo(args) -> int:
+    from motionlab.demo import run_demo
+
+    return run_demo(out_dir=Path(args.out), characters=args.characters, seed=args.seed, force=args.force)
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("info", help="describe a BVH file: skeleton, frames, fps, 22-joint mapping")
+    p.add_argument("file", help="a .bvh file")
+    p.add_argument("--joints", action="store_true", help="also print the joint tree with channels")
+    p.set_defaults(func=_info)
+
+    p = sub.add_parser("convert", help="reduce a BVH file to the 22-joint humanoid and/or resample it")
+    p.add_argument("input", help="input .bvh")
+    p.add_argument("-o", "--output", required=True, help="output .bvh")
+    p.add_argument("--canonical", action="store_true", help="reduce to the canonical 22 joints")
+    p.add_argument("--fps", type=float, default=None, help="resample to this frame rate")
+    p.add_argument("--force", action="store_true", help="overwrite the output if it exists")
+    p.set_defaults(func=_convert)
+
+    p = sub.add_parser("synth", help="write synthetic motion (idle, walk, run, jump, squat or mix) as BVH")
+    p.add_argument("behaviour", choices=["idle", "walk", "run", "jump", "squat", "mix"])
+    p.add_argument("-o", "--output", required=True, help="output .bvh")
+    p.add_argument("--seconds", type=float, default=4.0, help="length (ignored for mix)")
+    p.add_argument("--fps", type=float, default=60.0)
+    p.add_argument("--height", type=float, default=1.75, help="character height, metres")
+    p.add_argument("--legs", type=float, default=1.0, help="leg length factor")
+    p.add_argument("--arms", type=float, default=1.0, help="arm length factor")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--force", action="store_true", help="overwrite the output if it exists")
+    p.set_defaults(func=_synth)
+
+    p = sub.add_parser("demo", help="the main job on built-in data: retarget a synthetic performance onto new characters")
+    p.add_argument("--out", default="outputs/demo", help="output folder (default: outputs/demo)")
+    p.add_argument("--characters", type=int, default=4, help="how many new characters")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--force", action="store_true", help="overwrite files in the output folder")
+    p.set_defaults(func=_demo)
+
+

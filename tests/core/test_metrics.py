@@ -1,0 +1,69 @@
+"""Metrics on hand-made cases with known answers."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from motionlab.core import metrics
+
+
+def test_mse_and_mpjpe_known_values():
+    a = np.zeros((2, 3, 3))
+    b = a.copy()
+    b[..., 0] = 3.0
+    b[..., 1] = 4.0  # every joint 5 units away
+    assert metrics.mpjpe(a, b) == pytest.approx(5.0)
+    assert metrics.mse(a, b) == pytest.approx((9 + 16 + 0) / 3)
+    assert metrics.mse(a, b, height=2.0) == pytest.approx(25 / 3 / 4)
+    assert metrics.mpjpe(a, b, height=2.0) == pytest.approx(2.5)
+    assert metrics.mse(a, a) == 0.0
+
+
+def test_shape_mismatch_is_an_error():
+    with pytest.raises(ValueError, match="equal shape"):
+        metrics.mse(np.zeros((2, 3, 3)), np.zeros((2, 4, 3)))
+
+
+def test_smoothness_zero_for_constant_velocity_and_known_for_a_kick():
+    t = np.arange(10.0)
+    pos = np.zeros((10, 1, 3))
+    pos[:, 0, 0] = 2.0 * t  # uniform motion
+    assert metrics.smoothness(pos) == pytest.approx(0.0)
+    pos[5, 0, 1] = 1.0  # one frame displaced by 1: accelerations 1, -2, 1 at frames 4, 5, 6
+    assert metrics.smoothness(pos) == pytest.approx((1 + 2 + 1) / 8)
+    with pytest.raises(ValueError, match="3 frames"):
+        metrics.smoothness(pos[:2])
+
+
+def test_foot_penetration_counts_only_depth_below_ground():
+    pos = np.zeros((4, 2, 3))
+    pos[:, 0, 1] = [0.1, -0.2, 0.0, -0.4]  # foot joint 0
+    pos[:, 1, 1] = 0.5
+    assert metrics.foot_penetration(pos, [0]) == pytest.approx(0.15)
+    assert metrics.foot_penetration(pos, [0, 1]) == pytest.approx(0.075)
+    assert metrics.foot_penetration(pos, [1]) == 0.0
+
+
+def test_foot_skating_measures_sliding_only_in_contact():
+    pos = np.zeros((5, 1, 3))
+    pos[:, 0, 0] = np.arange(5) * 0.01  # slides 1 cm per frame on the ground
+    assert metrics.foot_skating(pos, [0], fps=100) == pytest.approx(1.0)
+    pos[:, 0, 1] = 1.0  # in the air: no contact, no skating
+    assert metrics.foot_skating(pos, [0], fps=100) == 0.0
+
+
+def test_foot_contacts():
+    pos = np.zeros((5, 1, 3))
+    pos[3:, 0, 1] = 1.0
+    c = metrics.foot_contacts(pos, [0], fps=30)
+    assert c.shape == (5, 1)
+    assert c[:2, 0].all() and not c[3:, 0].any()
+
+
+def test_bone_length_error():
+    pos = np.zeros((3, 2, 3))
+    pos[:, 1, 1] = 1.0
+    assert metrics.bone_length_error(pos, [-1, 0]) == 0.0
+    pos[:, 1, 1] = [1.0, 2.0, 3.0]
+    assert metrics.bone_length_error(pos, [-1, 0]) == pytest.approx(np.std([1, 2, 3]) / 2)
