@@ -22,6 +22,14 @@ def _check_parents(parents, num_joints: int) -> np.ndarray:
     parents = np.asarray(parents, dtype=np.int64)
     if parents.shape != (num_joints,):
         raise ValueError(f"expected {num_joints} parent indices, got shape {parents.shape}")
+    # joint 0 is the root; any other order would read joints not yet computed
+    index = np.arange(num_joints)
+    ok = np.where(index == 0, parents == -1, (parents >= 0) & (parents < index))
+    if not np.all(ok):
+        j = int(np.flatnonzero(~ok)[0])
+        raise ValueError(
+            f"expected parents[0] == -1 and 0 <= parents[j] < j, got parents[{j}] = {int(parents[j])}"
+        )
     return parents
 
 
@@ -41,10 +49,12 @@ def fk(local_rot, local_pos, parents) -> tuple[np.ndarray, np.ndarray]:
     global_pos : ndarray, shape (..., J, 3)
     """
     local_rot = quat.check(local_rot, "local_rot")
-    local_pos = np.asarray(local_pos, dtype=local_rot.dtype)
-    if local_pos.shape[-1:] != (3,) or local_pos.ndim < 2:
-        raise ValueError(f"expected local_pos of shape (..., J, 3), got {local_pos.shape}")
+    if local_rot.ndim < 2:
+        raise ValueError(f"expected local_rot of shape (..., J, 4), got {local_rot.shape}")
     num_joints = local_rot.shape[-2]
+    local_pos = np.asarray(local_pos, dtype=local_rot.dtype)
+    if local_pos.ndim < 2 or local_pos.shape[-2:] != (num_joints, 3):
+        raise ValueError(f"expected local_pos of shape (..., {num_joints}, 3) to match local_rot, got {local_pos.shape}")
     parents = _check_parents(parents, num_joints)
     batch = np.broadcast_shapes(local_rot.shape[:-2], local_pos.shape[:-2])
     local_rot = np.broadcast_to(local_rot, batch + local_rot.shape[-2:])

@@ -16,6 +16,9 @@ def _parents_list(parents, num_joints: int) -> list[int]:
     parents = [int(p) for p in (parents.tolist() if hasattr(parents, "tolist") else parents)]
     if len(parents) != num_joints:
         raise ValueError(f"expected {num_joints} parent indices, got {len(parents)}")
+    for j, p in enumerate(parents):
+        if (j == 0 and p != -1) or (j > 0 and not 0 <= p < j):
+            raise ValueError(f"expected parents[0] == -1 and 0 <= parents[j] < j, got parents[{j}] = {p}")
     return parents
 
 
@@ -34,7 +37,7 @@ def fk(local_rot: torch.Tensor, local_pos: torch.Tensor, parents) -> tuple[torch
     global_rot : Tensor, shape (..., J, 4)
     global_pos : Tensor, shape (..., J, 3)
     """
-    if local_rot.shape[-1] != 4 or local_pos.shape[-1] != 3:
+    if local_rot.ndim < 2 or local_pos.ndim < 2 or local_rot.shape[-1] != 4 or local_pos.shape[-2:] != (local_rot.shape[-2], 3):
         raise ValueError(
             f"expected local_rot (..., J, 4) and local_pos (..., J, 3), got {tuple(local_rot.shape)} "
             f"and {tuple(local_pos.shape)}"

@@ -20,6 +20,16 @@ from motionlab.core.skeleton import Skeleton
 __all__ = ["Motion"]
 
 
+def _check_fps(fps) -> float:
+    try:
+        value = float(fps)
+    except (TypeError, ValueError):
+        value = float("nan")
+    if not (np.isfinite(value) and value > 0):
+        raise ValueError(f"fps must be a positive number, got {fps!r}")
+    return value
+
+
 @dataclass(eq=False)
 class Motion:
     """A skeleton's animation.
@@ -58,9 +68,7 @@ class Motion:
             self.local_pos = np.asarray(self.local_pos, dtype=self.local_rot.dtype)
             if self.local_pos.shape != (T, J, 3):
                 raise ValueError(f"expected local_pos of shape ({T}, {J}, 3), got {self.local_pos.shape}")
-        if not (np.isfinite(self.fps) and self.fps > 0):
-            raise ValueError(f"fps must be a positive number, got {self.fps}")
-        self.fps = float(self.fps)
+        self.fps = _check_fps(self.fps)
 
     # ------------------------------------------------------------------ basics
     @property
@@ -81,14 +89,24 @@ class Motion:
         return f"Motion({label}{self.num_frames} frames @ {self.fps:g} fps, {self.skeleton.num_joints} joints)"
 
     def __getitem__(self, frames) -> Motion:
-        """Frames ``frames`` (a slice or index array) as a new Motion."""
+        """Frames ``frames`` (an int, a slice or an index array) as a new Motion.
+
+        An int gives a one-frame Motion. A slice with a step ``s`` keeps every ``s``-th frame,
+        so the frame rate becomes ``fps / |s|`` (playback speed is unchanged); index arrays keep ``fps``.
+        """
+        fps = self.fps
         if isinstance(frames, (int, np.integer)):
-            frames = slice(int(frames), int(frames) + 1 if frames != -1 else None)
+            k = int(frames) + (self.num_frames if frames < 0 else 0)
+            if not 0 <= k < self.num_frames:
+                raise IndexError(f"frame {int(frames)} is out of range for a {self.num_frames}-frame motion")
+            frames = slice(k, k + 1)
+        elif isinstance(frames, slice) and frames.step is not None:
+            fps = self.fps / abs(int(frames.step))
         return Motion(
             self.skeleton,
             self.local_rot[frames].copy(),
             self.root_pos[frames].copy(),
-            self.fps,
+            fps,
             None if self.local_pos is None else self.local_pos[frames].copy(),
             self.name,
         )
@@ -134,8 +152,7 @@ class Motion:
 
         The first frame is kept; the last new frame is the last one at or before the end.
         """
-        if not (np.isfinite(fps) and fps > 0):
-            raise ValueError(f"fps must be a positive number, got {fps}")
+        fps = _check_fps(fps)
         if abs(fps - self.fps) < 1e-9 * self.fps or self.num_frames < 2:
             return self.copy(fps=float(fps))
         n_new = int(np.floor(self.duration * fps + 1e-6)) + 1

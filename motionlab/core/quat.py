@@ -122,7 +122,7 @@ def normalize(q, name: str = "q") -> np.ndarray:
     if np.any(~(n > _EPS_NORM)):
         bad = np.argwhere(~(n[..., 0] > _EPS_NORM))
         raise ValueError(
-            f"cannot normalise zero-norm (or NaN) quaternion {name} at index {tuple(bad[0])}"
+            f"cannot normalise zero-norm (or NaN) quaternion {name} at index {tuple(int(i) for i in bad[0])}"
         )
     return q / n
 
@@ -256,11 +256,14 @@ def to_euler(q, order: str) -> np.ndarray:
     # sign of the permutation (i, j, k): +1 for cyclic xyz/yzx/zxy, -1 otherwise
     sign = 1.0 if (j - i) % 3 == 1 else -1.0
     # R = R_i(a) R_j(b) R_k(c); then R[i, k] = sign * sin(b)
+    # and cos(b) = |(R[i, i], R[i, j])|; atan2 keeps b accurate near ±π/2, where arcsin is not
     sb = np.clip(sign * m[..., i, k], -1.0, 1.0)
-    b = np.arcsin(sb)
+    cb = np.hypot(m[..., i, i], m[..., i, j])
+    b = np.arctan2(sb, cb)
     a = np.arctan2(-sign * m[..., j, k], m[..., k, k])
     c = np.arctan2(-sign * m[..., i, j], m[..., i, i])
-    locked = np.abs(sb) > 1.0 - 1e-9
+    # a and c come from entries scaled by cos(b): below sqrt(eps) they are noise, so call it locked
+    locked = cb < np.sqrt(np.finfo(m.dtype).eps)
     if np.any(locked):
         # c := 0, then R = R_i(a) R_j(±π/2): read a from the j-column
         a_locked = np.arctan2(sign * m[..., k, j], m[..., j, j])
@@ -342,7 +345,8 @@ def between(u, v) -> np.ndarray:
 
 def yaw(q) -> np.ndarray:
     """Heading angle (radians) about +Y of each rotation: where it sends the +Z axis, projected."""
-    fwd = rotate(check(q), np.array([0.0, 0.0, 1.0]))
+    q = check(q)
+    fwd = rotate(q, np.array([0.0, 0.0, 1.0], dtype=q.dtype))
     return np.arctan2(fwd[..., 0], fwd[..., 2])
 
 

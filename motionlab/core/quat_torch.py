@@ -191,10 +191,11 @@ def to_euler(q: torch.Tensor, order: str) -> torch.Tensor:
     i, j, k = (_AXIS[a] for a in order)
     sign = 1.0 if (j - i) % 3 == 1 else -1.0
     sb = (sign * m[..., i, k]).clamp(-1.0, 1.0)
-    b = torch.asin(sb)
+    cb = torch.hypot(m[..., i, i], m[..., i, j])
+    b = torch.atan2(sb, cb)  # accurate near ±π/2, where asin is not
     a = torch.atan2(-sign * m[..., j, k], m[..., k, k])
     c = torch.atan2(-sign * m[..., i, j], m[..., i, i])
-    locked = sb.abs() > 1.0 - 1e-9
+    locked = cb < torch.finfo(m.dtype).eps ** 0.5
     a = torch.where(locked, torch.atan2(sign * m[..., k, j], m[..., j, j]), a)
     c = torch.where(locked, torch.zeros_like(c), c)
     return torch.stack([a, b, c], dim=-1)

@@ -47,7 +47,7 @@ class Skeleton:
 
     def __post_init__(self) -> None:
         names = tuple(str(n) for n in self.names)
-        parents = np.asarray(self.parents, dtype=np.int64).reshape(-1)
+        parents = np.array(self.parents, dtype=np.int64).reshape(-1)  # a copy: never alias the caller's array
         offsets = np.asarray(self.offsets, dtype=np.float64)
         n = len(names)
         if n == 0:
@@ -78,7 +78,7 @@ class Skeleton:
         for j, off in dict(self.end_sites).items():
             if not 0 <= int(j) < n:
                 raise SkeletonError(f"end site attached to joint index {j}, but there are {n} joints")
-            end_sites[int(j)] = np.asarray(off, dtype=np.float64).reshape(3)
+            end_sites[int(j)] = np.array(off, dtype=np.float64).reshape(3)
         if self.channels is not None and len(self.channels) != n:
             raise SkeletonError(f"expected {n} channel layouts (one per joint), got {len(self.channels)}")
         parents.setflags(write=False)
@@ -147,6 +147,8 @@ class Skeleton:
     def with_offsets(self, offsets: np.ndarray) -> Skeleton:
         """The same tree with new rest offsets (J, 3); end sites scale with their bone."""
         offsets = np.asarray(offsets, dtype=np.float64)
+        if offsets.shape != self.offsets.shape:
+            raise SkeletonError(f"expected offsets of shape {self.offsets.shape}, got {offsets.shape}")
         end_sites = {}
         for j, off in self.end_sites.items():
             old = np.linalg.norm(self.offsets[j])
