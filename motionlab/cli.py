@@ -63,5 +63,7 @@ def main(argv: list[str] | None = None) -> int:
         return 130
 
 
-if __name__ == "__main__":
-    sys.exit(main())
+if __name__ == "__main__":  # `python -m motionlab.cli`: use the imported module so CLIError is one class
+    from motionlab.cli import main as _main
+
+    sys.exit(_main())

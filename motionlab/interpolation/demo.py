@@ -1,0 +1,78 @@
+"""Clips for notebook 06: real mocap when ``MOTIONLAB_DATA`` is set, synthetic motion otherwise.
+
+Every function returns canonical 22-joint motions at ``fps`` and says where they came from, so a
+notebook cell can print its data source. Nothing is downloaded.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+from motionlab import data
+from motionlab.core.motion import Motion
+
+__all__ = ["BEHAVIOUR_CLIPS", "behaviours", "walk_clip", "benchmark_clips"]
+
+BEHAVIOUR_CLIPS = {
+    "run": "mixamo/Aj/Running",
+    "walk": "mixamo/Aj/Injured_Walk_Left_Turn",
+    "stand": "mixamo/Aj/Idle",
+    "squat": "mixamo/Aj/Standing_To_Crouched",
+}
+"""The real clips (Mixamo Aj, one skeleton) used for each action when data is available."""
+
+_SYNTHETIC = {"run": "run", "walk": "walk", "stand": "idle", "squat": "squat"}
+
+
+def _load(rel: str, fps: float) -> Motion:
+    from motionlab.core import bvh, humanoid
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        m = humanoid.to_canonical(bvh.load(data.clip_path(*rel.split("/"))))
+    return m.resample(fps)
+
+
+def behaviours(fps: float = 30.0, frames: int = 90, seed: int = 0) -> tuple[dict[str, Motion], str]:
+    """``({action: Motion}, source)`` for run, walk, stand and squat.
+
+    Real: the Mixamo Aj clips of :data:`BEHAVIOUR_CLIPS`. Synthetic: :func:`motionlab.synthetic.generate`
+    with ``frames`` frames each.
+    """
+    if data.has_data("mixamo", "Aj"):
+        return {k: _load(v, fps) for k, v in BEHAVIOUR_CLIPS.items()}, "real: Mixamo Aj clips " + ", ".join(
+            v.split("/")[-1] for v in BEHAVIOUR_CLIPS.values()
+        )
+    from motionlab import synthetic
+
+    clips = {k: synthetic.generate(b, None, frames, fps, seed=seed + i) for i, (k, b) in enumerate(_SYNTHETIC.items())}
+    for k, m in clips.items():
+        m.name = k
+    return clips, "synthetic: motionlab.synthetic.generate (set MOTIONLAB_DATA for real mocap)"
+
+
+def walk_clip(fps: float = 30.0, frames: int = 240) -> tuple[Motion, str]:
+    """A long walk: Bandai Namco dataset-2 walk 001 (real) or a synthetic walk."""
+    rel = "bandai_namco/dataset-2/walk/dataset-2_walk_normal_001"
+    if data.has_data(*rel.split("/")[:-1]):
+        return _load(rel, fps), f"real: {rel}.bvh"
+    from motionlab import synthetic
+
+    m = synthetic.generate("walk", None, frames, fps, seed=1)
+    return m, "synthetic walk (set MOTIONLAB_DATA for real mocap)"
+
+
+def benchmark_clips(fps: float = 30.0) -> tuple[list[Motion], str]:
+    """The in-betweening test clips (Bandai Namco dataset-2) or synthetic stand-ins."""
+    if data.has_data("bandai_namco", "dataset-2"):
+        from motionlab.interpolation.benchmark import load_clips
+
+        return load_clips([data.data_root() / "bandai_namco" / "dataset-2"], fps=fps), "real: bandai_namco/dataset-2"
+    from motionlab import synthetic
+
+    clips = []
+    for i, b in enumerate(["walk", "walk", "walk", "run", "run"]):
+        m = synthetic.generate(b, None, 200, fps, seed=10 + i)
+        m.name = f"synthetic_{b}_{i:03d}"
+        clips.append(m)
+    return clips, "synthetic walks and runs (set MOTIONLAB_DATA for real mocap)"

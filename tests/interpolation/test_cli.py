@@ -1,0 +1,51 @@
+"""``motionlab fill-gaps``: fills dropped frames, reports them, never overwrites without --force."""
+
+import numpy as np
+import pytest
+
+from motionlab.cli import main
+from motionlab.core import bvh
+
+from .conftest import toy_motion
+
+
+@pytest.fixture
+def dropped(tmp_path):
+    m = toy_motion(120)
+    keep = np.r_[0:50, 58:120]
+    path = tmp_path / "dropped.bvh"
+    bvh.save(path, m[keep])
+    return path
+
+
+def test_fill_gaps_writes_filled_file(dropped, tmp_path, capsys):
+    out = tmp_path / "out.bvh"
+    assert main(["fill-gaps", str(dropped), "-o", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "filled 1 gap(s)" in text and "frames 50-" in text
+    filled = bvh.load(out)
+    assert filled.num_frames > 112
+    assert np.all(np.isfinite(filled.local_rot))
+
+
+def test_fill_gaps_refuses_to_overwrite(dropped, tmp_path, capsys):
+    out = tmp_path / "out.bvh"
+    out.write_text("keep me")
+    assert main(["fill-gaps", str(dropped), "-o", str(out)]) == 2
+    assert "--force" in capsys.readouterr().err
+    assert out.read_text() == "keep me"
+    assert main(["fill-gaps", str(dropped), "-o", str(out), "--force", "--method", "hermite"]) == 0
+
+
+def test_fill_gaps_user_errors(dropped, tmp_path, capsys):
+    assert main(["fill-gaps", str(tmp_path / "nope.bvh"), "-o", str(tmp_path / "o.bvh")]) == 2
+    assert main(["fill-gaps", str(dropped), "-o", str(tmp_path / "o.bvh"), "--method", "graph"]) == 2
+    assert "--action" in capsys.readouterr().err
+
+
+def test_fill_gaps_with_graph(dropped, tmp_path, capsys):
+    clip = tmp_path / "walk.bvh"
+    bvh.save(clip, toy_motion(80, phase=0.7))
+    out = tmp_path / "g.bvh"
+    assert main(["fill-gaps", str(dropped), "-o", str(out), "--method", "graph", "--action", f"walk={clip}"]) == 0
+    assert "via walk" in capsys.readouterr().out
