@@ -30,6 +30,12 @@ def _check_fps(fps) -> float:
     return value
 
 
+def _nominal(fps: float) -> float:
+    """``fps`` snapped to the nearest whole number when within 1e-4 relative of it."""
+    r = round(fps)
+    return float(r) if r > 0 and abs(fps - r) < 1e-4 * fps else float(fps)
+
+
 @dataclass(eq=False)
 class Motion:
     """A skeleton's animation.
@@ -151,12 +157,15 @@ class Motion:
         """The motion at another frame rate: SLERP for rotations, linear for positions.
 
         The first frame is kept; the last new frame is the last one at or before the end.
+        Frame rates within 1e-4 (relative) of a whole number count as that number: BVH files
+        write ``Frame Time: 0.0333333``, which means 30 fps, not 30.0000003.
         """
         fps = _check_fps(fps)
-        if abs(fps - self.fps) < 1e-9 * self.fps or self.num_frames < 2:
+        src = _nominal(self.fps)
+        if abs(_nominal(fps) - src) < 1e-9 * src or self.num_frames < 2:
             return self.copy(fps=float(fps))
-        n_new = int(np.floor(self.duration * fps + 1e-6)) + 1
-        t = np.arange(n_new) * (self.fps / fps)  # in source frames
+        n_new = int(np.floor((self.num_frames - 1) * _nominal(fps) / src + 1e-6)) + 1
+        t = np.arange(n_new) * (src / _nominal(fps))  # in source frames
         i0 = np.clip(np.floor(t).astype(np.int64), 0, self.num_frames - 1)
         i1 = np.clip(i0 + 1, 0, self.num_frames - 1)
         alpha = t - i0

@@ -1,0 +1,44 @@
+"""Motion graphs (Kovar et al. 2002) and the structured motion graph of paper B.
+
+* :mod:`.distance` — Kovar's point-cloud frame distance for whole clip pairs, transition candidates;
+* :mod:`.graph` — the graph data structure, the standard graph and its pruning;
+* :mod:`.registration` — DTW time registration, root alignment and blends;
+* :mod:`.structured` — structure table, transition clips, interpolation space, local pruning;
+* :mod:`.search` — requests of (behaviour, style, frames) segments; the standard-graph baseline;
+* :mod:`.synthesis` — a path turned into one continuous, blended motion;
+* :mod:`.io` — save/load (``.mlgraph``, npz + JSON); :mod:`.naming` — clip-name labels;
+* :mod:`.clips` — real clips through ``MOTIONLAB_DATA`` or synthetic stand-ins; :mod:`.plots`.
+
+Taught in ``notebooks/05_motion_graphs.ipynb``.
+"""
+
+from motionlab.motion_graphs import clips, distance, io, naming, registration, search, synthesis
+from motionlab.motion_graphs.graph import ClipInfo, GraphError, MotionGraph, build_standard
+from motionlab.motion_graphs.search import SearchError, SearchResult, Segment, parse_request, search_standard
+from motionlab.motion_graphs.search import search as search_path
+from motionlab.motion_graphs.structured import build_structured, structure_rows
+from motionlab.motion_graphs.synthesis import synthesize, transition_quality
+
+__all__ = [
+    "distance",
+    "registration",
+    "search",
+    "synthesis",
+    "io",
+    "naming",
+    "clips",
+    "ClipInfo",
+    "GraphError",
+    "MotionGraph",
+    "build_standard",
+    "build_structured",
+    "structure_rows",
+    "SearchError",
+    "SearchResult",
+    "Segment",
+    "parse_request",
+    "search_path",
+    "search_standard",
+    "synthesize",
+    "transition_quality",
+]

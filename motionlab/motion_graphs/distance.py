@@ -1,0 +1,310 @@
+r"""Kovar's frame distance, for all frame pairs of two clips at once.
+
+Kovar, Gleicher and Pighin (2002) compare frame :math:`i` of clip A with frame :math:`j` of
+clip B through *point clouds*: the joint positions of a short window of frames around each
+frame. Because a character may walk anywhere and face any way, B's cloud is first moved by the
+ground transform :math:`T_{\theta,x_0,z_0}` (a turn by :math:`\theta` about the vertical
+axis, then a shift on the ground) that brings it closest to A's:
+
+.. math::
+
+    D(i, j) = \min_{\theta, x_0, z_0} \sum_k w_k \,\lVert p_k - T_{\theta,x_0,z_0}\, p'_k \rVert^2 .
+
+With weights summing to 1 the optimum is closed-form. Centre both clouds horizontally on their
+weighted means (:math:`c = p - \bar p`, :math:`y` stays), then
+
+.. math::
+
+    D = S_A(i) + S_B(j) - 2\,Y(i, j) - 2\sqrt{a(i,j)^2 + b(i,j)^2},
+
+    a = \sum_k w_k (c_x c'_x + c_z c'_z), \quad b = \sum_k w_k (c_x c'_z - c_z c'_x),
+    \quad Y = \sum_k w_k\, y\, y', \quad S = \sum_k w_k \lVert c \rVert^2 ,
+
+and :math:`\tan\theta = b / a`. :math:`a`, :math:`b` and :math:`Y` are inner products of
+per-frame feature rows, so the whole matrix :math:`D` is three matrix products: no loop over
+frame pairs. Rows are done in blocks, so memory stays bounded for long clips.
+
+Unit of :math:`D`: m² (a weighted *mean* squared point distance); :func:`rms` turns a value
+into metres. Windows are centred (``window`` frames, clamped at the clip ends) and tapered;
+joints are weighted equally. Both choices are documented in ``notebooks/05_motion_graphs``.
+
+Transition candidates are the *local minima* of :math:`D` (no smaller value among the 8
+neighbouring cells) below a threshold, see :func:`candidates` and :func:`threshold_from`.
+
+Taught in ``notebooks/05_motion_graphs.ipynb``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = [
+    "CloudFeatures",
+    "cloud_features",
+    "distance_matrix",
+    "distance_blocks",
+    "local_minima",
+    "candidates",
+    "alignment",
+    "rms",
+    "threshold_from",
+    "DEFAULT_WINDOW",
+]
+
+DEFAULT_WINDOW = 5
+"""Frames per point cloud (centred on the frame): 5 frames ≈ 0.17 s at 30 fps."""
+
+_BLOCK_ELEMENTS = 4_000_000  # cells of D computed at once (≈ 32 MB in float64, plus temporaries)
+
+
+@dataclass
+class CloudFeatures:
+    """Per-frame point-cloud rows of one clip (see the module docstring).
+
+    Attributes
+    ----------
+    centred : ndarray, shape (T, 2n)   ``[c_x | c_z]`` horizontally centred window points, m
+    height  : ndarray, shape (T, n)    ``y`` of the window points, m
+    weights : ndarray, shape (n,)      point weights, summing to 1
+    self_term : ndarray, shape (T,)    ``S = Σ w (c_x² + c_z² + y²)``, m²
+    mean_xz : ndarray, shape (T, 2)    weighted horizontal centroid of each cloud, m
+    """
+
+    centred: np.ndarray
+    height: np.ndarray
+    weights: np.ndarray
+    self_term: np.ndarray
+    mean_xz: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.centred.shape[0])
+
+    def __getitem__(self, frames) -> CloudFeatures:
+        return CloudFeatures(
+            self.centred[frames], self.height[frames], self.weights, self.self_term[frames], self.mean_xz[frames]
+        )
+
+
+def _window_weights(window: int) -> np.ndarray:
+    # a tent taper: the centre frame counts most, the window's ends least (never zero)
+    h = (window - 1) / 2
+    return 1.0 - np.abs(np.arange(window) - h) / (h + 1)
+
+
+def cloud_features(global_pos, window: int = DEFAULT_WINDOW, joint_weights=None, dtype=np.float64) -> CloudFeatures:
+    """Point-cloud rows of every frame of a clip.
+
+    Parameters
+    ----------
+    global_pos : ndarray, shape (T, J, 3)   world joint positions, metres, Y up
+    window : odd int                         frames per cloud, centred (clamped at the ends)
+    joint_weights : ndarray, shape (J,), optional   (uniform by default)
+    dtype : float dtype of the products (float32 halves time and memory; ~1e-6 m² error)
+    """
+    pos = np.asarray(global_pos, dtype=np.float64)
+    if pos.ndim != 3 or pos.shape[-1] != 3 or pos.shape[0] < 1:
+        raise ValueError(f"expected global positions of shape (T, J, 3), got {pos.shape}")
+    if not (isinstance(window, (int, np.integer)) and window >= 1 and window % 2 == 1):
+        raise ValueError(f"window must be a positive odd number of frames, got {window}")
+    T, J, _ = pos.shape
+    jw = np.ones(J) if joint_weights is None else np.asarray(joint_weights, dtype=np.float64)
+    if jw.shape != (J,) or np.any(jw < 0) or jw.sum() <= 0:
+        raise ValueError(f"joint_weights must be {J} non-negative numbers with a positive sum")
+    h = window // 2
+    idx = np.clip(np.arange(T)[:, None] + np.arange(-h, h + 1)[None, :], 0, T - 1)  # (T, K)
+    cloud = pos[idx].reshape(T, window * J, 3)  # (T, n, 3)
+    w = (_window_weights(window)[:, None] * jw[None, :]).reshape(-1)
+    w = w / w.sum()
+    mean_xz = cloud[:, :, [0, 2]].transpose(0, 2, 1) @ w  # (T, 2)
+    cx = cloud[:, :, 0] - mean_xz[:, :1]
+    cz = cloud[:, :, 2] - mean_xz[:, 1:]
+    y = cloud[:, :, 1]
+    self_term = (cx * cx + cz * cz + y * y) @ w
+    return CloudFeatures(
+        np.concatenate([cx, cz], axis=1).astype(dtype),
+        y.astype(dtype),
+        w.astype(dtype),
+        self_term.astype(np.float64),
+        mean_xz,
+    )
+
+
+def _as_features(x, window: int) -> CloudFeatures:
+    return x if isinstance(x, CloudFeatures) else cloud_features(x, window)
+
+
+def _block(fa: CloudFeatures, fb: CloudFeatures, rows: slice, right: np.ndarray, yb: np.ndarray) -> np.ndarray:
+    n = fa.height.shape[1]
+    left = fa.centred[rows] * np.concatenate([fa.weights, fa.weights])  # (r, 2n)
+    ab = left @ right  # (r, 2 Tb): [a | b]
+    tb = fb.centred.shape[0]
+    a, b = ab[:, :tb], ab[:, tb:]
+    cross_y = (fa.height[rows] * fa.weights[:n]) @ yb
+    d = fa.self_term[rows, None] + fb.self_term[None, :] - 2.0 * cross_y - 2.0 * np.sqrt(a * a + b * b)
+    return np.maximum(d, 0.0, out=d.astype(np.float64, copy=False))
+
+
+def _right(fb: CloudFeatures) -> tuple[np.ndarray, np.ndarray]:
+    n = fb.height.shape[1]
+    cx, cz = fb.centred[:, :n], fb.centred[:, n:]
+    # a = [cx|cz]·[cx'|cz'],  b = [cx|cz]·[cz'|-cx']
+    right = np.concatenate([fb.centred, np.concatenate([cz, -cx], axis=1)], axis=0).T  # (2n, 2 Tb)
+    return np.ascontiguousarray(right), np.ascontiguousarray(fb.height.T)
+
+
+def distance_blocks(
+    a, b, window: int = DEFAULT_WINDOW, block_rows: int | None = None
+) -> Iterator[tuple[int, np.ndarray]]:
+    """Yield ``(first_row, D[rows])`` blocks of the distance matrix, in row order.
+
+    ``a``, ``b``: positions (T, J, 3) or :class:`CloudFeatures`. Each block has at most
+    ``block_rows`` rows (default: about 4 million cells per block).
+    """
+    fa, fb = _as_features(a, window), _as_features(b, window)
+    if fa.height.shape[1] != fb.height.shape[1]:
+        raise ValueError("the two clips have different joint counts or window sizes; they cannot be compared")
+    right, yb = _right(fb)
+    rows = block_rows or max(1, _BLOCK_ELEMENTS // max(len(fb), 1))
+    for r0 in range(0, len(fa), rows):
+        yield r0, _block(fa, fb, slice(r0, min(r0 + rows, len(fa))), right, yb)
+
+
+def distance_matrix(a, b=None, window: int = DEFAULT_WINDOW) -> np.ndarray:
+    """The full matrix ``D`` (Ta, Tb) in m²; ``b=None`` compares ``a`` with itself.
+
+    For long clips prefer :func:`candidates`, which never holds the whole matrix.
+    """
+    fa = _as_features(a, window)
+    fb = fa if b is None else _as_features(b, window)
+    out = np.empty((len(fa), len(fb)))
+    for r0, blk in distance_blocks(fa, fb, window):
+        out[r0 : r0 + len(blk)] = blk
+    return out
+
+
+def alignment(fa: CloudFeatures, fb: CloudFeatures, i, j) -> tuple[np.ndarray, np.ndarray]:
+    """The optimal ground transform taking B's cloud ``j`` onto A's cloud ``i``.
+
+    Returns ``theta`` (radians, turn about +Y) and ``shift`` (..., 3) with ``shift[..., 1] = 0``
+    such that ``p ≈ R_y(theta) p' + shift``.
+    """
+    i, j = np.asarray(i), np.asarray(j)
+    n = fa.height.shape[1]
+    w2 = np.concatenate([fa.weights, fa.weights])
+    ca, cb = fa.centred[i].astype(np.float64), fb.centred[j].astype(np.float64)
+    a = np.sum(ca * w2 * cb, axis=-1)
+    cb_perp = np.concatenate([cb[..., n:], -cb[..., :n]], axis=-1)
+    b = np.sum(ca * w2 * cb_perp, axis=-1)
+    # R_y(θ) maps (x, z) to (x cosθ + z sinθ, -x sinθ + z cosθ); maximising Σ w c·R c' gives θ:
+    theta = np.arctan2(b, a)
+    ma, mb = fa.mean_xz[i], fb.mean_xz[j]
+    c, s = np.cos(theta), np.sin(theta)
+    sx = ma[..., 0] - (c * mb[..., 0] + s * mb[..., 1])
+    sz = ma[..., 1] - (-s * mb[..., 0] + c * mb[..., 1])
+    return theta, np.stack([sx, np.zeros_like(sx), sz], axis=-1)
+
+
+def local_minima(block: np.ndarray, above: np.ndarray | None = None, below: np.ndarray | None = None) -> np.ndarray:
+    """Mask of cells no larger than any of their 8 neighbours.
+
+    ``above``/``below``: the matrix rows just before/after the block (``None`` at the
+    matrix's edge), so blocks give the same answer as the whole matrix.
+    """
+    r, c = block.shape
+    inf_row = np.full((1, c), np.inf)
+    top = inf_row if above is None else above.reshape(1, c)
+    bottom = inf_row if below is None else below.reshape(1, c)
+    padded = np.concatenate([top, block, bottom], axis=0)
+    padded = np.pad(padded, ((0, 0), (1, 1)), constant_values=np.inf)
+    centre = padded[1:-1, 1:-1]
+    mask = np.ones((r, c), dtype=bool)
+    for di in (0, 1, 2):
+        for dj in (0, 1, 2):
+            if di == 1 and dj == 1:
+                continue
+            mask &= centre <= padded[di : di + r, dj : dj + c]
+    return mask
+
+
+def candidates(
+    a,
+    b=None,
+    threshold: float = np.inf,
+    window: int = DEFAULT_WINDOW,
+    min_gap: int = 0,
+    rows: slice | None = None,
+    cols: slice | None = None,
+    block_rows: int | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Transition candidates: local minima of ``D`` below ``threshold`` (m²).
+
+    Parameters
+    ----------
+    a, b : positions (T, J, 3) or :class:`CloudFeatures`; ``b=None`` compares a clip with itself
+    threshold : largest accepted distance, m² (see :func:`threshold_from`)
+    min_gap : with ``b=None``, drop pairs with ``|i - j| < min_gap`` (the trivial diagonal)
+    rows, cols : only these frames of ``a`` / ``b`` take part
+    block_rows : rows per block (memory bound); the answer does not depend on it
+
+    Returns
+    -------
+    i, j : int arrays (frame of ``a``, frame of ``b``, absolute indices)
+    cost : float array, m²
+    """
+    fa = _as_features(a, window)
+    same = b is None
+    fb = fa if same else _as_features(b, window)
+    r0_, r1_ = (rows.start or 0, len(fa) if rows.stop is None else rows.stop) if rows else (0, len(fa))
+    c0_, c1_ = (cols.start or 0, len(fb) if cols.stop is None else cols.stop) if cols else (0, len(fb))
+    sub_a, sub_b = fa[r0_:r1_], fb[c0_:c1_]
+    if len(sub_a) == 0 or len(sub_b) == 0:
+        empty = np.zeros(0, dtype=np.int64)
+        return empty, empty, np.zeros(0)
+    right, yb = _right(sub_b)
+    n_rows = block_rows or max(1, _BLOCK_ELEMENTS // max(len(sub_b), 1))
+    out_i, out_j, out_c = [], [], []
+    T = len(sub_a)
+    for start in range(0, T, n_rows):
+        stop = min(start + n_rows, T)
+        lo, hi = max(start - 1, 0), min(stop + 1, T)  # one extra row each side for the 3x3 test
+        d = _block(sub_a, sub_b, slice(lo, hi), right, yb)
+        core = d[start - lo : start - lo + (stop - start)]
+        above = d[0] if start > 0 else None
+        below = d[-1] if stop < T else None
+        mask = local_minima(core, above, below) & (core < threshold)
+        ii, jj = np.nonzero(mask)
+        gi, gj = ii + start + r0_, jj + c0_
+        if same and min_gap > 0:
+            keep = np.abs(gi - gj) >= min_gap
+            ii, jj, gi, gj = ii[keep], jj[keep], gi[keep], gj[keep]
+        out_i.append(gi)
+        out_j.append(gj)
+        out_c.append(core[ii, jj])
+    return np.concatenate(out_i), np.concatenate(out_j), np.concatenate(out_c)
+
+
+def rms(d) -> np.ndarray:
+    """Distance values (m²) as a root-mean-square point distance in metres."""
+    return np.sqrt(np.maximum(np.asarray(d, dtype=np.float64), 0.0))
+
+
+def threshold_from(rms_metres: float | None = None, relative: float | None = None, scale: float | None = None) -> float:
+    """A threshold in m² for :func:`candidates`.
+
+    Either absolute — ``rms_metres``: accept poses whose aligned clouds differ by at most this
+    many metres (root mean square over the weighted points) — or *relative to the data*:
+    ``relative × scale`` metres, where ``scale`` is a size of the data, by convention the
+    character's height (so ``relative=0.03`` accepts 3% of the height, about 5 cm for an adult).
+    """
+    if (rms_metres is None) == (relative is None):
+        raise ValueError("give exactly one of rms_metres (absolute) or relative (with scale)")
+    if rms_metres is not None:
+        if not rms_metres > 0:
+            raise ValueError(f"threshold must be positive metres, got {rms_metres}")
+        return float(rms_metres) ** 2
+    if scale is None or not scale > 0 or not relative > 0:
+        raise ValueError(f"a relative threshold needs positive relative and scale, got {relative} and {scale}")
+    return float(relative * scale) ** 2

@@ -1,0 +1,114 @@
+"""Saving and loading motion graphs: one ``.mlgraph`` file, NumPy arrays plus JSON.
+
+The file is a NumPy ``.npz`` archive (no pickle: it loads with ``allow_pickle=False``):
+arrays ``local_rot``, ``root_pos``, ``alive``, ``src``, ``dst``, ``cost``, ``kind``,
+``offsets``, ``parents`` and one string array ``meta`` holding JSON — format version, fps,
+joint names, clips, structure table and build info.
+
+Taught in ``notebooks/05_motion_graphs.ipynb``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from motionlab.core.skeleton import Skeleton
+from motionlab.motion_graphs.graph import ClipInfo, GraphError, MotionGraph
+
+__all__ = ["save", "load", "FORMAT"]
+
+FORMAT = "motionlab-graph-1"
+
+
+def _jsonable(x):
+    if isinstance(x, dict):
+        return {str(k): _jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_jsonable(v) for v in x]
+    if isinstance(x, np.generic):
+        return x.item()
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    return x
+
+
+def save(path: str | os.PathLike, graph: MotionGraph, overwrite: bool = False) -> Path:
+    """Write ``graph`` to ``path`` (``.mlgraph`` added if there is no suffix).
+
+    Raises ``FileExistsError`` when the file exists and ``overwrite`` is False.
+    """
+    path = Path(path)
+    if path.suffix == "":
+        path = path.with_suffix(".mlgraph")
+    if path.exists() and not overwrite:
+        raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --force) to replace it")
+    sk = graph.skeleton
+    meta = {
+        "format": FORMAT,
+        "fps": graph.fps,
+        "names": list(sk.names),
+        "end_sites": {str(k): v.tolist() for k, v in sk.end_sites.items()},
+        "clips": [c.to_dict() for c in graph.clips],
+        "table": graph.table,
+        "info": graph.info,
+    }
+    tmp = path.with_name(path.name + ".tmp")
+    with open(tmp, "wb") as fh:
+        np.savez_compressed(
+            fh,
+            meta=np.array(json.dumps(_jsonable(meta))),
+            local_rot=graph.local_rot.astype(np.float32),
+            root_pos=graph.root_pos,
+            alive=graph.alive,
+            src=graph.src,
+            dst=graph.dst,
+            cost=graph.cost,
+            kind=graph.kind,
+            offsets=sk.offsets,
+            parents=sk.parents,
+        )
+    os.replace(tmp, path)
+    return path
+
+
+def load(path: str | os.PathLike) -> MotionGraph:
+    """Read a graph written by :func:`save`. Raises :class:`GraphError` for other files."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"no motion graph file at {path}")
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            arrays = {k: z[k] for k in z.files}
+    except (ValueError, OSError) as e:
+        raise GraphError(f"{path} is not a motion graph file ({e})") from None
+    if "meta" not in arrays:
+        raise GraphError(f"{path} is not a motion graph file (no 'meta' entry)")
+    meta = json.loads(str(arrays["meta"]))
+    if meta.get("format") != FORMAT:
+        raise GraphError(f"{path}: unknown format {meta.get('format')!r}, expected {FORMAT!r}")
+    sk = Skeleton(
+        tuple(meta["names"]),
+        arrays["parents"],
+        arrays["offsets"],
+        {int(k): np.array(v) for k, v in meta["end_sites"].items()},
+    )
+    rot = arrays["local_rot"].astype(np.float64)
+    rot /= np.linalg.norm(rot, axis=-1, keepdims=True)
+    return MotionGraph(
+        sk,
+        float(meta["fps"]),
+        [ClipInfo(**c) for c in meta["clips"]],
+        rot,
+        arrays["root_pos"],
+        arrays["alive"].astype(bool),
+        arrays["src"].astype(np.int64),
+        arrays["dst"].astype(np.int64),
+        arrays["cost"].astype(np.float64),
+        arrays["kind"].astype(np.int8),
+        meta["table"],
+        meta["info"],
+    )

@@ -1,0 +1,524 @@
+r"""Searching a motion graph for a requested sequence of behaviours.
+
+A request is a list of segments ``(behaviour, style, frames)``: "300 frames of an angry walk,
+then 200 frames of a normal run". The answer is a *path*: runs of frames
+``(clip, first, last)`` joined by the graph's edges, and for every segment the number of
+frames it got. A segment runs from its first frame in its clip up to the first frame of the
+next segment's clip, so the frames of a transition count towards the segment it leaves and the
+segment lengths add up to the path length.
+
+**Structured graph** (paper B). The structure table gives each segment's clip and the
+recorded routes out of it, so the search never explores the graph. Within a clip the walk from
+the entry frame ``e`` to an exit frame ``x`` may repeat parts through self-loops; which
+lengths are possible is a reachability recursion over frame counts,
+
+.. math:: R_{c+1} = \operatorname{shift}(R_c) \,\lor\, \operatorname{loops}(R_c), \qquad R_0 = \{e\},
+
+(``R_c``: frames where a walk of ``c + 1`` frames can be) run once per segment. The exit whose
+route length ``r`` satisfies ``c + 1 + r = n`` wins (exactly, or else the closest). Long
+segments first repeat the clip's main cycle (the last self-loop) so the recursion stays short:
+the *iterative choice of self-loop and transition points*. Clips crossed on the way to the next
+segment (a style bridge before a transition clip) are passed as quickly as possible, walking
+forward and looping back at the last self-loop point; the **loop guard** stops with an error
+when the last self-loop point is passed twice without finding the exit.
+
+**Standard graph** (for comparison). Dijkstra's shortest path (in frames) on the compressed
+graph from the current frame to any frame of the requested clip, then the same in-clip
+recursion over the clip's self-loops. Its cost grows with the graph; the table lookup does not.
+
+Taught in ``notebooks/05_motion_graphs.ipynb``.
+"""
+
+from __future__ import annotations
+
+import re
+from collections import deque
+from dataclasses import dataclass, field
+
+import networkx as nx
+import numpy as np
+
+from motionlab.motion_graphs.graph import GraphError, MotionGraph
+
+__all__ = ["Segment", "SearchResult", "parse_request", "search", "search_standard", "SearchError", "TOLERANCE"]
+
+TOLERANCE = 0.05
+"""Documented accuracy: a reachable segment length is met exactly when the clip's loops allow,
+and otherwise within ``max(2 frames, 5%)`` — checked by the tests."""
+
+
+class SearchError(GraphError):
+    """A request the graph cannot satisfy; the message names what is missing."""
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One requested segment: behaviour, style and a frame count (> 0)."""
+
+    behaviour: str
+    style: str
+    frames: int
+
+
+@dataclass
+class SearchResult:
+    """A path and how well it meets the request.
+
+    ``pieces``: list of ``(clip, first, last)`` (clip-local frames, inclusive); ``achieved``:
+    frames given to each segment; ``requested``: the request's counts; ``transitions``: index in
+    the output of the first frame after each jump (for smoothness metrics).
+    """
+
+    pieces: list[tuple[int, int, int]]
+    requested: list[int]
+    achieved: list[int]
+    segments: list[Segment] = field(default_factory=list)
+
+    @property
+    def num_frames(self) -> int:
+        return int(sum(b - a + 1 for _, a, b in self.pieces))
+
+    @property
+    def errors(self) -> list[int]:
+        return [a - r for a, r in zip(self.achieved, self.requested)]
+
+    def transitions(self) -> list[int]:
+        """Output frame index where each piece after the first begins."""
+        out, t = [], 0
+        for _, a, b in self.pieces[:-1]:
+            t += b - a + 1
+            out.append(t)
+        return out
+
+    def report(self) -> str:
+        lines = []
+        for s, a in zip(self.segments, self.achieved):
+            lines.append(f"{s.behaviour}:{s.style}: requested {s.frames}, got {a} ({a - s.frames:+d})")
+        return "\n".join(lines)
+
+
+def parse_request(text: str) -> list[Segment]:
+    """``"walk:angry:300,run:normal:200"`` → segments. Raises ValueError on bad syntax."""
+    segs = []
+    for part in [p.strip() for p in re.split(r"[,;]", text) if p.strip()]:
+        bits = part.split(":")
+        if len(bits) != 3:
+            raise ValueError(f"request segment {part!r} should be behaviour:style:frames, e.g. walk:angry:300")
+        try:
+            n = int(bits[2])
+        except ValueError:
+            raise ValueError(f"request segment {part!r}: frame count {bits[2]!r} is not a whole number") from None
+        if n < 1:
+            raise ValueError(f"request segment {part!r}: frame count must be positive")
+        segs.append(Segment(bits[0].strip().lower(), bits[1].strip().lower(), n))
+    if not segs:
+        raise ValueError("empty request: give segments like walk:angry:300,run:normal:200")
+    return segs
+
+
+# ---------------------------------------------------------------------------- in-clip walks
+@dataclass
+class _Clip:
+    """One clip's walkable frames: ``step[f]``: f → f+1 allowed; loops ``src → dst``."""
+
+    index: int
+    length: int
+    step: np.ndarray
+    loop_src: np.ndarray
+    loop_dst: np.ndarray
+    last_src: int
+    last_dst: int
+
+    @property
+    def cycle(self) -> int:
+        return self.last_src - self.last_dst + 1
+
+
+def _clip_walker(graph: MotionGraph, c: int) -> _Clip:
+    info = graph.clips[c]
+    n = info.num_frames
+    alive = graph.alive[info.start : info.stop]
+    step = alive.copy()
+    step[:-1] &= alive[1:]
+    step[-1] = False
+    m = (graph.src >= info.start) & (graph.src < info.stop) & (graph.dst >= info.start) & (graph.dst < info.stop)
+    m &= graph.alive[graph.src] & graph.alive[graph.dst]
+    src, dst = graph.src[m] - info.start, graph.dst[m] - info.start
+    back = dst <= src
+    src, dst = src[back], dst[back]
+    if src.size:
+        k = int(np.argmax(src - 1e-6 * (src - dst)))  # the last loop point (the longest of its loops)
+        last_src, last_dst = int(src[k]), int(dst[k])
+    else:
+        last_src, last_dst = -1, -1
+    return _Clip(c, n, step, src, dst, last_src, last_dst)
+
+
+def _reach(cw: _Clip, start: int, steps: int) -> np.ndarray:
+    """(steps, L) bool: frames where a walk of ``c + 1`` frames from ``start`` can be."""
+    out = np.zeros((max(steps, 1), cw.length), dtype=bool)
+    out[0, start] = True
+    step_ok = cw.step[:-1]
+    src, dst = cw.loop_src, cw.loop_dst
+    loops = src.size > 0
+    for c in range(1, steps):
+        prev, cur = out[c - 1], out[c]
+        np.logical_and(prev[:-1], step_ok, out=cur[1:])
+        if loops:
+            cur[dst[prev[src]]] = True
+    return out
+
+
+def _backtrack(cw: _Clip, reach: np.ndarray, c: int, x: int) -> list[int]:
+    """Frames of one walk reaching ``x`` after ``c + 1`` frames (reverse-engineered from ``reach``)."""
+    frames = [x]
+    while c > 0:
+        if x > 0 and cw.step[x - 1] and reach[c - 1, x - 1]:
+            x -= 1
+        else:
+            cand = cw.loop_src[(cw.loop_dst == x) & reach[c - 1, cw.loop_src]]
+            if cand.size == 0:
+                raise GraphError("internal: walk reconstruction failed")
+            x = int(cand[0])
+        frames.append(x)
+        c -= 1
+    return frames[::-1]
+
+
+def _runs(clip: int, frames: list[int]) -> list[tuple[int, int, int]]:
+    out = []
+    a = prev = frames[0]
+    for f in frames[1:]:
+        if f != prev + 1:
+            out.append((clip, a, prev))
+            a = f
+        prev = f
+    out.append((clip, a, prev))
+    return out
+
+
+def _deltas(n: int):
+    """0, +1, -1, +2, -2, … (longer before shorter at equal distance)."""
+    yield 0
+    for d in range(1, n):
+        yield d
+        yield -d
+
+
+def _walk(cw: _Clip, start: int, need: list[int], exits: list[int]) -> tuple[list[tuple[int, int, int]], int, int]:
+    """A walk from ``start`` of about ``need[r]`` frames ending at ``exits[r]`` (``-1``: any frame).
+
+    Returns pieces, the chosen option ``r`` and the frames played.
+    """
+    pieces: list[tuple[int, int, int]] = []
+    played = 0
+    budget = cw.length + 2 * max(cw.cycle, 1)
+    lo = min(need)
+    if cw.last_src >= 0 and lo > budget + (cw.length - start):
+        # long segment: play on to the last self-loop point, then whole main cycles
+        pieces.append((cw.index, start, cw.last_src))
+        played += cw.last_src - start + 1
+        reps = max(0, (lo - played - budget) // cw.cycle)
+        pieces.extend([(cw.index, cw.last_dst, cw.last_src)] * reps)
+        played += reps * cw.cycle
+        start = cw.last_dst
+    steps = max(n - played for n in need) + max(cw.cycle, 2)
+    steps = max(steps, 2)
+    reach = _reach(cw, start, steps)
+    need_c = np.array(need) - played - 1
+    ex = np.array(exits)
+    best = None
+    for delta in _deltas(steps):
+        c = need_c + delta
+        ok = np.flatnonzero((c >= 0) & (c < steps))
+        if ok.size == 0:
+            continue
+        anywhere = ok[ex[ok] < 0]
+        for r in anywhere:
+            hit = np.flatnonzero(reach[c[r]])
+            if hit.size:
+                best = (int(r), int(c[r]), int(hit[-1]))
+                break
+        if best is not None:
+            break
+        fixed = ok[ex[ok] >= 0]
+        hits = fixed[reach[c[fixed], ex[fixed]]]
+        if hits.size:
+            r = int(hits[0])
+            best = (r, int(c[r]), int(ex[r]))
+            break
+    if best is None:
+        raise SearchError(f"clip {cw.index}: no walk from frame {start} reaches any exit")
+    r, c, x = best
+    frames = _backtrack(cw, reach, c, x)
+    pieces.extend(_runs(cw.index, frames))
+    return pieces, r, played + c + 1
+
+
+def _quick_exit(cw: _Clip, start: int, exits: list[int], name: str) -> tuple[list[tuple[int, int, int]], int, int]:
+    """Walk forward to the nearest exit, looping back at the last self-loop point.
+
+    The loop guard: passing the last self-loop point a second time means the whole clip was
+    searched, so the search stops with an error.
+    """
+    ex = np.array(exits)
+    pieces, played, f, passes = [], 0, start, 0
+    while True:
+        ahead = np.flatnonzero(ex >= f)
+        # reachable without loops only while the frames ahead are walkable
+        stop = f
+        while stop < cw.length - 1 and cw.step[stop]:
+            stop += 1
+        ahead = ahead[ex[ahead] <= stop]
+        if ahead.size:
+            r = int(ahead[np.argmin(ex[ahead])])
+            pieces.append((cw.index, f, int(ex[r])))
+            return pieces, r, played + int(ex[r]) - f + 1
+        if cw.last_src < 0 or passes >= 1:
+            raise SearchError(
+                f"loop guard: walked clip {name!r} through its last self-loop point twice without finding the way on"
+            )
+        passes += 1
+        pieces.append((cw.index, f, cw.last_src))
+        played += cw.last_src - f + 1
+        f = cw.last_dst
+
+
+# ---------------------------------------------------------------------------- structured search
+class _Planner:
+    def __init__(self, graph: MotionGraph):
+        if not graph.table.get("behaviours"):
+            raise SearchError("this graph has no structure table (a standard graph?); use search_standard")
+        self.g = graph
+        self.entries = graph.table["behaviours"]
+        self.walkers: dict[int, _Clip] = {}
+        self.links: dict[tuple[str, str], list[dict]] = {}
+        self.memo: dict = {}
+        for link in graph.table["links"]:
+            self.links.setdefault(tuple(link["from"]), []).append(link)
+
+    def walker(self, key: tuple[str, str]) -> _Clip:
+        c = self.entries[key[0]][key[1]]["clip"]
+        if c not in self.walkers:
+            self.walkers[c] = _clip_walker(self.g, c)
+        return self.walkers[c]
+
+    def check(self, seg: Segment) -> tuple[str, str]:
+        if seg.behaviour not in self.entries:
+            raise SearchError(f"no behaviour {seg.behaviour!r} in the graph; behaviours: {sorted(self.entries)}")
+        styles = self.entries[seg.behaviour]
+        if seg.style not in styles:
+            raise SearchError(
+                f"no style {seg.style!r} of behaviour {seg.behaviour!r} in the graph; its styles: {sorted(styles)}"
+            )
+        return (seg.behaviour, seg.style)
+
+    def hops(self, a: tuple[str, str], b: tuple[str, str]) -> list[dict]:
+        """Links from ``a`` to ``b`` through the structure table, fewest hops (BFS)."""
+        prev: dict[tuple[str, str], tuple] = {a: None}
+        queue = deque([a])
+        while queue:
+            u = queue.popleft()
+            if u == b:
+                break
+            for link in self.links.get(u, []):
+                v = tuple(link["to"])
+                if v not in prev:
+                    prev[v] = (u, link)
+                    queue.append(v)
+        if b not in prev:
+            reach = sorted({f"{k[0]}/{k[1]}" for k in prev})
+            behaviours = {k[0] for k in prev}
+            if b[0] not in behaviours:
+                why = f"no recorded transition clip leads from behaviour {a[0]!r} (or its styles) to {b[0]!r}"
+            else:
+                why = f"no interpolation-space path between styles {a[1]!r} and {b[1]!r} of {b[0]!r}"
+            raise SearchError(
+                f"cannot go from {a[0]}/{a[1]} to {b[0]}/{b[1]}: {why}; reachable from {a[0]}/{a[1]}: {reach}"
+            )
+        out = []
+        v = b
+        while prev[v] is not None:
+            u, link = prev[v]
+            out.append(link)
+            v = u
+        return out[::-1]
+
+    def options(self, plan: list[dict]):
+        """Every way out along ``plan``: (route, pieces after it, their frames, final entry),
+        the frames each spends after leaving the clip, and each exit frame (cached)."""
+        key = tuple(id(h) for h in plan)
+        if key not in self.memo:
+            first, rest = plan[0], plan[1:]
+            seen, options = set(), []
+            for route in first["routes"]:
+                more, more_frames, final_enter = self.onward(rest, route["enter"])
+                sig = (route["exit"], route["frames"] + more_frames)
+                if sig in seen:  # same exit, same length: one is enough (routes come best first)
+                    continue
+                seen.add(sig)
+                options.append((route, more, more_frames, final_enter))
+            spent = np.array([o[0]["frames"] + o[2] for o in options])
+            exits = [o[0]["exit"] for o in options]
+            self.memo[key] = (options, spent, exits)
+        return self.memo[key]
+
+    def onward(self, hops: list[dict], enter: int) -> tuple[list[tuple[int, int, int]], int, int]:
+        """Pass through the basic clips between hops; returns pieces, frames and the final entry."""
+        key = (tuple(id(h) for h in hops), enter)
+        if key not in self.memo:
+            self.memo[key] = self._onward(hops, enter)
+        return self.memo[key]
+
+    def _onward(self, hops: list[dict], enter: int) -> tuple[list[tuple[int, int, int]], int, int]:
+        pieces, frames = [], 0
+        for link in hops:
+            key = tuple(link["from"])
+            cw = self.walker(key)
+            routes = link["routes"]
+            exits = [r["exit"] for r in routes]
+            p, r, n = _quick_exit(cw, enter, exits, self.entries[key[0]][key[1]]["name"])
+            route = routes[r]
+            pieces.extend(p)
+            pieces.extend(tuple(x) for x in route["pieces"])
+            frames += n + route["frames"]
+            enter = route["enter"]
+        return pieces, frames, enter
+
+
+def search(graph: MotionGraph, request) -> SearchResult:
+    """Meet a request on a structured graph (see the module docstring).
+
+    Parameters
+    ----------
+    graph : a graph from :func:`~motionlab.motion_graphs.structured.build_structured`
+    request : list of :class:`Segment` / ``(behaviour, style, frames)`` tuples, or the text form
+        ``"walk:angry:300,run:normal:200"``
+
+    Raises
+    ------
+    SearchError naming a missing behaviour or style, or two behaviours with no transition clip.
+    """
+    segs = _segments(request)
+    planner = graph.__dict__.get("_planner")
+    if planner is None:
+        planner = _Planner(graph)
+        graph.__dict__["_planner"] = planner
+    keys = [planner.check(s) for s in segs]
+    plans = [planner.hops(a, b) if a != b else [] for a, b in zip(keys[:-1], keys[1:])]
+    pieces: list[tuple[int, int, int]] = []
+    achieved: list[int] = []
+    enter = 0
+    for k, seg in enumerate(segs):
+        cw = planner.walker(keys[k])
+        if k == len(segs) - 1 or not plans[k]:
+            p, _, n = _walk(cw, enter, [seg.frames], [-1])
+            pieces.extend(p)
+            achieved.append(n)
+            if k < len(segs) - 1:  # the same clip again: continue from the next frame
+                last = p[-1][2]
+                enter = last + 1 if last + 1 < cw.length and cw.step[last] else cw.last_dst
+            continue
+        options, spent, exits = planner.options(plans[k])
+        p, r, n = _walk(cw, enter, np.maximum(seg.frames - spent, 1).tolist(), exits)
+        route, more, more_frames, enter = options[r]
+        pieces.extend(p)
+        pieces.extend(tuple(x) for x in route["pieces"])
+        pieces.extend(more)
+        achieved.append(n + route["frames"] + more_frames)
+    return SearchResult(_merge(pieces), [s.frames for s in segs], achieved, segs)
+
+
+def _segments(request) -> list[Segment]:
+    if isinstance(request, str):
+        return parse_request(request)
+    out = []
+    for s in request:
+        s = s if isinstance(s, Segment) else Segment(str(s[0]).lower(), str(s[1]).lower(), int(s[2]))
+        if s.frames < 1:
+            raise ValueError(f"segment {s} asks for {s.frames} frames; ask for at least 1")
+        out.append(s)
+    if not out:
+        raise ValueError("empty request")
+    return out
+
+
+def _merge(pieces: list[tuple[int, int, int]]) -> list[tuple[int, int, int]]:
+    out: list[tuple[int, int, int]] = []
+    for c, a, b in pieces:
+        if out and out[-1][0] == c and out[-1][2] + 1 == a:
+            out[-1] = (c, out[-1][1], b)
+        else:
+            out.append((int(c), int(a), int(b)))
+    return out
+
+
+# ---------------------------------------------------------------------------- standard search
+def search_standard(graph: MotionGraph, request, start_clip: int | None = None) -> SearchResult:
+    """The comparison search on an unstructured graph: shortest paths between segments.
+
+    Clips are matched to segments through their labels (``ClipInfo.behaviour/style``). The
+    frames of the shortest path into the next clip count towards the segment being left.
+    """
+    segs = _segments(request)
+    g = graph.__dict__.get("_segment_graph")
+    if g is None:
+        g = graph.segment_graph()
+        graph.__dict__["_segment_graph"] = g
+        first, last, seg = graph.segments()
+        graph.__dict__["_segments"] = (first, last, seg)
+    first, last, seg = graph.__dict__["_segments"]
+    label_clips: dict[tuple[str, str], list[int]] = {}
+    for i, c in enumerate(graph.clips):
+        if c.behaviour is not None:
+            label_clips.setdefault((c.behaviour, c.style), []).append(i)
+    pieces: list[tuple[int, int, int]] = []
+    achieved: list[int] = []
+    current = None  # global frame
+    for s in segs:
+        clips = [
+            c
+            for c in label_clips.get((s.behaviour, s.style), [])
+            if graph.alive[graph.clips[c].start : graph.clips[c].stop].any()
+        ]
+        if not clips:
+            raise SearchError(f"no clip labelled {s.behaviour}/{s.style} survives in the graph")
+        lead = 0
+        if current is None:
+            c = clips[0]
+            enter = int(np.argmax(graph.alive[graph.clips[c].start : graph.clips[c].stop]))
+        else:
+            targets = {
+                int(n)
+                for n in np.unique(
+                    seg[np.concatenate([np.arange(graph.clips[c].start, graph.clips[c].stop) for c in clips])]
+                )
+                if n >= 0
+            }
+            src_node = int(seg[current])
+            dist, paths = nx.single_source_dijkstra(g, src_node, weight=lambda u, v, d: g.nodes[v]["frames"])
+            reachable = [t for t in targets if t in dist]
+            if not reachable:
+                raise SearchError(f"no path in the graph to {s.behaviour}/{s.style}")
+            t = min(reachable, key=lambda n: dist[n])
+            path = paths[t]
+            # the frames after `current` in its segment, then the whole segments on the way
+            cur_last = int(last[src_node])
+            c0 = int(graph.clip_of(current))
+            if cur_last > current:
+                pieces.append((c0, current + 1 - graph.clips[c0].start, cur_last - graph.clips[c0].start))
+                lead += cur_last - current
+            for node in path[1:-1]:
+                cn = g.nodes[node]
+                st = graph.clips[cn["clip"]].start
+                pieces.append((cn["clip"], cn["first"] - st, cn["last"] - st))
+                lead += cn["frames"]
+            achieved[-1] += lead
+            c = g.nodes[t]["clip"]
+            enter = g.nodes[t]["first"] - graph.clips[c].start
+        cw = _clip_walker(graph, c)
+        p, _, n = _walk(cw, enter, [s.frames], [-1])
+        pieces.extend(p)
+        achieved.append(n)
+        current = graph.clips[c].start + p[-1][2]
+    return SearchResult(_merge(pieces), [s.frames for s in segs], achieved, segs)

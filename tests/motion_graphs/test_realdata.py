@@ -1,0 +1,28 @@
+"""On real mocap (skipped unless MOTIONLAB_DATA points at the shared data)."""
+
+from __future__ import annotations
+
+import warnings
+
+import pytest
+
+from motionlab import data
+from motionlab.motion_graphs import clips, search, structured
+from tests.motion_graphs.conftest import THRESHOLD
+
+pytestmark = pytest.mark.realdata
+
+
+def test_bandai_walk_styles_end_to_end():
+    if not data.has_data("bandai_namco", "dataset-1", "walk"):
+        pytest.skip(f"needs real mocap (bandai_namco/dataset-1): {data.HOW_TO}")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ms = clips.bandai_styles(["walk"], ("normal", "happy", "angry"))
+    g = structured.build_structured(ms, THRESHOLD)
+    assert g.dead_ends().size == 0
+    assert set(g.table["behaviours"]["walk"]) == {"normal", "happy", "angry"}
+    r = search.search(g, "walk:angry:200,walk:happy:150,walk:normal:150")
+    g.check_path(r.pieces)
+    for req, got in zip(r.requested, r.achieved):
+        assert abs(got - req) <= max(2, search.TOLERANCE * req)

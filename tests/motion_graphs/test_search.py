@@ -1,0 +1,69 @@
+"""Searching requests: lengths, edges, clear errors, the standard baseline."""
+
+from __future__ import annotations
+
+import pytest
+
+from motionlab.motion_graphs import graph, search, structured
+from tests.motion_graphs.conftest import THRESHOLD
+
+REQUEST = "walk:normal:200,walk:happy:240,run:normal:220,walk:normal:180,walk:happy:200"
+
+
+def _within(result):
+    for req, got in zip(result.requested, result.achieved):
+        assert abs(got - req) <= max(2, search.TOLERANCE * req), result.report()
+
+
+def test_request_is_met_along_edges(sgraph):
+    r = search.search(sgraph, REQUEST)
+    sgraph.check_path(r.pieces)
+    assert r.num_frames == sum(r.achieved)
+    _within(r)
+    assert [s.behaviour for s in r.segments] == ["walk", "walk", "run", "walk", "walk"]
+
+
+def test_long_segments_use_loops(sgraph):
+    r = search.search(sgraph, [("walk", "happy", 700), ("run", "normal", 650)])
+    sgraph.check_path(r.pieces)
+    _within(r)
+
+
+def test_missing_style_and_behaviour(sgraph):
+    with pytest.raises(search.SearchError, match=r"no style 'sneaky' of behaviour 'walk'.*normal"):
+        search.search(sgraph, "walk:sneaky:100")
+    with pytest.raises(search.SearchError, match=r"no behaviour 'fly'"):
+        search.search(sgraph, "walk:normal:100,fly:normal:100")
+
+
+def test_no_transition_clip_is_named(library):
+    g = structured.build_structured([m for m in library if "_to_" not in m.name], THRESHOLD)
+    with pytest.raises(search.SearchError, match=r"from behaviour 'walk'.*'run'"):
+        search.search(g, "walk:normal:100,run:normal:100")
+
+
+def test_parse_request_errors():
+    assert search.parse_request("walk:angry:300, run:normal:200")[1] == search.Segment("run", "normal", 200)
+    for bad in ("walk:angry", "walk:angry:x", "walk:angry:0", ""):
+        with pytest.raises(ValueError):
+            search.parse_request(bad)
+
+
+def test_loop_guard():
+    import numpy as np
+
+    cw = search._Clip(0, 10, np.array([True] * 9 + [False]), np.array([9]), np.array([4]), 9, 4)
+    with pytest.raises(search.SearchError, match="loop guard"):
+        search._quick_exit(cw, 5, [2], "clip")
+    pieces, r, n = search._quick_exit(cw, 5, [2, 7], "clip")
+    assert pieces == [(0, 5, 7)] and n == 3
+
+
+def test_standard_search_follows_edges(library):
+    infos = [graph.ClipInfo(m.name, "clip", *m.name.split("_")[:2]) for m in library if "_to_" not in m.name]
+    g = graph.build_standard([m for m in library if "_to_" not in m.name], THRESHOLD, infos=infos)
+    present = {(c.behaviour, c.style) for c, n in zip(g.clips, range(len(g.clips))) if g.alive[c.start : c.stop].any()}
+    req = [(b, s, 60) for b, s in sorted(present)][:2]
+    r = search.search_standard(g, req)
+    g.check_path(r.pieces)
+    assert r.num_frames == sum(r.achieved)

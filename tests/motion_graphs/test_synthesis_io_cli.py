@@ -1,0 +1,79 @@
+"""Synthesis continuity, save/load round trip, the CLI."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from motionlab.cli import main
+from motionlab.motion_graphs import io, search, synthesis
+
+
+@pytest.fixture(scope="module")
+def result(sgraph):
+    return search.search(sgraph, "walk:normal:120,walk:happy:120,run:normal:120")
+
+
+def test_synthesis_is_continuous(sgraph, result):
+    m = synthesis.synthesize(sgraph, result.pieces)
+    assert m.num_frames == result.num_frames
+    pos = m.global_positions()
+    root_step = np.linalg.norm(np.diff(m.root_pos[:, [0, 2]], axis=0), axis=1)
+    # the root never jumps: no step much larger than the clips' own fastest step
+    own = max(
+        np.linalg.norm(np.diff(sgraph.root_pos[c.start : c.stop, [0, 2]], axis=0), axis=1).max() for c in sgraph.clips
+    )
+    assert root_step.max() < 1.5 * own
+    q = synthesis.transition_quality(m, result.transitions())
+    assert np.isfinite(q["smoothness"]) and q["max_jump"] <= q["max_jump_all"] + 1e-12
+    # without root alignment the character would teleport
+    raw = np.concatenate(
+        [sgraph.root_pos[sgraph.clips[c].start + a : sgraph.clips[c].start + b + 1] for c, a, b in result.pieces]
+    )
+    assert np.linalg.norm(np.diff(raw[:, [0, 2]], axis=0), axis=1).max() > root_step.max()
+    assert np.all(np.isfinite(pos))
+
+
+def test_blending_smooths_transitions(sgraph, result):
+    hard = synthesis.synthesize(sgraph, result.pieces, blend=0, fix_feet=False)
+    soft = synthesis.synthesize(sgraph, result.pieces, blend=8, fix_feet=False)
+    t = result.transitions()
+    assert (
+        synthesis.transition_quality(soft, t)["smoothness"]
+        <= synthesis.transition_quality(hard, t)["smoothness"] * 1.05
+    )
+
+
+def test_save_load_round_trip(sgraph, result, tmp_path):
+    path = io.save(tmp_path / "g", sgraph)
+    assert path.suffix == ".mlgraph"
+    with pytest.raises(FileExistsError):
+        io.save(path, sgraph)
+    g2 = io.load(path)
+    assert g2.summary() == sgraph.summary()
+    assert g2.table == sgraph.table
+    np.testing.assert_array_equal(g2.src, sgraph.src)
+    np.testing.assert_allclose(g2.local_rot, sgraph.local_rot, atol=1e-6)
+    assert search.search(g2, "walk:normal:120,walk:happy:120,run:normal:120").pieces == result.pieces
+    bad = tmp_path / "bad.mlgraph"
+    bad.write_bytes(b"not a graph")
+    with pytest.raises(ValueError, match="not a motion graph"):
+        io.load(bad)
+
+
+def test_cli_build_search(tmp_path, capsys):
+    g = tmp_path / "s.mlgraph"
+    assert main(["graph-build", "--synthetic", "-o", str(g)]) == 0
+    assert main(["graph-build", "--synthetic", "-o", str(g)]) == 2  # no overwrite without --force
+    out = tmp_path / "o.bvh"
+    assert main(["graph-search", str(g), "--request", "walk:happy:90,run:tired:60", "-o", str(out)]) == 0
+    assert out.is_file()
+    assert main(["graph-search", str(g), "--request", "walk:zany:90", "-o", str(tmp_path / "x.bvh")]) == 2
+    err = capsys.readouterr().err
+    assert "no style 'zany'" in err
+    assert main(["graph-info", str(g)]) == 0
+    gs = tmp_path / "std.mlgraph"
+    assert main(["graph-build", "--synthetic", "--standard", "-o", str(gs)]) == 0
+    assert (
+        main(["graph-search", str(gs), "--request", "walk:normal:60,walk:happy:60", "-o", str(tmp_path / "s.bvh")]) == 0
+    )
