@@ -1,0 +1,65 @@
+"""System A: retargeting by latent-space iteration (paper ``seeds/000_*.txt``).
+
+Train a network on ONE character's motion, then generate the motion of a character with other
+proportions by optimising the network's latent code (weights frozen) so that joint directions
+match the source and the feet stay above the ground.
+
+* :mod:`.model` — F_enc, F_qlinear, F_skel, F_Δ, Hamilton correction and FK;
+* :mod:`.losses` — L_recon, L_angle, L_foot;
+* :mod:`.train` — training on one character; :mod:`.checkpoint` — save / load;
+* :mod:`.solver` — the latent iteration; :mod:`.baselines` — copy-rotation;
+* :mod:`.pipeline` — a Motion onto a target skeleton, end to end;
+* :mod:`.evaluate` — Table 1 on real data; :mod:`.cli` — ``motionlab retarget/train/evaluate``.
+
+``load_default()`` returns the small network shipped in ``motionlab/assets`` (trained by this
+package on its own synthetic data), so retargeting works without training first. Re-create it
+with::
+
+    motionlab train --synthetic 300 --seed 0 -o motionlab/assets/retarget_default.pt --force
+
+Taught in ``notebooks/02_retargeting_network.ipynb`` and ``03_latent_iteration.ipynb``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from motionlab.retargeting.baselines import copy_rotation
+from motionlab.retargeting.checkpoint import Checkpoint, CheckpointError, load, save
+from motionlab.retargeting.model import ModelConfig, RetargetNet
+from motionlab.retargeting.pipeline import RetargetResult, retarget
+from motionlab.retargeting.solver import SolverConfig, SolverResult, solve
+from motionlab.retargeting.train import TrainConfig, train, training_set
+
+__all__ = [
+    "DEFAULT_CHECKPOINT",
+    "load_default",
+    "Checkpoint",
+    "CheckpointError",
+    "load",
+    "save",
+    "ModelConfig",
+    "RetargetNet",
+    "TrainConfig",
+    "train",
+    "training_set",
+    "SolverConfig",
+    "SolverResult",
+    "solve",
+    "RetargetResult",
+    "retarget",
+    "copy_rotation",
+]
+
+DEFAULT_CHECKPOINT = Path(__file__).resolve().parent.parent / "assets" / "retarget_default.pt"
+"""The shipped checkpoint (trained on ``motionlab.synthetic`` data; see the module docstring)."""
+
+
+def load_default(device=None) -> Checkpoint:
+    """The shipped pretrained network (CUDA when available, else CPU)."""
+    if not DEFAULT_CHECKPOINT.is_file():
+        raise FileNotFoundError(
+            f"the default retargeting checkpoint {DEFAULT_CHECKPOINT} is missing; re-create it with "
+            "`motionlab train --synthetic 300 --seed 0 -o motionlab/assets/retarget_default.pt --force`"
+        )
+    return load(DEFAULT_CHECKPOINT, device)

@@ -26,8 +26,12 @@ def _split(rng: np.random.Generator, total: int, parts: int) -> list[int]:
     parts = max(1, min(parts, total // _MIN_SEGMENT))
     if parts == 1:
         return [total]
-    cuts = np.sort(rng.choice(np.arange(1, total - parts * _MIN_SEGMENT + 1), parts - 1, replace=False))
-    sizes = np.diff(np.concatenate([[0], cuts, [total - parts * _MIN_SEGMENT]])) + _MIN_SEGMENT
+    slack = total - parts * _MIN_SEGMENT  # frames left after every part got its minimum
+    if slack >= parts - 1:  # distinct cut points (the stream the shipped checkpoint was trained on)
+        cuts = np.sort(rng.choice(np.arange(1, slack + 1), parts - 1, replace=False))
+    else:  # too little slack for distinct cuts: parts may share it unevenly
+        cuts = np.sort(rng.integers(0, slack + 1, size=parts - 1))
+    sizes = np.diff(np.concatenate([[0], cuts, [slack]])) + _MIN_SEGMENT
     return [int(s) for s in sizes]
 
 

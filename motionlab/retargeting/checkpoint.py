@@ -1,0 +1,153 @@
+"""Save and load a trained retargeting network with everything needed to use it.
+
+A checkpoint holds the weights, the network's sizes, the normalisation statistics of the
+input features, the training character's canonical skeleton (character A), the frame rate and
+window length it was trained with, free-form training info (seed, steps, final loss) and
+:data:`FORMAT_VERSION`. It is written with ``torch.save`` using plain types only, and read with
+``weights_only=True`` (no arbitrary code runs on load). Loading a file of another format
+version, or one that is not a checkpoint, raises :class:`CheckpointError` saying so.
+
+Taught in ``notebooks/02_retargeting_network.ipynb``.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from motionlab.core.preprocess import NormStats
+from motionlab.core.skeleton import Skeleton
+from motionlab.retargeting.model import ModelConfig, RetargetNet
+
+__all__ = ["FORMAT", "FORMAT_VERSION", "CheckpointError", "Checkpoint", "save", "load"]
+
+FORMAT = "motionlab-retargeting"
+FORMAT_VERSION = 1
+
+
+class CheckpointError(ValueError):
+    """A file that is not a retargeting checkpoint of this version (or is damaged)."""
+
+
+@dataclass
+class Checkpoint:
+    """A trained network and its context.
+
+    Attributes
+    ----------
+    model : RetargetNet            the network (put in ``eval()`` mode by :func:`load`)
+    stats : NormStats              mean/std of the 70 input features
+    skeleton : Skeleton            the training character's canonical 22-joint skeleton
+    fps : float                    frame rate of the training data
+    window : int                   training window length, frames
+    info : dict                    seed, steps, final loss, data description (plain JSON types)
+    """
+
+    model: RetargetNet
+    stats: NormStats
+    skeleton: Skeleton
+    fps: float = 60.0
+    window: int = 120
+    info: dict = field(default_factory=dict)
+
+    @property
+    def device(self) -> torch.device:
+        return next(self.model.parameters()).device
+
+    def to(self, device) -> Checkpoint:
+        """Move the network to ``device`` (in place); returns ``self``."""
+        self.model.to(device)
+        return self
+
+
+def _skeleton_dict(sk: Skeleton) -> dict:
+    return {
+        "names": list(sk.names),
+        "parents": [int(p) for p in sk.parents],
+        "offsets": sk.offsets.tolist(),
+        "end_sites": {str(j): o.tolist() for j, o in sk.end_sites.items()},
+    }
+
+
+def _skeleton_from(d: dict) -> Skeleton:
+    return Skeleton(
+        tuple(d["names"]),
+        np.asarray(d["parents"]),
+        np.asarray(d["offsets"], dtype=np.float64),
+        {int(j): np.asarray(o) for j, o in d["end_sites"].items()},
+    )
+
+
+def save(path: str | os.PathLike, checkpoint: Checkpoint, overwrite: bool = True) -> Path:
+    """Write ``checkpoint`` to ``path`` atomically (temporary file, then rename).
+
+    Raises ``FileExistsError`` when ``path`` exists and ``overwrite`` is False.
+    """
+    path = Path(path)
+    if path.exists() and not overwrite:
+        raise FileExistsError(f"{path} exists; pass overwrite=True (or --force) to replace it")
+    payload = {
+        "format": FORMAT,
+        "version": FORMAT_VERSION,
+        "config": checkpoint.model.config.to_dict(),
+        "state_dict": {k: v.detach().cpu().clone() for k, v in checkpoint.model.state_dict().items()},
+        "stats": checkpoint.stats.to_dict(),
+        "skeleton": _skeleton_dict(checkpoint.skeleton),
+        "fps": float(checkpoint.fps),
+        "window": int(checkpoint.window),
+        "info": dict(checkpoint.info),
+    }
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(suffix=".pt.tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        torch.save(payload, tmp)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+    return path
+
+
+def load(path: str | os.PathLike, device: str | torch.device | None = None) -> Checkpoint:
+    """Read a checkpoint written by :func:`save`; the network is in ``eval()`` mode on ``device``
+    (default: CUDA when available, else CPU)."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"checkpoint {path} not found")
+    try:
+        payload = torch.load(path, map_location="cpu", weights_only=True)
+    except Exception as e:  # torch raises many kinds for a damaged or foreign file
+        raise CheckpointError(
+            f"{path}: not a readable motionlab retargeting checkpoint ({type(e).__name__}: {e})"
+        ) from None
+    if not isinstance(payload, dict) or payload.get("format") != FORMAT:
+        raise CheckpointError(f"{path}: not a motionlab retargeting checkpoint (no {FORMAT!r} format tag)")
+    version = payload.get("version")
+    if version != FORMAT_VERSION:
+        raise CheckpointError(
+            f"{path}: checkpoint format version {version}, but this motionlab reads version {FORMAT_VERSION}; "
+            "re-train it with `motionlab train` (or load it with the motionlab release that wrote it)"
+        )
+    try:
+        model = RetargetNet(ModelConfig(**payload["config"]))
+        model.load_state_dict(payload["state_dict"])
+        ckpt = Checkpoint(
+            model=model,
+            stats=NormStats.from_dict(payload["stats"]),
+            skeleton=_skeleton_from(payload["skeleton"]),
+            fps=float(payload["fps"]),
+            window=int(payload["window"]),
+            info=dict(payload.get("info", {})),
+        )
+    except (KeyError, TypeError, RuntimeError, ValueError) as e:
+        raise CheckpointError(f"{path}: damaged retargeting checkpoint ({type(e).__name__}: {e})") from None
+    if device is None:
+        device = "cuda" if torch.cuda.is_available() else "cpu"
+    model.to(device).eval()
+    return ckpt

@@ -1,0 +1,284 @@
+"""``motionlab retarget``, ``motionlab train`` and ``motionlab evaluate``.
+
+Examples::
+
+    motionlab retarget Aj/Running.bvh --target BigVegas/Running.bvh -o running_bigvegas.bvh
+    motionlab retarget Aj/Running.bvh --scale-legs 1.2 -o long_legs.bvh --method full
+    motionlab train $MOTIONLAB_DATA/mixamo/Aj/*.bvh -o /tmp/motionlab_aj.pt
+    motionlab train --synthetic 300 --seed 0 -o motionlab/assets/retarget_default.pt --force
+    motionlab evaluate --data $MOTIONLAB_DATA/mixamo --checkpoint /tmp/motionlab_aj.pt
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["register"]
+
+
+def _error(msg: str):
+    from motionlab.cli import CLIError
+
+    return CLIError(msg)
+
+
+def _positive(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not (np.isfinite(v) and v > 0):
+        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
+    return v
+
+
+def _load_bvh(path: str, what: str):
+    from motionlab.core import bvh
+
+    p = Path(path)
+    if not p.is_file():
+        raise _error(f"{what} file {p} not found")
+    return bvh.load(p)
+
+
+def _load_checkpoint(path: str | None, device: str | None):
+    from motionlab import retargeting
+
+    try:
+        return retargeting.load(path, device) if path else retargeting.load_default(device)
+    except retargeting.CheckpointError as e:
+        raise _error(str(e)) from None
+
+
+def _solver_config(args):
+    from motionlab.retargeting.solver import SolverConfig
+
+    return SolverConfig(max_steps=args.steps, lr=args.lr, threshold=args.threshold)
+
+
+def _add_solver_args(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("latent iteration")
+    g.add_argument("--steps", type=int, default=100, help="step limit of the latent iteration (default 100)")
+    g.add_argument("--lr", type=float, default=0.1, help="Adam learning rate on the latent (default 0.1)")
+    g.add_argument("--threshold", type=float, default=2e-3, help="stop when L_iter drops below this (default 2e-3)")
+
+
+# ---------------------------------------------------------------------------- retarget
+def _cmd_retarget(args) -> int:
+    from motionlab.core import bvh, humanoid
+    from motionlab.retargeting.pipeline import retarget
+
+    out = Path(args.output)
+    if out.suffix.lower() != ".bvh":
+        raise _error(f"output {out} must end in .bvh")
+    if out.exists() and not args.force:
+        raise _error(f"{out} exists; pass --force to overwrite it")
+    source = _load_bvh(args.source, "source")
+    try:
+        humanoid.find_mapping(source.skeleton)
+        base = _load_bvh(args.target, "target").skeleton if args.target else source.skeleton
+        target = humanoid.to_canonical_skeleton(base)
+    except humanoid.RigMappingError as e:
+        raise _error(str(e)) from None
+    scales = dict(
+        legs=args.scale_legs, arms=args.scale_arms, spine=args.scale_spine, neck=args.scale_neck, overall=args.scale
+    )
+    if any(v != 1.0 for v in scales.values()):
+        target = humanoid.scale_bones(target, **scales)
+    if not args.target and all(v == 1.0 for v in scales.values()):
+        raise _error("give --target TARGET.bvh and/or a --scale-* factor: otherwise the target is the source itself")
+    ckpt = None if args.method == "copy" else _load_checkpoint(args.checkpoint, args.device)
+    result = retarget(source, target, ckpt, args.method, _solver_config(args), args.root, progress=not args.quiet)
+    bvh.save(out, result.motion, overwrite=args.force)
+    if args.npz:
+        npz = Path(args.npz)
+        if npz.exists() and not args.force:
+            raise _error(f"{npz} exists; pass --force to overwrite it")
+        np.savez(
+            npz,
+            local_rot=result.motion.local_rot,
+            root_pos=result.motion.root_pos,
+            positions=result.positions,
+            offsets=result.motion.skeleton.offsets,
+            parents=result.motion.skeleton.parents,
+            fps=result.motion.fps,
+        )
+    if not args.quiet:
+        msg = f"wrote {out} ({result.motion.num_frames} frames @ {result.motion.fps:g} fps, method {result.method}"
+        if result.method == "full":
+            h = result.history
+            msg += f"; L_iter {h['loss'][0]:.4g} -> {h['loss'][-1]:.4g} in {result.steps} steps ({result.stop_reason})"
+        print(msg + f", {result.seconds:.2f} s)")
+    return 0
+
+
+# ---------------------------------------------------------------------------- train
+def _cmd_train(args) -> int:
+    from motionlab.retargeting import checkpoint as ck
+    from motionlab.retargeting.model import ModelConfig
+    from motionlab.retargeting.train import TrainConfig, train, training_set
+
+    out = Path(args.output)
+    if out.exists() and not args.force:
+        raise _error(f"{out} exists; pass --force to overwrite it")
+    if args.synthetic:
+        if args.clips:
+            raise _error("give BVH clips or --synthetic N, not both")
+        from motionlab import synthetic
+
+        motions = synthetic.dataset(args.synthetic, seed=args.seed)
+    else:
+        if not args.clips:
+            raise _error("give the BVH clips of ONE character to train on (or --synthetic N)")
+        motions = [_load_bvh(p, "training") for p in args.clips]
+    try:
+        data = training_set(motions, progress=not args.quiet)
+    except ValueError as e:
+        raise _error(str(e)) from None
+    cfg = TrainConfig(
+        steps=args.train_steps, batch_size=args.batch_size, lr=args.train_lr, seed=args.seed, device=args.device
+    )
+    mcfg = ModelConfig(latent=args.latent, hidden=args.hidden)
+    ckpt, history = train(data, cfg, mcfg, progress=not args.quiet)
+    ckpt.info["source"] = "synthetic" if args.synthetic else [Path(p).name for p in args.clips]
+    ck.save(out, ckpt, overwrite=args.force)
+    if not args.quiet:
+        print(
+            f"wrote {out}: {len(data)} windows, final loss {history[-1]['loss']:.4g} after {cfg.steps} steps ({ckpt.info['seconds']:.0f} s)"
+        )
+    return 0
+
+
+# ---------------------------------------------------------------------------- evaluate
+def _cmd_evaluate(args) -> int:
+    from motionlab import data as mdata
+    from motionlab.retargeting import checkpoint as ck
+    from motionlab.retargeting.evaluate import evaluate, training_clips
+    from motionlab.retargeting.train import TrainConfig, train
+
+    folder = Path(args.data) if args.data else mdata.data_root() / "mixamo"
+    if not folder.is_dir():
+        raise _error(f"data folder {folder} not found")
+    path = Path(args.checkpoint) if args.checkpoint else Path(tempfile.gettempdir()) / f"motionlab_{args.source}.pt"
+    animations = args.animations or None
+    if path.is_file() and not args.retrain:
+        ckpt = _load_checkpoint(str(path), args.device)
+        if not args.quiet:
+            print(f"using checkpoint {path}")
+    else:
+        from motionlab.core import bvh
+        from motionlab.retargeting.evaluate import DEFAULT_ANIMATIONS
+
+        clips = training_clips(folder, args.source, animations or DEFAULT_ANIMATIONS)
+        if not args.quiet:
+            print(f"training on {len(clips)} clips of {args.source} -> {path}")
+        ckpt, _ = train(
+            [bvh.load(p) for p in clips],
+            TrainConfig(steps=args.train_steps, seed=args.seed, device=args.device),
+            progress=not args.quiet,
+        )
+        ck.save(path, ckpt)
+    from motionlab.retargeting.evaluate import DEFAULT_ANIMATIONS
+
+    result = evaluate(
+        folder,
+        ckpt,
+        source=args.source,
+        targets=args.targets,
+        animations=animations or (DEFAULT_ANIMATIONS if not args.all_animations else None),
+        solver=_solver_config(args),
+        progress=not args.quiet,
+    )
+    print(result.table())
+    if args.csv:
+        import csv
+
+        with open(args.csv, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=list(result.records[0]))
+            w.writeheader()
+            w.writerows(result.records)
+    return 0
+
+
+def register(subparsers) -> None:
+    """Add ``retarget``, ``train`` and ``evaluate`` to the ``motionlab`` command."""
+    p = subparsers.add_parser(
+        "retarget",
+        help="retarget a BVH clip onto another character (latent iteration)",
+        description="Generate TARGET's version of SOURCE.bvh. The target character is defined by the rest "
+        "skeleton of --target (its motion is ignored) and/or --scale-* factors; the output is a BVH on the "
+        "22-joint canonical skeleton.",
+    )
+    p.add_argument("source", help="source motion (BVH, any rig that maps onto the 22 canonical joints)")
+    p.add_argument("--target", help="BVH whose rest skeleton defines the target character")
+    p.add_argument("-o", "--output", required=True, help="output BVH file")
+    p.add_argument("--npz", help="also write arrays (local_rot, root_pos, positions, offsets) to this .npz")
+    p.add_argument(
+        "--method",
+        choices=("full", "network", "copy"),
+        default="full",
+        help="full = latent iteration (default); network = no iteration; copy = copy rotations",
+    )
+    p.add_argument("--checkpoint", help="trained network (default: the shipped one)")
+    p.add_argument(
+        "--root", choices=("hips", "legs"), default="hips", help="leg measure that scales the root trajectory"
+    )
+    for name in ("legs", "arms", "spine", "neck"):
+        p.add_argument(
+            f"--scale-{name}", type=_positive, default=1.0, metavar="F", help=f"scale the target's {name} bones by F"
+        )
+    p.add_argument("--scale", type=_positive, default=1.0, metavar="F", help="scale the whole target by F")
+    p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
+    p.add_argument("--force", action="store_true", help="overwrite existing output files")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary")
+    _add_solver_args(p)
+    p.set_defaults(func=_cmd_retarget)
+
+    p = subparsers.add_parser(
+        "train",
+        help="train the retargeting network on one character",
+        description="Train the retargeting network on the clips of ONE character (L_recon) and save a checkpoint.",
+    )
+    p.add_argument("clips", nargs="*", help="BVH clips of one character")
+    p.add_argument("--synthetic", type=int, default=0, metavar="N", help="train on N built-in synthetic clips instead")
+    p.add_argument("-o", "--output", required=True, help="checkpoint file to write (.pt)")
+    p.add_argument("--train-steps", type=int, default=1500, help="Adam steps (default 1500)")
+    p.add_argument("--batch-size", type=int, default=32)
+    p.add_argument("--train-lr", type=float, default=2e-3)
+    p.add_argument("--latent", type=int, default=128, help="latent channels D per frame")
+    p.add_argument("--hidden", type=int, default=96, help="hidden channels")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing checkpoint")
+    p.add_argument("-q", "--quiet", action="store_true")
+    p.set_defaults(func=_cmd_train)
+
+    p = subparsers.add_parser(
+        "evaluate",
+        help="reproduce Table 1 (retargeting vs real clips) on a <Character>/<Animation>.bvh folder",
+        description="Retarget SOURCE's clips onto each target's T-pose skeleton and compare with the targets' real "
+        "clips: copy-rotation baseline, network without iteration, full method. Trains the network on SOURCE's "
+        "other clips first if the checkpoint does not exist.",
+    )
+    p.add_argument("--data", help="folder laid out as <Character>/<Animation>.bvh (default: $MOTIONLAB_DATA/mixamo)")
+    p.add_argument("--source", default="Aj")
+    p.add_argument(
+        "--targets", nargs="+", default=["BigVegas", "Kaya", "SportyGranny", "Goblin_m", "Mousey_m", "Vampire_m"]
+    )
+    p.add_argument("--animations", nargs="+", help="clip stems (default: the 10 retarget_gt animations)")
+    p.add_argument("--all-animations", action="store_true", help="use every animation shared by source and targets")
+    p.add_argument(
+        "--checkpoint", help="checkpoint to use, trained there if missing (default: <tmp>/motionlab_<source>.pt)"
+    )
+    p.add_argument("--retrain", action="store_true", help="train even if the checkpoint exists")
+    p.add_argument("--train-steps", type=int, default=1500)
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--csv", help="write the per-clip records to this CSV")
+    p.add_argument("--device")
+    p.add_argument("-q", "--quiet", action="store_true")
+    _add_solver_args(p)
+    p.set_defaults(func=_cmd_evaluate)

@@ -1,0 +1,260 @@
+"""Table 1 of paper A on real data: retarget A's clips to other characters, compare with theirs.
+
+Works on any folder laid out as ``<Character>/<Animation>.bvh``: for every target character B
+and animation, A's clip is retargeted onto B's canonical T-pose skeleton (B's rig alone, none
+of B's motion) and compared with B's real clip reduced to the same 22 joints.
+
+Metrics (all from :mod:`motionlab.core.metrics`, positions in world space):
+
+* ``mse`` (cm²) and ``mse/h²`` — squared joint-position error over frames, joints and axes; the
+  second divides by B's height² (``h`` = B's full rig rest height, highest minus lowest
+  joint, as in the data notes), the de facto metric; ``pose mse/h²`` does the same after
+  subtracting each frame's root position (pose only, root trajectory removed);
+* ``mpjpe`` (cm) — mean per-joint Euclidean error;
+* ``smooth`` (cm/frame²) — mean acceleration magnitude (the real clips' value is printed too);
+* ``pen`` (% of h) — mean depth of the four foot joints below the ground;
+* ``skate`` (cm/s) — mean horizontal foot speed while touching the ground;
+* ``time`` (s) — wall time of the method per clip (network + latent iteration).
+
+Alignment with the ground truth: every method uses the root trajectory of
+:mod:`motionlab.retargeting.pipeline`: A's trajectory scaled by B/A leg size about the world
+origin (so the start is A's start scaled, with A's heading). Mixamo's own clips start at the
+origin too, so no per-clip fitting to the ground truth is done.
+
+Taught in ``notebooks/03_latent_iteration.ipynb``.
+"""
+
+from __future__ import annotations
+
+import csv
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from motionlab.core import humanoid, metrics, preprocess
+from motionlab.retargeting.checkpoint import Checkpoint
+from motionlab.retargeting.pipeline import retarget
+from motionlab.retargeting.solver import SolverConfig
+
+__all__ = [
+    "DEFAULT_SOURCE",
+    "DEFAULT_TARGETS",
+    "DEFAULT_ANIMATIONS",
+    "ROWS",
+    "Evaluation",
+    "training_clips",
+    "evaluate",
+]
+
+DEFAULT_SOURCE = "Aj"
+DEFAULT_TARGETS = ("BigVegas", "Kaya", "SportyGranny", "Goblin_m", "Mousey_m", "Vampire_m")
+DEFAULT_ANIMATIONS = (
+    "Running", "Jumping", "Body_Jab_Cross", "Standing_To_Crouch", "Catwalk_Idle_To_Walk_Forward",
+    "Run_Arc_Left", "Injured_Walk_Left_Turn", "Standing_Turn_Right_90", "Jazz_Dancing",
+    "Standing_Land_To_Standing_Idle",
+)  # fmt: skip
+"""The 10 ``retarget_gt`` animations of the shared Mixamo data."""
+
+ROWS: tuple[tuple[str, str, str], ...] = (
+    ("copy rotations, root x leg length", "copy", "legs"),
+    ("copy rotations (baseline)", "copy", "hips"),
+    ("no iteration", "network", "hips"),
+    ("full method", "full", "hips"),
+)
+"""Table rows as ``(label, method, root_mode)``: the first is the data notes' plain baseline."""
+
+_CM = 100.0  # metres → file units (centimetres)
+
+
+def _load(path: Path):
+    from motionlab.core import bvh  # imported here: the BVH module is optional for the rest
+
+    return bvh.load(path)
+
+
+def training_clips(
+    folder: str | Path, source: str = DEFAULT_SOURCE, exclude: Sequence[str] = DEFAULT_ANIMATIONS
+) -> list[Path]:
+    """A's training clips in ``folder``.
+
+    If a ``manifest.csv`` with ``path``, ``purpose`` and ``subject`` columns sits in the folder or
+    its parent (the shared data does), the rows with ``purpose == "train_character"`` and
+    ``subject == source`` inside ``folder`` are used; otherwise every ``<source>/*.bvh`` whose
+    stem is not in ``exclude``. Evaluated animations are always excluded.
+    """
+    folder = Path(folder)
+    excluded = {e.lower() for e in exclude}
+    for manifest in (folder / "manifest.csv", folder.parent / "manifest.csv"):
+        if manifest.is_file():
+            with open(manifest, newline="") as f:
+                rows = list(csv.DictReader(f))
+            if rows and {"path", "purpose", "subject"} <= set(rows[0]):
+                paths = [
+                    (manifest.parent / r["path"]).resolve()
+                    for r in rows
+                    if r["purpose"] == "train_character" and r["subject"] == source
+                ]
+                paths = [
+                    p for p in paths
+                    if p.is_file() and p.is_relative_to(folder.resolve()) and p.stem.lower() not in excluded
+                ]  # fmt: skip
+                if paths:
+                    return sorted(paths)
+    src = folder / source
+    if not src.is_dir():
+        raise FileNotFoundError(f"no folder {src} (expected <Character>/<Animation>.bvh under {folder})")
+    paths = sorted(p for p in src.glob("*.bvh") if p.stem.lower() not in excluded)
+    if not paths:
+        raise FileNotFoundError(f"no training clips for {source!r} in {src} (all excluded or none present)")
+    return paths
+
+
+@dataclass
+class Evaluation:
+    """Per-clip records and the summary table.
+
+    Attributes
+    ----------
+    records : list of dict   one per (row label, target, animation) with every metric
+    ground_truth : list of dict   the real clips' own smoothness, penetration and skating
+    rows : list of str       row labels in order
+    """
+
+    records: list = field(default_factory=list)
+    ground_truth: list = field(default_factory=list)
+    rows: list = field(default_factory=list)
+
+    def summary(self) -> dict[str, dict[str, float]]:
+        """Mean of every metric per row label (and ``"ground truth"``)."""
+        out = {}
+        for label in self.rows:
+            recs = [r for r in self.records if r["row"] == label]
+            keys = [k for k in recs[0] if isinstance(recs[0][k], float)] if recs else []
+            out[label] = {k: float(np.mean([r[k] for r in recs])) for k in keys}
+        if self.ground_truth:
+            keys = [k for k in self.ground_truth[0] if isinstance(self.ground_truth[0][k], float)]
+            out["ground truth"] = {k: float(np.mean([r[k] for r in self.ground_truth])) for k in keys}
+        return out
+
+    def table(self) -> str:
+        """The summary as a fixed-width text table (units in the header)."""
+        s = self.summary()
+        cols = [
+            ("mse", "MSE cm²", "{:9.2f}"),
+            ("mse_h2", "MSE/h²", "{:9.2e}"),
+            ("pose_mse_h2", "pose MSE/h²", "{:11.2e}"),
+            ("mpjpe", "MPJPE cm", "{:8.2f}"),
+            ("smooth", "smooth cm/f²", "{:12.3f}"),
+            ("pen", "pen %h", "{:7.3f}"),
+            ("skate", "skate cm/s", "{:10.2f}"),
+            ("time", "time s/clip", "{:11.3f}"),
+        ]
+        n = len(self.records) // max(len(self.rows), 1)
+        width = max([len(r) for r in s] + [12])
+        head = f"{'method':<{width}} " + " ".join(f"{c[1]:>{len(c[2].format(0.0))}}" for c in cols)
+        lines = [
+            f"Retargeting evaluation over {n} clips (h = target height, 1 file unit = 1 cm)",
+            head,
+            "-" * len(head),
+        ]
+        for label, vals in s.items():
+            cells = []
+            for key, _, fmt in cols:
+                w = len(fmt.format(0.0))
+                cells.append(fmt.format(vals[key]) if key in vals else " " * (w - 1) + "-")
+            lines.append(f"{label:<{width}} " + " ".join(cells))
+        return "\n".join(lines)
+
+
+def _gt_metrics(pos: np.ndarray, fps: float, height: float) -> dict:
+    feet = [humanoid.JOINTS.index(f) for f in humanoid.FEET]
+    return {
+        "smooth": metrics.smoothness(pos) * _CM,
+        "pen": 100 * metrics.foot_penetration(pos, feet) / height,
+        "skate": metrics.foot_skating(pos, feet, fps) * _CM,
+    }
+
+
+def evaluate(
+    folder: str | Path,
+    checkpoint: Checkpoint | None,
+    source: str = DEFAULT_SOURCE,
+    targets: Sequence[str] = DEFAULT_TARGETS,
+    animations: Sequence[str] | None = DEFAULT_ANIMATIONS,
+    rows: Sequence[tuple[str, str, str]] = ROWS,
+    solver: SolverConfig | None = None,
+    progress: bool = True,
+) -> Evaluation:
+    """Run every row's method on every (target, animation) pair and collect the metrics.
+
+    Parameters
+    ----------
+    folder : a folder laid out as ``<Character>/<Animation>.bvh``
+    checkpoint : the network trained on ``source`` (None is allowed when only "copy" rows run)
+    source, targets : character folder names
+    animations : clip stems; ``None``: every stem that the source and all targets share
+    rows : ``(label, method, root_mode)`` triples, see :data:`ROWS`
+    solver : latent iteration settings for the "full" rows
+    """
+    folder = Path(folder)
+    if not (folder / source).is_dir():
+        raise FileNotFoundError(f"source character folder {folder / source} not found")
+    for t in targets:
+        if not (folder / t).is_dir():
+            raise FileNotFoundError(f"target character folder {folder / t} not found")
+    if animations is None:
+        common = {p.stem for p in (folder / source).glob("*.bvh")}
+        for t in targets:
+            common &= {p.stem for p in (folder / t).glob("*.bvh")}
+        animations = sorted(common)
+    if not animations:
+        raise ValueError(f"no animation shared by {source} and {list(targets)} in {folder}")
+    if checkpoint is None and any(m != "copy" for _, m, _ in rows):
+        raise ValueError("a checkpoint is needed for the network rows")
+    result = Evaluation(rows=[r[0] for r in rows])
+    sources = {}
+    pairs = [(t, a) for t in targets for a in animations]
+    for target, anim in tqdm(pairs, desc="evaluating", disable=not progress):
+        src_path, gt_path = folder / source / f"{anim}.bvh", folder / target / f"{anim}.bvh"
+        if not src_path.is_file() or not gt_path.is_file():
+            warnings.warn(
+                f"skipping {target}/{anim}: {src_path if not src_path.is_file() else gt_path} missing", stacklevel=2
+            )
+            continue
+        if anim not in sources:
+            sources[anim] = _load(src_path)
+        gt_rig = _load(gt_path)
+        fps = checkpoint.fps if checkpoint is not None else gt_rig.fps
+        gt = preprocess.prepare(gt_rig, fps)
+        gt_pos = gt.global_positions()
+        height = gt_rig.skeleton.height()
+        result.ground_truth.append({"target": target, "animation": anim, **_gt_metrics(gt_pos, fps, height)})
+        for label, method, root_mode in rows:
+            out = retarget(sources[anim], gt_rig.skeleton, checkpoint, method, solver, root_mode)
+            pos = out.positions
+            n = min(len(pos), len(gt_pos))
+            if len(pos) != len(gt_pos):
+                warnings.warn(
+                    f"{target}/{anim}: {len(pos)} generated vs {len(gt_pos)} real frames; comparing {n}", stacklevel=2
+                )
+            p, g = pos[:n], gt_pos[:n]
+            rel_p, rel_g = p - p[:, :1], g - g[:, :1]
+            rec = {
+                "row": label,
+                "target": target,
+                "animation": anim,
+                "mse": metrics.mse(p, g) * _CM**2,
+                "mse_h2": metrics.mse(p, g, height=height),
+                "pose_mse_h2": metrics.mse(rel_p, rel_g, height=height),
+                "mpjpe": metrics.mpjpe(p, g) * _CM,
+                **_gt_metrics(p, fps, height),
+                "time": out.seconds,
+                "steps": out.steps,
+                "stop_reason": out.stop_reason,
+            }
+            result.records.append(rec)
+    return result

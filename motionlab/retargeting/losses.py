@@ -1,0 +1,133 @@
+"""The losses of paper A: L_recon for training, L_angle and L_foot for the latent iteration.
+
+=====================  ===========================================================  ==========
+loss                   formula                                                      unit
+=====================  ===========================================================  ==========
+``recon_loss``         λ/(3TJ) Σ_t Σ_j ‖p_t^j − p'_t^j‖₂, λ = 0.5 (eq. 8)           metres
+``angle_loss``         1/(22T) Σ_t Σ_i ‖θ_i,t(A) − θ_i,t(B')‖₂, θ = joint rotations   unitless
+``direction_loss``     the same with θ = unit bone directions (from positions)      unitless
+``foot_loss``          1/(4T) Σ_t Σ_{i ∈ feet} |min(y_i,t, 0)|                      metres
+``rotation_loss``      mean over frames and joints of 1 − ⟨q, q̂⟩²                   unitless
+=====================  ===========================================================  ==========
+
+**Our choice of θ (the paper leaves it open): the joint angles themselves**, i.e. each joint's
+local rotation as a unit quaternion (the root's in the heading frame), compared up to sign:
+``‖θ(A) − θ(B')‖ = min(‖q_A − q_B'‖, ‖q_A + q_B'‖)`` (≈ the rotation angle between them for
+small differences). We tried the other natural choice first — the unit direction of every bone
+in the root-centred heading frame, computed from positions (:func:`direction_loss`) — and
+measured why it is worse: real rigs have *different rest poses* (a bone of B points elsewhere
+than A's in the T-pose), so matching A's bone directions bends B away from what its animators
+(and Mixamo's retargeter) do, which is to keep the local rotations. On the shared Mixamo data,
+copying the rotations already leaves a direction loss of 0.12–0.16; for Aj → BigVegas
+"Running" the direction-driven iteration ended with a root-centred pose error (MSE/h²) of
+8.5e-4, the rotation-driven one with 1.7e-4, copy-rotation 1.3e-4. With joint angles,
+copy-rotation has zero angle loss, and the foot term decides how far the pose moves from it.
+``SolverConfig(theta="directions")`` keeps the other choice available.
+
+``rotation_loss`` is *our addition* (weight 0.1 by default in :func:`~motionlab.retargeting.train.train`;
+0 is the paper's setting): positions cannot see the rotation of a leaf joint (head, hands, toes)
+nor a bone's twist, so without it those rotations drift freely and the BVH output looks wrong
+even when every joint position is right.
+
+Paper: ``seeds/000_*.txt``, eqs. (8)–(10). Taught in ``notebooks/03_latent_iteration.ipynb``.
+"""
+
+from __future__ import annotations
+
+import torch
+
+from motionlab.core import fk_torch, humanoid
+
+__all__ = [
+    "LAMBDA_RECON",
+    "LAMBDA_ANGLE",
+    "LAMBDA_FOOT",
+    "FOOT_JOINTS",
+    "recon_loss",
+    "bone_directions",
+    "angle_loss",
+    "direction_loss",
+    "foot_loss",
+    "rotation_loss",
+]
+
+LAMBDA_RECON = 0.5
+"""λ_recon of eq. (8)."""
+LAMBDA_ANGLE = 0.3
+"""λ_angle of the iteration loss."""
+LAMBDA_FOOT = 0.5
+"""λ_foot of the iteration loss."""
+FOOT_JOINTS: tuple[int, ...] = tuple(humanoid.JOINTS.index(n) for n in humanoid.FEET)
+"""Indices of LeftFoot, RightFoot, LeftToeBase, RightToeBase in the canonical skeleton."""
+
+
+def _same_shape(a: torch.Tensor, b: torch.Tensor, what: str) -> None:
+    if a.shape != b.shape or a.shape[-1] != 3:
+        raise ValueError(
+            f"{what}: expected two (..., T, J, 3) position tensors of equal shape, got {tuple(a.shape)} and {tuple(b.shape)}"
+        )
+
+
+def recon_loss(pred: torch.Tensor, target: torch.Tensor, weight: float = LAMBDA_RECON) -> torch.Tensor:
+    """Eq. (8): ``λ/(3TJ) Σ ‖p − p'‖₂`` averaged over the batch; positions (..., T, J, 3), metres."""
+    _same_shape(pred, target, "recon_loss")
+    return weight * (pred - target).norm(dim=-1).mean() / 3.0
+
+
+def bone_directions(positions: torch.Tensor) -> torch.Tensor:
+    """θ: unit parent→joint directions (..., T, 22, 3) of root-centred heading-frame positions."""
+    if positions.shape[-2:] != (len(humanoid.JOINTS), 3):
+        raise ValueError(f"expected canonical positions (..., 22, 3), got {tuple(positions.shape)}")
+    return fk_torch.bone_directions(positions, humanoid.PARENTS)
+
+
+def angle_loss(source_rot: torch.Tensor, generated_rot: torch.Tensor) -> torch.Tensor:
+    """L_angle with θ = joint rotations: mean over frames and joints of ``min(‖q_A − q_B'‖, ‖q_A + q_B'‖)``.
+
+    Both inputs are local rotations (..., T, 22, 4) (unit quaternions; the root's in the heading frame).
+    """
+    if source_rot.shape != generated_rot.shape or source_rot.shape[-1] != 4:
+        raise ValueError(
+            f"angle_loss: expected two (..., T, J, 4) rotation tensors of equal shape, got {tuple(source_rot.shape)} and {tuple(generated_rot.shape)}"
+        )
+    diff = torch.minimum(_length(source_rot - generated_rot), _length(source_rot + generated_rot))
+    return diff.mean()
+
+
+def _length(v: torch.Tensor) -> torch.Tensor:
+    """Euclidean length along the last axis with a finite gradient at zero."""
+    return torch.sqrt((v * v).sum(-1) + 1e-12)
+
+
+def direction_loss(source_positions: torch.Tensor, generated_positions: torch.Tensor) -> torch.Tensor:
+    """L_angle with θ = unit bone directions: mean over frames and the 22 joints of ‖θ(A) − θ(B')‖₂.
+
+    Both inputs are root-centred heading-frame positions (..., T, 22, 3); their bone lengths may
+    differ (that is the point).
+    """
+    _same_shape(source_positions, generated_positions, "angle_loss")
+    return (bone_directions(source_positions) - bone_directions(generated_positions)).norm(dim=-1).mean()
+
+
+def foot_loss(world_y: torch.Tensor) -> torch.Tensor:
+    """L_foot: mean of ``|min(y, 0)|`` over frames and the four foot joints.
+
+    Parameters
+    ----------
+    world_y : Tensor (..., T, 22) heights of all joints above the ground, or (..., T, 4) of the
+        feet only (LeftFoot, RightFoot, LeftToeBase, RightToeBase), metres.
+    """
+    if world_y.shape[-1] == len(humanoid.JOINTS):
+        world_y = world_y[..., list(FOOT_JOINTS)]
+    elif world_y.shape[-1] != len(FOOT_JOINTS):
+        raise ValueError(f"expected heights (..., T, 22) or (..., T, 4), got {tuple(world_y.shape)}")
+    return torch.relu(-world_y).mean()
+
+
+def rotation_loss(local_rot: torch.Tensor, target_rot: torch.Tensor) -> torch.Tensor:
+    """Mean of ``1 − ⟨q, q̂⟩²`` (0 for equal rotations, sign-agnostic) over (..., J, 4) quaternions."""
+    if local_rot.shape != target_rot.shape or local_rot.shape[-1] != 4:
+        raise ValueError(
+            f"rotation_loss: expected two (..., 4) tensors of equal shape, got {tuple(local_rot.shape)} and {tuple(target_rot.shape)}"
+        )
+    return (1.0 - (local_rot * target_rot).sum(-1) ** 2).mean()

@@ -1,0 +1,204 @@
+"""Retarget a Motion onto a target skeleton, end to end.
+
+::
+
+    ckpt = retargeting.load_default()                       # or checkpoint.load("aj.pt")
+    result = retarget(source_motion, target_skeleton, ckpt)  # method="full" | "network" | "copy"
+    bvh.save("out.bvh", result.motion)
+
+Steps: the source is reduced to the 22 canonical joints and resampled to the checkpoint's
+frame rate; the target rig is reduced to its canonical T-pose skeleton
+(:func:`humanoid.to_canonical_skeleton`) — nothing but B's rest offsets is used.
+
+**Whole clips, no seams (our choice).** The encoder is fully convolutional and φ is a latent
+per frame, so a clip of any length goes through the network as *one* sequence and the latent
+solver optimises all its frames together. There are no windows to stitch, hence no seams;
+the 120-frame window is only the training unit.
+
+**Root motion of B (our choice, the paper leaves it open).** With ``r`` the ratio of B's to A's
+*hip height* (rest height of the Hips above the lowest rest joint, i.e. the leg length
+including the foot; ``root_scale="legs"`` uses thigh + shin, :func:`humanoid.leg_length`):
+
+* ``root_B(t) = r · root_A(t)``: the horizontal trajectory is A's scaled about the world origin
+  (A's ground velocity times ``r``, starting at ``r`` × A's start position, same heading), and
+  the root height is A's scaled by ``r``, so a standing pose keeps its feet on the ground;
+* the heading (facing direction) of every frame is A's: the network's root rotation, expressed
+  in A's heading frame, is turned back by A's heading.
+
+All three methods (copy-rotation, network without iteration, full method) use the same root
+trajectory, so the comparison is on poses; ``root_scale`` switches it for all of them.
+
+Taught in ``notebooks/03_latent_iteration.ipynb``.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import torch
+
+from motionlab.core import humanoid, preprocess, quat
+from motionlab.core.motion import Motion
+from motionlab.core.skeleton import Skeleton
+from motionlab.retargeting.checkpoint import Checkpoint
+from motionlab.retargeting.features import ClipFeatures, check_motion, clip_features
+from motionlab.retargeting.solver import SolverConfig, solve
+
+__all__ = [
+    "METHODS",
+    "ROOT_SCALES",
+    "RetargetResult",
+    "hip_height",
+    "root_scale",
+    "target_skeleton",
+    "retarget",
+]
+
+METHODS = ("full", "network", "copy")
+"""``full``: network + latent iteration; ``network``: no iteration; ``copy``: copy local rotations."""
+ROOT_SCALES = ("hips", "legs")
+
+
+@dataclass
+class RetargetResult:
+    """A retargeted clip.
+
+    Attributes
+    ----------
+    motion : Motion           on B's canonical 22-joint skeleton, world space, checkpoint fps
+    positions : ndarray (T, 22, 3)   world joint positions (FK of ``motion``), metres
+    method : str              one of :data:`METHODS`
+    root_scale : float        ``r`` used for the root trajectory
+    history : dict            solver history (``loss``, ``angle``, ``foot`` per step); empty otherwise
+    stop_reason : str         why the solver stopped ("" without iteration)
+    steps : int               solver steps
+    seconds : float           wall time of the method itself (network + solver), seconds
+    """
+
+    motion: Motion
+    positions: np.ndarray
+    method: str
+    root_scale: float
+    history: dict = field(default_factory=dict)
+    stop_reason: str = ""
+    steps: int = 0
+    seconds: float = 0.0
+
+
+def hip_height(skeleton: Skeleton) -> float:
+    """Rest-pose height of the root above the lowest joint (metres) of a canonical skeleton."""
+    rest = skeleton.rest_positions()
+    return float(rest[0, 1] - rest[:, 1].min())
+
+
+def root_scale(source: Skeleton, target: Skeleton, mode: str = "hips") -> float:
+    """The ratio ``r`` of B's to A's leg size that scales the root trajectory (see module doc)."""
+    if mode == "hips":
+        a, b = hip_height(source), hip_height(target)
+    elif mode == "legs":
+        a, b = humanoid.leg_length(source), humanoid.leg_length(target)
+    else:
+        raise ValueError(f"root_scale mode must be one of {ROOT_SCALES}, got {mode!r}")
+    if not (a > 1e-9 and b > 1e-9):
+        raise ValueError(f"cannot scale the root: leg size {a:.4g} m (source) / {b:.4g} m (target)")
+    return b / a
+
+
+def target_skeleton(target: Skeleton | Motion) -> Skeleton:
+    """B's canonical 22-joint T-pose skeleton from a rig (or a Motion on it).
+
+    Raises :class:`humanoid.RigMappingError` naming the joints that cannot be mapped.
+    """
+    sk = target.skeleton if isinstance(target, Motion) else target
+    if not isinstance(sk, Skeleton):
+        raise ValueError(f"expected a target Skeleton or Motion, got {type(target).__name__}")
+    out = humanoid.to_canonical_skeleton(sk)
+    if out.height() <= 1e-6:
+        raise ValueError("the target skeleton has zero height")
+    return out
+
+
+def _to_world(local_rot: np.ndarray, yaw: np.ndarray) -> np.ndarray:
+    """Turn heading-frame root rotations (T, 22, 4) back into world ones by the heading ``yaw`` (T,)."""
+    out = quat.normalize(np.asarray(local_rot, dtype=np.float64))
+    out[:, 0] = quat.mul(quat.from_yaw(yaw), out[:, 0])
+    return quat.normalize(out)
+
+
+def _network_inputs(ckpt: Checkpoint, feats: ClipFeatures, theta: str) -> tuple[torch.Tensor, torch.Tensor]:
+    """A's normalised features (1, T, 70) and θ(A): rotations (1, T, 22, 4) or positions (1, T, 22, 3)."""
+    device = ckpt.device
+    x = ckpt.stats.normalize(feats.x)
+    source = feats.local_rot if theta == "rotations" else feats.positions
+    return (
+        torch.as_tensor(x, dtype=torch.float32, device=device)[None],
+        torch.as_tensor(source, dtype=torch.float32, device=device)[None],
+    )
+
+
+def retarget(
+    source: Motion,
+    target: Skeleton | Motion,
+    checkpoint: Checkpoint | None = None,
+    method: str = "full",
+    solver: SolverConfig | None = None,
+    root_mode: str = "hips",
+    progress: bool = False,
+    callback=None,
+) -> RetargetResult:
+    """Generate B's version of ``source``.
+
+    Parameters
+    ----------
+    source : Motion of character A on any rig :func:`humanoid.find_mapping` recognises
+    target : B's rig (Skeleton) or a Motion on it; only its rest pose is used
+    checkpoint : trained network (default: :func:`motionlab.retargeting.load_default`);
+        not needed for ``method="copy"``
+    method : ``"full"`` (latent iteration), ``"network"`` (no iteration) or ``"copy"``
+    solver : settings of the latent iteration
+    root_mode : ``"hips"`` or ``"legs"``: which leg measure scales the root trajectory
+    progress : tqdm bar for the iteration
+    callback : passed to :func:`solver.solve` (per-step ``loss``, ``angle``, ``foot``)
+
+    Returns
+    -------
+    RetargetResult; ``result.motion`` is a proper Motion (local rotations + root positions) on
+    B's canonical skeleton, so bone lengths are exact.
+    """
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    check_motion(source, "source motion")
+    tgt = target_skeleton(target)
+    if method != "copy" and checkpoint is None:
+        from motionlab.retargeting import load_default
+
+        checkpoint = load_default()
+    fps = checkpoint.fps if checkpoint is not None else source.fps
+    src = preprocess.prepare(source, fps)
+    check_motion(src, "source motion")
+    r = root_scale(src.skeleton, tgt, root_mode)
+    root_pos = src.root_pos * r
+    history: dict = {}
+    reason, steps = "", 0
+    start = time.perf_counter()
+    if method == "copy":
+        local_rot = src.local_rot.copy()
+    else:
+        feats = clip_features(src)
+        solver = solver or SolverConfig()
+        x, theta_a = _network_inputs(checkpoint, feats, solver.theta)
+        offsets = torch.tensor(tgt.offsets, dtype=torch.float32, device=checkpoint.device)
+        if method == "network":
+            with torch.no_grad():
+                heading_rot = checkpoint.model(x, offsets).local_rot[0].cpu().numpy()
+        else:
+            height = torch.as_tensor(root_pos[:, 1], dtype=torch.float32)[None]
+            res = solve(checkpoint.model, x, theta_a, offsets, height, solver, callback=callback, progress=progress)
+            heading_rot, history, reason, steps = res.local_rot[0], res.history, res.stop_reason, res.steps
+        local_rot = _to_world(heading_rot, feats.yaw)
+    seconds = time.perf_counter() - start
+    name = f"{source.name}_on_target" if source.name else "retargeted"
+    motion = Motion(tgt, local_rot, root_pos, fps, None, name)
+    return RetargetResult(motion, motion.global_positions(), method, r, history, reason, steps, seconds)

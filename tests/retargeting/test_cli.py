@@ -1,0 +1,126 @@
+"""``motionlab retarget / train / evaluate``: help, outputs, and clear user errors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from motionlab import cli
+from motionlab.core import bvh, humanoid
+from motionlab.retargeting import checkpoint
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory, clips, tiny_checkpoint):
+    d = tmp_path_factory.mktemp("cli")
+    src = bvh.save(d / "source.bvh", clips[0])
+    big = humanoid.scale_bones(clips[1].skeleton, legs=1.3, overall=1.2)
+    tgt = bvh.save(d / "target.bvh", clips[1].copy(skeleton=big))
+    ckpt = checkpoint.save(d / "tiny.pt", tiny_checkpoint)
+    return d, src, tgt, ckpt
+
+
+def _run(capsys, *argv):
+    code = cli.main([str(a) for a in argv])
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+@pytest.mark.parametrize("command", ["retarget", "train", "evaluate"])
+def test_help(command, capsys):
+    with pytest.raises(SystemExit) as e:
+        cli.main([command, "--help"])
+    assert e.value.code == 0
+    assert "usage: motionlab " + command in capsys.readouterr().out
+
+
+def test_retarget_writes_bvh_and_arrays(files, capsys):
+    d, src, tgt, ckpt = files
+    out, npz = d / "out.bvh", d / "out.npz"
+    code, stdout, err = _run(
+        capsys, "retarget", src, "--target", tgt, "-o", out, "--checkpoint", ckpt, "--steps", "3", "--npz", npz
+    )
+    assert code == 0, err
+    assert "L_iter" in stdout
+    m = bvh.load(out)
+    assert m.num_frames == 120 and m.skeleton.num_joints == 22
+    target = humanoid.to_canonical_skeleton(bvh.load(tgt).skeleton)
+    np.testing.assert_allclose(m.skeleton.offsets[1:], target.offsets[1:], atol=1e-5)
+    arrays = np.load(npz)
+    np.testing.assert_allclose(arrays["positions"], m.global_positions(), atol=1e-4)
+    # no silent overwrite
+    code, _, err = _run(capsys, "retarget", src, "--target", tgt, "-o", out, "--checkpoint", ckpt)
+    assert code == 2 and "--force" in err
+    code, _, err = _run(capsys, "retarget", src, "--target", tgt, "-o", out, "--method", "copy", "--force", "-q")
+    assert code == 0, err
+
+
+def test_retarget_with_scaled_source_skeleton(files, capsys):
+    d, src, _, ckpt = files
+    out = d / "legs.bvh"
+    code, _, err = _run(
+        capsys, "retarget", src, "--scale-legs", "1.2", "-o", out, "--method", "network", "--checkpoint", ckpt, "-q"
+    )
+    assert code == 0, err
+    m = bvh.load(out)
+    base = humanoid.to_canonical_skeleton(bvh.load(src).skeleton)
+    j = humanoid.JOINTS.index("LeftLeg")
+    assert m.skeleton.bone_lengths()[j] == pytest.approx(1.2 * base.bone_lengths()[j], rel=1e-5)
+
+
+def test_retarget_user_errors(files, capsys, clips):
+    d, src, tgt, ckpt = files
+    code, _, err = _run(capsys, "retarget", d / "missing.bvh", "--target", tgt, "-o", d / "x.bvh")
+    assert code == 2 and "not found" in err
+    code, _, err = _run(capsys, "retarget", src, "-o", d / "x.bvh")
+    assert code == 2 and "--target" in err
+    sk = clips[0].skeleton
+    odd = clips[0].copy(skeleton=sk.renamed(["LeftKnee" if n == "LeftLeg" else n for n in sk.names]))
+    bad = bvh.save(d / "odd.bvh", odd, overwrite=True)
+    code, _, err = _run(capsys, "retarget", bad, "--target", tgt, "-o", d / "x.bvh", "--method", "copy")
+    assert code == 2 and "LeftLeg" in err
+    broken = d / "broken.pt"
+    broken.write_text("nope")
+    code, _, err = _run(capsys, "retarget", src, "--target", tgt, "-o", d / "x.bvh", "--checkpoint", broken)
+    assert code == 2 and "checkpoint" in err
+    code, _, err = _run(capsys, "retarget", src, "--target", tgt, "-o", d / "x.pt")
+    assert code == 2 and ".bvh" in err
+
+
+def test_train_and_evaluate_on_a_small_folder(tmp_path, clips, capsys):
+    """Train on one synthetic character, evaluate against a re-proportioned copy of it."""
+    root = tmp_path / "chars"
+    big = humanoid.scale_bones(clips[0].skeleton, legs=1.2)
+    for name, sk in (("A", clips[0].skeleton), ("B", big)):
+        (root / name).mkdir(parents=True)
+        for i, c in enumerate(clips):
+            bvh.save(root / name / f"anim{i}.bvh", c.copy(skeleton=sk))
+    ck = tmp_path / "a.pt"
+    code, stdout, err = _run(
+        capsys,
+        "train",
+        root / "A" / "anim0.bvh",
+        "-o",
+        ck,
+        "--train-steps",
+        "3",
+        "--latent",
+        "8",
+        "--hidden",
+        "16",
+        "-q",
+    )
+    assert code == 0, err
+    assert checkpoint.load(ck).info["train_config"]["steps"] == 3
+    code, _, err = _run(capsys, "train", root / "A" / "anim0.bvh", "-o", ck)
+    assert code == 2 and "--force" in err
+    code, stdout, err = _run(
+        capsys, "evaluate", "--data", root, "--source", "A", "--targets", "B", "--animations", "anim1",
+        "--checkpoint", ck, "--steps", "2", "-q", "--csv", tmp_path / "rec.csv",
+    )  # fmt: skip
+    assert code == 0, err
+    for row in ("copy rotations (baseline)", "no iteration", "full method", "ground truth", "MSE/h²"):
+        assert row in stdout
+    assert (tmp_path / "rec.csv").read_text().count("\n") == 1 + 4
+    code, _, err = _run(capsys, "evaluate", "--data", root, "--source", "Nobody", "--checkpoint", ck)
+    assert code == 2 and "Nobody" in err

@@ -1,0 +1,96 @@
+"""End to end: a Motion onto another skeleton, with every method."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from motionlab import retargeting
+from motionlab.core import humanoid
+from motionlab.retargeting.pipeline import hip_height, retarget, root_scale
+from motionlab.retargeting.solver import SolverConfig
+
+
+@pytest.fixture(scope="module")
+def target():
+    return humanoid.scale_bones(humanoid.canonical_skeleton(), legs=1.3, arms=0.8, overall=1.1)
+
+
+@pytest.mark.parametrize("method", ["copy", "network", "full"])
+def test_every_method_gives_a_proper_motion(method, clips, target, tiny_checkpoint):
+    src = clips[0]
+    out = retarget(src, target, tiny_checkpoint, method, SolverConfig(max_steps=5))
+    m = out.motion
+    assert m.num_frames == src.num_frames and m.skeleton.num_joints == 22 and m.fps == 60
+    assert m.skeleton.equals(target)
+    np.testing.assert_allclose(np.linalg.norm(m.local_rot, axis=-1), 1.0, atol=1e-9)
+    np.testing.assert_allclose(out.positions, m.global_positions())
+    # bone lengths are exactly the target's, in every frame
+    bones = np.linalg.norm(out.positions[:, 1:] - out.positions[:, humanoid.PARENTS[1:]], axis=-1)
+    np.testing.assert_allclose(bones, np.broadcast_to(target.bone_lengths()[1:], bones.shape), atol=1e-9)
+    assert (out.stop_reason != "") == (method == "full")
+
+
+def test_copy_keeps_rotations_and_scales_the_root(clips, target):
+    src = clips[0]
+    out = retarget(src, target, None, "copy", root_mode="hips")
+    r = hip_height(target) / hip_height(src.skeleton)
+    assert out.root_scale == pytest.approx(r)
+    np.testing.assert_allclose(out.motion.root_pos, src.root_pos * r)
+    np.testing.assert_allclose(out.motion.local_rot, src.local_rot)
+    legs = retarget(src, target, None, "copy", root_mode="legs")
+    assert legs.root_scale == pytest.approx(humanoid.leg_length(target) / humanoid.leg_length(src.skeleton))
+    assert retargeting.copy_rotation(src, target, "legs").root_pos == pytest.approx(legs.motion.root_pos)
+
+
+def test_network_on_its_own_skeleton_reconstructs(clips, tiny_checkpoint):
+    """Without iteration, on the training skeleton, the output approximates the input."""
+    src = clips[0]
+    out = retarget(src, src.skeleton, tiny_checkpoint, "network")
+    err = np.linalg.norm(out.positions - src.global_positions(), axis=-1).mean()
+    assert err < 0.3  # tiny net after 40 steps; the real one is checked in the benchmark
+
+
+def test_target_may_be_a_full_rig_motion(clips, target, tiny_checkpoint):
+    from motionlab.core.motion import Motion
+
+    rig = Motion(target, clips[1].local_rot, clips[1].root_pos, 60.0)
+    out = retarget(clips[0], rig, tiny_checkpoint, "copy")
+    assert out.motion.skeleton.equals(target)
+
+
+def test_nan_and_empty_motions_are_refused(clips, target, tiny_checkpoint):
+    bad = clips[0].copy()
+    bad.root_pos[7, 1] = np.nan
+    with pytest.raises(ValueError, match="frame 7 has NaN"):
+        retarget(bad, target, tiny_checkpoint)
+    with pytest.raises(ValueError, match="at least 2"):
+        retarget(clips[0][:1], target, tiny_checkpoint)
+    with pytest.raises(ValueError, match="method"):
+        retarget(clips[0], target, tiny_checkpoint, "magic")
+    with pytest.raises(ValueError, match="root_scale"):
+        root_scale(target, target, "arms")
+
+
+def test_unmappable_target_names_the_missing_joints(clips, tiny_checkpoint):
+    sk = clips[0].skeleton
+    renamed = sk.renamed([("LeftElbow" if n == "LeftForeArm" else n) for n in sk.names])
+    with pytest.raises(humanoid.RigMappingError, match="LeftForeArm"):
+        retarget(clips[0], renamed, tiny_checkpoint, "copy")
+
+
+def test_input_is_not_modified(clips, target, tiny_checkpoint):
+    src = clips[0]
+    rot, root = src.local_rot.copy(), src.root_pos.copy()
+    retarget(src, target, tiny_checkpoint, "full", SolverConfig(max_steps=2))
+    np.testing.assert_array_equal(src.local_rot, rot)
+    np.testing.assert_array_equal(src.root_pos, root)
+
+
+def test_default_checkpoint_loads_and_runs(clips, target):
+    if not retargeting.DEFAULT_CHECKPOINT.is_file():
+        pytest.skip("no shipped checkpoint yet")
+    assert retargeting.DEFAULT_CHECKPOINT.stat().st_size < 3_000_000
+    ckpt = retargeting.load_default("cpu")
+    out = retarget(clips[0][:60], target, ckpt, "network")
+    assert np.isfinite(out.positions).all()

@@ -1,0 +1,124 @@
+"""The latent iteration: it lowers L_iter, only moves the latent, and says why it stopped."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+
+from motionlab.core import humanoid
+from motionlab.retargeting.model import Decoded
+from motionlab.retargeting.solver import SolverConfig, iteration_loss, solve
+
+
+def _inputs(ckpt, data, root_height=0.5):
+    x = torch.as_tensor(ckpt.stats.normalize(data.x[:2]), dtype=torch.float32)
+    src = torch.as_tensor(data.local_rot[:2])
+    target = humanoid.scale_bones(data.skeleton, legs=1.3, arms=0.8)
+    offsets = torch.as_tensor(target.offsets, dtype=torch.float32)
+    height = torch.full(x.shape[:2], root_height)
+    return x, src, offsets, height
+
+
+def test_solver_lowers_the_loss_and_keeps_weights(tiny_checkpoint, data):
+    model = tiny_checkpoint.model
+    before = {k: v.clone() for k, v in model.state_dict().items()}
+    flags = [p.requires_grad for p in model.parameters()]
+    res = solve(model, *_inputs(tiny_checkpoint, data), SolverConfig(max_steps=30, lr=0.05, threshold=0.0, patience=0))
+    h = res.history
+    assert res.steps == 30 and res.stop_reason == "max_steps"
+    assert len(h["loss"]) == len(h["angle"]) == len(h["foot"]) == 31
+    assert h["loss"][-1] < h["loss"][0]
+    np.testing.assert_allclose(h["loss"], 0.3 * np.array(h["angle"]) + 0.5 * np.array(h["foot"]), rtol=1e-5)
+    for k, v in model.state_dict().items():
+        assert torch.equal(v, before[k]), f"weight {k} changed"
+    assert [p.requires_grad for p in model.parameters()] == flags
+    assert res.local_rot.shape == (2, data.window, 22, 4) and res.positions.shape == (2, data.window, 22, 3)
+    np.testing.assert_allclose(np.linalg.norm(res.local_rot, axis=-1), 1.0, atol=1e-5)
+
+
+@pytest.mark.parametrize("sigma", [0.0, 3.0])
+def test_plain_and_smoothed_latent_updates_both_descend(tiny_checkpoint, data, sigma):
+    cfg = SolverConfig(max_steps=15, lr=0.05, threshold=0.0, patience=0, smooth_sigma=sigma)
+    res = solve(tiny_checkpoint.model, *_inputs(tiny_checkpoint, data), cfg)
+    assert res.history["loss"][-1] < res.history["loss"][0]
+
+
+def test_smoothed_updates_are_smooth_in_time(tiny_checkpoint, data):
+    """With σ > 0 the latent's change from its start has no frame-to-frame jitter."""
+    x, src, off, h = _inputs(tiny_checkpoint, data)
+    phi0 = tiny_checkpoint.model.encode(x).detach()
+    jitter = {}
+    for sigma in (0.0, 3.0):
+        res = solve(
+            tiny_checkpoint.model,
+            x,
+            src,
+            off,
+            h,
+            SolverConfig(max_steps=20, lr=0.05, threshold=0.0, patience=0, smooth_sigma=sigma),
+        )
+        d = res.phi - phi0
+        jitter[sigma] = float((d[:, 2:] - 2 * d[:, 1:-1] + d[:, :-2]).abs().mean() / d.abs().mean())
+    assert jitter[3.0] < 0.5 * jitter[0.0]
+
+
+def test_foot_term_pulls_feet_out_of_the_ground(tiny_checkpoint, data):
+    """Root placed so low that the feet are under the floor: L_foot must drop."""
+    res = solve(
+        tiny_checkpoint.model,
+        *_inputs(tiny_checkpoint, data, root_height=0.6),
+        SolverConfig(max_steps=40, lr=0.05, threshold=0.0, patience=0),
+    )
+    assert res.history["foot"][0] > 0
+    assert res.history["foot"][-1] < 0.7 * res.history["foot"][0]
+
+
+def test_stop_reasons(tiny_checkpoint, data):
+    inputs = _inputs(tiny_checkpoint, data)
+    res = solve(tiny_checkpoint.model, *inputs, SolverConfig(threshold=1e9))
+    assert res.stop_reason == "threshold" and res.steps == 0
+    res = solve(tiny_checkpoint.model, *inputs, SolverConfig(max_steps=0, threshold=0.0))
+    assert res.stop_reason == "max_steps" and res.steps == 0
+    res = solve(tiny_checkpoint.model, *inputs, SolverConfig(max_steps=500, lr=1e-9, threshold=0.0, patience=3))
+    assert res.stop_reason == "plateau" and res.steps <= 4
+
+
+def test_callback_and_iteration_loss(tiny_checkpoint, data):
+    seen = []
+    solve(
+        tiny_checkpoint.model,
+        *_inputs(tiny_checkpoint, data),
+        SolverConfig(max_steps=3, threshold=0.0, patience=0),
+        callback=lambda s, r: seen.append(s),
+    )
+    assert seen == [0, 1, 2, 3]
+    rot = torch.as_tensor(data.local_rot[:1])
+    out = Decoded(rot, torch.as_tensor(data.positions[:1]), rot, rot)
+    for theta, source in (("rotations", rot), ("directions", out.positions)):
+        total, angle, foot = iteration_loss(source, out, torch.full((1, data.window), 5.0), SolverConfig(theta=theta))
+        assert float(total) == pytest.approx(0.0, abs=1e-6) and float(foot) == 0.0
+
+
+def test_directions_variant_runs(tiny_checkpoint, data):
+    x, _, off, h = _inputs(tiny_checkpoint, data)
+    src = torch.as_tensor(data.positions[:2])
+    res = solve(
+        tiny_checkpoint.model,
+        x,
+        src,
+        off,
+        h,
+        SolverConfig(theta="directions", max_steps=10, lr=0.05, threshold=0.0, patience=0),
+    )
+    assert res.history["loss"][-1] < res.history["loss"][0]
+
+
+def test_bad_shapes_refused(tiny_checkpoint, data):
+    x, src, off, h = _inputs(tiny_checkpoint, data)
+    with pytest.raises(ValueError, match="root_height"):
+        solve(tiny_checkpoint.model, x, src, off, h[:, :5])
+    with pytest.raises(ValueError, match="theta"):
+        solve(tiny_checkpoint.model, x, src, off, h, SolverConfig(theta="directions"))
+    with pytest.raises(ValueError, match="theta"):
+        SolverConfig(theta="angles")
