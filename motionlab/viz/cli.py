@@ -1,0 +1,166 @@
+"""``motionlab view``: play a BVH file in a 3D window, or write it to a movie.
+
+Examples::
+
+    motionlab view $MOTIONLAB_DATA/mixamo/Aj/Running.bvh                 # window (needs a display)
+    motionlab view Running.bvh --out running.mp4 --camera follow          # movie, off-screen
+    motionlab view Running.bvh --out running.gif --size 480x360 --force   # replace an old GIF
+
+Without a display and without ``--out`` the movie goes to ``<file stem>.mp4`` in the current
+folder. Existing files are never overwritten without ``--force``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+__all__ = ["register"]
+
+
+def _error(message: str):
+    from motionlab.cli import CLIError
+
+    return CLIError(message)
+
+
+def _size(text: str) -> tuple[int, int]:
+    try:
+        width, height = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT in pixels (e.g. 640x480), got {text!r}") from None
+    if width < 16 or height < 16:
+        raise argparse.ArgumentTypeError(f"the window must be at least 16x16 pixels, got {text!r}")
+    return width, height
+
+
+def _positive(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
+    return value
+
+
+def _open_window(scene) -> None:
+    """Interactive window: a frame slider, space bar plays/pauses, the clip loops."""
+    state = {"playing": True, "frame": 0}
+    slider = {}
+
+    def on_slider(value: float) -> None:
+        state["frame"] = int(round(value))
+        scene.set_frame(state["frame"])
+
+    def on_tick(_step: int) -> None:
+        if state["playing"]:
+            state["frame"] = (state["frame"] + 1) % scene.num_frames
+            scene.set_frame(state["frame"], render=False)
+            if "widget" in slider:
+                slider["widget"].GetRepresentation().SetValue(state["frame"])
+            scene.plotter.render()
+
+    def toggle() -> None:
+        state["playing"] = not state["playing"]
+
+    slider["widget"] = scene.plotter.add_slider_widget(
+        on_slider,
+        [0, scene.num_frames - 1],
+        value=0,
+        title="frame (space: play/pause)",
+        pointa=(0.35, 0.08),
+        pointb=(0.95, 0.08),
+        style="modern",
+        fmt="%.0f",
+        interaction_event="always",
+    )
+    scene.plotter.add_key_event("space", toggle)
+    scene.plotter.add_timer_event(max_steps=10**9, duration=max(int(1000 / scene.fps), 10), callback=on_tick)
+    scene.show(title="motionlab view")
+
+
+def _cmd_view(args) -> int:
+    from motionlab.core import bvh
+    from motionlab.viz import backend
+    from motionlab.viz.export import MOVIE_SUFFIXES, save_movie
+    from motionlab.viz.scene import Scene
+
+    source = Path(args.file)
+    if not source.is_file():
+        raise _error(f"BVH file {source} not found")
+    out = Path(args.out) if args.out else None
+    if out is None and not backend.has_display():
+        out = Path.cwd() / f"{source.stem}.mp4"
+        print(f"no display found: writing a movie to {out} instead of opening a window")
+    if out is not None:
+        if out.suffix.lower() not in MOVIE_SUFFIXES:
+            raise _error(f"--out must end in .mp4 or .gif, got {str(out)!r}")
+        if out.exists() and not args.force:
+            raise _error(f"{out} exists; add --force to overwrite it")
+        if not out.parent.exists():
+            raise _error(f"folder {out.parent} does not exist")
+    try:
+        motion = bvh.load(source, scale=args.scale)
+    except bvh.BVHError as e:
+        raise _error(str(e)) from None
+    if args.canonical:
+        from motionlab.core import humanoid
+
+        try:
+            motion = humanoid.to_canonical(motion)
+        except humanoid.RigMappingError as e:
+            raise _error(str(e)) from None
+    if args.start < 0:
+        raise _error(f"--start must be 0 or more, got {args.start}")
+    if args.start or args.stop is not None:
+        motion = motion[args.start : args.stop]
+        if motion.num_frames == 0:
+            raise _error(f"no frames between --start {args.start} and --stop {args.stop}")
+    trails = tuple(t for t, on in (("root", not args.no_trail), ("feet", args.feet_trails)) if on)
+    options = dict(camera=args.camera, window_size=args.size, trails=trails, contacts=not args.no_contacts)
+    if out is None:
+        scene = Scene(motion, off_screen=False, **options)
+        _open_window(scene)
+        return 0
+    try:
+        backend.import_pyvista()
+    except backend.RenderingUnavailable as e:
+        raise _error(str(e)) from None
+    start = time.perf_counter()
+    kwargs = {"stride": args.stride} if args.stride else {}
+    save_movie(motion, out, overwrite=args.force, off_screen=True, anti_aliasing=args.smooth, **kwargs, **options)
+    seconds = time.perf_counter() - start
+    print(f"wrote {out} ({motion.num_frames} frames of {motion.name or source.name}, {seconds:.1f} s)")
+    return 0
+
+
+def register(subparsers) -> None:
+    """Add ``view`` to the ``motionlab`` command."""
+    p = subparsers.add_parser(
+        "view",
+        help="play a BVH file in 3D, or write it to an MP4/GIF movie",
+        description="Play FILE.bvh in a 3D window (where a display exists) or render it off-screen to a movie "
+        "(--out, or <stem>.mp4 when there is no display). Foot contacts light up red.",
+    )
+    p.add_argument("file", help="BVH file to play")
+    p.add_argument("--out", metavar="MOVIE", help="write a movie instead of opening a window (.mp4 or .gif)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing movie")
+    p.add_argument(
+        "--camera",
+        choices=("follow", "frame"),
+        default="follow",
+        help="follow the character (default) or frame the whole clip from one place",
+    )
+    p.add_argument("--size", type=_size, default=(640, 480), metavar="WxH", help="picture size in pixels (640x480)")
+    p.add_argument("--scale", type=_positive, default=0.01, help="BVH units to metres (default 0.01: centimetres)")
+    p.add_argument("--start", type=int, default=0, help="first frame")
+    p.add_argument("--stop", type=int, default=None, help="frame to stop before (default: the end)")
+    p.add_argument("--stride", type=int, default=None, help="movie: keep every N-th frame (GIF default: ~15 fps)")
+    p.add_argument("--canonical", action="store_true", help="show the 22-joint humanoid instead of the full rig")
+    p.add_argument("--no-trail", action="store_true", help="do not draw the root's path on the ground")
+    p.add_argument("--feet-trails", action="store_true", help="draw the feet's paths")
+    p.add_argument("--no-contacts", action="store_true", help="do not highlight foot contacts")
+    p.add_argument("--smooth", action="store_true", help="anti-aliased movie (slower in software rendering)")
+    p.set_defaults(func=_cmd_view)

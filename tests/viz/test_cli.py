@@ -1,0 +1,93 @@
+"""``motionlab view``: movies off-screen, no silent overwrite, user errors as CLIError."""
+
+from __future__ import annotations
+
+import pytest
+
+from motionlab.cli import main
+from tests.viz.conftest import stepping_motion
+
+bvh = pytest.importorskip("motionlab.core.bvh")
+
+
+@pytest.fixture
+def clip(tmp_path):
+    path = tmp_path / "walk.bvh"
+    bvh.save(path, stepping_motion(12))
+    return path
+
+
+FAST = ["--size", "96x80"]
+
+
+def test_view_writes_a_movie_and_refuses_to_overwrite(can_render, clip, tmp_path, capsys):
+    out = tmp_path / "walk.mp4"
+    assert main(["view", str(clip), "--out", str(out), *FAST]) == 0
+    assert out.stat().st_size > 0
+    assert "wrote" in capsys.readouterr().out
+    size = out.stat().st_size
+    assert main(["view", str(clip), "--out", str(out), *FAST]) == 2
+    assert "--force" in capsys.readouterr().err
+    assert out.stat().st_size == size
+    assert main(["view", str(clip), "--out", str(out), "--force", "--stop", "6", *FAST]) == 0
+
+
+def test_view_gif(can_render, clip, tmp_path):
+    out = tmp_path / "walk.gif"
+    assert main(["view", str(clip), "--out", str(out), "--camera", "frame", *FAST]) == 0
+    assert out.read_bytes()[:3] == b"GIF"
+
+
+def test_view_without_display_writes_stem_mp4(can_render, clip, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr("motionlab.viz.backend.has_display", lambda: False)
+    assert main(["view", str(clip), "--stop", "4", *FAST]) == 0
+    assert (tmp_path / "walk.mp4").is_file()
+    assert "no display" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["missing.bvh", "--out", "x.mp4"], "not found"),
+        (["{clip}", "--out", "x.avi"], ".mp4 or .gif"),
+        (["{clip}", "--out", "nowhere/x.mp4"], "does not exist"),
+        (["{clip}", "--out", "x.mp4", "--start", "-3"], "--start"),
+    ],
+)
+def test_view_user_errors(clip, tmp_path, monkeypatch, capsys, args, message):
+    monkeypatch.chdir(tmp_path)
+    args = [a.replace("{clip}", str(clip)) for a in args]
+    assert main(["view", *args]) == 2
+    assert message in capsys.readouterr().err
+
+
+def test_view_bad_size_is_an_argparse_error(clip, capsys):
+    with pytest.raises(SystemExit):
+        main(["view", str(clip), "--size", "big"])
+    assert "WIDTHxHEIGHT" in capsys.readouterr().err
+
+
+def test_window_mode_when_a_display_exists(can_render, clip, monkeypatch):
+    from motionlab.viz import cli as viz_cli
+
+    shown = []
+    monkeypatch.setattr("motionlab.viz.backend.has_display", lambda: True)
+    monkeypatch.setattr(viz_cli, "_open_window", shown.append)  # no real window in a test
+    assert main(["view", str(clip), "--size", "96x80", "--camera", "frame"]) == 0
+    (scene,) = shown
+    assert scene.num_frames == 12 and scene.camera_mode == "frame" and not scene.off_screen
+    scene.close()
+
+
+def test_open_window_adds_slider_and_timer(can_render):
+    from motionlab.viz import cli as viz_cli
+    from motionlab.viz.scene import Scene
+
+    scene = Scene(stepping_motion(8), window_size=(96, 80), off_screen=True)
+    calls = []
+    scene.show = lambda **kw: calls.append(kw)
+    viz_cli._open_window(scene)
+    assert calls == [{"title": "motionlab view"}]
+    assert len(scene.plotter.widgets.slider_widgets) == 1
+    scene.close()
