@@ -222,30 +222,36 @@ def _reduced_offsets(rest: np.ndarray, source: tuple[int, ...]) -> np.ndarray:
 
 
 def _end_sites(skeleton: Skeleton, source: tuple[int, ...], rest: np.ndarray) -> dict[int, np.ndarray]:
-    """End sites for the canonical leaves (head, hands, toes): the rig's farthest descendant tip."""
-    leaves = [JOINTS.index(n) for n in ("Head", "LeftHand", "RightHand", "LeftToeBase", "RightToeBase")]
+    """End sites of the canonical leaves (head, hands, toes), for drawing and BVH export.
+
+    A leaf's own BVH ``End Site`` wins; otherwise the tip of a descendant named as an end
+    (``HeadTop_End``, ``LeftToe_End``, ``…Middle4``); accessories such as hair, hats or shoe
+    tongues are ignored, so a leaf without either gets no end site.
+    """
+    leaves = {"Head": ("headtop", "head_end", "headend"), "LeftHand": ("middle4", "hand_end", "handend"),
+              "RightHand": ("middle4", "hand_end", "handend"), "LeftToeBase": ("toe_end", "toeend", "toe_end_end"),
+              "RightToeBase": ("toe_end", "toeend", "toe_end_end")}  # fmt: skip
     children: dict[int, list[int]] = {}
     for j in range(1, skeleton.num_joints):
         children.setdefault(int(skeleton.parents[j]), []).append(j)
     out = {}
-    for c in leaves:
-        s = source[c]
+    for name, keys in leaves.items():
+        c, s = JOINTS.index(name), source[JOINTS.index(name)]
         if s < 0:
             continue
-        tips = [rest[s] + skeleton.end_sites[s]] if s in skeleton.end_sites else []
-        stack = list(children.get(s, []))
-        while stack:  # follow the single-child chain (head top, toe end), not fingers
+        if s in skeleton.end_sites:
+            out[c] = skeleton.end_sites[s].copy()
+            continue
+        stack, tips = list(children.get(s, [])), []
+        while stack:
             j = stack.pop()
-            tips.append(rest[j])
-            if j in skeleton.end_sites:
-                tips.append(rest[j] + skeleton.end_sites[j])
+            base = strip_prefix(skeleton.names[j]).lower()
+            if any(k in base for k in keys):
+                tips.append(rest[j] + skeleton.end_sites.get(j, np.zeros(3)) - rest[s])
             stack.extend(children.get(j, []))
         if tips:
-            vec = np.array(tips) - rest[s]
-            if c == JOINTS.index("Head"):
-                out[c] = vec[np.argmax(vec[:, 1])]
-            else:
-                out[c] = vec[np.argmax(np.linalg.norm(vec, axis=1))]
+            tips = np.array(tips)
+            out[c] = tips[np.argmax(np.linalg.norm(tips, axis=1))]
     return out
 
 
