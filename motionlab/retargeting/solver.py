@@ -50,7 +50,9 @@ class SolverConfig:
     Attributes
     ----------
     max_steps : int        step limit
-    lr : float             Adam learning rate on φ
+    lr : float             Adam step size on φ, relative to the spread of the starting latent:
+                           the actual learning rate is ``lr · std(φ₀)``, so one setting suits
+                           networks whose latents live at different scales
     threshold : float      stop when ``L_iter`` is below this
     patience : int         stop after this many steps without a relative improvement of
                            ``min_delta`` of the best loss (0: never)
@@ -94,6 +96,8 @@ class SolverResult:
     history : dict of lists             per evaluated step: ``loss`` (L_iter), ``angle`` (L_angle),
                                         ``foot`` (L_foot, metres); entry 0 is the starting point
     stop_reason : str                   ``"threshold"``, ``"plateau"`` or ``"max_steps"``
+    best_step : int                     the step whose latent is returned: the lowest ``L_iter``
+                                        seen (Adam may overshoot after it)
     steps : int                         Adam updates made
     seconds : float                     wall time of the iteration
     """
@@ -105,6 +109,7 @@ class SolverResult:
     stop_reason: str = ""
     steps: int = 0
     seconds: float = 0.0
+    best_step: int = 0
 
 
 def _smoother(sigma: float, channels: int, dtype, device):
@@ -196,8 +201,10 @@ def solve(
             phi0 = model.encode(x)
         delta = torch.zeros_like(phi0, requires_grad=True)
         smooth = _smoother(cfg.smooth_sigma, phi0.shape[-1], x.dtype, device)
-        opt = torch.optim.Adam([delta], lr=cfg.lr)
+        scale = float(phi0.std()) if phi0.numel() > 1 else 1.0
+        opt = torch.optim.Adam([delta], lr=cfg.lr * max(scale, 1e-6))
         best, since_best, steps, reason = float("inf"), 0, 0, "max_steps"
+        best_value, best_out, best_phi, best_step = float("inf"), None, None, 0
         bar = tqdm(total=cfg.max_steps, desc="latent iteration", disable=not progress, leave=False)
         while True:
             phi = phi0 + smooth(delta)
@@ -209,6 +216,10 @@ def solve(
             history["foot"].append(float(foot.detach()))
             if callback is not None:
                 callback(steps, {"loss": value, "angle": history["angle"][-1], "foot": history["foot"][-1]})
+            if value < best_value:  # Adam can overshoot: keep the best iterate seen, not the last
+                best_value, best_step = value, steps
+                best_out = Decoded(out.local_rot.detach(), out.positions.detach(), out.q.detach(), out.q_delta.detach())
+                best_phi = phi.detach()
             if value < best * (1.0 - cfg.min_delta):
                 best, since_best = value, 0
             else:
@@ -232,10 +243,12 @@ def solve(
         for p, f in zip(model.parameters(), flags):
             p.requires_grad_(f)
         model.train(was_training)
+    out, phi = best_out, best_phi
     return SolverResult(
         local_rot=out.local_rot.detach().cpu().numpy().astype(np.float64),
         positions=out.positions.detach().cpu().numpy().astype(np.float64),
         phi=phi.detach(),
+        best_step=best_step,
         history=history,
         stop_reason=reason,
         steps=steps,
