@@ -36,6 +36,8 @@ Taught in ``notebooks/05_motion_graphs.ipynb``.
 
 from __future__ import annotations
 
+import contextlib
+import functools
 from collections.abc import Iterator
 from dataclasses import dataclass
 
@@ -136,13 +138,31 @@ def _as_features(x, window: int) -> CloudFeatures:
     return x if isinstance(x, CloudFeatures) else cloud_features(x, window)
 
 
+@functools.cache
+def _blas_controller():
+    """threadpoolctl's view of the BLAS libraries numpy uses (built once; None if unavailable)."""
+    try:
+        from threadpoolctl import ThreadpoolController
+    except ImportError:  # pragma: no cover - threadpoolctl is a dependency
+        return None
+    return ThreadpoolController()
+
+
+def _one_blas_thread():
+    """Run BLAS single-threaded: these products are a few hundred columns wide, and a second
+    BLAS thread competing for a 2-core machine made the whole build 3-4x slower (measured)."""
+    ctl = _blas_controller()
+    return ctl.limit(limits=1, user_api="blas") if ctl is not None else contextlib.nullcontext()
+
+
 def _block(fa: CloudFeatures, fb: CloudFeatures, rows: slice, right: np.ndarray, yb: np.ndarray) -> np.ndarray:
     n = fa.height.shape[1]
     left = fa.centred[rows] * np.concatenate([fa.weights, fa.weights])  # (r, 2n)
-    ab = left @ right  # (r, 2 Tb): [a | b]
     tb = fb.centred.shape[0]
+    with _one_blas_thread():
+        ab = left @ right  # (r, 2 Tb): [a | b]
+        cross_y = (fa.height[rows] * fa.weights[:n]) @ yb
     a, b = ab[:, :tb], ab[:, tb:]
-    cross_y = (fa.height[rows] * fa.weights[:n]) @ yb
     d = fa.self_term[rows, None] + fb.self_term[None, :] - 2.0 * cross_y - 2.0 * np.sqrt(a * a + b * b)
     return np.maximum(d, 0.0, out=d.astype(np.float64, copy=False))
 
