@@ -113,7 +113,7 @@ def run_demo(out_dir: str | Path = "outputs/demo", characters: int = 4, seed: in
     ax.axhline(0, color="k", lw=0.8)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("lowest toe height (cm)")
-    ax.set_title("character 0: toes never below the ground with the latent iteration")
+    ax.set_title("character 0: lowest toe height per frame (below 0 = through the floor)")
     ax.legend()
     fig.tight_layout()
     fig.savefig(out_dir / "foot_heights.png", dpi=110)
