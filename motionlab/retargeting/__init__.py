@@ -17,7 +17,7 @@ with::
 
     motionlab train --synthetic 300 --seed 0 -o motionlab/assets/retarget_default.pt --force
 
-Taught in ``notebooks/02_retargeting_network.ipynb`` and ``03_latent_iteration.ipynb``.
+Taught in ``notebooks/02_training_autoencoder.ipynb`` and ``03_latent_iteration.ipynb``.
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ window length it was trained with, free-form training info (seed, steps, final l
 ``weights_only=True`` (no arbitrary code runs on load). Loading a file of another format
 version, or one that is not a checkpoint, raises :class:`CheckpointError` saying so.
 
-Taught in ``notebooks/02_retargeting_network.ipynb``.
+Taught in ``notebooks/02_training_autoencoder.ipynb``.
 """
 
 from __future__ import annotations

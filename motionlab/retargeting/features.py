@@ -9,7 +9,7 @@
 * ``local_rot``: the clip's local rotations with the root rotation expressed in the heading
   frame (T, 22, 4), so that ``FK(local_rot, offsets)`` equals ``positions`` exactly.
 
-Taught in ``notebooks/02_retargeting_network.ipynb``.
+Taught in ``notebooks/02_training_autoencoder.ipynb``.
 """
 
 from __future__ import annotations

@@ -27,7 +27,7 @@ Design choices the paper leaves open (documented here, shown in notebook 02):
   :mod:`motionlab.retargeting.pipeline`.
 
 Paper: "Skeletal motion generation by latent-space iteration" (``seeds/000_*.txt``), §3.
-Taught in ``notebooks/02_retargeting_network.ipynb``.
+Taught in ``notebooks/02_training_autoencoder.ipynb``.
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ by FK of A's own rotations on that skeleton. This uses A's data only and teaches
 rotations alone when only proportions change; the latent iteration then adapts the motion.
 ``augment=False`` gives the paper's plain setting.
 
-Taught in ``notebooks/02_retargeting_network.ipynb``.
+Taught in ``notebooks/02_training_autoencoder.ipynb``.
 """
 
 from __future__ import annotations
