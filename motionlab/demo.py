@@ -59,8 +59,10 @@ def run_demo(out_dir: str | Path = "outputs/demo", characters: int = 4, seed: in
     performance = synthetic.sequence(SEGMENTS, source_skeleton, fps=60, seed=seed)
     performance.name = "source"
     bvh.save(out_dir / "source.bvh", performance, overwrite=True)
-    print(f"source: {performance.num_frames} frames on a {source_skeleton.height():.2f} m character "
-          f"({' → '.join(s for s, _ in SEGMENTS)})")
+    print(
+        f"source: {performance.num_frames} frames on a {source_skeleton.height():.2f} m character "
+        f"({' → '.join(s for s, _ in SEGMENTS)})"
+    )
 
     targets = synthetic.character_set(characters, seed=seed + 1)
     rows, curves = [], {}
@@ -92,10 +94,18 @@ def run_demo(out_dir: str | Path = "outputs/demo", characters: int = 4, seed: in
     means = {}
     for method in ("copy", "network", "full"):
         sel = [r for r in rows if r["method"] == method]
-        means[method] = {k: float(np.mean([r[k] for r in sel])) for k in ("mpjpe_cm", "pen_pct", "skate", "smooth", "seconds")}
-    lines += ["", "| mean over characters | MPJPE (cm) | below ground (% h) | skating (m/s) | smoothness | time (s) |", "|---|---|---|---|---|---|"]
+        means[method] = {
+            k: float(np.mean([r[k] for r in sel])) for k in ("mpjpe_cm", "pen_pct", "skate", "smooth", "seconds")
+        }
+    lines += [
+        "",
+        "| mean over characters | MPJPE (cm) | below ground (% h) | skating (m/s) | smoothness | time (s) |",
+        "|---|---|---|---|---|---|",
+    ]
     for method, m in means.items():
-        lines.append(f"| {method} | {m['mpjpe_cm']:.2f} | {m['pen_pct']:.3f} | {m['skate']:.3f} | {m['smooth']:.3f} | {m['seconds']:.2f} |")
+        lines.append(
+            f"| {method} | {m['mpjpe_cm']:.2f} | {m['pen_pct']:.3f} | {m['skate']:.3f} | {m['smooth']:.3f} | {m['seconds']:.2f} |"
+        )
     table = "\n".join(lines)
     (out_dir / "summary.md").write_text("# motionlab demo\n\n" + table + "\n")
     print()

@@ -60,5 +60,7 @@ def check(student: Callable, reference: Callable, cases: Sequence, atol: float =
             if sign_free:
                 err = np.minimum(err.max(axis=-1), np.abs(g + w).max(axis=-1))
             if not np.all(err <= atol):
-                raise AssertionError(f"case {i}: {name} differs by {np.nanmax(err):.3g} (atol {atol:g})\n got {g}\n want {w}")
+                raise AssertionError(
+                    f"case {i}: {name} differs by {np.nanmax(err):.3g} (atol {atol:g})\n got {g}\n want {w}"
+                )
     print(f"✓ {name} agrees with the package on {len(cases)} case(s)")

@@ -33,8 +33,10 @@ def main() -> None:
     result = retarget(source, truth.skeleton, checkpoint=load(args.checkpoint), method="full")
     generated = result.motion
     source.name, generated.name, truth.name = "Aj (source)", f"{args.target}: motionlab", f"{args.target}: Mixamo"
-    print(f"{args.clip}: Aj {source.skeleton.height():.2f} m → {args.target} {truth.skeleton.height():.2f} m, "
-          f"{result.steps} solver steps ({result.stop_reason}), {result.seconds:.2f} s")
+    print(
+        f"{args.clip}: Aj {source.skeleton.height():.2f} m → {args.target} {truth.skeleton.height():.2f} m, "
+        f"{result.steps} solver steps ({result.stop_reason}), {result.seconds:.2f} s"
+    )
     scene = side_by_side([truth, generated, source], error=False, window_size=(720, 360), off_screen=True)
     path = save_gif(scene, Path(args.out), overwrite=args.force, colors=96)
     print(f"wrote {path} ({path.stat().st_size / 1e6:.2f} MB)")

@@ -40,8 +40,10 @@ def _info(args) -> int:
     try:
         mapping = humanoid.find_mapping(sk)
         canon = humanoid.to_canonical_skeleton(sk)
-        print(f"humanoid  maps onto the 22 joints (profile {mapping.profile!r}); 22-joint height {canon.height():.4f} m, "
-              f"leg length {humanoid.leg_length(canon):.4f} m")
+        print(
+            f"humanoid  maps onto the 22 joints (profile {mapping.profile!r}); 22-joint height {canon.height():.4f} m, "
+            f"leg length {humanoid.leg_length(canon):.4f} m"
+        )
     except humanoid.RigMappingError as e:
         print(f"humanoid  {e}")
     if args.joints:
@@ -77,7 +79,9 @@ def _synth(args) -> int:
         segments = [("idle", 60), ("walk", 150), ("run", 120), ("jump", 70), ("walk", 90), ("squat", 100), ("idle", 60)]
         motion = synthetic.sequence(segments, skeleton, fps=args.fps, seed=args.seed)
     else:
-        motion = synthetic.generate(args.behaviour, skeleton, num_frames=int(args.seconds * args.fps), fps=args.fps, seed=args.seed)
+        motion = synthetic.generate(
+            args.behaviour, skeleton, num_frames=int(args.seconds * args.fps), fps=args.fps, seed=args.seed
+        )
     motion.name = args.behaviour
     bvh.save(out, motion, overwrite=args.force)
     print(f"wrote {out}: {motion.num_frames} frames of {args.behaviour} at {motion.fps:g} fps")
@@ -116,11 +120,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--force", action="store_true", help="overwrite the output if it exists")
     p.set_defaults(func=_synth)
 
-    p = sub.add_parser("demo", help="the main job on built-in data: retarget a synthetic performance onto new characters")
+    p = sub.add_parser(
+        "demo", help="the main job on built-in data: retarget a synthetic performance onto new characters"
+    )
     p.add_argument("--out", default="outputs/demo", help="output folder (default: outputs/demo)")
     p.add_argument("--characters", type=int, default=4, help="how many new characters")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--force", action="store_true", help="overwrite files in the output folder")
     p.set_defaults(func=_demo)
-
-

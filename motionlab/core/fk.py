@@ -27,9 +27,7 @@ def _check_parents(parents, num_joints: int) -> np.ndarray:
     ok = np.where(index == 0, parents == -1, (parents >= 0) & (parents < index))
     if not np.all(ok):
         j = int(np.flatnonzero(~ok)[0])
-        raise ValueError(
-            f"expected parents[0] == -1 and 0 <= parents[j] < j, got parents[{j}] = {int(parents[j])}"
-        )
+        raise ValueError(f"expected parents[0] == -1 and 0 <= parents[j] < j, got parents[{j}] = {int(parents[j])}")
     return parents
 
 
@@ -54,7 +52,9 @@ def fk(local_rot, local_pos, parents) -> tuple[np.ndarray, np.ndarray]:
     num_joints = local_rot.shape[-2]
     local_pos = np.asarray(local_pos, dtype=local_rot.dtype)
     if local_pos.ndim < 2 or local_pos.shape[-2:] != (num_joints, 3):
-        raise ValueError(f"expected local_pos of shape (..., {num_joints}, 3) to match local_rot, got {local_pos.shape}")
+        raise ValueError(
+            f"expected local_pos of shape (..., {num_joints}, 3) to match local_rot, got {local_pos.shape}"
+        )
     parents = _check_parents(parents, num_joints)
     batch = np.broadcast_shapes(local_rot.shape[:-2], local_pos.shape[:-2])
     local_rot = np.broadcast_to(local_rot, batch + local_rot.shape[-2:])

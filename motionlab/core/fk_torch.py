@@ -37,7 +37,12 @@ def fk(local_rot: torch.Tensor, local_pos: torch.Tensor, parents) -> tuple[torch
     global_rot : Tensor, shape (..., J, 4)
     global_pos : Tensor, shape (..., J, 3)
     """
-    if local_rot.ndim < 2 or local_pos.ndim < 2 or local_rot.shape[-1] != 4 or local_pos.shape[-2:] != (local_rot.shape[-2], 3):
+    if (
+        local_rot.ndim < 2
+        or local_pos.ndim < 2
+        or local_rot.shape[-1] != 4
+        or local_pos.shape[-2:] != (local_rot.shape[-2], 3)
+    ):
         raise ValueError(
             f"expected local_rot (..., J, 4) and local_pos (..., J, 3), got {tuple(local_rot.shape)} "
             f"and {tuple(local_pos.shape)}"

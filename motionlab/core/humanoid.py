@@ -87,7 +87,9 @@ def _sides(template: dict[str, str | None]) -> dict[str, str | None]:
     for key, value in template.items():
         for side, short in (("Left", "L"), ("Right", "R")):
             out[key.replace("{S}", side)] = (
-                None if value is None else value.replace("{S}", side).replace("{s}", short).replace("{sl}", short.lower())
+                None
+                if value is None
+                else value.replace("{S}", side).replace("{s}", short).replace("{sl}", short.lower())
             )
     return out
 
@@ -312,7 +314,6 @@ def to_canonical(motion: Motion, profile=None, tolerance: float = 1e-4) -> Motio
         local_pos = np.concatenate([pos[:, :1], local_bones], axis=1)
     reduced = Skeleton(JOINTS, PARENTS, offsets, _end_sites(skeleton, mapping.source, rest))
     return Motion(reduced, local_rot, pos[:, 0].copy(), motion.fps, local_pos, motion.name)
-
 
 
 # ---------------------------------------------------------------------------- proportions

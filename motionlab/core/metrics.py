@@ -36,7 +36,9 @@ __all__ = [
 def _pair(pred, target) -> tuple[np.ndarray, np.ndarray]:
     pred, target = np.asarray(pred, dtype=np.float64), np.asarray(target, dtype=np.float64)
     if pred.shape != target.shape or pred.shape[-1:] != (3,):
-        raise ValueError(f"expected two (..., T, J, 3) position arrays of equal shape, got {pred.shape} and {target.shape}")
+        raise ValueError(
+            f"expected two (..., T, J, 3) position arrays of equal shape, got {pred.shape} and {target.shape}"
+        )
     return pred, target
 
 

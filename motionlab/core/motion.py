@@ -136,7 +136,9 @@ class Motion:
         if self.local_pos is not None:
             t = self.local_pos.copy()
         else:
-            t = np.broadcast_to(self.skeleton.offsets.astype(self.local_rot.dtype), (self.num_frames, self.skeleton.num_joints, 3)).copy()
+            t = np.broadcast_to(
+                self.skeleton.offsets.astype(self.local_rot.dtype), (self.num_frames, self.skeleton.num_joints, 3)
+            ).copy()
         t[:, 0] = self.root_pos
         return t
 

@@ -132,7 +132,9 @@ def to_global(positions: np.ndarray, root: np.ndarray, start=(0.0, 0.0, 0.0), st
     ndarray (..., T, 22, 3) world positions, metres
     """
     positions, root = np.asarray(positions, dtype=np.float64), np.asarray(root, dtype=np.float64)
-    yaw = start_heading + np.concatenate([np.zeros(root.shape[:-2] + (1,)), np.cumsum(root[..., :-1, 2], axis=-1)], axis=-1)
+    yaw = start_heading + np.concatenate(
+        [np.zeros(root.shape[:-2] + (1,)), np.cumsum(root[..., :-1, 2], axis=-1)], axis=-1
+    )
     rot = quat.from_yaw(yaw)  # (..., T, 4)
     vel = np.stack([root[..., 0], np.zeros_like(root[..., 0]), root[..., 1]], axis=-1)
     vel_world = quat.rotate(rot, vel)
@@ -210,7 +212,9 @@ class NormStats:
         return cls.from_dict(json.loads(Path(path).read_text()))
 
 
-def window_stack(arrays: Sequence[np.ndarray], window: int, stride: int) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
+def window_stack(
+    arrays: Sequence[np.ndarray], window: int, stride: int
+) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
     """Cut each (T, ...) array into windows and stack them: returns (N, window, ...) and, for
     each window, ``(clip index, start, stop)`` (short clips are edge-padded to ``window``)."""
     out, index = [], []

@@ -66,8 +66,7 @@ class Skeleton:
                 raise SkeletonError(f"joint {names[j]!r} is a second root; a skeleton has exactly one")
             if not 0 <= parents[j] < j:
                 raise SkeletonError(
-                    f"joint {names[j]!r} (index {j}) has parent index {parents[j]}; "
-                    "parents must precede their children"
+                    f"joint {names[j]!r} (index {j}) has parent index {parents[j]}; parents must precede their children"
                 )
         seen: dict[str, int] = {}
         for j, name in enumerate(names):

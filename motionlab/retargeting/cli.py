@@ -63,7 +63,9 @@ def _solver_config(args):
 def _add_solver_args(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("latent iteration")
     g.add_argument("--steps", type=int, default=100, help="step limit of the latent iteration (default 100)")
-    g.add_argument("--lr", type=float, default=0.1, help="Adam step on the latent, relative to its spread std(φ₀) (default 0.1)")
+    g.add_argument(
+        "--lr", type=float, default=0.1, help="Adam step on the latent, relative to its spread std(φ₀) (default 0.1)"
+    )
     g.add_argument("--threshold", type=float, default=2e-3, help="stop when L_iter drops below this (default 2e-3)")
 
 

@@ -29,7 +29,9 @@ def test_heading_of_the_rest_pose_is_zero_and_follows_yaw():
     sk = humanoid.canonical_skeleton()
     assert preprocess.heading(sk.rest_positions()) == pytest.approx(0.0, abs=1e-12)
     m = _walker(wobble=0.005)
-    np.testing.assert_allclose(np.unwrap(preprocess.heading(m.global_positions())), 0.3 + 0.02 * np.arange(90), atol=0.05)
+    np.testing.assert_allclose(
+        np.unwrap(preprocess.heading(m.global_positions())), 0.3 + 0.02 * np.arange(90), atol=0.05
+    )
 
 
 def test_features_shape_and_heading_normalisation():
