@@ -85,7 +85,7 @@ def _solve(ckpt, args):
         rot = preprocess.pad_to(f.local_rot, 120)[:120]
         for tgt in targets:
             r = root_scale(c.skeleton, tgt)
-            height = preprocess.pad_to(c.root_pos[:, 1] * r, 120)[:120]
+            height = preprocess.pad_to(c.root_pos[:, 1] * r[1], 120)[:120]
             res = solve(
                 ckpt.model,
                 torch.tensor(x, dtype=torch.float32)[None],

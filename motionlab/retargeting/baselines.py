@@ -1,7 +1,7 @@
 """The simple baseline every retargeting result is compared with: copy the rotations.
 
 Copy-rotation puts A's local joint rotations unchanged on B's skeleton and scales A's root
-trajectory by B/A leg size (see :mod:`motionlab.retargeting.pipeline` for the root policy).
+trajectory by B/A leg sizes (see :mod:`motionlab.retargeting.pipeline` for the root policy).
 Because Mixamo keeps most local rotations when it retargets, this is a strong baseline on the
 shared data; its weakness is the feet (they sink or float when the legs' proportions differ).
 
@@ -19,7 +19,10 @@ __all__ = ["copy_rotation"]
 
 
 def copy_rotation(source: Motion, target: Skeleton | Motion, root_mode: str = "legs") -> Motion:
-    """A's local rotations on B's canonical skeleton, root trajectory scaled (``"legs"`` or ``"hips"``).
+    """A's local rotations on B's canonical skeleton, root trajectory scaled by ``root_mode``.
+
+    ``"legs"`` (default): every axis by thigh + shin, the plain baseline of the data notes;
+    ``"stride"`` and ``"hips"``: see :mod:`motionlab.retargeting.pipeline`.
 
     Returns a Motion on B's canonical 22-joint skeleton (at A's frame rate).
     """

@@ -17,6 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
+ROOT_MODES = ("stride", "hips", "legs")
+"""``pipeline.ROOT_MODES``, repeated so that ``--help`` does not import torch (a test keeps them equal)."""
+
 __all__ = ["register"]
 
 
@@ -159,7 +162,7 @@ def _cmd_train(args) -> int:
 def _cmd_evaluate(args) -> int:
     from motionlab import data as mdata
     from motionlab.retargeting import checkpoint as ck
-    from motionlab.retargeting.evaluate import evaluate, training_clips
+    from motionlab.retargeting.evaluate import evaluate, rows_with_root, training_clips
     from motionlab.retargeting.train import TrainConfig, train
 
     folder = Path(args.data) if args.data else mdata.data_root() / "mixamo"
@@ -192,6 +195,7 @@ def _cmd_evaluate(args) -> int:
         source=args.source,
         targets=args.targets,
         animations=animations or (DEFAULT_ANIMATIONS if not args.all_animations else None),
+        rows=rows_with_root(args.root),
         solver=_solver_config(args),
         progress=not args.quiet,
     )
@@ -227,7 +231,11 @@ def register(subparsers) -> None:
     )
     p.add_argument("--checkpoint", help="trained network (default: the shipped one)")
     p.add_argument(
-        "--root", choices=("hips", "legs"), default="hips", help="leg measure that scales the root trajectory"
+        "--root",
+        choices=ROOT_MODES,
+        default="stride",
+        help="how A's root path is scaled: stride = leg chain on the ground, hip height up (default); "
+        "hips / legs = one ratio for all axes",
     )
     for name in ("legs", "arms", "spine", "neck"):
         p.add_argument(
@@ -280,6 +288,12 @@ def register(subparsers) -> None:
     p.add_argument("--train-steps", type=int, default=1500)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--csv", help="write the per-clip records to this CSV")
+    p.add_argument(
+        "--root",
+        choices=ROOT_MODES,
+        default="stride",
+        help="root trajectory of every row but the plain baseline (default stride, as in `motionlab retarget`)",
+    )
     p.add_argument("--device")
     p.add_argument("-q", "--quiet", action="store_true")
     _add_solver_args(p)

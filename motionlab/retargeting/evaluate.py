@@ -17,9 +17,9 @@ Metrics (all from :mod:`motionlab.core.metrics`, positions in world space):
 * ``time`` (s) — wall time of the method per clip (network + latent iteration).
 
 Alignment with the ground truth: every method uses the root trajectory of
-:mod:`motionlab.retargeting.pipeline`: A's trajectory scaled by B/A leg size about the world
-origin (so the start is A's start scaled, with A's heading). Mixamo's own clips start at the
-origin too, so no per-clip fitting to the ground truth is done.
+:mod:`motionlab.retargeting.pipeline`: A's trajectory scaled about the world origin by B/A
+leg sizes (so the start is A's start scaled, with A's heading). Mixamo's own clips start at
+the origin too, so no per-clip fitting to the ground truth is done.
 
 Taught in ``notebooks/03_latent_iteration.ipynb``.
 """
@@ -45,6 +45,7 @@ __all__ = [
     "DEFAULT_TARGETS",
     "DEFAULT_ANIMATIONS",
     "ROWS",
+    "rows_with_root",
     "Evaluation",
     "training_clips",
     "evaluate",
@@ -61,11 +62,20 @@ DEFAULT_ANIMATIONS = (
 
 ROWS: tuple[tuple[str, str, str], ...] = (
     ("copy rotations, root x leg length", "copy", "legs"),
-    ("copy rotations (baseline)", "copy", "hips"),
-    ("no iteration", "network", "hips"),
-    ("full method", "full", "hips"),
+    ("copy rotations, our root", "copy", "stride"),
+    ("no iteration", "network", "stride"),
+    ("full method", "full", "stride"),
 )
-"""Table rows as ``(label, method, root_mode)``: the first is the data notes' plain baseline."""
+"""Table rows as ``(label, method, root_mode)``: the first is the data notes' plain baseline
+(everything scaled by thigh + shin); the others share the pipeline's default root trajectory."""
+
+
+def rows_with_root(root_mode: str) -> tuple[tuple[str, str, str], ...]:
+    """:data:`ROWS` with the root trajectory of every row but the plain baseline set to ``root_mode``."""
+    if root_mode == ROWS[-1][2]:
+        return ROWS
+    return ROWS[:1] + tuple((label.replace("our root", f"root {root_mode}"), m, root_mode) for label, m, _ in ROWS[1:])
+
 
 _CM = 100.0  # metres → file units (centimetres)
 

@@ -15,18 +15,24 @@ per frame, so a clip of any length goes through the network as *one* sequence an
 solver optimises all its frames together. There are no windows to stitch, hence no seams;
 the 120-frame window is only the training unit.
 
-**Root motion of B (our choice, the paper leaves it open).** With ``r`` the ratio of B's to A's
-*hip height* (rest height of the Hips above the lowest rest joint, i.e. the leg length
-including the foot; ``root_scale="legs"`` uses thigh + shin, :func:`humanoid.leg_length`):
+**Root motion of B (our choice, the paper leaves it open).** A's root trajectory is scaled
+about the world origin, with one ratio for the ground plane and one for the height
+(``root_mode="stride"``, the default):
 
-* ``root_B(t) = r · root_A(t)``: the horizontal trajectory is A's scaled about the world origin
-  (A's ground velocity times ``r``, starting at ``r`` × A's start position, same heading), and
-  the root height is A's scaled by ``r``, so a standing pose keeps its feet on the ground;
+* horizontally by ``r_xz`` = B's / A's **leg chain**, the summed bone lengths from the Hips
+  down to the toe (Hips→UpLeg→Leg→Foot→ToeBase, :func:`leg_chain`): with the same joint
+  angles, a longer leg takes a longer stride, and the hip offset and the foot count too;
+* vertically by ``r_y`` = B's / A's **hip height** (rest height of the Hips above the lowest
+  rest joint, :func:`hip_height`), so a standing pose keeps its feet on the ground;
 * the heading (facing direction) of every frame is A's: the network's root rotation, expressed
   in A's heading frame, is turned back by A's heading.
 
-All three methods (copy-rotation, network without iteration, full method) use the same root
-trajectory, so the comparison is on poses; ``root_scale`` switches it for all of them.
+``root_mode="hips"`` scales all three axes by the hip height and ``"legs"`` by thigh + shin
+(:func:`humanoid.leg_length`, the plain baseline of the data notes). On the shared Mixamo data
+the stride ratio matches Mixamo's own horizontal root scaling best of five leg measures, in
+every leave-one-character-out split (``benchmarks/bench_root.py``); the hip height matches
+its vertical one best. All three methods (copy-rotation, network without iteration, full
+method) use the same root trajectory, so the comparison is on poses.
 
 Taught in ``notebooks/03_latent_iteration.ipynb``.
 """
@@ -48,9 +54,10 @@ from motionlab.retargeting.solver import SolverConfig, solve
 
 __all__ = [
     "METHODS",
-    "ROOT_SCALES",
+    "ROOT_MODES",
     "RetargetResult",
     "hip_height",
+    "leg_chain",
     "root_scale",
     "target_skeleton",
     "retarget",
@@ -58,7 +65,8 @@ __all__ = [
 
 METHODS = ("full", "network", "copy")
 """``full``: network + latent iteration; ``network``: no iteration; ``copy``: copy local rotations."""
-ROOT_SCALES = ("hips", "legs")
+ROOT_MODES = ("stride", "hips", "legs")
+"""How the root trajectory is scaled: see the module docstring."""
 
 
 @dataclass
@@ -70,7 +78,7 @@ class RetargetResult:
     motion : Motion           on B's canonical 22-joint skeleton, world space, checkpoint fps
     positions : ndarray (T, 22, 3)   world joint positions (FK of ``motion``), metres
     method : str              one of :data:`METHODS`
-    root_scale : float        ``r`` used for the root trajectory
+    root_scale : (float, float)  ``(r_xz, r_y)`` that scaled A's root trajectory
     history : dict            solver history (``loss``, ``angle``, ``foot`` per step); empty otherwise
     stop_reason : str         why the solver stopped ("" without iteration)
     steps : int               solver steps
@@ -80,7 +88,7 @@ class RetargetResult:
     motion: Motion
     positions: np.ndarray
     method: str
-    root_scale: float
+    root_scale: tuple[float, float]
     history: dict = field(default_factory=dict)
     stop_reason: str = ""
     steps: int = 0
@@ -93,17 +101,30 @@ def hip_height(skeleton: Skeleton) -> float:
     return float(rest[0, 1] - rest[:, 1].min())
 
 
-def root_scale(source: Skeleton, target: Skeleton, mode: str = "hips") -> float:
-    """The ratio ``r`` of B's to A's leg size that scales the root trajectory (see module doc)."""
-    if mode == "hips":
-        a, b = hip_height(source), hip_height(target)
-    elif mode == "legs":
-        a, b = humanoid.leg_length(source), humanoid.leg_length(target)
-    else:
-        raise ValueError(f"root_scale mode must be one of {ROOT_SCALES}, got {mode!r}")
-    if not (a > 1e-9 and b > 1e-9):
-        raise ValueError(f"cannot scale the root: leg size {a:.4g} m (source) / {b:.4g} m (target)")
-    return b / a
+def leg_chain(skeleton: Skeleton) -> float:
+    """Summed bone lengths Hips→UpLeg→Leg→Foot→ToeBase (metres), averaged over both legs.
+
+    The length of the whole leg stretched out, hip offset and foot included; ``skeleton`` is a
+    canonical or mappable rig.
+    """
+    sk = skeleton if humanoid.is_canonical(skeleton) else humanoid.to_canonical_skeleton(skeleton)
+    lengths = sk.bone_lengths()
+    chain = ("UpLeg", "Leg", "Foot", "ToeBase")
+    return float(np.mean([sum(lengths[sk.index(side + j)] for j in chain) for side in ("Left", "Right")]))
+
+
+def root_scale(source: Skeleton, target: Skeleton, mode: str = "stride") -> tuple[float, float]:
+    """``(r_xz, r_y)``: how much B's root moves per unit of A's, on the ground and up (module doc)."""
+    measures = {"hips": hip_height, "legs": humanoid.leg_length, "stride": leg_chain}
+    if mode not in measures:
+        raise ValueError(f"root_mode must be one of {ROOT_MODES}, got {mode!r}")
+    ratios = {}
+    for name in {mode, "hips"} if mode == "stride" else {mode}:
+        a, b = measures[name](source), measures[name](target)
+        if not (a > 1e-9 and b > 1e-9):
+            raise ValueError(f"cannot scale the root: {name} {a:.4g} m (source) / {b:.4g} m (target)")
+        ratios[name] = b / a
+    return (ratios[mode], ratios["hips"]) if mode == "stride" else (ratios[mode], ratios[mode])
 
 
 def target_skeleton(target: Skeleton | Motion) -> Skeleton:
@@ -144,7 +165,7 @@ def retarget(
     checkpoint: Checkpoint | None = None,
     method: str = "full",
     solver: SolverConfig | None = None,
-    root_mode: str = "hips",
+    root_mode: str = "stride",
     progress: bool = False,
     callback=None,
 ) -> RetargetResult:
@@ -158,7 +179,7 @@ def retarget(
         not needed for ``method="copy"``
     method : ``"full"`` (latent iteration), ``"network"`` (no iteration) or ``"copy"``
     solver : settings of the latent iteration
-    root_mode : ``"hips"`` or ``"legs"``: which leg measure scales the root trajectory
+    root_mode : ``"stride"`` (default), ``"hips"`` or ``"legs"``: how A's root trajectory is scaled
     progress : tqdm bar for the iteration
     callback : passed to :func:`solver.solve` (per-step ``loss``, ``angle``, ``foot``)
 
@@ -179,7 +200,7 @@ def retarget(
     src = preprocess.prepare(source, fps)
     check_motion(src, "source motion")
     r = root_scale(src.skeleton, tgt, root_mode)
-    root_pos = src.root_pos * r
+    root_pos = src.root_pos * np.array([r[0], r[1], r[0]])
     history: dict = {}
     reason, steps = "", 0
     start = time.perf_counter()

@@ -119,8 +119,14 @@ def test_train_and_evaluate_on_a_small_folder(tmp_path, clips, capsys):
         "--checkpoint", ck, "--steps", "2", "-q", "--csv", tmp_path / "rec.csv",
     )  # fmt: skip
     assert code == 0, err
-    for row in ("copy rotations (baseline)", "no iteration", "full method", "ground truth", "MSE/h²"):
+    for row in ("copy rotations, our root", "no iteration", "full method", "ground truth", "MSE/h²"):
         assert row in stdout
     assert (tmp_path / "rec.csv").read_text().count("\n") == 1 + 4
+    code, stdout, err = _run(
+        capsys, "evaluate", "--data", root, "--source", "A", "--targets", "B", "--animations", "anim1",
+        "--checkpoint", ck, "--steps", "2", "-q", "--root", "hips",
+    )  # fmt: skip
+    assert code == 0, err
+    assert "copy rotations, root hips" in stdout and "root x leg length" in stdout
     code, _, err = _run(capsys, "evaluate", "--data", root, "--source", "Nobody", "--checkpoint", ck)
     assert code == 2 and "Nobody" in err

@@ -7,7 +7,7 @@ import pytest
 
 from motionlab import retargeting
 from motionlab.core import humanoid
-from motionlab.retargeting.pipeline import hip_height, retarget, root_scale
+from motionlab.retargeting.pipeline import hip_height, leg_chain, retarget, root_scale
 from motionlab.retargeting.solver import SolverConfig
 
 
@@ -35,12 +35,42 @@ def test_copy_keeps_rotations_and_scales_the_root(clips, target):
     src = clips[0]
     out = retarget(src, target, None, "copy", root_mode="hips")
     r = hip_height(target) / hip_height(src.skeleton)
-    assert out.root_scale == pytest.approx(r)
+    assert out.root_scale == pytest.approx((r, r))
     np.testing.assert_allclose(out.motion.root_pos, src.root_pos * r)
     np.testing.assert_allclose(out.motion.local_rot, src.local_rot)
     legs = retarget(src, target, None, "copy", root_mode="legs")
-    assert legs.root_scale == pytest.approx(humanoid.leg_length(target) / humanoid.leg_length(src.skeleton))
+    r_legs = humanoid.leg_length(target) / humanoid.leg_length(src.skeleton)
+    assert legs.root_scale == pytest.approx((r_legs, r_legs))
     assert retargeting.copy_rotation(src, target, "legs").root_pos == pytest.approx(legs.motion.root_pos)
+
+
+def test_default_root_scales_ground_by_leg_chain_and_height_by_hips(clips, target):
+    src = clips[0]
+    out = retarget(src, target, None, "copy")
+    r_xz = leg_chain(target) / leg_chain(src.skeleton)
+    r_y = hip_height(target) / hip_height(src.skeleton)
+    assert r_xz != pytest.approx(r_y, rel=1e-3)  # the test target has other leg proportions
+    assert out.root_scale == pytest.approx((r_xz, r_y))
+    np.testing.assert_allclose(out.motion.root_pos[:, [0, 2]], src.root_pos[:, [0, 2]] * r_xz)
+    np.testing.assert_allclose(out.motion.root_pos[:, 1], src.root_pos[:, 1] * r_y)
+
+
+def test_leg_chain_is_the_summed_leg_bones():
+    sk = humanoid.canonical_skeleton()
+    lengths = np.linalg.norm(sk.offsets, axis=1)
+    left = sum(lengths[sk.index(f"Left{j}")] for j in ("UpLeg", "Leg", "Foot", "ToeBase"))
+    right = sum(lengths[sk.index(f"Right{j}")] for j in ("UpLeg", "Leg", "Foot", "ToeBase"))
+    assert leg_chain(sk) == pytest.approx((left + right) / 2)
+    assert leg_chain(humanoid.scale_bones(sk, overall=2.0)) == pytest.approx(2 * leg_chain(sk))
+    longer = humanoid.scale_bones(sk, legs=1.5)  # thigh, shin and foot; the hip offset stays
+    hip_offset = (lengths[sk.index("LeftUpLeg")] + lengths[sk.index("RightUpLeg")]) / 2
+    assert leg_chain(longer) == pytest.approx(hip_offset + 1.5 * (leg_chain(sk) - hip_offset))
+
+
+def test_cli_root_modes_match_the_pipeline():
+    from motionlab.retargeting import cli, pipeline
+
+    assert cli.ROOT_MODES == pipeline.ROOT_MODES
 
 
 def test_network_on_its_own_skeleton_reconstructs(clips, tiny_checkpoint):
@@ -68,7 +98,7 @@ def test_nan_and_empty_motions_are_refused(clips, target, tiny_checkpoint):
         retarget(clips[0][:1], target, tiny_checkpoint)
     with pytest.raises(ValueError, match="method"):
         retarget(clips[0], target, tiny_checkpoint, "magic")
-    with pytest.raises(ValueError, match="root_scale"):
+    with pytest.raises(ValueError, match="root_mode"):
         root_scale(target, target, "arms")
 
 

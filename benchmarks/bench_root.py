@@ -1,0 +1,115 @@
+"""Which leg measure should scale the root trajectory? Measured against Mixamo's own retargets.
+
+    python benchmarks/bench_root.py                          # $MOTIONLAB_DATA/mixamo, Aj -> 6 targets
+    python benchmarks/bench_root.py path/to/folder --source Aj --targets BigVegas Kaya
+
+The paper leaves B's root motion open. All three retargeting methods share it, and on the
+shared Mixamo data it carries most of the error, so the choice is measured here, with no
+network involved: A's root trajectory is scaled about the origin by B/A of a leg measure and
+compared with B's real root trajectory (the error of the root alone, as MSE/h² over the three
+axes, h = B's rig height). The ground plane (x, z) and the height (y) are scored separately.
+
+Printed: the per-character scale Mixamo used (least squares over all clips), each measure's
+ratio and root error, and a leave-one-character-out check: for every target, the measure
+that is best on the *other* targets, and its error on the held-out one. The pipeline's
+default (``root_mode="stride"``) is the outcome: leg chain on the ground, hip height up.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from motionlab import data
+from motionlab.core import bvh, humanoid, preprocess
+from motionlab.core.skeleton import Skeleton
+from motionlab.retargeting.evaluate import DEFAULT_ANIMATIONS, DEFAULT_SOURCE, DEFAULT_TARGETS
+from motionlab.retargeting.pipeline import hip_height, leg_chain
+
+
+def _chain(*joints: str):
+    def measure(sk: Skeleton) -> float:
+        lengths = sk.bone_lengths()
+        return float(np.mean([sum(lengths[sk.index(s + j)] for j in joints) for s in ("Left", "Right")]))
+
+    return measure
+
+
+MEASURES = {
+    "hip height": hip_height,
+    "thigh+shin": humanoid.leg_length,
+    "thigh+shin+foot": _chain("Leg", "Foot", "ToeBase"),
+    "hip..ankle chain": _chain("UpLeg", "Leg", "Foot"),
+    "leg chain (hip..toe)": leg_chain,
+}
+"""Candidate leg measures (metres) of a canonical skeleton; ``leg chain`` is :func:`pipeline.leg_chain`."""
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("folder", nargs="?", help="<Character>/<Animation>.bvh folder (default: $MOTIONLAB_DATA/mixamo)")
+    ap.add_argument("--source", default=DEFAULT_SOURCE)
+    ap.add_argument("--targets", nargs="+", default=list(DEFAULT_TARGETS))
+    ap.add_argument("--animations", nargs="+", default=list(DEFAULT_ANIMATIONS))
+    args = ap.parse_args(argv)
+    folder = Path(args.folder) if args.folder else data.data_root() / "mixamo"
+    if not (folder / args.source).is_dir():
+        sys.exit(f"no folder {folder / args.source}: set MOTIONLAB_DATA to the shared data (see README) or pass FOLDER")
+
+    src = {a: preprocess.prepare(bvh.load(folder / args.source / f"{a}.bvh"), 60) for a in args.animations}
+    sk_a = next(iter(src.values())).skeleton
+    names = list(MEASURES)
+    err = {ax: {t: {} for t in args.targets} for ax in ("xz", "y")}  # axis -> target -> measure -> mean error
+    print(f"Root trajectory of {args.source} scaled onto each target vs the target's real Mixamo root ({folder})")
+    print(f"{len(args.animations)} animations; error = mean over frames of |root - real root|^2 / 3 / h^2\n")
+    head = f"{'target':<14} {'Mixamo xz':>9} {'Mixamo y':>8}  " + "  ".join(f"{n:>20}" for n in names)
+    print("ratio B/A of each measure next to the scale Mixamo used (least squares over the clips)")
+    print(head)
+    for t in args.targets:
+        clips = [preprocess.prepare(bvh.load(folder / t / f"{a}.bvh"), 60) for a in args.animations]
+        heights = [bvh.load(folder / t / f"{a}.bvh").skeleton.height() for a in args.animations[:1]] * len(clips)
+        sk_b = clips[0].skeleton
+        a_xz = np.concatenate([src[a].root_pos[:, [0, 2]] for a in args.animations])
+        b_xz = np.concatenate([c.root_pos[:, [0, 2]] for c in clips])
+        a_y = np.concatenate([src[a].root_pos[:, 1] for a in args.animations])
+        b_y = np.concatenate([c.root_pos[:, 1] for c in clips])
+        fit_xz = float((a_xz * b_xz).sum() / (a_xz * a_xz).sum())
+        fit_y = float((a_y * b_y).sum() / (a_y * a_y).sum())
+        ratios = {n: MEASURES[n](sk_b) / MEASURES[n](sk_a) for n in names}
+        print(f"{t:<14} {fit_xz:9.3f} {fit_y:8.3f}  " + "  ".join(f"{ratios[n]:20.3f}" for n in names))
+        for n in names:
+            r = ratios[n]
+            per_xz, per_y = [], []
+            for a, c, h in zip(args.animations, clips, heights, strict=True):
+                ra = src[a].root_pos
+                per_xz.append(((ra[:, [0, 2]] * r - c.root_pos[:, [0, 2]]) ** 2).sum(1).mean() / 3 / h**2)
+                per_y.append(((ra[:, 1] * r - c.root_pos[:, 1]) ** 2).mean() / 3 / h**2)
+            err["xz"][t][n], err["y"][t][n] = float(np.mean(per_xz)), float(np.mean(per_y))
+
+    for ax, what in (("xz", "ground plane (x, z)"), ("y", "height (y)")):
+        print(f"\nroot error of the {what}, MSE/h^2")
+        print(f"{'target':<14} " + "  ".join(f"{n:>20}" for n in names))
+        for t in args.targets:
+            print(f"{t:<14} " + "  ".join(f"{err[ax][t][n]:20.2e}" for n in names))
+        means = {n: float(np.mean([err[ax][t][n] for t in args.targets])) for n in names}
+        print(f"{'mean':<14} " + "  ".join(f"{means[n]:20.2e}" for n in names))
+        if len(args.targets) > 1:
+            held = []
+            picks = []
+            for t in args.targets:
+                others = [u for u in args.targets if u != t]
+                best = min(names, key=lambda n, o=others: np.mean([err[ax][u][n] for u in o]))
+                picks.append(best)
+                held.append(err[ax][t][best])
+            print(
+                f"leave-one-character-out: picks {', '.join(sorted(set(picks)))}; "
+                f"held-out error {np.mean(held):.2e} (best single measure on all: {min(means, key=means.get)})"
+            )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
