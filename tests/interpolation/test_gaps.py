@@ -107,3 +107,123 @@ def test_fill_gap_cut_from_a_real_clip(real_walk, method):
     assert rigid.size >= m.skeleton.num_joints - 2
     err = np.linalg.norm(pos[start:stop] - m.global_positions()[start:stop], axis=-1).mean()
     assert err < 0.3  # metres: a plausible fill, not an exact one
+
+
+# ---------------------------------------------------------------------------- C1 root through anchors
+def _corner_motion():
+    """A toy motion whose root runs straight at 0.04 m/frame, then is filled piece-wise linearly
+    through anchors at frames 30, 40, 50, 60 (corners at every anchor), then runs along +X."""
+    m = toy_motion(90)
+    anchors = [30, 40, 50, 60]
+    points = np.array([[0.0, 0.9, 1.2], [0.3, 0.97, 1.5], [0.1, 0.94, 2.0], [0.4, 0.9, 2.2]])
+    t = np.arange(90)
+    root = np.empty((90, 3))
+    root[:31] = points[0] + (t[:31, None] - 30) * np.array([0.0, 0.0, 0.04])
+    root[60:] = points[-1] + (t[60:, None] - 60) * np.array([0.03, 0.0, 0.0])
+    for k in range(3):
+        root[30:61, k] = np.interp(t[30:61], anchors, points[:, k])
+    return m.copy(root_pos=root), anchors
+
+
+def _second_difference(p):
+    """|p[t+1] - 2 p[t] + p[t-1]| (T-2,), centred on frames 1 … T-2 (index t-1 is frame t)."""
+    return np.linalg.norm(np.diff(p, 2, axis=0), axis=-1)
+
+
+def test_smooth_root_passes_through_anchors_without_corners():
+    m, anchors = _corner_motion()
+    out = gaps.smooth_root(m, anchors)
+    a, b = anchors[0], anchors[-1]
+    np.testing.assert_array_equal(out.root_pos[anchors], m.root_pos[anchors])
+    np.testing.assert_array_equal(out.root_pos[: a + 1], m.root_pos[: a + 1])  # known frames untouched
+    np.testing.assert_array_equal(out.root_pos[b:], m.root_pos[b:])
+    np.testing.assert_array_equal(out.local_rot, m.local_rot)
+    old, new = _second_difference(m.root_pos), _second_difference(out.root_pos)
+    at = np.array(anchors) - 1
+    assert old[at].min() > 0.02 and old[at - 1].max() < 1e-12  # the piece-wise linear path has corners
+    assert np.all(new[at] < 0.5 * old[at])
+    # no spike: at an anchor the curve bends about as much as on the frames around it
+    assert np.all(new[at] <= 1.25 * np.maximum(new[at - 1], new[at + 1]))
+    elsewhere = np.setdiff1d(np.arange(a, b - 1), at)  # frames a+1 … b-1 that are not anchors
+    assert new[at].max() <= 1.25 * new[elsewhere].max()
+    # the gap leaves a and reaches b with the velocities measured outside it
+    np.testing.assert_allclose(out.root_pos[a + 1] - out.root_pos[a], [0.0, 0.0, 0.04], atol=0.008)
+    np.testing.assert_allclose(out.root_pos[b] - out.root_pos[b - 1], [0.03, 0.0, 0.0], atol=0.008)
+
+
+def test_smooth_root_keeps_detail_between_anchors():
+    """A wiggle riding on a linear piece (as a recorded stretch brings) survives the smoothing, and
+    its own slopes at the anchors do not survive as corners."""
+    m, anchors = _corner_motion()
+    t = np.arange(41, 50)
+    wiggle = 0.03 * np.sin(3 * np.pi * (t - 40) / 10)  # zero at both anchors, 1.5 periods
+    m.root_pos[t, 0] += wiggle
+    plain = gaps.smooth_root(_corner_motion()[0], anchors).root_pos
+    out = gaps.smooth_root(m, anchors).root_pos
+    # the piece's own end slopes changed, so the result differs by a cubic; the wiggle's shape stays
+    assert np.corrcoef(out[t, 0] - plain[t, 0], wiggle)[0, 1] > 0.9
+    new = _second_difference(out)
+    at = np.array(anchors[1:3]) - 1
+    assert np.all(new[at] <= 1.25 * np.maximum(new[at - 1], new[at + 1]))
+
+
+def test_smooth_root_never_pushes_feet_further_through_the_floor(monkeypatch):
+    m, anchors = _corner_motion()
+    # arrive at a falling fast: the smooth curve would dive below the anchors right after a
+    m.root_pos[:30, 1] = 0.9 + 0.03 * (30 - np.arange(30))
+    out = gaps.smooth_root(m, anchors)
+    monkeypatch.setattr(gaps, "_floor_guard", lambda motion, a, b, drop: drop)
+    unguarded = gaps.smooth_root(m, anchors)
+
+    def lowest(motion):
+        return motion.global_positions()[:, 1:, 1].min(axis=-1)  # the root joint is no foot
+
+    before = lowest(m)
+    allowed = np.minimum(before, min(before[30], before[60]))
+    assert np.all(lowest(out) >= allowed - 1e-12)
+    assert lowest(unguarded).min() < allowed.min() - 0.01  # without the guard the feet go through
+    np.testing.assert_array_equal(out.root_pos[anchors], m.root_pos[anchors])
+    np.testing.assert_array_equal(out.root_pos[:, [0, 2]], unguarded.root_pos[:, [0, 2]])  # only y held
+
+
+def test_smooth_root_without_outside_neighbours_keeps_the_fill_ends():
+    m, anchors = _corner_motion()
+    m.root_pos[61:] = np.nan  # the next gap starts right after b: no velocity there
+    m.local_rot[61:] = np.nan
+    out = gaps.smooth_root(m, anchors)
+    assert np.all(np.isfinite(out.root_pos[:61]))
+    np.testing.assert_array_equal(out.root_pos[anchors], m.root_pos[anchors])
+    end = out.root_pos[60] - out.root_pos[59]
+    np.testing.assert_allclose(end, m.root_pos[60] - m.root_pos[59], atol=0.005)
+    with pytest.raises(ValueError, match="increasing"):
+        gaps.smooth_root(m, [40, 30])
+    with pytest.raises(ValueError, match="filled"):
+        gaps.smooth_root(m, [30, 70])
+
+
+def test_graph_fill_root_is_c1_through_key_poses(monkeypatch):
+    """run -> walk -> stand across a 20-frame gap: the key pose of 'walk' sits inside the gap."""
+    g = ActionGraph()
+    run, walk, stand = toy_motion(60, speed=3.0), toy_motion(60, speed=1.2, phase=1.0), toy_motion(60, speed=0.0)
+    stand.local_rot[:] = stand.local_rot[:1]
+    for name, clip in (("run", run), ("walk", walk), ("stand", stand)):
+        g.add_node(name, clip)
+    g.allow(["run -> walk", "walk -> stand"], both_ways=True)
+    from motionlab.interpolation.inbetween import concatenate
+
+    joined, where = gaps.insert_missing(concatenate([run[:30], stand[:20]]), [(29, 20)])
+    out, report = gaps.fill(joined, method="graph", graph=g)
+    monkeypatch.setattr(gaps, "smooth_root", lambda motion, anchors, joint=None: motion.copy())
+    corner, _ = gaps.fill(joined, method="graph", graph=g)  # the same fill without the smoothing
+    anchors = [29] + report[0].anchors + [50]
+    assert len(anchors) == 3
+    np.testing.assert_array_equal(out.root_pos[anchors], corner.root_pos[anchors])
+    np.testing.assert_array_equal(out.root_pos[:30], joined.root_pos[:30])
+    np.testing.assert_array_equal(out.root_pos[50:], joined.root_pos[50:])
+    np.testing.assert_array_equal(out.local_rot, corner.local_rot)  # only the root moves
+    old, new = _second_difference(corner.root_pos), _second_difference(out.root_pos)
+    at = np.array(anchors) - 1
+    inside = np.setdiff1d(np.arange(29, 50), at)
+    assert old[at].max() > 3.0 * np.median(old[inside])  # the unsmoothed fill has corners
+    assert new[at].max() < 0.5 * old[at].max()
+    assert np.all(new[at] <= 1.25 * np.maximum(new[at - 1], new[at + 1]))
