@@ -34,6 +34,7 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
+import numpy as np
 import torch
 from torch import nn
 
@@ -113,6 +114,8 @@ def skeleton_tensor(offsets, dtype=torch.float32, device=None) -> torch.Tensor:
                 "the retargeting network needs a 22-joint canonical skeleton; use humanoid.to_canonical_skeleton"
             )
         offsets = offsets.offsets
+    if not isinstance(offsets, torch.Tensor):
+        offsets = np.array(offsets, dtype=np.float64)  # a writable copy (Skeleton arrays are read-only)
     t = torch.as_tensor(offsets, dtype=dtype, device=device).clone()
     if t.shape[-2:] != (NUM_JOINTS, 3):
         raise ValueError(f"expected skeleton offsets (..., {NUM_JOINTS}, 3), got {tuple(t.shape)}")

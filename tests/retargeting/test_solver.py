@@ -15,7 +15,7 @@ def _inputs(ckpt, data, root_height=0.5):
     x = torch.as_tensor(ckpt.stats.normalize(data.x[:2]), dtype=torch.float32)
     src = torch.as_tensor(data.local_rot[:2])
     target = humanoid.scale_bones(data.skeleton, legs=1.3, arms=0.8)
-    offsets = torch.as_tensor(target.offsets, dtype=torch.float32)
+    offsets = torch.tensor(np.array(target.offsets), dtype=torch.float32)
     height = torch.full(x.shape[:2], root_height)
     return x, src, offsets, height
 

@@ -26,7 +26,7 @@ def test_training_set_shapes(data):
     assert data.positions.shape == (n, w, 22, 3) and data.local_rot.shape == (n, w, 22, 4)
     # FK of the heading-frame rotations on the skeleton gives the target positions
     pos = RetargetNet.forward_kinematics(
-        torch.from_numpy(data.local_rot[:2]), torch.as_tensor(data.skeleton.offsets, dtype=torch.float32)
+        torch.from_numpy(data.local_rot[:2]), torch.tensor(np.array(data.skeleton.offsets), dtype=torch.float32)
     )
     np.testing.assert_allclose(pos.numpy(), data.positions[:2], atol=1e-5)
 
