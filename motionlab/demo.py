@@ -71,7 +71,8 @@ def run_demo(out_dir: str | Path = "outputs/demo", characters: int = 4, seed: in
         height = target.height()
         for method in ("copy", "network", "full"):
             t0 = time.perf_counter()
-            result = retarget(performance, target, checkpoint=checkpoint, method=method)
+            # the procedural reference scales strides by thigh + shin: scale the root the same way
+            result = retarget(performance, target, checkpoint, method, root_mode=synthetic.ROOT_MODE)
             seconds = time.perf_counter() - t0
             n = min(len(result.positions), len(reference))
             row = _row(method, result.positions[:n], reference[:n], performance.fps, height, seconds)

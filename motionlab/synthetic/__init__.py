@@ -21,7 +21,14 @@ from motionlab.synthetic.clips import dataset
 from motionlab.synthetic.gaits import generate, sequence
 from motionlab.synthetic.style import BEHAVIOURS, Style, default_style, random_style
 
+ROOT_MODE = "legs"
+"""The retargeting root rule that matches this generator (``retarget(..., root_mode=ROOT_MODE)``):
+it makes every stride ``style.stride × (thigh + shin)`` long and puts the pelvis at the height the
+legs reach, so B's path is A's scaled by the thigh + shin ratio. Mixamo's retargets follow the
+leg chain instead (the pipeline's default, ``"stride"``); compare with a reference made the same way."""
+
 __all__ = [
+    "ROOT_MODE",
     "BEHAVIOURS",
     "Style",
     "default_style",
