@@ -19,30 +19,21 @@ from __future__ import annotations
 
 import argparse
 import sys
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 
 from motionlab import data
 from motionlab.core import bvh, humanoid, preprocess
-from motionlab.core.skeleton import Skeleton
 from motionlab.retargeting.evaluate import DEFAULT_ANIMATIONS, DEFAULT_SOURCE, DEFAULT_TARGETS
 from motionlab.retargeting.pipeline import hip_height, leg_chain
-
-
-def _chain(*joints: str):
-    def measure(sk: Skeleton) -> float:
-        lengths = sk.bone_lengths()
-        return float(np.mean([sum(lengths[sk.index(s + j)] for j in joints) for s in ("Left", "Right")]))
-
-    return measure
-
 
 MEASURES = {
     "hip height": hip_height,
     "thigh+shin": humanoid.leg_length,
-    "thigh+shin+foot": _chain("Leg", "Foot", "ToeBase"),
-    "hip..ankle chain": _chain("UpLeg", "Leg", "Foot"),
+    "thigh+shin+foot": partial(leg_chain, joints=("Leg", "Foot", "ToeBase")),
+    "hip..ankle chain": partial(leg_chain, joints=("UpLeg", "Leg", "Foot")),
     "leg chain (hip..toe)": leg_chain,
 }
 """Candidate leg measures (metres) of a canonical skeleton; ``leg chain`` is :func:`pipeline.leg_chain`."""
@@ -69,8 +60,9 @@ def main(argv=None) -> int:
     print("ratio B/A of each measure next to the scale Mixamo used (least squares over the clips)")
     print(head)
     for t in args.targets:
-        clips = [preprocess.prepare(bvh.load(folder / t / f"{a}.bvh"), 60) for a in args.animations]
-        heights = [bvh.load(folder / t / f"{a}.bvh").skeleton.height() for a in args.animations[:1]] * len(clips)
+        rigs = [bvh.load(folder / t / f"{a}.bvh") for a in args.animations]
+        clips = [preprocess.prepare(rig, 60) for rig in rigs]
+        heights = [rig.skeleton.height() for rig in rigs]
         sk_b = clips[0].skeleton
         a_xz = np.concatenate([src[a].root_pos[:, [0, 2]] for a in args.animations])
         b_xz = np.concatenate([c.root_pos[:, [0, 2]] for c in clips])

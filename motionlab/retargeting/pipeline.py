@@ -101,30 +101,35 @@ def hip_height(skeleton: Skeleton) -> float:
     return float(rest[0, 1] - rest[:, 1].min())
 
 
-def leg_chain(skeleton: Skeleton) -> float:
-    """Summed bone lengths Hips→UpLeg→Leg→Foot→ToeBase (metres), averaged over both legs.
+def leg_chain(skeleton: Skeleton, joints: tuple[str, ...] = ("UpLeg", "Leg", "Foot", "ToeBase")) -> float:
+    """Summed lengths of the bones into ``joints`` of each leg (metres), averaged over both legs.
 
-    The length of the whole leg stretched out, hip offset and foot included; ``skeleton`` is a
-    canonical or mappable rig.
+    By default Hips→UpLeg→Leg→Foot→ToeBase: the length of the whole leg stretched out, hip
+    offset and foot included. ``skeleton`` is a canonical or mappable rig.
     """
     sk = skeleton if humanoid.is_canonical(skeleton) else humanoid.to_canonical_skeleton(skeleton)
     lengths = sk.bone_lengths()
-    chain = ("UpLeg", "Leg", "Foot", "ToeBase")
-    return float(np.mean([sum(lengths[sk.index(side + j)] for j in chain) for side in ("Left", "Right")]))
+    return float(np.mean([sum(lengths[sk.index(side + j)] for j in joints) for side in ("Left", "Right")]))
+
+
+_MEASURES = {  # root mode -> (ground-plane measure, height measure)
+    "stride": (leg_chain, hip_height),
+    "hips": (hip_height, hip_height),
+    "legs": (humanoid.leg_length, humanoid.leg_length),
+}
 
 
 def root_scale(source: Skeleton, target: Skeleton, mode: str = "stride") -> tuple[float, float]:
     """``(r_xz, r_y)``: how much B's root moves per unit of A's, on the ground and up (module doc)."""
-    measures = {"hips": hip_height, "legs": humanoid.leg_length, "stride": leg_chain}
-    if mode not in measures:
+    if mode not in _MEASURES:
         raise ValueError(f"root_mode must be one of {ROOT_MODES}, got {mode!r}")
-    ratios = {}
-    for name in {mode, "hips"} if mode == "stride" else {mode}:
-        a, b = measures[name](source), measures[name](target)
+    ratios = []
+    for measure in _MEASURES[mode]:
+        a, b = measure(source), measure(target)
         if not (a > 1e-9 and b > 1e-9):
-            raise ValueError(f"cannot scale the root: {name} {a:.4g} m (source) / {b:.4g} m (target)")
-        ratios[name] = b / a
-    return (ratios[mode], ratios["hips"]) if mode == "stride" else (ratios[mode], ratios[mode])
+            raise ValueError(f"cannot scale the root: {measure.__name__} {a:.4g} m (source) / {b:.4g} m (target)")
+        ratios.append(b / a)
+    return ratios[0], ratios[1]
 
 
 def target_skeleton(target: Skeleton | Motion) -> Skeleton:

@@ -9,6 +9,17 @@ from motionlab.interpolation.action_graph import ActionGraph
 from .conftest import toy_motion
 
 
+def _run_walk_stand():
+    """An action graph run <-> walk <-> stand of toy clips, and the three clips."""
+    g = ActionGraph()
+    run, walk, stand = toy_motion(60, speed=3.0), toy_motion(60, speed=1.2, phase=1.0), toy_motion(60, speed=0.0)
+    stand.local_rot[:] = stand.local_rot[:1]
+    for name, clip in (("run", run), ("walk", walk), ("stand", stand)):
+        g.add_node(name, clip)
+    g.allow(["run -> walk", "walk -> stand"], both_ways=True)
+    return g, run, walk, stand
+
+
 def test_nan_and_timestamp_gaps():
     x = np.arange(20.0).reshape(10, 2)
     x[2:4, 0] = np.nan
@@ -55,12 +66,7 @@ def test_fill_nan_frames(method):
 
 
 def test_graph_fill_across_actions_places_key_poses():
-    g = ActionGraph()
-    run, walk, stand = toy_motion(60, speed=3.0), toy_motion(60, speed=1.2, phase=1.0), toy_motion(60, speed=0.0)
-    stand.local_rot[:] = stand.local_rot[:1]
-    for name, clip in (("run", run), ("walk", walk), ("stand", stand)):
-        g.add_node(name, clip)
-    g.allow(["run -> walk", "walk -> stand"], both_ways=True)
+    g, run, walk, stand = _run_walk_stand()
     stream = run[:30].copy()
     gap = 20
     tail = stand[:20]
@@ -203,12 +209,7 @@ def test_smooth_root_without_outside_neighbours_keeps_the_fill_ends():
 
 def test_graph_fill_root_is_c1_through_key_poses(monkeypatch):
     """run -> walk -> stand across a 20-frame gap: the key pose of 'walk' sits inside the gap."""
-    g = ActionGraph()
-    run, walk, stand = toy_motion(60, speed=3.0), toy_motion(60, speed=1.2, phase=1.0), toy_motion(60, speed=0.0)
-    stand.local_rot[:] = stand.local_rot[:1]
-    for name, clip in (("run", run), ("walk", walk), ("stand", stand)):
-        g.add_node(name, clip)
-    g.allow(["run -> walk", "walk -> stand"], both_ways=True)
+    g, run, walk, stand = _run_walk_stand()
     from motionlab.interpolation.inbetween import concatenate
 
     joined, where = gaps.insert_missing(concatenate([run[:30], stand[:20]]), [(29, 20)])
