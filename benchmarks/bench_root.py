@@ -46,7 +46,10 @@ def main(argv=None) -> int:
     ap.add_argument("--targets", nargs="+", default=list(DEFAULT_TARGETS))
     ap.add_argument("--animations", nargs="+", default=list(DEFAULT_ANIMATIONS))
     args = ap.parse_args(argv)
-    folder = Path(args.folder) if args.folder else data.data_root() / "mixamo"
+    try:
+        folder = Path(args.folder) if args.folder else data.data_root() / "mixamo"
+    except data.DataNotFound as e:
+        sys.exit(f"bench_root: {e}")
     if not (folder / args.source).is_dir():
         sys.exit(f"no folder {folder / args.source}: set MOTIONLAB_DATA to the shared data (see README) or pass FOLDER")
 
