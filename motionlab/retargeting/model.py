@@ -281,10 +281,14 @@ class RetargetNet(nn.Module):
             s = s[:, None]
         return fk_by_level(local_rot, s, humanoid.PARENTS)
 
-    def decode(self, phi: torch.Tensor, offsets: torch.Tensor) -> Decoded:
-        """The whole decoder on skeleton ``offsets`` (J, 3) or (B, J, 3) from the latent φ (B, T, D)."""
+    def decode(self, phi: torch.Tensor, offsets: torch.Tensor, embedding: torch.Tensor | None = None) -> Decoded:
+        """The whole decoder on skeleton ``offsets`` (J, 3) or (B, J, 3) from the latent φ (B, T, D).
+
+        ``embedding`` (B or 1, E): ``skeleton_embedding(offsets)`` when the caller already has it
+        (the latent solver computes it once, not at every step).
+        """
         q = self.rotations(phi)
-        q_delta = self.correction(phi, self.skeleton_embedding(offsets))
+        q_delta = self.correction(phi, self.skeleton_embedding(offsets) if embedding is None else embedding)
         local_rot = self.combine(q, q_delta)
         return Decoded(local_rot, self.forward_kinematics(local_rot, offsets), q, q_delta)
 

@@ -60,6 +60,11 @@ __all__ = [
     "leg_chain",
     "root_scale",
     "target_skeleton",
+    "PreparedSource",
+    "PreparedPair",
+    "prepare_source",
+    "prepare_pair",
+    "finish",
     "retarget",
 ]
 
@@ -164,6 +169,102 @@ def _network_inputs(ckpt: Checkpoint, feats: ClipFeatures, theta: str) -> tuple[
     )
 
 
+@dataclass
+class PreparedSource:
+    """The source side of a retargeting job, shared by every target character.
+
+    Attributes
+    ----------
+    name : str                   the source motion's name
+    motion : Motion              A on the canonical 22 joints, resampled to the checkpoint's fps
+    features : ClipFeatures or None   network-side features (None for ``method="copy"``)
+    x : Tensor (1, T, 70) or None      A's normalised features on the checkpoint's device
+    theta : Tensor (1, T, 22, 4) or (1, T, 22, 3) or None   θ(A) for the solver's ``theta``
+    """
+
+    name: str
+    motion: Motion
+    features: ClipFeatures | None = None
+    x: torch.Tensor | None = None
+    theta: torch.Tensor | None = None
+
+
+@dataclass
+class PreparedPair:
+    """One (source, target) job, ready for the network: what :func:`solver.solve` needs and what
+    turns its answer into B's Motion (:func:`finish`).
+
+    Attributes
+    ----------
+    source : PreparedSource
+    target : Skeleton           B's canonical skeleton
+    root_scale : (float, float)
+    root_pos : ndarray (T, 3)   B's root trajectory, metres
+    offsets : Tensor (22, 3) or None   B's bone offsets on the checkpoint's device
+    root_height : Tensor (1, T) or None   B's root height, metres
+    """
+
+    source: PreparedSource
+    target: Skeleton
+    root_scale: tuple[float, float]
+    root_pos: np.ndarray
+    offsets: torch.Tensor | None = None
+    root_height: torch.Tensor | None = None
+
+
+def prepare_source(
+    source: Motion, checkpoint: Checkpoint | None, method: str = "full", solver: SolverConfig | None = None
+) -> PreparedSource:
+    """A's side of :func:`retarget`: canonical joints, the checkpoint's fps, features."""
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    check_motion(source, "source motion")
+    fps = checkpoint.fps if checkpoint is not None else source.fps
+    src = preprocess.prepare(source, fps)
+    check_motion(src, "source motion")
+    if method == "copy":
+        return PreparedSource(source.name, src)
+    feats = clip_features(src)
+    x, theta = _network_inputs(checkpoint, feats, (solver or SolverConfig()).theta)
+    return PreparedSource(source.name, src, feats, x, theta)
+
+
+def prepare_pair(source: PreparedSource, target: Skeleton | Motion, root_mode: str = "stride") -> PreparedPair:
+    """B's side of :func:`retarget`: canonical target skeleton and root trajectory."""
+    tgt = target_skeleton(target)
+    src = source.motion
+    r = root_scale(src.skeleton, tgt, root_mode)
+    root_pos = src.root_pos * np.array([r[0], r[1], r[0]])
+    if source.x is None:
+        return PreparedPair(source, tgt, r, root_pos)
+    device = source.x.device
+    offsets = torch.tensor(tgt.offsets, dtype=torch.float32, device=device)
+    height = torch.as_tensor(root_pos[:, 1], dtype=torch.float32)[None]
+    return PreparedPair(source, tgt, r, root_pos, offsets, height)
+
+
+def finish(
+    pair: PreparedPair,
+    heading_rot: np.ndarray | None,
+    method: str,
+    history: dict | None = None,
+    stop_reason: str = "",
+    steps: int = 0,
+    seconds: float = 0.0,
+) -> RetargetResult:
+    """B's Motion from the network's heading-frame rotations (T, 22, 4) (``None`` for "copy")."""
+    src = pair.source
+    if method == "copy":
+        local_rot = src.motion.local_rot.copy()
+    else:
+        local_rot = _to_world(heading_rot, src.features.yaw)
+    name = f"{src.name}_on_target" if src.name else "retargeted"
+    motion = Motion(pair.target, local_rot, pair.root_pos, src.motion.fps, None, name)
+    return RetargetResult(
+        motion, motion.global_positions(), method, pair.root_scale, history or {}, stop_reason, steps, seconds
+    )
+
+
 def retarget(
     source: Motion,
     target: Skeleton | Motion,
@@ -192,39 +293,40 @@ def retarget(
     -------
     RetargetResult; ``result.motion`` is a proper Motion (local rotations + root positions) on
     B's canonical skeleton, so bone lengths are exact.
+
+    Notes
+    -----
+    The steps are :func:`prepare_source`, :func:`prepare_pair`, the solver and :func:`finish`;
+    :mod:`motionlab.retargeting.expand` runs the same steps for many pairs, solving them in
+    batches with :func:`solver.solve_many` (for one pair the same computation as here).
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     check_motion(source, "source motion")
-    tgt = target_skeleton(target)
+    target_skeleton(target)  # a bad target fails before any work
     if method != "copy" and checkpoint is None:
         from motionlab.retargeting import load_default
 
         checkpoint = load_default()
-    fps = checkpoint.fps if checkpoint is not None else source.fps
-    src = preprocess.prepare(source, fps)
-    check_motion(src, "source motion")
-    r = root_scale(src.skeleton, tgt, root_mode)
-    root_pos = src.root_pos * np.array([r[0], r[1], r[0]])
+    solver = solver or SolverConfig()
+    pair = prepare_pair(prepare_source(source, checkpoint, method, solver), target, root_mode)
     history: dict = {}
-    reason, steps = "", 0
+    reason, steps, heading_rot = "", 0, None
     start = time.perf_counter()
-    if method == "copy":
-        local_rot = src.local_rot.copy()
-    else:
-        feats = clip_features(src)
-        solver = solver or SolverConfig()
-        x, theta_a = _network_inputs(checkpoint, feats, solver.theta)
-        offsets = torch.tensor(tgt.offsets, dtype=torch.float32, device=checkpoint.device)
-        if method == "network":
-            with torch.no_grad():
-                heading_rot = checkpoint.model(x, offsets).local_rot[0].cpu().numpy()
-        else:
-            height = torch.as_tensor(root_pos[:, 1], dtype=torch.float32)[None]
-            res = solve(checkpoint.model, x, theta_a, offsets, height, solver, callback=callback, progress=progress)
-            heading_rot, history, reason, steps = res.local_rot[0], res.history, res.stop_reason, res.steps
-        local_rot = _to_world(heading_rot, feats.yaw)
-    seconds = time.perf_counter() - start
-    name = f"{source.name}_on_target" if source.name else "retargeted"
-    motion = Motion(tgt, local_rot, root_pos, fps, None, name)
-    return RetargetResult(motion, motion.global_positions(), method, r, history, reason, steps, seconds)
+    if method == "network":
+        with torch.no_grad():
+            heading_rot = checkpoint.model(pair.source.x, pair.offsets).local_rot[0].cpu().numpy()
+    elif method == "full":
+        src = pair.source
+        res = solve(
+            checkpoint.model,
+            src.x,
+            src.theta,
+            pair.offsets,
+            pair.root_height,
+            solver,
+            callback=callback,
+            progress=progress,
+        )
+        heading_rot, history, reason, steps = res.local_rot[0], res.history, res.stop_reason, res.steps
+    return finish(pair, heading_rot, method, history, reason, steps, time.perf_counter() - start)

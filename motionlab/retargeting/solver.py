@@ -40,7 +40,7 @@ from tqdm.auto import tqdm
 from motionlab.retargeting import losses
 from motionlab.retargeting.model import Decoded, RetargetNet
 
-__all__ = ["SolverConfig", "SolverResult", "iteration_loss", "solve"]
+__all__ = ["SolverConfig", "SolverResult", "iteration_loss", "sequence_losses", "solve", "solve_many"]
 
 
 @dataclass
@@ -149,6 +149,39 @@ def iteration_loss(
     return cfg.lambda_angle * angle + cfg.lambda_foot * foot, angle, foot
 
 
+def sequence_losses(
+    source: torch.Tensor,
+    generated: Decoded,
+    root_height: torch.Tensor,
+    config: SolverConfig | None = None,
+) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """:func:`iteration_loss` of every sequence on its own: three tensors of shape (N,).
+
+    The same function, mapped over the batch axis with ``torch.func.vmap``, so entry ``i`` is
+    what :func:`iteration_loss` gives for sequence ``i`` alone (inputs as there, (N, T, ...)).
+    """
+    cfg = config or SolverConfig()
+
+    def one(src, rot, pos, q, q_delta, height):
+        return iteration_loss(src[None], Decoded(rot[None], pos[None], q[None], q_delta[None]), height[None], cfg)
+
+    return torch.func.vmap(one)(
+        source, generated.local_rot, generated.positions, generated.q, generated.q_delta, root_height
+    )
+
+
+def _check_inputs(x, source, offsets, root_height, cfg) -> None:
+    last = 4 if cfg.theta == "rotations" else 3
+    if x.ndim != 3 or source.shape != x.shape[:2] + (22, last) or root_height.shape != x.shape[:2]:
+        raise ValueError(
+            f"expected x (N, T, 70), source (N, T, 22, {last}) for theta={cfg.theta!r} and root_height (N, T), got "
+            f"{tuple(x.shape)}, {tuple(source.shape)} and {tuple(root_height.shape)}"
+        )
+    shape = tuple(torch.as_tensor(offsets).shape)
+    if shape not in ((22, 3), (x.shape[0], 22, 3)):
+        raise ValueError(f"expected offsets (22, 3) or ({x.shape[0]}, 22, 3), got {shape}")
+
+
 def solve(
     model: RetargetNet,
     x: torch.Tensor,
@@ -160,6 +193,10 @@ def solve(
     progress: bool = False,
 ) -> SolverResult:
     """Optimise the latent of a frozen network for skeleton ``offsets``.
+
+    The N sequences form ONE problem: their losses are averaged, one Adam run moves every
+    latent, and one stopping rule applies. :func:`solve_many` solves N independent problems
+    with the same loop; for N = 1 the two are the same computation.
 
     Parameters
     ----------
@@ -179,78 +216,160 @@ def solve(
     SolverResult
     """
     cfg = config or SolverConfig()
-    last = 4 if cfg.theta == "rotations" else 3
-    if x.ndim != 3 or source.shape != x.shape[:2] + (22, last) or root_height.shape != x.shape[:2]:
-        raise ValueError(
-            f"expected x (N, T, 70), source (N, T, 22, {last}) for theta={cfg.theta!r} and root_height (N, T), got "
-            f"{tuple(x.shape)}, {tuple(source.shape)} and {tuple(root_height.shape)}"
-        )
+    _check_inputs(x, source, offsets, root_height, cfg)
+    return _iterate(model, x, source, offsets, root_height, cfg, [x.shape[0]], callback, progress)[0]
+
+
+def solve_many(
+    model: RetargetNet,
+    x: torch.Tensor,
+    source: torch.Tensor,
+    offsets: torch.Tensor,
+    root_height: torch.Tensor,
+    config: SolverConfig | None = None,
+    progress: bool = False,
+) -> list[SolverResult]:
+    """Solve N independent problems (one per sequence) in one batched latent iteration.
+
+    Each sequence has its own loss, its own Adam step size (``lr · std(φ₀)`` of its own latent),
+    its own stopping rule and its own best iterate, so result ``i`` is what :func:`solve` gives for
+    sequence ``i`` alone (up to float rounding: batched matrix products may round differently).
+    A sequence that has stopped leaves the batch, so later steps only compute the others.
+    Typical use: the windows of several clips and characters of equal length
+    (:mod:`motionlab.retargeting.expand`).
+
+    Parameters are those of :func:`solve` (``offsets`` usually (N, 22, 3): one skeleton per
+    sequence). Returns one :class:`SolverResult` per sequence, arrays with a leading axis of 1;
+    ``seconds`` is the wall time of the whole batch.
+    """
+    cfg = config or SolverConfig()
+    _check_inputs(x, source, offsets, root_height, cfg)
+    return _iterate(model, x, source, offsets, root_height, cfg, [1] * x.shape[0], None, progress)
+
+
+def _iterate(model, x, source, offsets, root_height, cfg, sizes, callback, progress) -> list[SolverResult]:
+    """The latent iteration for consecutive groups of sequences (``sizes`` rows each), each group
+    an independent problem: group loss = mean of its sequences' losses, own step size and stop."""
     device = next(model.parameters()).device
     x, src = x.to(device), source.to(device=device, dtype=x.dtype)
     offsets = torch.as_tensor(offsets, dtype=x.dtype, device=device)
     root_height = root_height.to(device=device, dtype=x.dtype)
+    per_row_offsets = offsets.ndim == 3
+    bounds = np.cumsum([0] + list(sizes))
+    groups = len(sizes)
+    group_of_row = torch.as_tensor(np.repeat(np.arange(groups), sizes), device=device)
     was_training = model.training
     flags = [p.requires_grad for p in model.parameters()]
     model.eval()
     for p in model.parameters():
         p.requires_grad_(False)
-    history: dict[str, list[float]] = {"loss": [], "angle": [], "foot": []}
+    histories = [{"loss": [], "angle": [], "foot": []} for _ in range(groups)]
     start = time.perf_counter()
     try:
-        with torch.no_grad():
-            phi0 = model.encode(x)
-        delta = torch.zeros_like(phi0, requires_grad=True)
+        with torch.no_grad():  # one sequence at a time: a row's numbers then do not depend on the batch
+            phi0 = torch.cat([model.encode(x[i : i + 1]) for i in range(x.shape[0])])
+            embedding = (
+                model.skeleton_embedding(offsets)
+                if offsets.ndim == 2
+                else torch.cat([model.skeleton_embedding(o) for o in offsets])
+            )
         smooth = _smoother(cfg.smooth_sigma, phi0.shape[-1], x.dtype, device)
-        scale = float(phi0.std()) if phi0.numel() > 1 else 1.0
-        opt = torch.optim.Adam([delta], lr=cfg.lr * max(scale, 1e-6))
-        best, since_best, steps, reason = float("inf"), 0, 0, "max_steps"
-        best_value, best_out, best_phi, best_step = float("inf"), None, None, 0
+        deltas, param_groups = [], []
+        for g in range(groups):
+            part = phi0[bounds[g] : bounds[g + 1]]
+            scale = float(part.std()) if part.numel() > 1 else 1.0
+            deltas.append(torch.zeros_like(part, requires_grad=True))
+            param_groups.append({"params": [deltas[-1]], "lr": cfg.lr * max(scale, 1e-6)})
+        opt = torch.optim.Adam(param_groups)
+        best = [float("inf")] * groups  # best loss that counted as an improvement (plateau rule)
+        since_best, reasons = [0] * groups, ["max_steps"] * groups
+        best_value, best_step, steps = [float("inf")] * groups, [0] * groups, [0] * groups
+        best_rot = torch.empty(x.shape[:2] + (22, 4), dtype=x.dtype, device=device)
+        best_pos = torch.empty(x.shape[:2] + (22, 3), dtype=x.dtype, device=device)
+        best_phi = torch.empty_like(phi0)
+        active = list(range(groups))
         bar = tqdm(total=cfg.max_steps, desc="latent iteration", disable=not progress, leave=False)
-        while True:
-            phi = phi0 + smooth(delta)
-            out = model.decode(phi, offsets)
-            loss, angle, foot = iteration_loss(src, out, root_height, cfg)
-            value = float(loss.detach())
-            history["loss"].append(value)
-            history["angle"].append(float(angle.detach()))
-            history["foot"].append(float(foot.detach()))
-            if callback is not None:
-                callback(steps, {"loss": value, "angle": history["angle"][-1], "foot": history["foot"][-1]})
-            if value < best_value:  # Adam can overshoot: keep the best iterate seen, not the last
-                best_value, best_step = value, steps
-                best_out = Decoded(out.local_rot.detach(), out.positions.detach(), out.q.detach(), out.q_delta.detach())
-                best_phi = phi.detach()
-            if value < best * (1.0 - cfg.min_delta):
-                best, since_best = value, 0
+        while active:
+            everyone = len(active) == groups
+            rows = None if everyone else torch.cat([torch.arange(bounds[g], bounds[g + 1]) for g in active]).to(device)
+            delta = deltas[0] if groups == 1 else torch.cat([deltas[g] for g in active])
+            phi = (phi0 if everyone else phi0[rows]) + smooth(delta)
+            if per_row_offsets and not everyone:
+                out = model.decode(phi, offsets[rows], embedding[rows])
             else:
-                since_best += 1
-            if value < cfg.threshold:
-                reason = "threshold"
+                out = model.decode(phi, offsets, embedding)
+            s, h = (src, root_height) if everyone else (src[rows], root_height[rows])
+            loss, angle, foot = sequence_losses(s, out, h, cfg)  # (rows,): each sequence on its own
+            owner = group_of_row if everyone else group_of_row[rows]
+            which = owner if everyone else torch.searchsorted(torch.as_tensor(active, device=device), owner)
+            count = torch.zeros(len(active), dtype=x.dtype, device=device).index_add_(0, which, torch.ones_like(loss))
+            parts = [
+                torch.zeros(len(active), dtype=x.dtype, device=device).index_add_(0, which, v) / count
+                for v in (loss, angle, foot)
+            ]
+            group_loss = parts[0]  # (active groups,): the mean over each group's sequences
+            values = torch.stack([p.detach() for p in parts], 1).tolist()
+            stopped, row = [], 0
+            for k, g in enumerate(active):
+                value, a_value, f_value = values[k]
+                n = sizes[g]
+                hist = histories[g]
+                hist["loss"].append(value)
+                hist["angle"].append(a_value)
+                hist["foot"].append(f_value)
+                if callback is not None:
+                    callback(steps[g], {"loss": value, "angle": a_value, "foot": f_value})
+                if value < best_value[g]:  # Adam can overshoot: keep the best iterate seen, not the last
+                    best_value[g], best_step[g] = value, steps[g]
+                    b0, b1 = bounds[g], bounds[g + 1]
+                    best_rot[b0:b1] = out.local_rot[row : row + n].detach()
+                    best_pos[b0:b1] = out.positions[row : row + n].detach()
+                    best_phi[b0:b1] = phi[row : row + n].detach()
+                if value < best[g] * (1.0 - cfg.min_delta):
+                    best[g], since_best[g] = value, 0
+                else:
+                    since_best[g] += 1
+                if value < cfg.threshold:
+                    reasons[g] = "threshold"
+                elif cfg.patience and since_best[g] >= cfg.patience:
+                    reasons[g] = "plateau"
+                elif steps[g] < cfg.max_steps:
+                    row += n
+                    continue
+                stopped.append(k)
+                row += n
+            if len(stopped) == len(active):
                 break
-            if cfg.patience and since_best >= cfg.patience:
-                reason = "plateau"
-                break
-            if steps >= cfg.max_steps:
-                break
+            keep = torch.ones(len(active), dtype=x.dtype, device=device)
+            keep[stopped] = 0.0
             opt.zero_grad(set_to_none=True)
-            loss.backward()
+            (group_loss * keep).sum().backward()
+            for k in stopped:
+                deltas[active[k]].grad = None  # Adam skips it: a stopped problem keeps its latent
             opt.step()
-            steps += 1
+            active = [g for k, g in enumerate(active) if k not in stopped]
+            for g in active:
+                steps[g] += 1
             bar.update(1)
-            bar.set_postfix(loss=f"{value:.4g}")
+            bar.set_postfix(loss=f"{float(group_loss.detach().mean()):.4g}")
         bar.close()
     finally:
         for p, f in zip(model.parameters(), flags):
             p.requires_grad_(f)
         model.train(was_training)
-    out, phi = best_out, best_phi
-    return SolverResult(
-        local_rot=out.local_rot.detach().cpu().numpy().astype(np.float64),
-        positions=out.positions.detach().cpu().numpy().astype(np.float64),
-        phi=phi.detach(),
-        best_step=best_step,
-        history=history,
-        stop_reason=reason,
-        steps=steps,
-        seconds=time.perf_counter() - start,
-    )
+    seconds = time.perf_counter() - start
+    rot = best_rot.cpu().numpy().astype(np.float64)
+    pos = best_pos.cpu().numpy().astype(np.float64)
+    return [
+        SolverResult(
+            local_rot=rot[bounds[g] : bounds[g + 1]],
+            positions=pos[bounds[g] : bounds[g + 1]],
+            phi=best_phi[bounds[g] : bounds[g + 1]],
+            best_step=best_step[g],
+            history=histories[g],
+            stop_reason=reasons[g],
+            steps=steps[g],
+            seconds=seconds,
+        )
+        for g in range(groups)
+    ]
