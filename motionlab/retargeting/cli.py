@@ -211,7 +211,10 @@ def _cmd_evaluate(args) -> int:
 
 
 def register(subparsers) -> None:
-    """Add ``retarget``, ``train`` and ``evaluate`` to the ``motionlab`` command."""
+    """Add ``retarget``, ``train``, ``evaluate`` and ``expand`` to the ``motionlab`` command."""
+    from motionlab.retargeting import expand_cli
+
+    expand_cli.register(subparsers)
     p = subparsers.add_parser(
         "retarget",
         help="retarget a BVH clip onto another character (latent iteration)",

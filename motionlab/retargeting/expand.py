@@ -1,0 +1,512 @@
+"""Expand a motion database: many clips onto many characters in one batched, resumable job.
+
+The retargeting paper's stated purpose is to *expand motion databases*: one performer's
+library, generated for every new character (``seeds/000_*.txt``, §1). :func:`expand` takes
+source clips × target characters and writes ``OUT/<character>/<clip>.bvh`` plus
+``OUT/manifest.csv``, one row per (clip, character)::
+
+    job = expand(["Aj/*.bvh"], characters("Kaya/Running.bvh", "long_legs"), "out/")
+    print(job.summary())
+
+* **Batched.** The network is loaded once; pairs of equal length are solved together
+  (:mod:`motionlab.retargeting.batching`), each output bit-for-bit what ``motionlab retarget``
+  writes for that pair.
+* **Resumable and safe.** Every BVH is written to a temporary file; the manifest (rewritten
+  atomically) records a batch's rows *before* its files are renamed into place. A rerun keeps
+  every row whose file exists and redoes the rest: a kill at any moment loses at most the batch
+  in flight. An output that exists but is not in the manifest is someone else's file and is
+  only replaced with ``force=True``. A clip that cannot be read or mapped is recorded as an
+  ``error`` row with its message, and the job goes on.
+* **Quality flags.** A row is flagged when its mean foot penetration exceeds
+  ``max_penetration_cm`` (default 1 cm: about a shoe sole) or its foot skating exceeds
+  ``skate_ratio`` (default 2) times the source clip's own skating scaled by the root's ground
+  ratio ``r_xz`` (a longer-legged character moves its feet faster by that ratio; sliding beyond
+  twice that is new sliding the retargeting added). Both rules are set by these principles, not
+  fitted to any clip.
+* **Beyond one machine.** ``backend="ray"`` sends the same batches to Ray actors
+  (:mod:`motionlab.retargeting.cluster`), each loading the checkpoint once; this process
+  still writes every file and the manifest, so both backends give the same outputs.
+
+Taught in ``notebooks/07_expanding_a_database.ipynb``.
+"""
+
+from __future__ import annotations
+
+import csv
+import glob
+import io
+import os
+import tempfile
+import time
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from motionlab.core import bvh, humanoid, metrics
+from motionlab.core.skeleton import Skeleton
+from motionlab.retargeting.batching import Pair, PairResult, batch_frames, plan_batches, quality, solve_pairs
+from motionlab.retargeting.checkpoint import Checkpoint
+from motionlab.retargeting.pipeline import prepare_source
+from motionlab.retargeting.solver import SolverConfig
+
+__all__ = [
+    "PRESETS",
+    "MANIFEST",
+    "COLUMNS",
+    "Character",
+    "characters",
+    "find_sources",
+    "read_manifest",
+    "ExpandResult",
+    "expand",
+]
+
+PRESETS: dict[str, dict[str, float]] = {
+    "long_legs": {"legs": 1.3},
+    "short_legs": {"legs": 0.75},
+    "long_arms": {"arms": 1.35},
+    "stocky": {"legs": 0.8, "arms": 0.85, "spine": 0.85, "neck": 0.8},
+    "tall": {"overall": 1.2},
+    "child": {"legs": 0.85, "arms": 0.85, "spine": 0.9, "neck": 1.1, "overall": 0.7},
+}
+"""Synthetic characters: :func:`humanoid.scale_bones` factors applied to the canonical T-pose
+(:func:`humanoid.canonical_skeleton`, 1.75 m). ``NAME:legs=1.2,arms=0.9`` makes a custom one."""
+
+MANIFEST = "manifest.csv"
+COLUMNS = (
+    "clip", "character", "status", "output", "source", "character_file", "frames", "steps", "stop_reason",
+    "loss", "angle", "foot", "penetration_cm", "skating_cm_s", "source_skating_cm_s", "seconds", "batch_size",
+    "flag", "error",
+)  # fmt: skip
+"""Manifest columns: ``status`` is ``ok`` or ``error``; ``loss``/``angle``/``foot`` the final
+(best) L_iter, L_angle, L_foot (metres); ``seconds`` the pair's share of its batch's wall time;
+``flag`` lists the quality thresholds exceeded (``penetration``, ``skating``), empty if none."""
+
+_ERRORS = (
+    ValueError,
+    OSError,
+    KeyError,
+    IndexError,
+)  # what a bad input file raises (BVHError, RigMappingError ⊂ ValueError)
+
+
+@dataclass
+class Character:
+    """A target character: a name (the output folder) and its rest skeleton.
+
+    Attributes
+    ----------
+    name : str
+    skeleton : Skeleton or None     ``None`` when the file could not be read (``error`` says why)
+    origin : str                    the BVH path or ``preset:NAME``
+    error : str                     why the character cannot be used ("" if it can)
+    """
+
+    name: str
+    skeleton: Skeleton | None
+    origin: str
+    error: str = ""
+
+
+def _preset(spec: str) -> tuple[str, dict[str, float]]:
+    name, _, rest = spec.partition(":")
+    if not rest:
+        if name not in PRESETS:
+            raise ValueError(f"unknown character preset {name!r}; presets: {', '.join(PRESETS)} (or NAME:legs=1.2,...)")
+        return name, PRESETS[name]
+    factors = {}
+    for item in rest.split(","):
+        key, _, value = item.partition("=")
+        if key not in ("legs", "arms", "spine", "neck", "overall"):
+            raise ValueError(f"preset {spec!r}: unknown bone group {key!r}; expected legs, arms, spine, neck, overall")
+        try:
+            factors[key] = float(value)
+        except ValueError:
+            raise ValueError(f"preset {spec!r}: {key}={value!r} is not a number") from None
+    return name, factors
+
+
+def characters(*specs: str, presets: Iterable[str] = ()) -> list[Character]:
+    """Target characters from ``FILE.bvh``, ``NAME=FILE.bvh`` and preset names.
+
+    A file's character is named after its stem; stems shared by several files are made unique
+    with the parent folder (``Kaya/Jumping.bvh`` → ``Kaya_Jumping``). A file that cannot be read
+    or mapped gives a :class:`Character` with ``error`` set (its pairs are recorded as errors).
+    Raises ``ValueError`` for a name used twice, a missing file or an unknown preset.
+    """
+    entries = []
+    for spec in specs:
+        name, sep, path = str(spec).partition("=")
+        if not sep:
+            name, path = "", spec
+        p = Path(path)
+        if not p.is_file():
+            raise ValueError(f"character file {p} not found")
+        entries.append([name, p])
+    stems = [p.stem for n, p in entries if not n]
+    for e in entries:
+        if not e[0]:
+            e[0] = e[1].stem if stems.count(e[1].stem) == 1 else f"{e[1].parent.name}_{e[1].stem}"
+    out = []
+    for name, p in entries:
+        try:
+            sk = humanoid.to_canonical_skeleton(bvh.load(p).skeleton)
+            out.append(Character(name, sk, str(p)))
+        except _ERRORS as err:
+            out.append(Character(name, None, str(p), f"{type(err).__name__}: {err}"))
+    for spec in presets:
+        name, factors = _preset(spec)
+        out.append(Character(name, humanoid.scale_bones(humanoid.canonical_skeleton(), **factors), f"preset:{spec}"))
+    names = [c.name for c in out]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise ValueError(f"character name(s) {dup} used twice; name them with NAME=FILE.bvh")
+    for n in names:
+        _check_name(n, "character")
+    return out
+
+
+def _check_name(name: str, what: str) -> None:
+    if not name or name in (".", "..") or "/" in name or "\\" in name or name.startswith("."):
+        raise ValueError(f"{what} name {name!r} cannot be a folder or file name")
+
+
+def find_sources(specs: Sequence[str]) -> list[tuple[str, Path]]:
+    """``(clip name, path)`` for BVH files, folders (their ``*.bvh``, sorted) and glob patterns.
+
+    Clip names are file stems, made unique with the parent folder where stems repeat.
+    Raises ``ValueError`` when a spec matches nothing.
+    """
+    paths: list[Path] = []
+    for spec in specs:
+        p = Path(spec)
+        if p.is_dir():
+            found = sorted(p.glob("*.bvh"))
+        elif p.is_file():
+            found = [p]
+        else:
+            found = sorted(Path(f) for f in glob.glob(str(spec), recursive=True) if f.lower().endswith(".bvh"))
+        if not found:
+            raise ValueError(f"source {spec!r} matches no BVH file")
+        paths.extend(f for f in found if f not in paths)
+    stems = [p.stem for p in paths]
+    return [(p.stem if stems.count(p.stem) == 1 else f"{p.parent.name}_{p.stem}", p) for p in paths]
+
+
+# ---------------------------------------------------------------------------- manifest
+def read_manifest(out: str | Path) -> list[dict]:
+    """The rows of ``OUT/manifest.csv`` (empty when there is none). Raises ``ValueError`` naming the
+    file when it is not a manifest of this format."""
+    path = Path(out) / MANIFEST
+    if not path.is_file():
+        return []
+    with open(path, newline="", encoding="utf-8") as f:
+        reader = csv.DictReader(f)
+        if tuple(reader.fieldnames or ()) != COLUMNS:
+            raise ValueError(
+                f"{path} is not an expand manifest (columns {reader.fieldnames}, expected {list(COLUMNS)})"
+            )
+        return list(reader)
+
+
+def _umask_mode() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
+_MODE = _umask_mode()  # what open() would give a new file (mkstemp makes them private)
+
+
+def _write_atomic(path: Path, text: str) -> None:
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.chmod(tmp, _MODE)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def _write_manifest(out: Path, rows: list[dict]) -> None:
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=COLUMNS, lineterminator="\n")
+    w.writeheader()
+    for r in sorted(rows, key=lambda r: (r["character"], r["clip"])):
+        w.writerow({k: r.get(k, "") for k in COLUMNS})
+    _write_atomic(out / MANIFEST, buf.getvalue())
+
+
+def _fmt(v: float) -> str:
+    return f"{v:.6g}"
+
+
+# ---------------------------------------------------------------------------- result
+@dataclass
+class ExpandResult:
+    """What :func:`expand` did.
+
+    Attributes
+    ----------
+    out : Path              the output folder
+    rows : list of dict     the manifest rows (all of them, old and new), :data:`COLUMNS`
+    done : int              pairs solved in this run
+    skipped : int           pairs found complete (file + manifest row) and not redone
+    failed : int            pairs recorded as ``error`` in this run
+    source_frames : int     source frames (at the checkpoint's rate) solved in this run
+    seconds : float         wall time of the run
+    batches : int           latent-iteration batches run
+    """
+
+    out: Path
+    rows: list = field(default_factory=list)
+    done: int = 0
+    skipped: int = 0
+    failed: int = 0
+    source_frames: int = 0
+    seconds: float = 0.0
+    batches: int = 0
+
+    @property
+    def throughput(self) -> float:
+        """Source frames solved per second of wall time in this run."""
+        return self.source_frames / self.seconds if self.seconds > 0 else 0.0
+
+    def summary(self) -> str:
+        """A fixed-width table: one line per character, then the run's totals."""
+        head = f"{'character':<18} {'ok':>4} {'err':>4} {'flag':>4} {'steps':>6} {'L_iter':>8} {'pen cm':>7} {'skate cm/s':>10}"
+        lines = [head, "-" * len(head)]
+        for name in sorted({r["character"] for r in self.rows}):
+            rs = [r for r in self.rows if r["character"] == name]
+            ok = [r for r in rs if r["status"] == "ok"]
+
+            def mean(key, ok=ok):
+                return float(np.mean([float(r[key]) for r in ok])) if ok else float("nan")
+
+            lines.append(
+                f"{name:<18} {len(ok):>4} {len(rs) - len(ok):>4} {sum(1 for r in ok if r['flag']):>4} "
+                f"{mean('steps'):>6.1f} {mean('loss'):>8.4f} {mean('penetration_cm'):>7.3f} {mean('skating_cm_s'):>10.2f}"
+            )
+        lines.append(
+            f"this run: {self.done} solved, {self.skipped} already done, {self.failed} failed; "
+            f"{self.source_frames} source frames in {self.seconds:.1f} s = {self.throughput:.0f} frames/s "
+            f"({self.batches} batches); manifest {self.out / MANIFEST}"
+        )
+        return "\n".join(lines)
+
+
+# ---------------------------------------------------------------------------- the job
+def _row(pr: PairResult, source: str, char: Character, out: Path, source_skate: float, limits) -> dict:
+    res = pr.result
+    h = res.history
+    q = quality(res)
+    flags = []
+    if q["penetration_cm"] > limits[0]:
+        flags.append("penetration")
+    if q["skating_cm_s"] > limits[1] * source_skate * res.root_scale[0] and q["skating_cm_s"] > 0:
+        flags.append("skating")
+    best = int(np.argmin(h["loss"]))
+    return {
+        "clip": pr.clip,
+        "character": pr.character,
+        "status": "ok",
+        "output": f"{pr.character}/{pr.clip}.bvh",
+        "source": source,
+        "character_file": char.origin,
+        "frames": str(res.motion.num_frames),
+        "steps": str(res.steps),
+        "stop_reason": res.stop_reason,
+        "loss": _fmt(h["loss"][best]),
+        "angle": _fmt(h["angle"][best]),
+        "foot": _fmt(h["foot"][best]),
+        "penetration_cm": _fmt(q["penetration_cm"]),
+        "skating_cm_s": _fmt(q["skating_cm_s"]),
+        "source_skating_cm_s": _fmt(source_skate),
+        "seconds": _fmt(pr.seconds),
+        "batch_size": str(pr.batch_size),
+        "flag": "+".join(flags),
+        "error": "",
+    }
+
+
+def _error_row(clip: str, character: str, source: str, origin: str, message: str) -> dict:
+    return {
+        "clip": clip,
+        "character": character,
+        "status": "error",
+        "output": f"{character}/{clip}.bvh",
+        "source": source,
+        "character_file": origin,
+        "error": message.replace("\n", " "),
+    }
+
+
+def _clean_temporaries(folder: Path) -> None:
+    """Remove what a killed run left: our own ``.<name>.*.tmp`` files, nothing else."""
+    if folder.is_dir():
+        for t in folder.glob(".*.tmp"):
+            t.unlink(missing_ok=True)
+
+
+def expand(
+    sources: Sequence[str],
+    targets: Sequence[Character],
+    out: str | Path,
+    checkpoint: Checkpoint,
+    solver: SolverConfig | None = None,
+    root_mode: str = "stride",
+    force: bool = False,
+    max_frames: int | None = None,
+    backend: str = "local",
+    address: str | None = None,
+    workers: int = 2,
+    max_penetration_cm: float = 1.0,
+    skate_ratio: float = 2.0,
+    progress: bool = False,
+    on_batch: Callable[[int, list[dict]], None] | None = None,
+) -> ExpandResult:
+    """Retarget every source clip onto every character; see the module docstring.
+
+    Parameters
+    ----------
+    sources : files, folders or glob patterns of BVH clips (:func:`find_sources`)
+    targets : characters (:func:`characters`)
+    out : output folder (created)
+    checkpoint : the network (loaded once, used for every batch)
+    solver, root_mode : as for ``motionlab retarget``
+    force : redo and replace every output, including existing files not in the manifest
+    max_frames : frames per batch (default :func:`batching.batch_frames` for the device)
+    backend : ``"local"`` or ``"ray"``; ``address``: Ray cluster (default ``RAY_ADDRESS``, else a
+        local Ray instance with ``workers`` CPUs); ``workers``: Ray actors
+    max_penetration_cm, skate_ratio : quality-flag thresholds (module docstring)
+    progress : tqdm bar over batches
+    on_batch : called as ``on_batch(batch_index, rows)`` after each batch is on disk (tests use it
+        to interrupt a run)
+
+    Returns
+    -------
+    ExpandResult
+    """
+    if backend not in ("local", "ray"):
+        raise ValueError(f"backend must be 'local' or 'ray', got {backend!r}")
+    start = time.perf_counter()
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    solver = solver or SolverConfig()
+    clips = find_sources(sources)
+    for name, _ in clips:
+        _check_name(name, "clip")
+    if not targets:
+        raise ValueError("no target characters given")
+    known = {(r["character"], r["clip"]): r for r in read_manifest(out)}
+    for c in targets:
+        _clean_temporaries(out / c.name)
+    result = ExpandResult(out)
+    rows: dict[tuple[str, str], dict] = {}
+    todo: list[tuple[str, Path, Character]] = []
+    for clip, path in clips:
+        for c in targets:
+            key = (c.name, clip)
+            file = out / c.name / f"{clip}.bvh"
+            old = known.get(key)
+            if not force and old is not None and old["status"] == "ok" and file.is_file():
+                rows[key] = old
+                result.skipped += 1
+            elif file.exists() and not force and (old is None or old["status"] != "ok"):
+                rows[key] = _error_row(
+                    clip,
+                    c.name,
+                    str(path),
+                    c.origin,
+                    f"{file} exists and is not an output of this job; pass --force to replace it",
+                )
+                result.failed += 1
+            else:
+                todo.append((clip, path, c))
+    # rows of the old manifest for pairs outside this run stay while their files exist
+    planned = {(c.name, clip) for clip, _, c in todo}
+    for key, r in known.items():
+        if key not in rows and key not in planned and (r["status"] != "ok" or (out / r["output"]).is_file()):
+            rows[key] = r
+    pairs, sources_by_clip = _load_pairs(todo, checkpoint, solver, rows, result)
+    _write_manifest(out, list(rows.values()))
+    chars = {c.name: c for c in targets}
+    limits = (max_penetration_cm, skate_ratio)
+    batches = plan_batches(pairs, max_frames or batch_frames(checkpoint.device))
+    if backend == "ray":
+        from motionlab.retargeting.cluster import solve_batches_ray
+
+        stream = solve_batches_ray(checkpoint, batches, solver, root_mode, address=address, workers=workers)
+    else:
+        stream = (solve_pairs(checkpoint, b, solver, root_mode) for b in batches)
+    from tqdm.auto import tqdm
+
+    bar = tqdm(total=len(batches), desc="expand", unit="batch", disable=not progress)
+    for index, solved in enumerate(stream):
+        new = []
+        staged = []
+        try:
+            for pr in solved:
+                src_path, src_skate = sources_by_clip[pr.clip]
+                row = _row(pr, src_path, chars[pr.character], out, src_skate, limits)
+                file = out / row["output"]
+                file.parent.mkdir(parents=True, exist_ok=True)
+                fd, tmp = tempfile.mkstemp(dir=file.parent, prefix=f".{file.name}.", suffix=".tmp")
+                with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
+                    f.write(bvh.dumps(pr.result.motion))
+                os.chmod(tmp, _MODE)
+                staged.append((tmp, file))
+                new.append(row)
+                rows[(pr.character, pr.clip)] = row
+                result.source_frames += pr.result.motion.num_frames
+            _write_manifest(out, list(rows.values()))  # rows first, then the files: a kill between the
+            for tmp, file in staged:  # two leaves rows without files, which a rerun redoes
+                os.replace(tmp, file)
+        finally:
+            for tmp, _ in staged:
+                if os.path.exists(tmp):
+                    os.unlink(tmp)
+        result.done += len(new)
+        result.batches += 1
+        bar.update(1)
+        if on_batch is not None:
+            on_batch(index, new)
+    bar.close()
+    result.rows = sorted(rows.values(), key=lambda r: (r["character"], r["clip"]))
+    result.seconds = time.perf_counter() - start
+    return result
+
+
+def _load_pairs(todo, checkpoint, solver, rows, result):
+    """Read each source once; a clip or character that fails becomes ``error`` rows."""
+    pairs: list[Pair] = []
+    sources_by_clip: dict[str, tuple[str, float]] = {}
+    by_clip: dict[str, list] = {}
+    for clip, path, c in todo:
+        by_clip.setdefault(clip, [path, []])[1].append(c)
+    feet = [humanoid.JOINTS.index(f) for f in humanoid.FEET]
+    for clip, (path, chars) in by_clip.items():
+        try:
+            motion = bvh.load(path)
+            prepared = prepare_source(motion, checkpoint, "full", solver)
+        except _ERRORS as err:
+            for c in chars:
+                rows[(c.name, clip)] = _error_row(clip, c.name, str(path), c.origin, f"{type(err).__name__}: {err}")
+                result.failed += 1
+            continue
+        pos = prepared.motion.global_positions()
+        sources_by_clip[clip] = (str(path), 100.0 * metrics.foot_skating(pos, feet, prepared.motion.fps))
+        for c in chars:
+            if c.skeleton is None:
+                rows[(c.name, clip)] = _error_row(clip, c.name, str(path), c.origin, c.error)
+                result.failed += 1
+                continue
+            pairs.append(Pair(clip, c.name, motion, c.skeleton, prepared.motion.num_frames, prepared))
+    return pairs, sources_by_clip

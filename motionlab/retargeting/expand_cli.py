@@ -1,0 +1,102 @@
+"""``motionlab expand``: many clips onto many characters (:mod:`motionlab.retargeting.expand`).
+
+Examples::
+
+    motionlab expand $MOTIONLAB_DATA/mixamo/Aj --characters Kaya=$MOTIONLAB_DATA/mixamo/Kaya/Running.bvh \\
+        --preset long_legs --preset child -o expanded/
+    motionlab expand "clips/*.bvh" --characters rigs/*.bvh -o out/ --backend ray --address auto
+"""
+
+from __future__ import annotations
+
+import argparse
+
+__all__ = ["register"]
+
+
+def _cmd_expand(args) -> int:
+    from motionlab.cli import CLIError
+    from motionlab.retargeting import expand as ex
+    from motionlab.retargeting.cli import _load_checkpoint, _solver_config
+
+    if args.backend == "ray":
+        from motionlab.retargeting.cluster import INSTALL_HINT
+
+        try:
+            import ray  # noqa: F401
+        except ImportError:
+            raise CLIError(INSTALL_HINT) from None
+    if not args.characters and not args.preset:
+        raise CLIError("give target characters: --characters FILE.bvh ... and/or --preset NAME ...")
+    if args.threads:
+        import torch
+
+        torch.set_num_threads(args.threads)
+    try:
+        targets = ex.characters(*args.characters, presets=args.preset)
+    except ValueError as e:
+        raise CLIError(str(e)) from None
+    ckpt = _load_checkpoint(args.checkpoint, args.device)
+    job = ex.expand(
+        args.sources,
+        targets,
+        args.output,
+        ckpt,
+        _solver_config(args),
+        root_mode=args.root,
+        force=args.force,
+        max_frames=args.batch_frames,
+        backend=args.backend,
+        address=args.address,
+        workers=args.workers,
+        max_penetration_cm=args.max_penetration,
+        skate_ratio=args.skate_ratio,
+        progress=not args.quiet,
+    )
+    if not args.quiet:
+        print(job.summary())
+    return 1 if job.failed else 0
+
+
+def register(subparsers) -> None:
+    """Add ``expand`` to the ``motionlab`` command."""
+    from motionlab.retargeting.cli import ROOT_MODES, _add_solver_args
+
+    p = subparsers.add_parser(
+        "expand",
+        help="retarget many clips onto many characters (batched, resumable; local or Ray)",
+        description="Expand a motion database: every SOURCE clip onto every character, written as "
+        "OUT/<character>/<clip>.bvh with OUT/manifest.csv (one row per output). Rerunning the same command "
+        "redoes only what is missing. Exit status 1 when some pair failed (see the manifest's error column).",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog="presets: long_legs, short_legs, long_arms, stocky, tall, child, or NAME:legs=1.2,arms=0.9,...",
+    )
+    p.add_argument("sources", nargs="+", help="source BVH files, folders (their *.bvh) or glob patterns")
+    p.add_argument(
+        "--characters",
+        nargs="+",
+        default=[],
+        metavar="CHARACTER",
+        help="BVH files whose rest skeletons define the targets, as FILE.bvh or NAME=FILE.bvh",
+    )
+    p.add_argument("--preset", action="append", default=[], help="a synthetic character (repeatable)")
+    p.add_argument("-o", "--output", required=True, help="output folder")
+    p.add_argument("--checkpoint", help="trained network (default: the shipped one)")
+    p.add_argument("--root", choices=ROOT_MODES, default="stride", help="root trajectory rule (as in retarget)")
+    p.add_argument("--batch-frames", type=int, help="frames per solver batch (default: from free memory)")
+    p.add_argument("--backend", choices=("local", "ray"), default="local")
+    p.add_argument("--address", help="Ray cluster address (default: $RAY_ADDRESS, else a local Ray instance)")
+    p.add_argument("--workers", type=int, default=2, help="Ray actors (default 2)")
+    p.add_argument("--threads", type=int, default=0, help="torch threads of this process (0: torch's default)")
+    p.add_argument("--max-penetration", type=float, default=1.0, metavar="CM", help="flag above this (default 1 cm)")
+    p.add_argument(
+        "--skate-ratio",
+        type=float,
+        default=2.0,
+        help="flag when skating exceeds this times the source's own (scaled by the root ratio; default 2)",
+    )
+    p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
+    p.add_argument("--force", action="store_true", help="redo every pair and replace existing outputs")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary")
+    _add_solver_args(p)
+    p.set_defaults(func=_cmd_expand)
