@@ -1,0 +1,200 @@
+"""``motionlab expand``: batched outputs equal the single-pair path, resumption, bad inputs, Ray.
+
+Small synthetic clips and the shipped network keep every test a few seconds on 2 cores.
+"""
+
+from __future__ import annotations
+
+import csv
+import importlib.util
+import os
+
+import numpy as np
+import pytest
+import torch
+
+from motionlab import retargeting, synthetic
+from motionlab.cli import main
+from motionlab.core import bvh, humanoid
+from motionlab.core.motion import Motion
+from motionlab.core.skeleton import Skeleton
+from motionlab.retargeting import expand as ex
+from motionlab.retargeting.batching import Pair, plan_batches
+from motionlab.retargeting.pipeline import retarget
+from motionlab.retargeting.solver import SolverConfig, solve, solve_many
+
+FAST = SolverConfig(max_steps=8)
+
+
+@pytest.fixture(scope="module")
+def ckpt():
+    return retargeting.load_default("cpu")
+
+
+@pytest.fixture(scope="module")
+def library(tmp_path_factory):
+    """Three short clips (two of 40 frames, one of 30) and two character rigs, as BVH files."""
+    root = tmp_path_factory.mktemp("library")
+    clips = synthetic.dataset(2, seed=1, num_frames=40) + synthetic.dataset(1, seed=2, num_frames=30)
+    (root / "clips").mkdir()
+    for name, m in zip(("walk", "turn", "short"), clips):
+        bvh.save(root / "clips" / f"{name}.bvh", m)
+    (root / "rigs").mkdir()
+    for i, c in enumerate(synthetic.character_set(2, seed=5)):
+        motion = Motion(c, np.tile([1.0, 0, 0, 0], (2, 22, 1)), np.tile([0, 1.0, 0], (2, 1)), 60.0)
+        bvh.save(root / "rigs" / f"rig{i}.bvh", motion)
+    return root
+
+
+def _targets(library):
+    return ex.characters(str(library / "rigs" / "rig0.bvh"), str(library / "rigs" / "rig1.bvh"), presets=["long_legs"])
+
+
+def _bvh_files(out):
+    return sorted(str(p.relative_to(out)) for p in out.rglob("*.bvh"))
+
+
+def _ok_outputs(out):
+    return sorted(r["output"] for r in ex.read_manifest(out) if r["status"] == "ok")
+
+
+def test_solve_many_is_solve_per_sequence_bit_for_bit(ckpt):
+    clip = synthetic.dataset(1, seed=3, num_frames=30)[0]
+    from motionlab.retargeting.pipeline import prepare_pair, prepare_source
+
+    src = prepare_source(clip, ckpt)
+    pairs = [prepare_pair(src, c) for c in synthetic.character_set(3, seed=0)]
+    x, th = torch.cat([src.x] * 3), torch.cat([src.theta] * 3)
+    off, h = torch.stack([p.offsets for p in pairs]), torch.cat([p.root_height for p in pairs])
+    many = solve_many(ckpt.model, x, th, off, h, SolverConfig(max_steps=15))
+    for i, p in enumerate(pairs):
+        one = solve(ckpt.model, src.x, src.theta, p.offsets, p.root_height, SolverConfig(max_steps=15))
+        assert np.array_equal(one.local_rot, many[i].local_rot)
+        assert one.history == many[i].history and one.steps == many[i].steps
+        assert one.stop_reason == many[i].stop_reason
+
+
+def test_outputs_equal_single_pair_path(ckpt, library, tmp_path):
+    targets = _targets(library)
+    job = ex.expand([str(library / "clips")], targets, tmp_path, ckpt, FAST)
+    assert job.done == 9 and job.failed == 0 and job.batches == 2  # 40-frame clips together, 30 alone
+    assert {r["batch_size"] for r in job.rows} == {"6", "3"}
+    for clip in ("walk", "turn", "short"):
+        source = bvh.load(library / "clips" / f"{clip}.bvh")
+        for c in targets:
+            single = retarget(source, c.skeleton, ckpt, solver=FAST)
+            assert (tmp_path / c.name / f"{clip}.bvh").read_text() == bvh.dumps(single.motion), (clip, c.name)
+    row = next(r for r in job.rows if r["clip"] == "walk" and r["character"] == "rig0")
+    assert int(row["frames"]) == 40 and int(row["steps"]) <= FAST.max_steps and row["stop_reason"]
+    assert float(row["loss"]) == pytest.approx(0.3 * float(row["angle"]) + 0.5 * float(row["foot"]), rel=1e-4)
+    assert "rig0" in job.summary() and "9 solved" in job.summary()
+
+
+def test_resume_after_interruption_redoes_only_missing(ckpt, library, tmp_path):
+    targets = _targets(library)
+
+    def stop(index, rows):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        ex.expand([str(library / "clips")], targets, tmp_path, ckpt, FAST, on_batch=stop)
+    first = _ok_outputs(tmp_path)
+    assert len(first) == 6 and _bvh_files(tmp_path) == first  # the first batch, files and rows agree
+    stamps = {f: os.stat(tmp_path / f).st_mtime_ns for f in first}
+    job = ex.expand([str(library / "clips")], targets, tmp_path, ckpt, FAST)
+    assert job.skipped == 6 and job.done == 3
+    assert {f: os.stat(tmp_path / f).st_mtime_ns for f in first} == stamps  # finished pairs untouched
+    assert _bvh_files(tmp_path) == _ok_outputs(tmp_path) and len(_ok_outputs(tmp_path)) == 9
+    again = ex.expand([str(library / "clips")], targets, tmp_path, ckpt, FAST)
+    assert again.done == 0 and again.skipped == 9
+
+
+def test_kill_between_manifest_and_rename(ckpt, library, tmp_path):
+    """A row whose file never arrived (kill after the manifest write) is redone; leftovers are removed."""
+    targets = _targets(library)[:1]
+    ex.expand([str(library / "clips" / "short.bvh")], targets, tmp_path, ckpt, FAST)
+    out = tmp_path / "rig0" / "short.bvh"
+    text = out.read_text()
+    out.unlink()
+    (tmp_path / "rig0" / ".short.bvh.abc.tmp").write_text("half a file")
+    job = ex.expand([str(library / "clips" / "short.bvh")], targets, tmp_path, ckpt, FAST)
+    assert job.done == 1 and out.read_text() == text
+    assert not list(tmp_path.rglob("*.tmp"))
+
+
+def test_bad_sources_recorded_and_job_goes_on(ckpt, library, tmp_path):
+    bad = tmp_path / "in"
+    bad.mkdir()
+    (bad / "garbage.bvh").write_text("HIERARCHY\nROOT Hips\n{\n")
+    chain = Skeleton(("Root", "A", "B"), np.array([-1, 0, 1]), np.array([[0, 1.0, 0], [0, 0.3, 0], [0, 0.3, 0]]))
+    bvh.save(bad / "unmappable.bvh", Motion(chain, np.tile([1.0, 0, 0, 0], (3, 3, 1)), np.zeros((3, 3)), 30.0))
+    out = tmp_path / "out"
+    job = ex.expand([str(bad / "*.bvh"), str(library / "clips" / "short.bvh")], _targets(library)[:2], out, ckpt, FAST)
+    assert job.done == 2 and job.failed == 4
+    errors = {(r["clip"], r["character"]): r["error"] for r in job.rows if r["status"] == "error"}
+    assert "line" in errors[("garbage", "rig0")] and "garbage.bvh" in errors[("garbage", "rig0")]
+    assert "RigMappingError" in errors[("unmappable", "rig1")]
+    assert _bvh_files(out) == _ok_outputs(out) == ["rig0/short.bvh", "rig1/short.bvh"]
+    code = main(["expand", str(bad / "garbage.bvh"), "--preset", "tall", "-o", str(out), "-q", "--steps", "2"])
+    assert code == 1  # failures are reported by the exit status
+
+
+def test_existing_files_need_force(ckpt, library, tmp_path):
+    mine = tmp_path / "rig0" / "short.bvh"
+    mine.parent.mkdir()
+    mine.write_text("my own file")
+    targets = _targets(library)[:1]
+    job = ex.expand([str(library / "clips" / "short.bvh")], targets, tmp_path, ckpt, FAST)
+    assert job.failed == 1 and "--force" in job.rows[0]["error"] and mine.read_text() == "my own file"
+    job = ex.expand([str(library / "clips" / "short.bvh")], targets, tmp_path, ckpt, FAST, force=True)
+    assert job.done == 1 and bvh.load(mine).num_frames == 30
+
+
+def test_character_names_and_presets(library, tmp_path):
+    a, b = tmp_path / "Kaya", tmp_path / "Mousey_m"
+    for folder in (a, b):
+        folder.mkdir()
+        (folder / "Jumping.bvh").write_text((library / "rigs" / "rig0.bvh").read_text())
+    cs = ex.characters(str(a / "Jumping.bvh"), str(b / "Jumping.bvh"), presets=["child", "big:legs=1.2,overall=1.1"])
+    assert [c.name for c in cs] == ["Kaya_Jumping", "Mousey_m_Jumping", "child", "big"]
+    assert humanoid.is_canonical(cs[3].skeleton) and cs[3].origin == "preset:big:legs=1.2,overall=1.1"
+    assert [c.name for c in ex.characters(f"hero={a / 'Jumping.bvh'}")] == ["hero"]
+    with pytest.raises(ValueError, match="unknown character preset"):
+        ex.characters(presets=["giant"])
+    with pytest.raises(ValueError, match="used twice"):
+        ex.characters(f"tall={a / 'Jumping.bvh'}", presets=["tall"])
+    with pytest.raises(ValueError, match="not found"):
+        ex.characters(str(tmp_path / "nope.bvh"))
+
+
+def test_plan_batches_by_length_and_memory():
+    sk = humanoid.canonical_skeleton()
+    pairs = [Pair(f"c{i}", "x", None, sk, frames) for i, frames in enumerate([40, 30, 40, 40, 30])]
+    batches = plan_batches(pairs, max_frames=80)
+    assert [[p.clip for p in b] for b in batches] == [["c0", "c2"], ["c3"], ["c1", "c4"]]
+    assert len(plan_batches(pairs, max_frames=1)) == 5  # never less than one pair per batch
+
+
+def test_ray_backend_without_ray_says_how_to_install(monkeypatch, library, tmp_path, capsys):
+    monkeypatch.setitem(__import__("sys").modules, "ray", None)
+    code = main(["expand", str(library / "clips"), "--preset", "tall", "-o", str(tmp_path), "--backend", "ray"])
+    assert code == 2 and "pip install" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_ray_backend_equals_local(ckpt, library, tmp_path):
+    if importlib.util.find_spec("ray") is None:
+        pytest.skip('Ray is not installed: pip install "motionlab[cluster]" (CI installs it)')
+    targets = _targets(library)
+    local = ex.expand([str(library / "clips")], targets, tmp_path / "local", ckpt, FAST)
+    remote = ex.expand([str(library / "clips")], targets, tmp_path / "ray", ckpt, FAST, backend="ray", workers=2)
+    assert remote.done == local.done == 9
+    assert _bvh_files(tmp_path / "ray") == _bvh_files(tmp_path / "local")
+    for f in _bvh_files(tmp_path / "local"):
+        assert (tmp_path / "ray" / f).read_text() == (tmp_path / "local" / f).read_text(), f
+
+    def rows(folder):
+        with open(folder / ex.MANIFEST) as f:
+            return [{k: v for k, v in r.items() if k != "seconds"} for r in csv.DictReader(f)]
+
+    assert rows(tmp_path / "ray") == rows(tmp_path / "local")
