@@ -1,0 +1,208 @@
+"""Throughput of expanding a motion database: one process per pair vs batched vs Ray.
+
+Same inputs, same run: source clips × characters, retargeted three ways, each writing BVH files:
+
+1. ``motionlab retarget`` once per pair (a new Python process each: import, checkpoint, solve);
+2. ``expand`` in this process (network loaded once, pairs of equal length in one batch);
+3. ``expand --backend ray`` with a local Ray instance of 2 workers (when Ray is installed).
+
+Throughput is source frames (at the checkpoint's rate) per second of wall time, start-up
+included. The machine's load average is printed before and after (other jobs share the CPU).
+The outputs of all three are compared byte for byte.
+
+Usage::
+
+    MOTIONLAB_DATA=/work/shared/data python benchmarks/bench_expand.py              # 4 Aj clips x 4 characters
+    python benchmarks/bench_expand.py --clips 10 --device cuda                     # on a GPU
+    python benchmarks/bench_expand.py --synthetic                                  # no real data
+    python benchmarks/bench_expand.py --memory                                     # bytes per frame of a batch
+    python benchmarks/bench_expand.py --verify OUT                                 # OUT's files == retarget's
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+
+
+def _load() -> str:
+    return "load average " + " ".join(f"{x:.2f}" for x in os.getloadavg())
+
+
+def _inputs(args, folder: Path):
+    """Source clip paths and ``NAME=rig.bvh`` character specs (presets written as T-pose rigs)."""
+    from motionlab.core import bvh, humanoid
+    from motionlab.core.motion import Motion
+    from motionlab.retargeting import expand as ex
+
+    if args.synthetic:
+        from motionlab import synthetic
+
+        (folder / "clips").mkdir()
+        clips = synthetic.dataset(args.clips, seed=7, num_frames=150)
+        sources = [bvh.save(folder / "clips" / f"clip{i}.bvh", m) for i, m in enumerate(clips)]
+        names = [f"char{i}" for i in range(args.characters)]
+        skeletons = synthetic.character_set(args.characters, seed=3)
+    else:
+        from motionlab import data
+        from motionlab.retargeting.evaluate import DEFAULT_ANIMATIONS, DEFAULT_TARGETS
+
+        root = data.data_root() / "mixamo"
+        sources = [root / "Aj" / f"{a}.bvh" for a in DEFAULT_ANIMATIONS[: args.clips]]
+        real = list(DEFAULT_TARGETS[: max(args.characters - 1, 1)])
+        names = real + list(ex.PRESETS)[: args.characters - len(real)]
+        skeletons = [humanoid.to_canonical_skeleton(bvh.load(root / t / "Running.bvh").skeleton) for t in real]
+        skeletons += [ex.characters(presets=[n])[0].skeleton for n in names[len(real) :]]
+    (folder / "rigs").mkdir(exist_ok=True)
+    specs = []
+    for name, sk in zip(names, skeletons):
+        rig = Motion(sk, np.tile([1.0, 0, 0, 0], (2, 22, 1)), np.tile(sk.offsets[0], (2, 1)), 60.0)
+        specs.append(f"{name}={bvh.save(folder / 'rigs' / f'{name}.bvh', rig)}")
+    return [str(s) for s in sources], specs
+
+
+def _per_process(sources, specs, out: Path, args) -> float:
+    env = dict(
+        os.environ,
+        PYTHONPATH=os.pathsep.join([str(Path(__file__).resolve().parents[1]), os.environ.get("PYTHONPATH", "")]),
+    )
+    start = time.perf_counter()
+    for s in sources:
+        for spec in specs:
+            name, rig = spec.split("=", 1)
+            (out / name).mkdir(parents=True, exist_ok=True)
+            cmd = [
+                sys.executable,
+                "-m",
+                "motionlab",
+                "retarget",
+                s,
+                "--target",
+                rig,
+                "-o",
+                str(out / name / f"{Path(s).stem}.bvh"),
+                "-q",
+            ]
+            if args.device:
+                cmd += ["--device", args.device]
+            subprocess.run(cmd, check=True, env=env)
+    return time.perf_counter() - start
+
+
+def _expand(sources, specs, out: Path, args, backend: str):
+    from motionlab.retargeting import expand as ex
+    from motionlab.retargeting.cli import _load_checkpoint
+
+    start = time.perf_counter()
+    ckpt = _load_checkpoint(None, args.device)
+    job = ex.expand(sources, ex.characters(*specs), out, ckpt, backend=backend, workers=2)
+    return time.perf_counter() - start, job
+
+
+def _same(a: Path, b: Path) -> tuple[int, int]:
+    files = sorted(p.relative_to(a) for p in a.rglob("*.bvh"))
+    same = sum((b / f).is_file() and (b / f).read_bytes() == (a / f).read_bytes() for f in files)
+    return same, len(files)
+
+
+def _memory(args) -> None:
+    """Peak resident memory of solve_many at two batch sizes, in child processes: the slope per frame."""
+    code = (
+        "import resource,sys,torch,numpy as np\n"
+        "from motionlab.retargeting import load_default, solver\n"
+        "ck=load_default('cpu'); N,T=int(sys.argv[1]),150\n"
+        "x=torch.randn(N,T,70); th=torch.nn.functional.normalize(torch.randn(N,T,22,4),dim=-1)\n"
+        "off=torch.tensor(np.array(ck.skeleton.offsets),dtype=torch.float32).expand(N,22,3).clone()\n"
+        "b=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss\n"
+        "solver.solve_many(ck.model,x,th,off,torch.full((N,T),0.9),solver.SolverConfig(max_steps=3,threshold=0,patience=0))\n"
+        "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss-b)\n"
+    )
+    kb = {}
+    for n in (10, 100):
+        r = subprocess.run([sys.executable, "-c", code, str(n)], check=True, capture_output=True, text=True)
+        kb[n * 150] = int(r.stdout.split()[-1])
+    (f0, k0), (f1, k1) = sorted(kb.items())
+    print(f"peak memory of a solve_many step: {k0 / 1024:.0f} MiB at {f0} frames, {k1 / 1024:.0f} MiB at {f1} frames; "
+          f"{1024 * (k1 - k0) / (f1 - f0) / 1000:.1f} kB per frame (batching.BYTES_PER_FRAME assumes 32 kB)")  # fmt: skip
+
+
+def _verify(out: Path) -> None:
+    """Every ok row of OUT's manifest against the single-pair path (pipeline.retarget), byte for byte."""
+    from motionlab import retargeting
+    from motionlab.core import bvh, humanoid
+    from motionlab.retargeting import expand as ex
+
+    ckpt = retargeting.load_default()
+    rows = [r for r in ex.read_manifest(out) if r["status"] == "ok"]
+    sources: dict = {}
+    same = 0
+    for r in rows:
+        origin = r["character_file"]
+        if origin.startswith("preset:"):
+            target = ex.characters(presets=[origin[len("preset:") :]])[0].skeleton
+        else:
+            target = humanoid.to_canonical_skeleton(bvh.load(origin).skeleton)
+        if r["source"] not in sources:
+            sources[r["source"]] = bvh.load(r["source"])
+        single = retargeting.retarget(sources[r["source"]], target, ckpt)
+        same += (out / r["output"]).read_text() == bvh.dumps(single.motion)
+    print(f"verify {out}: {same} of {len(rows)} outputs equal the single-pair path byte for byte; "
+          f"{len(list(out.rglob('*.bvh')))} BVH files, {len(rows)} ok rows")  # fmt: skip
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--clips", type=int, default=4, help="source clips (Aj's retarget_gt animations; default 4)")
+    p.add_argument("--characters", type=int, default=4, help="characters: real ones, then presets (default 4)")
+    p.add_argument("--synthetic", action="store_true", help="synthetic clips and characters instead of MOTIONLAB_DATA")
+    p.add_argument("--device", help="torch device for all three (default: cuda if available, else cpu)")
+    p.add_argument("--memory", action="store_true", help="only measure memory per batch frame")
+    p.add_argument("--verify", metavar="OUT", help="only check OUT's outputs against the single-pair path")
+    args = p.parse_args()
+    if args.memory:
+        return _memory(args)
+    if args.verify:
+        return _verify(Path(args.verify))
+    print(f"torch {torch.__version__}, {torch.get_num_threads()} threads, {os.cpu_count()} CPUs; {_load()}")
+    with tempfile.TemporaryDirectory() as d:
+        d = Path(d)
+        sources, specs = _inputs(args, d)
+        from motionlab.core import bvh
+
+        frames = sum(bvh.load(s).resample(60.0).num_frames for s in sources) * len(specs)
+        pairs = len(sources) * len(specs)
+        print(f"{len(sources)} clips x {len(specs)} characters = {pairs} pairs, {frames} source frames")
+        results = {}
+        t = _per_process(sources, specs, d / "per_process", args)
+        results["one process per pair"] = t
+        t, job = _expand(sources, specs, d / "local", args, "local")
+        results["local batched"] = t
+        print(f"  local: {job.batches} batches, {job.done} outputs")
+        try:
+            import ray  # noqa: F401
+
+            t, job = _expand(sources, specs, d / "ray", args, "ray")
+            results["Ray local, 2 workers"] = t
+        except ImportError:
+            print('  Ray local: skipped (Ray is not installed: pip install "motionlab[cluster]")')
+        base = frames / results["one process per pair"]
+        for label, t in results.items():
+            fps = frames / t
+            print(f"{label:<22} {t:8.1f} s  {fps:8.0f} source frames/s  {fps / base:6.1f}x")
+        for other in ("local", "ray"):
+            if (d / other).is_dir():
+                s, n = _same(d / "per_process", d / other)
+                print(f"outputs of {other} equal to one-process-per-pair: {s} of {n} files byte for byte")
+        print(_load())
+
+
+if __name__ == "__main__":
+    main()
