@@ -3,7 +3,8 @@
 Same inputs, same run: source clips × characters, retargeted three ways, each writing BVH files:
 
 1. ``motionlab retarget`` once per pair (a new Python process each: import, checkpoint, solve);
-2. ``expand`` in this process (network loaded once, pairs of equal length in one batch);
+2. ``expand`` in this process (network loaded once, pairs of equal length in one batch), with
+   its default of one torch thread and, for comparison, with two;
 3. ``expand --backend ray`` with a local Ray instance of 2 workers (when Ray is installed).
 
 Throughput is source frames (at the checkpoint's rate) per second of wall time, start-up
@@ -97,13 +98,13 @@ def _per_process(sources, specs, out: Path, args) -> float:
     return time.perf_counter() - start
 
 
-def _expand(sources, specs, out: Path, args, backend: str):
+def _expand(sources, specs, out: Path, args, backend: str, threads=None):
     from motionlab.retargeting import expand as ex
     from motionlab.retargeting.cli import _load_checkpoint
 
     start = time.perf_counter()
     ckpt = _load_checkpoint(None, args.device)
-    job = ex.expand(sources, ex.characters(*specs), out, ckpt, backend=backend, workers=2)
+    job = ex.expand(sources, ex.characters(*specs), out, ckpt, backend=backend, workers=2, threads=threads)
     return time.perf_counter() - start, job
 
 
@@ -186,6 +187,9 @@ def main() -> None:
         t, job = _expand(sources, specs, d / "local", args, "local")
         results["local batched"] = t
         print(f"  local: {job.batches} batches, {job.done} outputs")
+        if not args.device or args.device == "cpu":
+            t, job = _expand(sources, specs, d / "local2", args, "local", threads=2)
+            results["local batched, 2 threads"] = t
         try:
             import ray  # noqa: F401
 
@@ -197,7 +201,7 @@ def main() -> None:
         for label, t in results.items():
             fps = frames / t
             print(f"{label:<22} {t:8.1f} s  {fps:8.0f} source frames/s  {fps / base:6.1f}x")
-        for other in ("local", "ray"):
+        for other in ("local", "local2", "ray"):
             if (d / other).is_dir():
                 s, n = _same(d / "per_process", d / other)
                 print(f"outputs of {other} equal to one-process-per-pair: {s} of {n} files byte for byte")

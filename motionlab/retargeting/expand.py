@@ -1,7 +1,7 @@
 """Expand a motion database: many clips onto many characters in one batched, resumable job.
 
 The retargeting paper's stated purpose is to *expand motion databases*: one performer's
-library, generated for every new character (``seeds/000_*.txt``, §1). :func:`expand` takes
+library, generated for every new character (``seeds/000_*.txt``, Abstract). :func:`expand` takes
 source clips × target characters and writes ``OUT/<character>/<clip>.bvh`` plus
 ``OUT/manifest.csv``, one row per (clip, character)::
 
@@ -43,6 +43,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import torch
 
 from motionlab.core import bvh, humanoid, metrics
 from motionlab.core.skeleton import Skeleton
@@ -371,6 +372,7 @@ def expand(
     skate_ratio: float = 2.0,
     progress: bool = False,
     on_batch: Callable[[int, list[dict]], None] | None = None,
+    threads: int | None = None,
 ) -> ExpandResult:
     """Retarget every source clip onto every character; see the module docstring.
 
@@ -389,6 +391,9 @@ def expand(
     progress : tqdm bar over batches
     on_batch : called as ``on_batch(batch_index, rows)`` after each batch is on disk (tests use it
         to interrupt a run)
+    threads : torch CPU threads during the job (restored afterwards). Default: 1 on the CPU — a
+        step's tensors are small, and on the shared 2-core CPU one thread ran the same batches
+        4-9x faster than two (``benchmarks/bench_expand.py`` prints both); unchanged on a GPU.
 
     Returns
     -------
@@ -396,6 +401,23 @@ def expand(
     """
     if backend not in ("local", "ray"):
         raise ValueError(f"backend must be 'local' or 'ray', got {backend!r}")
+    before = torch.get_num_threads()
+    if threads is None:
+        threads = 1 if checkpoint.device.type == "cpu" else before
+    torch.set_num_threads(threads)
+    try:
+        return _expand(
+            sources, targets, out, checkpoint, solver, root_mode, force, max_frames, backend, address, workers,
+            max_penetration_cm, skate_ratio, progress, on_batch,
+        )  # fmt: skip
+    finally:
+        torch.set_num_threads(before)
+
+
+def _expand(
+    sources, targets, out, checkpoint, solver, root_mode, force, max_frames, backend, address, workers,
+    max_penetration_cm, skate_ratio, progress, on_batch,
+) -> ExpandResult:  # fmt: skip
     start = time.perf_counter()
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

@@ -28,10 +28,6 @@ def _cmd_expand(args) -> int:
             raise CLIError(INSTALL_HINT) from None
     if not args.characters and not args.preset:
         raise CLIError("give target characters: --characters FILE.bvh ... and/or --preset NAME ...")
-    if args.threads:
-        import torch
-
-        torch.set_num_threads(args.threads)
     try:
         targets = ex.characters(*args.characters, presets=args.preset)
     except ValueError as e:
@@ -52,6 +48,7 @@ def _cmd_expand(args) -> int:
         max_penetration_cm=args.max_penetration,
         skate_ratio=args.skate_ratio,
         progress=not args.quiet,
+        threads=args.threads or None,
     )
     if not args.quiet:
         print(job.summary())
@@ -87,7 +84,7 @@ def register(subparsers) -> None:
     p.add_argument("--backend", choices=("local", "ray"), default="local")
     p.add_argument("--address", help="Ray cluster address (default: $RAY_ADDRESS, else a local Ray instance)")
     p.add_argument("--workers", type=int, default=2, help="Ray actors (default 2)")
-    p.add_argument("--threads", type=int, default=0, help="torch threads of this process (0: torch's default)")
+    p.add_argument("--threads", type=int, default=0, help="torch threads (default: 1 on the CPU, see expand())")
     p.add_argument("--max-penetration", type=float, default=1.0, metavar="CM", help="flag above this (default 1 cm)")
     p.add_argument(
         "--skate-ratio",

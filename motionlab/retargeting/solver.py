@@ -7,9 +7,12 @@ above the ground::
     L_iter = λ_angle · L_angle(A, B') + λ_foot · L_foot(B'),    λ_angle = 0.3, λ_foot = 0.5
 
 until ``L_iter`` drops below ``threshold``, stops improving (``patience`` steps without a
-relative gain of ``min_delta``), or ``max_steps`` is reached. All sequences of a batch (e.g.
-all windows of a clip, or several clips of equal length) are solved together: their losses are
-averaged, so one Adam run moves every latent.
+relative gain of ``min_delta``), or ``max_steps`` is reached. :func:`solve` treats all sequences
+of a batch (e.g. several clips of equal length) as one problem: their losses are averaged, so one
+Adam run moves every latent. :func:`solve_many` runs the same loop on N independent problems
+(one per sequence: own loss, step size, stopping rule and best iterate), which is how
+:mod:`motionlab.retargeting.expand` solves many (clip, character) pairs at once; each sequence's
+numbers do not depend on the rest of the batch, so its result equals :func:`solve` on it alone.
 
 **Smooth latent updates (our addition).** The decoder works frame by frame, so per-frame
 Adam steps on φ add frame-to-frame jitter (on the Mixamo data the mean acceleration tripled,
