@@ -141,6 +141,7 @@ def _verify(out: Path) -> None:
     from motionlab.core import bvh, humanoid
     from motionlab.retargeting import expand as ex
 
+    torch.set_num_threads(1)  # results do not depend on it; it is faster on a shared CPU
     ckpt = retargeting.load_default()
     rows = [r for r in ex.read_manifest(out) if r["status"] == "ok"]
     sources: dict = {}
