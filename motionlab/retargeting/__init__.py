@@ -10,6 +10,7 @@ match the source and the feet stay above the ground.
 * :mod:`.solver` — the latent iteration; :mod:`.baselines` — copy-rotation;
 * :mod:`.pipeline` — a Motion onto a target skeleton, end to end;
 * :mod:`.evaluate` — Table 1 on real data; :mod:`.cli` — ``motionlab retarget/train/evaluate``.
+* :mod:`.expand` — many clips onto many characters, batched and resumable (``motionlab expand``).
 
 ``load_default()`` returns the small network shipped in ``motionlab/assets`` (trained by this
 package on its own synthetic data), so retargeting works without training first. Re-create it

@@ -304,7 +304,7 @@ class ExpandResult:
 
 
 # ---------------------------------------------------------------------------- the job
-def _row(pr: PairResult, source: str, char: Character, out: Path, source_skate: float, limits) -> dict:
+def _row(pr: PairResult, source: str, char: Character, source_skate: float, limits) -> dict:
     res = pr.result
     h = res.history
     q = quality(res)
@@ -477,7 +477,7 @@ def _expand(
         try:
             for pr in solved:
                 src_path, src_skate = sources_by_clip[pr.clip]
-                row = _row(pr, src_path, chars[pr.character], out, src_skate, limits)
+                row = _row(pr, src_path, chars[pr.character], src_skate, limits)
                 file = out / row["output"]
                 file.parent.mkdir(parents=True, exist_ok=True)
                 fd, tmp = tempfile.mkstemp(dir=file.parent, prefix=f".{file.name}.", suffix=".tmp")
