@@ -53,6 +53,7 @@ __all__ = [
     "fill",
     "fill_rows",
     "smooth_root",
+    "lift_above_floor",
 ]
 
 METHODS = ("slerp", "hermite", "graph")
@@ -338,6 +339,28 @@ def _floor_guard(motion: Motion, a: int, b: int, drop: np.ndarray) -> np.ndarray
     return np.maximum(drop, np.minimum(0.0, floor - low[1:-1]))
 
 
+def lift_above_floor(motion: Motion, a: int, b: int) -> Motion:
+    """A copy of ``motion`` whose frames ``a+1 … b-1`` are raised (root translation, +Y) just enough
+    that no joint but the root goes below the floor of the gap's known ends ``a`` and ``b`` (the
+    lower of their lowest joints).
+
+    SLERP between two strides swings a leg through the floor half-way (measured on the Bandai
+    walks: up to 7 cm); lifting the whole body by the overshoot keeps the feet on the floor at
+    the cost of a small vertical bob, which the eye forgives far more readily than a foot in the
+    ground. Frames already above the floor are untouched.
+    """
+    out = motion.copy()
+    if b - a < 2:
+        return out
+    height = motion[a : b + 1].global_positions()[..., 1]  # (F+2, J)
+    low = (height[:, 1:] if height.shape[1] > 1 else height).min(axis=-1)
+    lift = np.maximum(0.0, min(low[0], low[-1]) - low[1:-1])
+    out.root_pos[a + 1 : b, 1] += lift
+    if out.local_pos is not None:
+        out.local_pos[a + 1 : b, 0] = out.root_pos[a + 1 : b]
+    return out
+
+
 def smooth_root(motion: Motion, anchors, joint: int | None = None) -> Motion:
     """A copy of ``motion`` whose root path through ``anchors`` is C1 (no corners).
 
@@ -409,6 +432,7 @@ def fill(
     method: str = "slerp",
     graph: ActionGraph | None = None,
     curve: str = "linear",
+    root: str = "linear",
 ) -> tuple[Motion, list[FilledGap]]:
     """Fill every NaN frame of ``motion``; returns the filled copy and a report per gap.
 
@@ -421,9 +445,17 @@ def fill(
         ends and key poses is then made C1 by :func:`smooth_root`)
     graph : ActionGraph whose node clips use ``motion``'s skeleton
     curve : α(k) curve for the interpolated parts
+    root : ``"linear"`` (the LaFAN1 baseline) or ``"hermite"``: for ``"slerp"``/``"hermite"``, the
+        reference joint's path across each gap is then the cubic Hermite curve whose end tangents
+        are the velocities measured just outside the gap (:func:`smooth_root` with the gap's two
+        ends as anchors), so a walking character keeps walking through it at the speed it had on
+        both sides; the foot-through-floor guard of :func:`smooth_root` applies. (The ``"graph"``
+        method always does this.)
     """
     if method not in METHODS:
         raise ValueError(f"unknown filling method {method!r}; expected one of {METHODS}")
+    if root not in ("linear", "hermite"):
+        raise ValueError(f"unknown root mode {root!r}; expected 'linear' or 'hermite'")
     if method == "graph":
         if graph is None or not graph.nodes:
             raise ValueError("method='graph' needs an ActionGraph with at least one action")
@@ -446,6 +478,9 @@ def fill(
             mode = "hermite" if method == "hermite" else "linear"
             out = inbetween.fill_between(out, start, stop, curve=curve, root=mode,
                                          rotation="hermite" if method == "hermite" else "slerp")  # fmt: skip
+            if root == "hermite":
+                out = smooth_root(out, [a, b], joint=ref)
+            out = lift_above_floor(out, a, b)
             report.append(FilledGap(start, stop, method))
             continue
         node_a = graph.classify(_frame_features(out, a, before=True)[None])[0]
@@ -474,6 +509,6 @@ def fill(
             if not ok:
                 out = inbetween.fill_between(out, lo + 1, hi, curve=curve)
                 used = "graph+slerp"
-        out = smooth_root(out, anchors, joint=ref)
+        out = lift_above_floor(smooth_root(out, anchors, joint=ref), a, b)
         report.append(FilledGap(start, stop, "graph" if inner else used, path, slots))
     return out, report
