@@ -14,12 +14,15 @@ from motionlab.core.motion import Motion
 __all__ = ["BEHAVIOUR_CLIPS", "behaviours", "walk_clip", "benchmark_clips"]
 
 BEHAVIOUR_CLIPS = {
-    "run": "mixamo/Aj/Running",
-    "walk": "mixamo/Aj/Injured_Walk_Left_Turn",
-    "stand": "mixamo/Aj/Idle",
+    "run": "mixamo/Aj/Run_Arc_Left",
+    "walk": "mixamo/Aj/Catwalk_Walk",
+    "stand": "mixamo/Aj/Ready_Idle",
     "squat": "mixamo/Aj/Standing_To_Crouched",
 }
-"""The real clips (Mixamo Aj, one skeleton) used for each action when data is available."""
+"""The real clips (Mixamo Aj, one skeleton) used for each action when data is available, chosen by
+content (:func:`motionlab.interpolation.labels.check`), not by file name: ``Running.bvh`` is a dive
+roll (hips at 9% of standing height) and ``Idle.bvh`` a crouched idle (58%); ``behaviours()``
+checks every clip against its label and refuses a mismatch."""
 
 _SYNTHETIC = {"run": "run", "walk": "walk", "stand": "idle", "squat": "squat"}
 
@@ -40,9 +43,12 @@ def behaviours(fps: float = 30.0, frames: int = 90, seed: int = 0) -> tuple[dict
     with ``frames`` frames each.
     """
     if data.has_data("mixamo", "Aj"):
-        return {k: _load(v, fps) for k, v in BEHAVIOUR_CLIPS.items()}, "real: Mixamo Aj clips " + ", ".join(
-            v.split("/")[-1] for v in BEHAVIOUR_CLIPS.values()
-        )
+        from motionlab.interpolation import labels
+
+        clips = {k: _load(v, fps) for k, v in BEHAVIOUR_CLIPS.items()}
+        for k, m in clips.items():
+            labels.check(m, k)
+        return clips, "real: Mixamo Aj clips " + ", ".join(v.split("/")[-1] for v in BEHAVIOUR_CLIPS.values())
     from motionlab import synthetic
 
     clips = {k: synthetic.generate(b, None, frames, fps, seed=seed + i) for i, (k, b) in enumerate(_SYNTHETIC.items())}

@@ -19,7 +19,8 @@ distance compares how the stream moved into ``M_c`` with how the graph moves at 
 with ``s(t)`` the stream's joint step into frame ``t`` (m/s) and ``s̄_graph(i)`` the graph clip's
 joint speed at the matched frame ``i`` (mean over ``i−2 … i+2``, never below ``STEP_FLOOR``). The
 graph predicts how fast the body moves *at this pose* (slow at a walk's double support, fast in
-swing); the running median of ``r`` (``WINDOW`` frames on each side, the larger side) removes
+swing); the running median of ``r`` (``WINDOW`` frames on each side, the larger side, and the
+two adjacent values, as in :func:`consecutive_gaps`, so only an isolated jump counts) removes
 the one factor by which this take is slower or faster than the graph's recordings (measured on
 the Bandai walk styles: an exhausted walk moves at about half the speed of a normal one, which a
 raw ``r > Δ`` rule flagged as 35 false gaps in 58 clean takes). With nothing missing ``D ≈ 1``;
@@ -233,8 +234,10 @@ def track(motion: Motion, graph, delta: float | None = None) -> GraphTrack:
     floor = STEP_FLOOR * body_height(motion)
     s = np.concatenate([[0.0], joint_steps(motion) * motion.fps])  # step INTO each frame, m/s
     rel = s / np.maximum(speed[best], floor)  # the stream's speed over the graph's at the match
-    before, after = _side_medians(rel[1:], WINDOW)
-    typical = np.concatenate([[np.inf], np.fmax(before, after)])
+    r = rel[1:]
+    before, after = _side_medians(r, WINDOW)
+    near = np.fmax(np.concatenate([[np.nan], r[:-1]]), np.concatenate([r[1:], [np.nan]]))
+    typical = np.concatenate([[np.inf], np.fmax(np.fmax(before, after), near)])
     typical = np.where(np.isfinite(typical) & (typical > 0), typical, np.inf)
     dist = np.where(s > floor, rel / typical, 0.0)
     dist[0] = 0.0
