@@ -5,9 +5,9 @@
 * NaN rows (a capture system that knows it lost the markers): :func:`nan_gaps`;
 * timestamps that jump by more than one frame period: :func:`timestamp_gaps`;
 * nothing at all — the frames were just dropped, as in a BVH file with a constant frame time.
-  Then the paper's rule applies: the distance ``D`` between consecutive frames is compared with a
-  threshold ``Δ``; ``D > Δ`` means frames are missing (:func:`distance_gaps`). We set
-  ``Δ = factor × median(D)`` and estimate how many frames are missing from ``D / median(D)``.
+  Then the paper's rule ``D > Δ`` applies, the stream tracked in the action graph or against its
+  own neighbouring steps, and the missing count comes from the motion on both sides: see
+  :mod:`.detect`.
 
 **Filling** (:func:`fill`). Each gap ``[start, stop)`` is bounded by known frames ``a = start − 1``
 and ``b = stop``:
@@ -48,7 +48,6 @@ __all__ = [
     "FilledGap",
     "nan_gaps",
     "timestamp_gaps",
-    "distance_gaps",
     "insert_missing",
     "fill",
     "fill_rows",
@@ -109,29 +108,6 @@ def timestamp_gaps(times, fps: float) -> list[tuple[int, int]]:
         raise ValueError("expected strictly increasing timestamps (T,) in seconds")
     steps = np.rint(np.diff(t) * fps).astype(np.int64)
     return [(int(i), int(s - 1)) for i, s in enumerate(steps) if s > 1]
-
-
-def distance_gaps(motion: Motion, factor: float = 4.0, threshold: float | None = None) -> list[tuple[int, int]]:
-    """Dropped frames by the paper's ``D > Δ`` rule: ``(after frame i, estimated missing count)``.
-
-    ``D(t)`` is the distance between frames ``t`` and ``t+1``: heading-frame joint positions plus
-    the reference joint's ground displacement (scaled by √J so it weighs like the whole body).
-    ``Δ = threshold`` if given, else ``factor × median(D)``; the missing count is
-    ``round(D / median(D)) − 1`` (at least 1).
-    """
-    if motion.num_frames < 3:
-        return []
-    if factor <= 1 and threshold is None:
-        raise ValueError(f"factor must exceed 1 (a multiple of the typical frame step), got {factor}")
-    f = pose_features(motion, velocity_weight=0.0)[:, : 3 * motion.skeleton.num_joints]
-    _, ground = reference_transform(motion)
-    ground = ground * np.array([1.0, 0.0, 1.0]) * np.sqrt(motion.skeleton.num_joints)
-    d = np.linalg.norm(np.diff(np.concatenate([f, ground], axis=1), axis=0), axis=1)
-    typical = float(np.median(d))
-    if typical <= 1e-9:
-        return []
-    delta = factor * typical if threshold is None else float(threshold)
-    return [(int(i), max(1, int(round(d[i] / typical)) - 1)) for i in np.flatnonzero(d > delta)]
 
 
 def insert_missing(motion: Motion, missing: list[tuple[int, int]]) -> tuple[Motion, list[tuple[int, int]]]:

@@ -58,7 +58,7 @@ class ActionMeasures:
 
 
 RULES = {
-    "run": {"hip_min": (0.65, None), "speed": (2.0, None), "flight": (0.05, None)},
+    "run": {"hip_min": (0.65, None), "speed": (2.0, None), "flight": (0.01, None)},
     "walk": {"hip_min": (0.65, None), "speed": (0.4, 2.5), "flight": (None, 0.05)},
     "stand": {"hip_median": (0.8, None), "speed": (None, 0.3), "flight": (None, 0.05)},
     "squat": {"hip_min": (None, 0.7), "speed": (None, 0.6), "flight": (None, 0.05)},

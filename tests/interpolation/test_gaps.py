@@ -40,12 +40,14 @@ def test_fill_rows_linear_and_edges():
         gaps.fill_rows(np.full((3, 2), np.nan))
 
 
-def test_distance_rule_finds_dropped_frames():
+def test_detected_gap_is_inserted():
+    from motionlab.interpolation import detect
+
     m = toy_motion(120)
     keep = np.r_[0:40, 48:120]
-    found = gaps.distance_gaps(m[keep])
+    found = detect.detect(m[keep])
     assert [i for i, _ in found] == [39]
-    assert abs(found[0][1] - 8) <= 2
+    assert abs(found[0][1] - 8) <= 1
     expanded, where = gaps.insert_missing(m[keep], found)
     assert where == [(40, 40 + found[0][1])]
     assert expanded.num_frames == len(keep) + found[0][1]
@@ -80,6 +82,27 @@ def test_graph_fill_across_actions_places_key_poses():
     assert np.all(np.isfinite(out.local_rot))
     with pytest.raises(ValueError, match="ActionGraph"):
         gaps.fill(joined, method="graph")
+
+
+def test_graph_fill_passes_through_the_key_pose_at_the_best_transition_frame():
+    """Fails if the fill bypasses the key poses: the anchor holds the intermediate node's key frame,
+    and moving that node's key frames moves what the fill inserts."""
+    from motionlab.interpolation.inbetween import concatenate
+
+    g, run, walk, stand = _run_walk_stand()
+    joined, _ = gaps.insert_missing(concatenate([run[:30], stand[:20]]), [(29, 20)])
+    out, report = gaps.fill(joined, method="graph", graph=g)
+    (slot,) = report[0].anchors
+    _, j, _ = g.best_transition("run", "walk")
+    assert j in g.nodes["walk"].keys
+    np.testing.assert_allclose(out.local_rot[slot, 1:], walk.local_rot[j, 1:])
+    other = next(
+        k for k in range(walk.num_frames) if k != j and not np.allclose(walk.local_rot[k, 1:], walk.local_rot[j, 1:])
+    )
+    g.nodes["walk"].keys = np.array([other])
+    g._best.clear()
+    out2, _ = gaps.fill(joined, method="graph", graph=g)
+    np.testing.assert_allclose(out2.local_rot[slot, 1:], walk.local_rot[other, 1:])
 
 
 @pytest.mark.realdata
