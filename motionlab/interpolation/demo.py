@@ -8,10 +8,12 @@ from __future__ import annotations
 
 import warnings
 
+import numpy as np
+
 from motionlab import data
 from motionlab.core.motion import Motion
 
-__all__ = ["BEHAVIOUR_CLIPS", "behaviours", "walk_clip", "benchmark_clips"]
+__all__ = ["BEHAVIOUR_CLIPS", "trim_frozen", "behaviours", "walk_clip", "benchmark_clips"]
 
 BEHAVIOUR_CLIPS = {
     "run": "mixamo/Aj/Run_Arc_Left",
@@ -27,13 +29,24 @@ checks every clip against its label and refuses a mismatch."""
 _SYNTHETIC = {"run": "run", "walk": "walk", "stand": "idle", "squat": "squat"}
 
 
+def trim_frozen(motion: Motion) -> Motion:
+    """``motion`` without the trailing frames that repeat the frame before them exactly (some Mixamo
+    exports pad a clip with a frozen pose: ``Run_Arc_Left`` stops moving after 33 of its 60 frames)."""
+    same = (motion.local_rot[1:] == motion.local_rot[:-1]).all(axis=(1, 2)) & (
+        motion.root_pos[1:] == motion.root_pos[:-1]
+    ).all(axis=1)
+    moving = np.flatnonzero(~same)
+    last = int(moving[-1]) + 2 if moving.size else 1
+    return motion[: max(last, 2)] if last < motion.num_frames else motion
+
+
 def _load(rel: str, fps: float) -> Motion:
     from motionlab.core import bvh, humanoid
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)
         m = humanoid.to_canonical(bvh.load(data.clip_path(*rel.split("/"))))
-    return m.resample(fps)
+    return trim_frozen(m).resample(fps)
 
 
 def behaviours(fps: float = 30.0, frames: int = 90, seed: int = 0) -> tuple[dict[str, Motion], str]:
