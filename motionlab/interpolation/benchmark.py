@@ -5,14 +5,19 @@ Protocol (as in the LaFAN1 evaluation code, restated):
 * clips at 30 fps, cut into windows of 65 frames every 40 frames; each window is moved so the
   root's mean ground position over the window is the origin, and turned about +Y so that the root
   of the last context frame (frame 9) faces +Z; local quaternions are made sign-continuous in time;
-* for a transition length ``N`` in {5, 15, 30}: frames 0–9 are the context, frames 10 … 9+N are to
-  be filled, frame 10+N is the target (only that one future frame is given);
+* for a transition length ``N`` in {5, 15, 30, 45}: frames 0–9 are the context, frames 10 … 9+N
+  are to be filled, frame 10+N is the target (only that one future frame is given);
+* every method's output (local quaternions) is made sign-continuous with the last context frame
+  (:func:`continuous` over ``[frame 9, outputs …]``) *before* FK, as LaFAN1's inputs are; nothing
+  is flipped at scoring time — a method whose quaternions jump to the other hemisphere pays for
+  it in L2Q and NPSS, exactly as in the official code;
 * **L2Q**: mean over windows and filled frames of ``‖q̂ − q‖₂`` over all joints' *global*
-  quaternions stacked (each predicted quaternion takes the sign closer to the truth, so the
-  arbitrary ±q choice never counts as an error);
+  quaternions stacked (the truth: FK of the sign-continuous local quaternions);
 * **L2P**: mean over windows and frames of ``‖(x̂ − μ)/σ − (x − μ)/σ‖₂`` over all joints' global
   positions stacked, with per-coordinate μ, σ of global positions. LaFAN1 takes them from its
-  training subjects; we take them from all windows (50 frames every 20) of the evaluated clips;
+  training subjects; here they come from a fixed set of clips of the *same skeleton* kept apart
+  from the scored windows (``benchmarks/bench_inbetween.py`` names both sets), one skeleton at a
+  time (statistics mixing two rigs mean nothing for either);
 * **NPSS** (Gopalakrishnan et al. 2019): per dimension of the stacked global quaternions, the
   earth mover's distance between the normalised power spectra (real FFT part squared, cumulative)
   of truth and prediction, averaged with the truth's total power as weights.
@@ -46,6 +51,7 @@ __all__ = [
     "load_clips",
     "make_windows",
     "continuous",
+    "continue_from_context",
     "position_stats",
     "l2q",
     "l2p",
@@ -59,7 +65,7 @@ __all__ = [
     "format_table",
 ]
 
-GAPS = (5, 15, 30)
+GAPS = (5, 15, 30, 45)
 N_PAST = 10
 
 
@@ -182,10 +188,17 @@ def position_stats(motions: Sequence[Motion]) -> tuple[np.ndarray, np.ndarray]:
 
 
 def l2q(pred_global_rot, true_global_rot) -> float:
-    """Mean over windows and frames of ‖q̂ − q‖ over all joints (W, N, J, 4); sign-aligned."""
+    """Mean over windows and frames of ‖q̂ − q‖ over all joints (W, N, J, 4), as given: no sign is
+    flipped here (make the prediction sign-continuous with its context first, see :func:`evaluate`)."""
     p, t = np.asarray(pred_global_rot), np.asarray(true_global_rot)
-    p = np.where(np.sum(p * t, axis=-1, keepdims=True) < 0, -p, p)
     return float(np.mean(np.sqrt(np.sum((p - t) ** 2, axis=(-2, -1)))))
+
+
+def continue_from_context(rot, last_context) -> np.ndarray:
+    """Local quaternions (W, N, J, 4) made sign-continuous in time starting from the last context
+    frame (W, J, 4), which keeps its sign (LaFAN1's treatment of inputs, applied to outputs)."""
+    seq = np.concatenate([np.asarray(last_context)[:, None], np.asarray(rot, dtype=np.float64)], axis=1)
+    return continuous(seq, axis=1)[:, 1:]
 
 
 def l2p(pred_global_pos, true_global_pos, mean, std) -> float:
@@ -300,11 +313,10 @@ def evaluate(
             raise ValueError(f"windows of {T} frames cannot hold {n_past} context + {gap} gap + 1 target frames")
         sl = slice(n_past, n_past + gap)
         true_rot, true_pos = fk(windows.local_rot[:, sl], windows.trans[:, sl], windows.parents)
-        true_rot = continuous(true_rot, axis=1)
         for name, method in methods.items():
             rot, trans = method(windows, n_past, gap)
+            rot = continue_from_context(rot, windows.local_rot[:, n_past - 1])
             g_rot, g_pos = fk(rot, trans, windows.parents)
-            g_rot = np.where(np.sum(g_rot * true_rot, axis=-1, keepdims=True) < 0, -g_rot, g_rot)
             res[(name, "L2Q", gap)] = l2q(g_rot, true_rot)
             res[(name, "L2P", gap)] = l2p(g_pos, true_pos, mean, std)
             flat = lambda x: x.reshape(x.shape[0], x.shape[1], -1)  # noqa: E731
