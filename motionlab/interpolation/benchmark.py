@@ -60,6 +60,7 @@ __all__ = [
     "method_interpolation",
     "method_hermite",
     "method_library",
+    "choose_max_cost",
     "action_label",
     "evaluate",
     "format_table",
@@ -268,33 +269,83 @@ def action_label(name: str) -> str:
     return re.sub(r"[_-]?\d+$", "", name).lower()
 
 
-def method_library(library, k: int = 1, leave_one_out: bool = True, same_action: bool = True) -> Method:
+def method_library(
+    library, k: int = 1, leave_one_out: bool = True, same_action: bool = True, max_cost: float | None = None
+) -> Method:
     """motionlab's key-pose-guided filling (:class:`~.library.MotionLibrary`) as a benchmark method.
 
     With ``leave_one_out`` the library clip with the window's own clip name is never used. With
     ``same_action`` a gap is filled only from recordings of its own action node (the library's
-    labels against :func:`action_label` of the window's clip); when the node holds no other
-    recording the gap falls back to plain interpolation, which is what the paper does inside a node.
+    labels against :func:`action_label` of the window's clip). A gap whose best stretch costs more
+    than ``max_cost`` (no recording matches its ends well; see :func:`choose_max_cost`), or whose
+    node holds no other recording, falls back to plain interpolation, which is what the paper does
+    inside a node.
     """
 
     def run(w: Windows, n_past: int, gap: int):
-        a, b = n_past - 1, n_past + gap
-        exclude = None
-        if leave_one_out:
-            index = {name: i for i, name in enumerate(library.names)}
-            exclude = np.array([index.get(w.names[c], -1) for c in w.clip])
-        labels = [action_label(w.names[c]) for c in w.clip] if same_action else None
-        rot, trans, cost = library.fill(
-            w.local_rot[:, a - 1 : a + 1], w.trans[:, a - 1 : a + 1], w.local_rot[:, b], w.trans[:, b], gap,
-            k=k, exclude_clip=exclude, query_labels=labels,
-        )  # fmt: skip
-        none = ~np.isfinite(cost)
+        rot, trans, cost = _library_fill(library, w, n_past, gap, k, leave_one_out, same_action)
+        none = ~np.isfinite(cost) if max_cost is None else ~(cost <= max_cost)
         if np.any(none):
             i_rot, i_trans = method_interpolation(w, n_past, gap)
             rot[none], trans[none] = i_rot[none], i_trans[none]
         return rot, trans
 
     return run
+
+
+def _library_fill(library, w: Windows, n_past: int, gap: int, k: int, leave_one_out: bool, same_action: bool):
+    a, b = n_past - 1, n_past + gap
+    exclude = None
+    if leave_one_out:
+        index = {name: i for i, name in enumerate(library.names)}
+        exclude = np.array([index.get(w.names[c], -1) for c in w.clip])
+    labels = [action_label(w.names[c]) for c in w.clip] if same_action else None
+    return library.fill(
+        w.local_rot[:, a - 1 : a + 1], w.trans[:, a - 1 : a + 1], w.local_rot[:, b], w.trans[:, b], gap,
+        k=k, exclude_clip=exclude, query_labels=labels,
+    )  # fmt: skip
+
+
+def _window_l2p(w: Windows, rot, trans, n_past: int, gap: int, stats) -> np.ndarray:
+    """L2P of each window (W,) (the mean over its filled frames)."""
+    mean, std = stats
+    sl = slice(n_past, n_past + gap)
+    _, true_pos = fk(w.local_rot[:, sl], w.trans[:, sl], w.parents)
+    _, pos = fk(rot, trans, w.parents)
+    d = (pos - true_pos).reshape(pos.shape[:2] + (-1,)) / std
+    return np.sqrt(np.sum(d * d, axis=-1)).mean(axis=1)
+
+
+def choose_max_cost(
+    windows: Windows,
+    library,
+    stats,
+    gaps: Sequence[int] = (15, 30),
+    k: int = 1,
+    same_action: bool = True,
+    n_past: int = N_PAST,
+) -> float:
+    """The matching cost above which the library fill is not trusted, chosen on ``windows`` that
+    must be kept apart from any scored window (leave-one-clip-out fills).
+
+    Every window's best-stretch cost and its L2P with the library fill and with plain
+    interpolation are computed at each gap; the threshold is the one (among the observed costs,
+    and ``inf``) that minimises the summed L2P when windows above it are interpolated instead.
+    """
+    costs, lib_err, int_err = [], [], []
+    for gap in gaps:
+        rot, trans, cost = _library_fill(library, windows, n_past, gap, k, True, same_action)
+        i_rot, i_trans = method_interpolation(windows, n_past, gap)
+        ok = np.isfinite(cost)
+        rot[~ok], trans[~ok] = i_rot[~ok], i_trans[~ok]
+        costs.append(np.where(ok, cost, np.inf))
+        lib_err.append(_window_l2p(windows, rot, trans, n_past, gap, stats))
+        int_err.append(_window_l2p(windows, i_rot, i_trans, n_past, gap, stats))
+    c, lib, itp = np.concatenate(costs), np.concatenate(lib_err), np.concatenate(int_err)
+    candidates = np.concatenate([[-np.inf], np.unique(c[np.isfinite(c)]), [np.inf]])
+    total = [np.sum(np.where(c <= t, lib, itp)) for t in candidates]
+    best = float(candidates[int(np.argmin(total))])
+    return max(best, 0.0)
 
 
 def evaluate(
@@ -330,9 +381,9 @@ def format_table(res: dict, gaps: Sequence[int] = GAPS) -> str:
     lines = []
     for metric, fmt in (("L2Q", "{:7.3f}"), ("L2P", "{:7.3f}"), ("NPSS", "{:7.4f}")):
         lines.append(f"=== {metric} ===")
-        lines.append(f"{'gap (frames)':<28}" + "".join(f"{g:>8d}" for g in gaps))
+        lines.append(f"{'gap (frames)':<32}" + "".join(f"{g:>8d}" for g in gaps))
         for m in methods:
-            lines.append(f"{m:<28}" + "".join(" " + fmt.format(res[(m, metric, g)]) for g in gaps))
+            lines.append(f"{m:<32}" + "".join(" " + fmt.format(res[(m, metric, g)]) for g in gaps))
         lines.append("")
     return "\n".join(lines)
 
