@@ -33,9 +33,8 @@ from pathlib import Path
 import numpy as np
 
 from motionlab.core import bvh
-from motionlab.interpolation import detect, gaps
+from motionlab.interpolation import detect, gap_eval
 from motionlab.interpolation.action_graph import ActionGraph
-from motionlab.interpolation.alignment import reference_joint, reference_transform
 
 REMOVED = (10, 20, 30)
 
@@ -72,64 +71,31 @@ def false_gaps(root: Path) -> None:
         print(f"   FLAGGED {f}: steps {hits}")
 
 
-def _root_path(m, joint: int) -> np.ndarray:
-    _, pos = reference_transform(m, joint=joint)
-    return pos
-
-
-def _lowest(m) -> np.ndarray:
-    """Lowest non-root joint per frame (T,), metres (the root of Bandai rigs is a floor marker)."""
-    y = m.global_positions()[..., 1]
-    return y[:, 1:].min(axis=1)
-
-
-def removed_frames(name: str, files: list[Path], rng) -> dict:
-    rows = []
+def removed_frames(name: str, files: list[Path], rng) -> list:
+    results = []
     for f in files:
         m = bvh.load(f)
-        ref = reference_joint(m)
-        truth_root = _root_path(m, ref)
-        floor = float(_lowest(m).min())
         for n in REMOVED:
             lo, hi = 20, m.num_frames - n - 20
             if hi <= lo:
                 continue
-            s = int(rng.integers(lo, hi))
-            cut = m[np.r_[0:s, s + n : m.num_frames]]
-            found = detect.consecutive_gaps(cut)
-            tp = int((s - 1) in found)
-            row = {"file": f.name, "n": n, "tp": tp, "fp": len(found) - tp, "est": None}
-            if tp:
-                est = detect.estimate_missing(cut, [s - 1])[0]
-                expanded, _ = gaps.insert_missing(cut, [(s - 1, est)])
-                filled, _ = gaps.fill(expanded, method="slerp", root="hermite")
-                path = _root_path(filled, ref)[s - 1 : s + est + 1]  # a, the est filled frames, b
-                u_fill = np.linspace(0.0, 1.0, est + 2)
-                u_true = np.arange(1, n + 1) / (n + 1)
-                fill_at = np.stack([np.interp(u_true, u_fill, path[:, k]) for k in range(3)], axis=1)
-                err = np.linalg.norm(fill_at - truth_root[s : s + n], axis=1).mean()
-                disp = np.linalg.norm(truth_root[s + n] - truth_root[s - 1])
-                below = max(0.0, floor - float(_lowest(filled[s : s + est]).min()))
-                row.update(est=est, root_rel=err / max(disp, 1e-9), below=below)
-            rows.append(row)
-    tp = sum(r["tp"] for r in rows)
-    fp = sum(r["fp"] for r in rows)
-    counted = [r for r in rows if r["est"] is not None]
-    within = [abs(r["est"] - r["n"]) <= max(1.0, 0.1 * r["n"]) for r in counted]
-    walks = [r for r in counted if "walk" in r["file"] and "turn" not in r["file"]]
-    print(f"   {name}: {len(files)} clips, {len(rows)} cases (10/20/30 frames removed)")
-    print(f"     detection precision {tp / max(tp + fp, 1):.3f}, recall {tp / max(len(rows), 1):.3f}")
-    print(f"     missing count within 10% (or one frame): {sum(within)} of {len(counted)} ({np.mean(within):.1%})")
-    bad = [f"{r['file']} {r['n']}->{r['est']}" for r, ok in zip(counted, within) if not ok]
+            results.append(gap_eval.evaluate_cut(m, int(rng.integers(lo, hi)), n))
+    s = gap_eval.summary(results)
+    print(f"   {name}: {len(files)} clips, {s['cases']} cases (10/20/30 frames removed)")
+    print(f"     detection precision {s['precision']:.3f}, recall {s['recall']:.3f}")
+    ok = sum(r.count_ok for r in results)
+    counted = sum(r.estimate is not None for r in results)
+    print(f"     missing count within 10% (or one frame): {ok} of {counted} ({s['count_ok']:.1%})")
+    bad = [f"{r.name} {r.n}->{r.estimate}" for r in results if r.estimate is not None and not r.count_ok]
     if bad:
         print("     outside: " + ", ".join(bad))
-    for label, sub in (("walks", walks), ("all", counted)):
-        if sub:
-            rel = np.array([r["root_rel"] for r in sub])
-            below = np.array([r["below"] for r in sub])
-            print(f"     {label}: mean root error over the gap / true displacement: mean {rel.mean():.1%}, "
-                  f"worst {rel.max():.1%}; lowest foot below the clip's floor by at most {1000 * below.max():.1f} mm")  # fmt: skip
-    return {"rows": rows}
+    walks = [r for r in results if "walk" in r.name and "turn" not in r.name]
+    for label, sub in (("straight walks", walks), ("all", results)):
+        w = gap_eval.summary(sub)
+        print(f"     {label}: mean root error over the gap / true displacement: mean {w['root_rel_mean']:.1%}, "
+              f"worst {w['root_rel_max']:.1%}; lowest foot below the clip's floor by at most "
+              f"{1000 * w['below_max']:.1f} mm")  # fmt: skip
+    return results
 
 
 def graph_tracking(root: Path, quick: bool, rng) -> None:
