@@ -13,7 +13,16 @@ import numpy as np
 from motionlab import data
 from motionlab.core.motion import Motion
 
-__all__ = ["BEHAVIOUR_CLIPS", "trim_frozen", "behaviours", "walk_clip", "benchmark_clips"]
+__all__ = [
+    "BEHAVIOUR_CLIPS",
+    "trim_frozen",
+    "behaviours",
+    "walk_clip",
+    "walk_takes",
+    "paper_walk",
+    "benchmark_clips",
+    "benchmark_apart_clips",
+]
 
 BEHAVIOUR_CLIPS = {
     "run": "mixamo/Aj/Run_Arc_Left",
@@ -95,3 +104,44 @@ def benchmark_clips(fps: float = 30.0) -> tuple[list[Motion], str]:
         m.name = f"synthetic_{b}_{i:03d}"
         clips.append(m)
     return clips, "synthetic walks and runs (set MOTIONLAB_DATA for real mocap)"
+
+
+def walk_takes(takes=(4, 5, 6), style: str = "normal", fps: float = 30.0) -> list[Motion]:
+    """Walk takes of ``bandai_namco/sessions/walk`` (canonical, at ``fps``), other recordings than
+    :func:`walk_clip`'s; an empty list without real data."""
+    if not data.has_data("bandai_namco", "sessions", "walk"):
+        return []
+    return [_load(f"bandai_namco/sessions/walk/dataset-2_walk_{style}_{t:03d}", fps) for t in takes]
+
+
+def benchmark_apart_clips(fps: float = 30.0) -> tuple[list[Motion], str]:
+    """Clips of the benchmark's skeleton kept apart from :func:`benchmark_clips` (L2P statistics
+    and extra library material): Bandai Namco dataset-1 normal-style clips, or synthetic ones with
+    other seeds."""
+    if data.has_data("bandai_namco", "dataset-1"):
+        from motionlab.interpolation.benchmark import load_clips
+
+        files = sorted((data.data_root() / "bandai_namco" / "dataset-1").rglob("*_normal_*.bvh"))
+        return load_clips(files, fps=fps), "real: bandai_namco/dataset-1 normal-style clips"
+    from motionlab import synthetic
+
+    clips = []
+    for i, b in enumerate(["walk", "walk", "run", "run"]):
+        m = synthetic.generate(b, None, 200, fps, seed=50 + i)
+        m.name = f"synthetic_apart_{b}_{i:03d}"
+        clips.append(m)
+    return clips, "synthetic walks and runs with other seeds"
+
+
+def paper_walk() -> tuple[Motion, str]:
+    """The walk of the paper's Fig. 6/7 experiment: ``xia/walk/normal_ganimator.bvh`` (CMU skeleton,
+    120 Hz, 360 frames: the nearest real walk to the paper's 495 CMU frames), or a synthetic 120 Hz
+    walk of the same length."""
+    rel = "xia/walk/normal_ganimator"
+    if data.has_data("xia", "walk"):
+        return _load(rel, 120.0), f"real: {rel}.bvh (120 Hz)"
+    from motionlab import synthetic
+
+    return synthetic.generate(
+        "walk", None, 360, 120.0, seed=3
+    ), "synthetic 120 Hz walk (set MOTIONLAB_DATA for real mocap)"
