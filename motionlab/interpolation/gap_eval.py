@@ -85,7 +85,8 @@ def evaluate_cut(motion: Motion, start: int, n: int, graph=None) -> CutResult:
     disp = float(np.linalg.norm(truth[start + n] - truth[start - 1]))
     floor = float(motion.global_positions()[:, 1:, 1].min())
     low = float(filled[a + 1 : a + est + 1].global_positions()[:, 1:, 1].min())
-    res.estimate, res.root_rel, res.below = int(est), err / max(disp, 1e-9), max(0.0, floor - low)
+    below = floor - low  # rounding below a nanometre is not a foot in the floor
+    res.estimate, res.root_rel, res.below = int(est), err / max(disp, 1e-9), below if below > 1e-9 else 0.0
     return res
 
 

@@ -189,5 +189,6 @@ def run_to_squat(clips: dict[str, Motion], missing: int = 10, context: int = 10)
     travel = float(np.linalg.norm((p[-1] - p[0])[[0, 2]]))
     speeds = np.linalg.norm(np.diff(p[:, [0, 2]], axis=0), axis=1) * run.fps
     floor = min(float(run.global_positions()[:, 1:, 1].min()), float(squat.global_positions()[:, 1:, 1].min()))
-    below = max(0.0, floor - float(filled[a + 1 : b].global_positions()[:, 1:, 1].min()))
+    below = floor - float(filled[a + 1 : b].global_positions()[:, 1:, 1].min())
+    below = below if below > 1e-9 else 0.0  # rounding below a nanometre is not a foot in the floor
     return RunSquatResult(filled, a, report[0].path, report[0].anchors, keys, travel, speeds, float(v * run.fps), below)

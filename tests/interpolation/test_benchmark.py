@@ -130,3 +130,15 @@ def test_outputs_continue_the_context_sign_before_scoring(windows):
     last = windows.local_rot[:, bm.N_PAST - 1]
     out = bm.continue_from_context(-np.repeat(last[:, None], 3, axis=1), last)
     np.testing.assert_allclose(out, np.repeat(last[:, None], 3, axis=1))
+
+
+def test_cost_limit_chosen_on_apart_windows(clips, windows):
+    lib = MotionLibrary(clips, labels=[bm.action_label(c.name) for c in clips])
+    stats = bm.position_stats(clips)
+    limit = bm.choose_max_cost(windows, lib, stats, gaps=(15,), k=1)
+    assert limit >= 0.0
+    capped = bm.method_library(lib, k=1, max_cost=-1.0)  # nothing trusted: plain interpolation
+    rot, trans = capped(windows, bm.N_PAST, 15)
+    i_rot, i_trans = bm.method_interpolation(windows, bm.N_PAST, 15)
+    np.testing.assert_allclose(rot, i_rot)
+    np.testing.assert_allclose(trans, i_trans)
