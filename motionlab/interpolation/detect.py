@@ -1,7 +1,7 @@
 """Finding dropped frames in a motion stream, and how many went missing (paper C, §3.3).
 
 A BVH file with a constant frame time cannot say that frames are missing; the motion has to.
-Two measures of "how far the body moved between stream frames ``t`` and ``t+1``" are used:
+One measure of "how far the body moved between stream frames ``t`` and ``t+1``" is used:
 
 * :func:`joint_steps` — the root-mean-square over joints of the *world* displacement of every
   joint, metres per stream step. It is what the eye sees: a dive roll that turns the hips upside
@@ -21,9 +21,9 @@ joint speed at the matched frame ``i`` (mean over ``i−2 … i+2``, never below
 graph predicts how fast the body moves *at this pose* (slow at a walk's double support, fast in
 swing); the running median of ``r`` (``WINDOW`` frames on each side, the larger side, and the
 two adjacent values, as in :func:`consecutive_gaps`, so only an isolated jump counts) removes
-the one factor by which this take is slower or faster than the graph's recordings (measured on
-the Bandai walk styles: an exhausted walk moves at about half the speed of a normal one, which a
-raw ``r > Δ`` rule flagged as 35 false gaps in 58 clean takes). With nothing missing ``D ≈ 1``;
+the one factor by which this take is slower or faster than the graph's recordings (an exhausted
+walk moves far slower than a normal one; a raw ``r > Δ`` rule flagged many false gaps in clean
+takes of the other Bandai walk styles). With nothing missing ``D ≈ 1``;
 with ``n`` frames missing the stream moved ``n+1`` steps at once, ``D ≈ n+1``. ``D > Δ`` flags a
 gap. **Δ is chosen by principle, not fitted**: one missing frame doubles the step (``D = 2``), the
 largest ``D`` over all 418 clean shared files by the stream-only rule is 1.6, so ``Δ = 2.5``
@@ -50,6 +50,7 @@ Taught in ``notebooks/06_keypose_interpolation.ipynb``; ``motionlab fill-gaps`` 
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -124,13 +125,10 @@ def _side_medians(steps: np.ndarray, window: int) -> tuple[np.ndarray, np.ndarra
     n = len(steps)
     pad = np.concatenate([np.full(window, np.nan), steps, np.full(window, np.nan)])
     idx = np.arange(n)[:, None] + np.arange(window)[None, :]
-    with np.errstate(all="ignore"):
-        import warnings
-
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            before = np.nanmedian(pad[idx], axis=1)
-            after = np.nanmedian(pad[idx + window + 1], axis=1)
+    with warnings.catch_warnings():  # an all-NaN window (clip edge) has no median: NaN is the answer
+        warnings.simplefilter("ignore", RuntimeWarning)
+        before = np.nanmedian(pad[idx], axis=1)
+        after = np.nanmedian(pad[idx + window + 1], axis=1)
     return before, after
 
 
@@ -275,8 +273,8 @@ def estimate_missing(motion: Motion, steps_at, seconds: float = 1.0) -> list[int
       the gap (``v_a``) and after it (``v_b``), other gaps left out: a whole step cycle, so the
       within-stride wobble averages out. (A straight-line fit of speed on each side, read at the
       gap's edges, follows runs that speed up or slow down better but picks up that wobble on
-      walks; measured by ``scripts/check_gaps.py`` and rejected: 90% of walk counts within
-      tolerance instead of 97%.)
+      walks; it was tried on the choose set of ``scripts/check_gaps.py`` and rejected, as was a
+      refinement by the step cycle's phase, which gained nothing there.)
     * the ground distance across the gap is the chord ``|g(t+1) − g(t)|`` lengthened to the arc
       of a circle turning by the change ``ψ`` of travel direction between the two sides,
       ``arc = chord · (ψ/2) / sin(ψ/2)``;
