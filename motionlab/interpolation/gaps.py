@@ -16,9 +16,12 @@ and ``b = stop``:
   linear root, or Hermite variants, or, when an :class:`~.action_graph.ActionGraph` is given, the
   key-pose-guided filling of :mod:`.library` with the node's recordings;
 * *across nodes*: find the path ``a's action → … → b's action`` in the graph, place one key pose of
-  every intermediate action (its best transition frame from the previous action, root-aligned onto
-  the straight line from ``a`` to ``b``) at evenly spaced frames inside the gap, and interpolate
-  the rest between consecutive anchors.
+  every intermediate action (its best transition frame from the previous action — a PPCA key frame,
+  :meth:`~.action_graph.ActionGraph.best_transition` — root-aligned onto the straight line from
+  ``a`` to ``b``) at evenly spaced frames inside the gap, and fill each piece between consecutive
+  anchors with eq. 4's moving SLERP (:func:`moving_slerp`): the earlier node's clip running on
+  from its frame at the first anchor, blended into the later node's clip running into its frame at
+  the second.
 
 Pieces filled one after another meet at the anchors with different velocities: the root path
 would have corners there. With the graph, :func:`smooth_root` therefore bends the root through the
@@ -38,6 +41,8 @@ from motionlab.core import quat
 from motionlab.core.motion import Motion
 from motionlab.interpolation import inbetween
 from motionlab.interpolation.action_graph import ActionGraph
+from motionlab.interpolation.alignment import apply as apply_rigid
+from motionlab.interpolation.alignment import estimate as estimate_rigid
 from motionlab.interpolation.alignment import reference_joint, reference_transform
 from motionlab.interpolation.features import pose_features
 from motionlab.interpolation.library import MotionLibrary
@@ -53,6 +58,7 @@ __all__ = [
     "fill_rows",
     "smooth_root",
     "lift_above_floor",
+    "moving_slerp",
 ]
 
 METHODS = ("slerp", "hermite", "graph")
@@ -219,6 +225,73 @@ def _place_key_pose(out: Motion, slot: int, node_motion: Motion, frame: int, a: 
     if out.local_pos is not None:
         out.local_pos[slot] = key.translations()[0]
         out.local_pos[slot, 0] = out.root_pos[slot]
+
+
+def _node_frame(graph: ActionGraph, name: str, feats: np.ndarray) -> int:
+    """The frame of node ``name``'s clip nearest to the feature row ``feats`` (D,)."""
+    f = graph.nodes[name].features
+    return int(np.argmin(np.sum((f - feats[None]) ** 2, axis=1)))
+
+
+def _clip_run(clip: Motion, start: int, count: int, out: Motion, at: int, anchor: int, ref: int):
+    """Frames ``start … start+count-1`` of ``clip`` (clamped to the clip: a run past its end holds
+    the last frame), moved rigidly (eq. 3: yaw about +Y and a ground translation) so that clip frame
+    ``anchor`` lands on frame ``at`` of ``out``. Returns rotations (count, J, 4) and translations
+    (count, J, 3), metres."""
+    idx = np.clip(np.arange(start, start + count), 0, clip.num_frames - 1)
+    ra, pa = reference_transform(out, [at], joint=ref)
+    rb, pb = reference_transform(clip, [anchor], joint=ref)
+    seg = apply_rigid(clip[idx], estimate_rigid(ra[0], pa[0], rb[0], pb[0]))
+    return seg.local_rot, seg.translations()
+
+
+def moving_slerp(rot_a, trans_a, rot_b, trans_b, curve: str = "linear") -> tuple[np.ndarray, np.ndarray]:
+    """Eq. 4 with its moving indices: a blend between two *running* sequences.
+
+    ``s_k = slerp(q_A[m+k], q_B[n−L+k], α(k))``, ``k = 0 … L``: sequence A runs on from its
+    transition frame ``A(m)`` while sequence B runs into its transition frame ``B(n)``, and the
+    weight moves from A to B (``α(0) = 0``, ``α(L) = 1``; between them ``α`` from ``curve``). Both
+    ends move, so the in-between keeps the motion of the two actions instead of sliding between
+    two frozen poses; when each sequence holds one repeated frame it is plain SLERP. (algorithms.md
+    §C.6 leaves the index directions open; this reading keeps both sequences in forward time.)
+
+    Parameters
+    ----------
+    rot_a, rot_b : array (L+1, J, 4)      local rotations of A's frames m … m+L and B's n−L … n
+    trans_a, trans_b : array (L+1, J, 3)  their translations (root: world position), metres,
+                                          already root-aligned (:mod:`.alignment`)
+    curve : α curve (:func:`~.slerp.alphas`)
+
+    Returns
+    -------
+    rot : ndarray (L+1, J, 4), trans : ndarray (L+1, J, 3)
+    """
+    rot_a, rot_b = quat.check(rot_a, "rot_a"), quat.check(rot_b, "rot_b")
+    if rot_a.shape != rot_b.shape or rot_a.ndim != 3 or len(rot_a) < 2:
+        raise ValueError(f"expected two (L+1, J, 4) sequences with L >= 1, got {rot_a.shape} and {rot_b.shape}")
+    L = len(rot_a) - 1
+    w = np.concatenate([[0.0], alphas(L - 1, curve), [1.0]])
+    rot = quat.slerp(rot_a, rot_b, w[:, None])
+    trans = np.asarray(trans_a) + w[:, None, None] * (np.asarray(trans_b) - np.asarray(trans_a))
+    return rot, trans
+
+
+def _moving_piece(out: Motion, lo: int, hi: int, run_a, run_b, curve: str) -> None:
+    """Fill ``out[lo+1 … hi-1]`` with :func:`moving_slerp` of the aligned runs, then blend the
+    remaining mismatch at both ends away (as :class:`~.library.MotionLibrary` does), so the piece
+    meets ``out[lo]`` and ``out[hi]`` exactly."""
+    rot, trans = moving_slerp(run_a[0], run_a[1], run_b[0], run_b[1], curve)
+    L = hi - lo
+    u = np.arange(L + 1) / L
+    t_all = out.translations()
+    d_a = quat.mul(out.local_rot[lo], quat.conj(rot[0]))
+    d_b = quat.mul(out.local_rot[hi], quat.conj(rot[L]))
+    rot = quat.mul(quat.slerp(d_a[None], d_b[None], u[:, None]), rot)
+    trans = trans + (1 - u)[:, None, None] * (t_all[lo] - trans[0]) + u[:, None, None] * (t_all[hi] - trans[L])
+    out.local_rot[lo + 1 : hi] = rot[1:L]
+    out.root_pos[lo + 1 : hi] = trans[1:L, 0]
+    if out.local_pos is not None:
+        out.local_pos[lo + 1 : hi] = trans[1:L]
 
 
 def _known_reference_joint(motion: Motion) -> int:
@@ -469,19 +542,26 @@ def fill(
         if len(slots) < len(inner) or len(set(slots)) < len(slots):
             inner, slots = [], []  # gap too short for the intermediate key poses: plain filling
         prev = path[0]
+        placed = {a: (path[0], _node_frame(graph, path[0], _frame_features(out, a, before=True)))}
         for name, slot in zip(inner, slots):
             _, j, _ = graph.best_transition(prev, name)
             _place_key_pose(out, slot, graph.nodes[name].motion, j, a, b, ref)
+            placed[slot] = (name, j)
             prev = name
+        placed[b] = (path[-1], _node_frame(graph, path[-1], _frame_features(out, b, before=False)))
         anchors = [a] + slots + [b]
         used = "library"
-        for i, (lo, hi) in enumerate(zip(anchors[:-1], anchors[1:])):
+        for lo, hi in zip(anchors[:-1], anchors[1:]):
             if hi - lo < 2:
                 continue
-            labels = (
-                sorted({path[min(i, len(path) - 1)], path[min(i + 1, len(path) - 1)]}) if inner else sorted(set(path))
-            )
-            ok = _library_fill(out, lo, hi, lib, labels, prev_frame=None if lo == a else lo)
+            if inner:  # across nodes: eq. 4, node lo's clip running on, node hi's clip running in
+                (na, m), (nb, n) = placed[lo], placed[hi]
+                L = hi - lo
+                run_a = _clip_run(graph.nodes[na].motion, m, L + 1, out, lo, m, ref)
+                run_b = _clip_run(graph.nodes[nb].motion, n - L, L + 1, out, hi, n, ref)
+                _moving_piece(out, lo, hi, run_a, run_b, curve)
+                continue
+            ok = _library_fill(out, lo, hi, lib, sorted(set(path)), prev_frame=None if lo == a else lo)
             if not ok:
                 out = inbetween.fill_between(out, lo + 1, hi, curve=curve)
                 used = "graph+slerp"
