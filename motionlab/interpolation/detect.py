@@ -40,9 +40,14 @@ and nothing visible is lost there). This is what ``motionlab fill-gaps`` uses wi
 
 **How many frames** (:func:`estimate_missing`). Not from the size of the jump alone — a jump in
 pose saturates once the gap exceeds half a step cycle — but from the motion on both sides: the
-ground distance the reference joint covered across the gap divided by its ground speed averaged
-over about one second on each side (a whole step cycle, so the within-stride speed wobble averages
-out). A body that does not travel (speed below ``STEP_FLOOR``) falls back to the joint-step ratio.
+ground distance the reference joint covered across the gap, against how far it travels per frame.
+Walking and running bodies speed up and slow down within every step (±10–20%), so a 10-frame gap
+cut at the fast phase holds more ground than the average speed says: where the ground speed on a
+side of the gap repeats with a step period ``P`` (autocorrelation ≥ 0.5 at a lag of 0.3–1.3 s),
+the gap is filled, in thought, with the last ``P`` steps before it repeated (or the first ``P``
+after it, backwards), and the count is where their cumulative distance reaches the gap's; else
+the mean ground speed over a second on each side is used. A body that does not travel (speed
+below ``STEP_FLOOR``) falls back to the joint-step ratio.
 Timestamps, where the input has them, give the count exactly (:func:`~.gaps.timestamp_gaps`).
 
 Taught in ``notebooks/06_keypose_interpolation.ipynb``; ``motionlab fill-gaps`` uses it.
@@ -264,21 +269,53 @@ def _turn(ground: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> float:
     return float(abs(np.angle(np.exp(1j * (np.arctan2(db[0], db[2]) - np.arctan2(da[0], da[2]))))))
 
 
+def _step_period(speed: np.ndarray, lo: int, hi: int) -> tuple[int | None, float]:
+    """The lag in ``lo … hi`` frames at which the speed signal (N,) best correlates with itself,
+    and that normalised autocorrelation (``None, -1`` when the signal is too short)."""
+    x = speed - speed.mean()
+    best, lag_best = -1.0, None
+    for lag in range(lo, min(hi, len(x) - 4) + 1):  # a loop over lags, not frames
+        a, b = x[:-lag], x[lag:]
+        r = float(np.sum(a * b) / np.sqrt(np.sum(a * a) * np.sum(b * b) + 1e-18))
+        if r > best:
+            best, lag_best = r, lag
+    return lag_best, best
+
+
+def _phase_count(gstep: np.ndarray, distance: float, before: np.ndarray, after: np.ndarray, fps: float):
+    """Frames ``n + 1`` spanning ``distance`` when the gap repeats the step cycle of its sides, or
+    ``None`` when neither side is periodic enough (see :func:`estimate_missing`)."""
+    lo, hi = max(2, int(round(0.3 * fps))), int(round(1.3 * fps))
+    estimates = []
+    for seq in (gstep[before], gstep[after][::-1]):  # after: predicted backwards from the gap's end
+        if len(seq) < hi + 4:
+            continue
+        period, r = _step_period(seq, lo, hi)
+        if period is None or r < 0.5:
+            continue
+        cycle = seq[-period:]  # the last cycle before the gap (or the first after, reversed)
+        reps = int(np.ceil(distance / max(float(cycle.sum()), 1e-12))) + 1
+        cum = np.concatenate([[0.0], np.cumsum(np.tile(cycle, reps))])
+        estimates.append(float(np.interp(distance, cum, np.arange(len(cum)))))
+    return float(np.mean(estimates)) if estimates else None
+
+
 def estimate_missing(motion: Motion, steps_at, seconds: float = 1.0) -> list[int]:
     """How many frames went missing at each stream step ``t → t+1`` in ``steps_at``.
 
     From the motion on both sides, not the jump alone:
 
-    * the reference joint's ground speed (metres per frame) is averaged over ``seconds`` before
-      the gap (``v_a``) and after it (``v_b``), other gaps left out: a whole step cycle, so the
-      within-stride wobble averages out. (A straight-line fit of speed on each side, read at the
-      gap's edges, follows runs that speed up or slow down better but picks up that wobble on
-      walks; it was tried on the choose set of ``scripts/check_gaps.py`` and rejected, as was a
-      refinement by the step cycle's phase, which gained nothing there.)
-    * the ground distance across the gap is the chord ``|g(t+1) − g(t)|`` lengthened to the arc
-      of a circle turning by the change ``ψ`` of travel direction between the two sides,
-      ``arc = chord · (ψ/2) / sin(ψ/2)``;
-    * ``n + 1 = arc / ((v_a + v_b) / 2)``.
+    * the ground distance across the gap is the chord ``|g(t+1) − g(t)|`` of the reference
+      joint's ground point, lengthened to the arc of a circle turning by the change ``ψ`` of travel
+      direction between the two sides, ``arc = chord · (ψ/2) / sin(ψ/2)``;
+    * **step phase**: where the ground speed on a side (up to two seconds, other gaps left out)
+      repeats with a period ``P`` of 0.3–1.3 s (normalised autocorrelation ≥ 0.5), the gap is taken
+      to repeat that side's last cycle (before) or first cycle (after, backwards) and ``n + 1`` is
+      where the cycle's cumulative ground distance reaches the arc; both sides are averaged;
+    * otherwise ``n + 1 = arc / v`` with ``v`` the mean ground speed (metres per frame) over
+      ``seconds`` on each side. (A straight-line fit of speed on each side, read at the gap's
+      edges, and a pose-matching phase estimate were tried on the choose set of
+      ``scripts/check_gaps.py`` and rejected.)
 
     When the body does not travel (speed below ``STEP_FLOOR``), ``n + 1`` is the joint step across
     the gap over the median joint step around it. Always at least 1.
@@ -287,7 +324,7 @@ def estimate_missing(motion: Motion, steps_at, seconds: float = 1.0) -> list[int
     ----------
     motion : Motion, the stream with the frames already missing (nothing inserted)
     steps_at : sequence of int, steps ``t → t+1`` that hide missing frames
-    seconds : float, the window on each side
+    seconds : float, the mean-speed window on each side
 
     Returns
     -------
@@ -299,28 +336,27 @@ def estimate_missing(motion: Motion, steps_at, seconds: float = 1.0) -> list[int
     ground = _ground_path(motion)
     gstep = np.linalg.norm(np.diff(ground, axis=0), axis=-1)  # (T-1,)
     jsteps = joint_steps(motion)
-    usable = np.ones(len(gstep), dtype=bool)
-    usable[at] = False
     half = max(3, int(round(seconds * motion.fps)))
+    far = max(half, int(round(2.0 * motion.fps)))
     floor = STEP_FLOOR * body_height(motion) / motion.fps
     out = []
     for t in at:
-        before = np.arange(max(0, t - half), t)
-        after = np.arange(t + 1, min(len(gstep), t + 1 + half))
-        before, after = before[usable[before]], after[usable[after]]
+        start = max([g + 1 for g in at if g < t], default=0)  # known steps between neighbouring gaps
+        stop = min([g for g in at if g > t], default=len(gstep))
+        before = np.arange(max(start, t - half), t)
+        after = np.arange(t + 1, min(stop, t + 1 + half))
         if before.size + after.size == 0:
             out.append(1)
             continue
-        speeds = []
-        if before.size:
-            speeds.append(float(np.mean(gstep[before])))
-        if after.size:
-            speeds.append(float(np.mean(gstep[after])))
+        speeds = [float(np.mean(gstep[w])) for w in (before, after) if w.size]
         v = float(np.mean(speeds))
         if v > floor:
             psi = min(_turn(ground, before, after), 0.9 * np.pi)
             arc = gstep[t] * ((0.5 * psi) / np.sin(0.5 * psi) if psi > 1e-6 else 1.0)
-            n = arc / v - 1.0
+            long_before = np.arange(max(start, t - far), t)
+            long_after = np.arange(t + 1, min(stop, t + 1 + far))
+            frames = _phase_count(gstep, arc, long_before, long_after, motion.fps)
+            n = (arc / v if frames is None else frames) - 1.0
         else:
             win = np.concatenate([before, after])
             n = jsteps[t] / max(float(np.median(jsteps[win])), 1e-9) - 1.0
