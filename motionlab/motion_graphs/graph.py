@@ -69,6 +69,7 @@ class ClipInfo:
     start: int = 0
     num_frames: int = 0
     synthetic: bool = False
+    take: str | None = None
 
     @property
     def stop(self) -> int:
@@ -197,10 +198,13 @@ class MotionGraph:
         a = self.alive[info.start : info.stop]
         return int(np.argmin(a)) if not a.all() else info.num_frames
 
-    def next_in_clip(self) -> np.ndarray:
-        """(N,) bool: frame ``f`` is followed by ``f + 1`` (same clip, both alive)."""
+    def next_in_clip(self, alive: np.ndarray | None = None) -> np.ndarray:
+        """(N,) bool: frame ``f`` is followed by ``f + 1`` (same clip, both alive).
+
+        ``alive``: use this (N,) mask instead of the graph's own (for sub-graphs)."""
+        alive = self.alive if alive is None else alive
         ok = np.zeros(self.num_frames, dtype=bool)
-        ok[:-1] = self.alive[:-1] & self.alive[1:]
+        ok[:-1] = alive[:-1] & alive[1:]
         last = np.array([c.stop - 1 for c in self.clips if c.num_frames > 0], dtype=np.int64)
         ok[last] = False
         return ok
@@ -224,48 +228,58 @@ class MotionGraph:
         return bool(np.any((self.src == a) & (self.dst == b)))
 
     # ------------------------------------------------------------------ compressed graph
-    def segments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def segments(self, alive: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Runs of alive frames between transition points.
+
+        ``alive``: an (N,) mask of the frames taking part (default: the graph's alive frames);
+        only edges between such frames count.
 
         Returns ``first`` and ``last`` global frame of each segment (S,) and ``seg`` (N,): the
         segment of every frame (-1 if removed).
         """
+        alive = self.alive if alive is None else alive
         n = self.num_frames
-        live = self.alive[self.src] & self.alive[self.dst]
+        live = alive[self.src] & alive[self.dst]
         begin = np.zeros(n + 1, dtype=bool)
         begin[self.starts()] = True
-        begin[1:n] |= ~self.alive[:-1]
+        begin[1:n] |= ~alive[:-1]
         begin[self.dst[live]] = True
         begin[self.src[live] + 1] = True
-        begin = begin[:n] & self.alive
+        begin = begin[:n] & alive
         seg = np.cumsum(begin) - 1
-        seg = np.where(self.alive, seg, -1)
+        seg = np.where(alive, seg, -1)
         first = np.flatnonzero(begin)
-        nxt = self.next_in_clip()
+        nxt = self.next_in_clip(alive)
         # a segment ends where the next frame begins another segment or does not follow
-        end = self.alive & ~(nxt & np.concatenate([~begin[1:], [False]]))
+        end = alive & ~(nxt & np.concatenate([~begin[1:], [False]]))
         last = np.flatnonzero(end)
         return first, last, seg
 
-    def segment_graph(self) -> nx.DiGraph:
+    def segment_graph(self, alive: np.ndarray | None = None) -> nx.DiGraph:
         """The compressed graph: one node per segment (attributes clip, first, last, frames)."""
-        first, last, seg = self.segments()
+        alive = self.alive if alive is None else alive
+        first, last, seg = self.segments(alive)
         g = nx.DiGraph()
         clip = self.clip_of(first)
         for k in range(first.size):
             g.add_node(k, clip=int(clip[k]), first=int(first[k]), last=int(last[k]), frames=int(last[k] - first[k] + 1))
-        nxt = self.next_in_clip()
+        nxt = self.next_in_clip(alive)
         follow = nxt[last]
         g.add_edges_from(zip(np.flatnonzero(follow).tolist(), seg[last[follow] + 1].tolist()), kind="clip")
-        live = self.alive[self.src] & self.alive[self.dst]
+        live = alive[self.src] & alive[self.dst]
         for s, d, k in zip(seg[self.src[live]].tolist(), seg[self.dst[live]].tolist(), self.kind[live].tolist()):
             g.add_edge(s, d, kind=EDGE_KINDS[k])
         return g
 
-    def largest_component(self) -> np.ndarray:
-        """(N,) bool: frames of the largest strongly connected component (by frame count)."""
-        g = self.segment_graph()
-        first, last, seg = self.segments()
+    def largest_component(self, mask: np.ndarray | None = None) -> np.ndarray:
+        """(N,) bool: frames of the largest strongly connected component (by frame count).
+
+        ``mask``: (N,) bool, look only at the sub-graph of these (alive) frames and the edges
+        between them (e.g. one behaviour, or one style's takes).
+        """
+        alive = self.alive if mask is None else self.alive & mask
+        g = self.segment_graph(alive)
+        first, last, seg = self.segments(alive)
         frames = last - first + 1
         best, best_frames = None, -1
         for comp in nx.strongly_connected_components(g):
