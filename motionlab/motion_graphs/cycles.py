@@ -27,7 +27,7 @@ import numpy as np
 
 from motionlab.core.motion import Motion
 
-__all__ = ["Cycles", "contacts", "strikes", "segment_cycles", "FOOT_JOINTS"]
+__all__ = ["Cycles", "contacts", "strikes", "cycles_from_ankles", "segment_cycles", "FOOT_JOINTS"]
 
 FOOT_JOINTS = ("LeftFoot", "RightFoot")
 """Ankle joints of the canonical humanoid whose contacts define the cycles."""
@@ -134,7 +134,28 @@ def segment_cycles(
             "(reduce the clip with preprocess.prepare first)"
         )
     idx = [names.index(f) for f in feet]
-    c = contacts(motion.global_positions()[:, idx], motion.fps, (0, 1), height, speed)
+    return cycles_from_ankles(motion.global_positions()[:, idx], motion.fps, height, speed, min_frames)
+
+
+def cycles_from_ankles(
+    ankles, fps: float, height: float = 0.06, speed: float = 0.6, min_frames: int = 3
+) -> Cycles:
+    """Whole gait cycles from ankle positions.
+
+    Parameters
+    ----------
+    ankles : ndarray, shape (T, 2, 3)   left then right ankle, world positions, metres, Y up
+    fps : frames per second
+    height, speed, min_frames : contact rule, metres, m/s and frames (see :func:`contacts`)
+
+    Returns
+    -------
+    :class:`Cycles`
+    """
+    ankles = np.asarray(ankles, dtype=np.float64)
+    if ankles.ndim != 3 or ankles.shape[1:] != (2, 3):
+        raise ValueError(f"expected ankle positions of shape (T, 2, 3), got {ankles.shape}")
+    c = contacts(ankles, fps, (0, 1), height, speed)
     left, right = strikes(c[:, 0], min_frames), strikes(c[:, 1], min_frames)
     if left.size >= 2:
         a, b = left[:-1], left[1:]
@@ -143,4 +164,4 @@ def segment_cycles(
         bounds = np.stack([a, b], axis=1)[n_right == 1]
     else:
         bounds = np.zeros((0, 2), dtype=np.int64)
-    return Cycles(left, right, bounds.astype(np.int64), motion.num_frames)
+    return Cycles(left, right, bounds.astype(np.int64), int(ankles.shape[0]))

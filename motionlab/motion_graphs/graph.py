@@ -335,14 +335,17 @@ class MotionGraph:
             prev = g1
 
     def summary(self) -> dict:
-        """Counts for tables: clips, frames, alive frames, transitions, largest component."""
+        """Counts for tables: clips (the recorded clips the graph was built from), intermediate
+        clips (made by the build), frames, alive frames, transitions, largest component."""
         comp = self.largest_component()
         kinds = {
             k: int(np.sum((self.kind == i) & self.alive[self.src] & self.alive[self.dst]))
             for i, k in enumerate(EDGE_KINDS)
         }
+        recorded = [c for c in self.clips if c.kind != "intermediate"]
         return dict(
-            clips=len(self.clips),
+            clips=int(self.info.get("input_clips", len(recorded))),
+            intermediate_clips=len(self.clips) - len(recorded),
             frames=self.num_frames,
             alive=self.num_alive,
             transitions=self.num_transitions,

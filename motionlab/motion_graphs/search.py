@@ -40,7 +40,21 @@ import numpy as np
 
 from motionlab.motion_graphs.graph import GraphError, MotionGraph
 
-__all__ = ["Segment", "SearchResult", "parse_request", "search", "search_standard", "SearchError", "TOLERANCE"]
+__all__ = [
+    "Segment",
+    "SearchResult",
+    "parse_request",
+    "search",
+    "search_standard",
+    "SearchError",
+    "TOLERANCE",
+    "MAX_FRAMES",
+]
+
+MAX_FRAMES = 100_000
+"""Longest request, frames in all segments together (55 minutes at 30 fps). The synthesised
+motion is held in memory and written as one BVH file; longer requests are refused, naming this
+limit, rather than running for minutes and filling the disk."""
 
 TOLERANCE = 0.05
 """Documented accuracy: a reachable segment length is met exactly when the clip's loops allow,
@@ -113,7 +127,17 @@ def parse_request(text: str) -> list[Segment]:
         segs.append(Segment(bits[0].strip().lower(), bits[1].strip().lower(), n))
     if not segs:
         raise ValueError("empty request: give segments like walk:angry:300,run:normal:200")
+    _check_total(segs)
     return segs
+
+
+def _check_total(segs: list[Segment]) -> None:
+    total = sum(s.frames for s in segs)
+    if total > MAX_FRAMES:
+        raise ValueError(
+            f"the request asks for {total} frames in all; the limit is {MAX_FRAMES} frames "
+            f"(search.MAX_FRAMES, {MAX_FRAMES / 30 / 60:.0f} minutes at 30 fps): split it into shorter requests"
+        )
 
 
 # ---------------------------------------------------------------------------- in-pool walks
@@ -460,14 +484,15 @@ class _Planner:
         return pieces, frames, enter
 
 
-def search(graph: MotionGraph, request) -> SearchResult:
+def search(graph: MotionGraph, request, progress: bool = False) -> SearchResult:
     """Meet a request on a structured graph (see the module docstring).
 
     Parameters
     ----------
     graph : a graph from :func:`~motionlab.motion_graphs.structured.build_structured`
     request : list of :class:`Segment` / ``(behaviour, style, frames)`` tuples, or the text form
-        ``"walk:angry:300,run:normal:200"``
+        ``"walk:angry:300,run:normal:200"``; at most :data:`MAX_FRAMES` frames in all
+    progress : show a tqdm bar over the segments (Ctrl-C stops the search between steps)
 
     Raises
     ------
@@ -483,7 +508,14 @@ def search(graph: MotionGraph, request) -> SearchResult:
     pieces: list[tuple[int, int, int]] = []
     achieved: list[int] = []
     enter = planner.walker(keys[0]).first_alive()
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=sum(s.frames for s in segs), desc="search", unit="frame", leave=False)
     for k, seg in enumerate(segs):
+        if bar is not None:
+            bar.update(seg.frames)
         cw = planner.walker(keys[k])
         name = f"{seg.behaviour}/{seg.style}"
         if k == len(segs) - 1 or not plans[k]:
@@ -502,6 +534,8 @@ def search(graph: MotionGraph, request) -> SearchResult:
         pieces.extend(tuple(x) for x in route["pieces"])
         pieces.extend(more)
         achieved.append(n + route["frames"] + more_frames)
+    if bar is not None:
+        bar.close()
     return SearchResult(_merge(pieces), [s.frames for s in segs], achieved, segs)
 
 
@@ -516,6 +550,7 @@ def _segments(request) -> list[Segment]:
         out.append(s)
     if not out:
         raise ValueError("empty request")
+    _check_total(out)
     return out
 
 

@@ -58,8 +58,9 @@ STYLE_PAIRS = ("hub", "chain", "all", "none")
 NEIGHBOURS = 3
 """Takes of one style each compared with the next 3 takes (cyclically, in take order)."""
 
-REP_CYCLES = 3
-"""Whole cycles of a representative take blended into the interpolation space."""
+REP_CYCLES = 4
+"""Whole cycles of each representative take registered and blended into an interpolation space
+(fewer when one of the two takes has fewer)."""
 
 
 def _style_pairs(
@@ -191,6 +192,7 @@ def build_structured(
     transitions = [where[k] for k, lab in enumerate(labels) if lab.kind == "transition"]
     glabels = [labels[k] for k in order]
     gmotions = [motions[k] for k in order]
+    take_frames = [m.num_frames for m in gmotions]
 
     # ---- cycles and representative cycles of every style
     t_cyc = time.perf_counter()
@@ -202,19 +204,25 @@ def build_structured(
             except ValueError:
                 cyc[c] = None
     rep: dict[tuple[str, str], int] = {}
-    rep_span: dict[tuple[str, str], tuple[int, int]] = {}
     for key, ks in pools.items():
         # the take with the most whole cycles (ties: the first take) represents the style
-        best = max(ks, key=lambda c: (cyc[c].count if cyc[c] is not None else -1, -c))
-        rep[key] = best
-        cy = cyc[best]
-        if cy is not None and cy.count >= 1:
-            n = min(rep_cycles, cy.count)
-            mid = (cy.count - n) // 2
-            rep_span[key] = (int(cy.bounds[mid, 0]), int(cy.bounds[mid + n - 1, 1]))
-        else:
-            rep_span[key] = (0, gmotions[best].num_frames)
-            notes.add("no whole cycle", f"{gmotions[best].name}: whole take used as the representative")
+        rep[key] = max(ks, key=lambda c: (cyc[c].count if cyc[c] is not None else -1, -c))
+        if cyc[rep[key]] is None or cyc[rep[key]].count == 0:
+            notes.add("no whole cycle", f"{gmotions[rep[key]].name}: the whole take represents its style")
+
+    def rep_span(key, n: int) -> tuple[int, int]:
+        """``n`` whole cycles from the middle of the representative take (all of it without cycles)."""
+        cy = cyc[rep[key]]
+        if cy is None or cy.count == 0:
+            return (0, take_frames[rep[key]])
+        n = min(n, cy.count)
+        mid = (cy.count - n) // 2
+        return int(cy.bounds[mid, 0]), int(cy.bounds[mid + n - 1, 1])
+
+    def rep_count(key) -> int:
+        cy = cyc[rep[key]]
+        return rep_cycles if cy is None or cy.count == 0 else min(rep_cycles, cy.count)
+
     t_cyc = time.perf_counter() - t_cyc
 
     # ---- interpolation spaces between representative cycles of styles of one behaviour
@@ -228,18 +236,20 @@ def build_structured(
     n_input = len(gmotions)
     pairs_todo = []
     for b, styles in sorted(by_behaviour.items()):
-        lengths = {s: rep_span[(b, s)][1] - rep_span[(b, s)][0] for s in styles}
+        lengths = {s: gmotions[rep[(b, s)]].num_frames for s in styles}
         pairs_todo += [(b, s1, s2) for s1, s2 in _style_pairs(styles, style_pairs, reference_style, lengths, 0)]
-    cut: dict[tuple[str, str], tuple[Motion, np.ndarray, _registration.RootTrack]] = {}
     for b, s1, s2 in _progress(pairs_todo, "interpolation spaces", enabled=progress):
+        # the same number of whole cycles of both styles, so registration pairs cycle with cycle
+        n = min(rep_count((b, s1)), rep_count((b, s2)))
+        cut = []
         for key in ((b, s1), (b, s2)):
-            if key not in cut:
-                f0, f1 = rep_span[key]
-                m = gmotions[rep[key]][f0:f1]
-                pos = m.global_positions()
-                cut[key] = (m, pos, _registration.root_track(m, pos))
-        (m1, p1, r1), (m2, p2, r2) = cut[(b, s1)], cut[(b, s2)]
-        reg = _registration.dtw(_distance.distance_matrix(p1, p2, window))
+            f0, f1 = rep_span(key, n)
+            m = gmotions[rep[key]][f0:f1]
+            pos = m.global_positions()
+            cut.append((m, pos, _registration.root_track(m, pos)))
+        (m1, p1, r1), (m2, p2, r2) = cut
+        # the registration must cover (nearly) both spans: 90% of the longer one
+        reg = _registration.dtw(_distance.distance_matrix(p1, p2, window), int(0.9 * max(len(p1), len(p2))))
         ids = []
         for w in weights:
             mid = _registration.blend(m1, m2, reg, w, name=f"{b}_{s1}~{s2}@{w:g}", tracks=(r1, r2))
@@ -249,7 +259,6 @@ def build_structured(
             extra.append(mid)
             extra_infos.append(ClipInfo(mid.name, "intermediate", b, f"{s1}~{s2}@{w:g}", b, s2))
         spaces.append((b, s1, s2, ids))
-    del cut
     t_reg = time.perf_counter() - t_reg
 
     infos = [
@@ -340,7 +349,7 @@ def build_structured(
             "alive": int(graph.alive[st:sp].sum()),
             "takes": takes,
             "representative": rep[(b, s)],
-            "representative_frames": list(rep_span[(b, s)]),
+            "representative_cycles": list(rep_span((b, s), rep_cycles)),
             "transitions": int(inside.sum()),
             "loops": int((inside & (graph.kind == loop_kind)).sum()),
             "synthetic": bool(any(clips[c].synthetic for c in ks)),
