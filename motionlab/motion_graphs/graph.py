@@ -276,23 +276,35 @@ class MotionGraph:
 
         ``mask``: (N,) bool, look only at the sub-graph of these (alive) frames and the edges
         between them (e.g. one behaviour, or one style's takes).
+
+        Forward-backward search on frames: the component of a seed frame is the set of frames
+        it reaches and that reach it, two breadth-first searches vectorised over their
+        frontiers. Seeds are drawn from the frames not yet placed until no remaining set can
+        hold a larger component; a component of more than half the frames is found at the first
+        seed it contains. Runs of a single frame with no edge back to themselves do not count.
         """
         alive = self.alive if mask is None else self.alive & mask
-        g = self.segment_graph(alive)
-        first, last, seg = self.segments(alive)
-        frames = last - first + 1
-        best, best_frames = None, -1
-        for comp in nx.strongly_connected_components(g):
-            comp = list(comp)
-            if len(comp) == 1 and not g.has_edge(comp[0], comp[0]):
-                continue  # a single segment without a cycle is no component worth keeping
-            total = int(frames[comp].sum())
-            if total > best_frames:
-                best, best_frames = comp, total
-        keep = np.zeros(first.size, dtype=bool)
-        if best is not None:
-            keep[best] = True
-        return np.where(seg >= 0, keep[np.maximum(seg, 0)], False)
+        live = alive[self.src] & alive[self.dst]
+        step = np.flatnonzero(self.next_in_clip(alive))
+        src = np.concatenate([step, self.src[live]])
+        dst = np.concatenate([step + 1, self.dst[live]])
+        n = self.num_frames
+        fwd, bwd = _csr(src, dst, n), _csr(dst, src, n)
+        remaining = alive.copy()
+        best = np.zeros(n, dtype=bool)
+        best_size = 0
+        while int(remaining.sum()) > best_size:
+            seed = int(np.argmax(remaining))
+            start = np.zeros(n, dtype=bool)
+            start[seed] = True
+            comp = _reach(fwd, start, remaining) & _reach(bwd, start, remaining)
+            size = int(comp.sum())
+            if size == 1 and not np.any((src == seed) & (dst == seed)):
+                size = 0  # a frame on no cycle
+            if size > best_size:
+                best, best_size = comp, size
+            remaining &= ~comp
+        return best
 
     def prune_to_largest_component(self) -> MotionGraph:
         """Kovar's pruning: keep only the largest strongly connected component (a new graph)."""
@@ -353,6 +365,34 @@ class MotionGraph:
             largest_scc=int(comp.sum()),
             dead_ends=int(self.dead_ends().size),
         )
+
+
+def _csr(src: np.ndarray, dst: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Adjacency of directed edges as (indptr (n+1,), indices (E,)), sorted by source."""
+    order = np.argsort(src, kind="stable")
+    indptr = np.zeros(n + 1, dtype=np.int64)
+    np.cumsum(np.bincount(src, minlength=n), out=indptr[1:])
+    return indptr, dst[order]
+
+
+def _reach(adj: tuple[np.ndarray, np.ndarray], start: np.ndarray, allowed: np.ndarray) -> np.ndarray:
+    """(N,) bool: frames reachable from ``start`` through ``allowed`` frames (breadth-first,
+    one vectorised step per round)."""
+    indptr, indices = adj
+    seen = start & allowed
+    frontier = np.flatnonzero(seen)
+    while frontier.size:
+        lo, hi = indptr[frontier], indptr[frontier + 1]
+        counts = hi - lo
+        total = int(counts.sum())
+        if total == 0:
+            break
+        offs = np.repeat(lo - np.cumsum(counts) + counts, counts) + np.arange(total)
+        nb = indices[offs]
+        nb = np.unique(nb[allowed[nb] & ~seen[nb]])
+        seen[nb] = True
+        frontier = nb
+    return seen
 
 
 def check_motions(motions: Sequence[Motion]) -> tuple[Skeleton, float]:
