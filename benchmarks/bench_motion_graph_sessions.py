@@ -127,7 +127,9 @@ def main(argv=None) -> int:
                 print(f"    {f}")
     print(report.format_report(e["report"]))
     costs = distance.rms(e["graph"].cost)
-    print(f"transition distance on all takes: median {np.median(costs):.4f} m, 95th percentile {np.percentile(costs, 95):.4f} m")
+    print(
+        f"transition distance on all takes: median {np.median(costs):.4f} m, 95th percentile {np.percentile(costs, 95):.4f} m"
+    )
     return 0
 
 

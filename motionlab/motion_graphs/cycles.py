@@ -137,9 +137,7 @@ def segment_cycles(
     return cycles_from_ankles(motion.global_positions()[:, idx], motion.fps, height, speed, min_frames)
 
 
-def cycles_from_ankles(
-    ankles, fps: float, height: float = 0.06, speed: float = 0.6, min_frames: int = 3
-) -> Cycles:
+def cycles_from_ankles(ankles, fps: float, height: float = 0.06, speed: float = 0.6, min_frames: int = 3) -> Cycles:
     """Whole gait cycles from ankle positions.
 
     Parameters
