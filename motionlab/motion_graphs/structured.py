@@ -116,6 +116,8 @@ def _ring_pairs(n: int, neighbours: int) -> list[tuple[int, int]]:
 
 
 def _best_only(i, j, cost):
+    if cost.size == 0:
+        return i, j, cost
     k = int(np.argmin(cost))
     return i[k : k + 1], j[k : k + 1], cost[k : k + 1]
 
@@ -314,6 +316,20 @@ def build_structured(
         mask = np.zeros(graph.num_frames, dtype=bool)
         mask[st:sp] = True
         keep = graph.largest_component(mask)
+        if not keep[st:sp].any() and force:
+            # no cycle under the threshold: the best jump back inside a take (a forced loop)
+            best = None
+            for c in ks:
+                i, j, cost = cands(c, None, thr=np.inf, min_gap=min_loop)
+                ok = (j < i) & (j + 1 < clips[c].num_frames)
+                if ok.any():
+                    k = int(np.argmin(np.where(ok, cost, np.inf)))
+                    if best is None or cost[k] < best[2]:
+                        best = (clips[c].start + int(i[k]), clips[c].start + int(j[k]) + 1, float(cost[k]), c)
+            if best is not None:
+                graph.add_edges([best[0]], [best[1]], [best[2]], "loop")
+                notes.add("forced", f"{clips[best[3]].name}: no loop under the threshold, best jump back used")
+                keep = graph.largest_component(mask)
         graph.alive[st:sp] = keep[st:sp]
         for c in ks:
             if not graph.alive[clips[c].start : clips[c].stop].any():
