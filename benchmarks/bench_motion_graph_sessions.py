@@ -116,6 +116,9 @@ def main(argv=None) -> int:
         print("no threshold of the grid meets the goals on the pick half")
         return 1
     print(f"chosen threshold (smallest meeting the goals on the pick half): {chosen} m")
+    print("the check half at every threshold of the grid (shown, not used to choose):")
+    for rms in GRID:
+        print(line("check", evaluate(check, rms, args.behaviour)))
     for name, ms in (("check", check), ("all", motions)):
         e = evaluate(ms, chosen, args.behaviour)
         print(line(name, e))

@@ -7,20 +7,21 @@ frames it got. A segment runs from its first frame in its clip up to the first f
 next segment's clip, so the frames of a transition count towards the segment it leaves and the
 segment lengths add up to the path length.
 
-**Structured graph** (paper B). The structure table gives each segment's clip and the
-recorded routes out of it, so the search never explores the graph. Within a clip the walk from
-the entry frame ``e`` to an exit frame ``x`` may repeat parts through self-loops; which
-lengths are possible is a reachability recursion over frame counts,
+**Structured graph** (paper B). The structure table gives each segment's style pool (its
+takes, side by side) and the recorded routes out of it, so the search never explores the whole
+graph. Within a pool the walk from the entry frame ``e`` to an exit frame ``x`` steps along a
+take or jumps (between takes, or back inside one); which lengths are possible is a
+reachability recursion over frame counts,
 
-.. math:: R_{c+1} = \operatorname{shift}(R_c) \,\lor\, \operatorname{loops}(R_c), \qquad R_0 = \{e\},
+.. math:: R_{c+1} = \operatorname{shift}(R_c) \,\lor\, \operatorname{jumps}(R_c), \qquad R_0 = \{e\},
 
 (``R_c``: frames where a walk of ``c + 1`` frames can be) run once per segment. The exit whose
 route length ``r`` satisfies ``c + 1 + r = n`` wins (exactly, or else the closest). Long
-segments first repeat the clip's main cycle (the last self-loop) so the recursion stays short:
-the *iterative choice of self-loop and transition points*. Clips crossed on the way to the next
-segment (a style bridge before a transition clip) are passed as quickly as possible, walking
-forward and looping back at the last self-loop point; the **loop guard** stops with an error
-when the last self-loop point is passed twice without finding the exit.
+segments first take the shortest way to the pool's main cycle (its longest jump back inside
+one take) and repeat it, so the recursion stays short: the *iterative choice of self-loop and
+transition points*. Pools crossed on the way to the next segment are passed by the shortest walk
+to an exit (a breadth-first search); the **loop guard** stops it with an error once every frame
+it can reach has been visited. A request may ask for at most :data:`MAX_FRAMES` frames.
 
 **Standard graph** (for comparison). Dijkstra's shortest path (in frames) on the compressed
 graph from the current frame to any frame of the requested clip, then the same in-clip
@@ -272,29 +273,46 @@ def _runs(cw: _Clip | int, frames: list[int]) -> list[tuple[int, int, int]]:
     return res
 
 
+_NEVER = np.iinfo(np.int16).max
+
+
 def _reach(cw: _Clip, start: int, steps: int) -> np.ndarray:
-    """(steps, L) bool: frames where a walk of ``c + 1`` frames from ``start`` can be."""
-    out = np.zeros((max(steps, 1), cw.length), dtype=bool)
-    out[0, start] = True
+    """(steps, L) int16: fewest jumps of a walk of ``c + 1`` frames from ``start`` that ends at
+    each frame (``_NEVER`` where no walk of that length ends there).
+
+    The reachability recursion with a count: ``J[c+1, f+1] = J[c, f]`` for a step,
+    ``J[c+1, d] = min over jumps s → d of J[c, s] + 1``; the jump part is one
+    ``np.minimum.reduceat`` over the jumps sorted by destination, so each row is vectorised.
+    """
+    out = np.full((max(steps, 1), cw.length), _NEVER, dtype=np.int16)
+    out[0, start] = 0
     step_ok = cw.step[:-1]
-    src, dst = cw.loop_src, cw.loop_dst
-    loops = src.size > 0
+    order = np.argsort(cw.loop_dst, kind="stable")
+    src, dst = cw.loop_src[order], cw.loop_dst[order]
+    if dst.size:
+        heads = np.flatnonzero(np.concatenate([[True], dst[1:] != dst[:-1]]))
+        targets = dst[heads]
     for c in range(1, steps):
         prev, cur = out[c - 1], out[c]
-        np.logical_and(prev[:-1], step_ok, out=cur[1:])
-        if loops:
-            cur[dst[prev[src]]] = True
+        cur[1:] = np.where(step_ok, prev[:-1], _NEVER)
+        if dst.size:
+            via = np.minimum.reduceat(prev[src], heads)
+            via = np.where(via < _NEVER, via + 1, _NEVER).astype(np.int16)
+            cur[targets] = np.minimum(cur[targets], via)
     return out
 
 
 def _backtrack(cw: _Clip, reach: np.ndarray, c: int, x: int) -> list[int]:
-    """Frames of one walk reaching ``x`` after ``c + 1`` frames (reverse-engineered from ``reach``)."""
+    """Frames of a walk with the fewest jumps reaching ``x`` after ``c + 1`` frames
+    (reverse-engineered from ``reach``, see :func:`_reach`); each jump is a blend in the
+    synthesised motion, so fewer is better."""
     frames = [x]
     while c > 0:
-        if x > 0 and cw.step[x - 1] and reach[c - 1, x - 1]:
+        j = int(reach[c, x])
+        if x > 0 and cw.step[x - 1] and reach[c - 1, x - 1] == j:
             x -= 1
         else:
-            cand = cw.loop_src[(cw.loop_dst == x) & reach[c - 1, cw.loop_src]]
+            cand = cw.loop_src[(cw.loop_dst == x) & (reach[c - 1, cw.loop_src] == j - 1)]
             if cand.size == 0:
                 raise GraphError("internal: walk reconstruction failed")
             x = int(cand[0])
@@ -348,16 +366,16 @@ def _walk(
             continue
         anywhere = ok[ex[ok] < 0]
         for r in anywhere:
-            hit = np.flatnonzero(reach[c[r]])
-            if hit.size:
-                best = (int(r), int(c[r]), int(hit[-1]))
+            row = reach[c[r]]
+            if row.min() < _NEVER:  # any frame may end it: the one reached with the fewest jumps
+                best = (int(r), int(c[r]), int(np.argmin(row)))
                 break
         if best is not None:
             break
         fixed = ok[ex[ok] >= 0]
-        hits = fixed[reach[c[fixed], ex[fixed]]]
-        if hits.size:
-            r = int(hits[0])
+        jumps = reach[c[fixed], ex[fixed]]
+        if jumps.min(initial=_NEVER) < _NEVER:
+            r = int(fixed[np.argmin(jumps)])  # of the exits met, the one with the fewest jumps
             best = (r, int(c[r]), int(ex[r]))
             break
     if best is None:

@@ -1,37 +1,47 @@
-r"""The structured motion graph of paper B: a structure table, transition clips and an
-interpolation space, pruned while it is built.
+r"""The structured motion graph of paper B: a structure table of pooled takes, transition clips
+and an interpolation space, pruned while it is built.
 
-**Structure table.** Two levels: behaviour → style → where the clip lies in the graph (its
-clip index, global start frame, usable length, self-loops). Beside it, *links* between table
-entries, each with the recorded *routes* a search may take (exit frame in the source clip,
-the pieces of frames in between, entry frame in the target clip, frame count).
+**Structure table.** Two levels: behaviour → style → where the style's material lies in the
+graph. A style is the *pool* of all its takes (a recording session gives many; a take number
+never makes a new style, see :mod:`.naming`): the cell records the pool's first frame and size
+and, per take, its clip index, take name, span (offset and frames), alive frames and whole
+gait cycles. Beside it, *links* between cells, each with the recorded *routes* a search may
+take (exit frame in the source pool, the pieces of frames in between, entry frame in the target
+pool, frame count; pool frames count from the pool's first frame).
+
+**Within a style** every take is compared with itself (jumps at least ``min_loop`` frames away)
+and with its ``neighbours`` next takes in take order, cyclically (:func:`_ring_pairs`), so the
+work grows linearly with the number of takes and the ring joins them all; takes of one style are
+similar by construction, so they meet at many frames.
 
 **Between behaviours** only recorded transition clips ``B1_s1_to_B2_s2`` are used. A
-transition clip is compared with its two endpoint clips only (never with everything, as a
-standard graph would): entries ``A_i → T_{j+1}`` from the first half of ``T``, exits
-``T_k → B_{l+1}`` from the second half, so a route always plays the recorded change.
+transition clip is compared with the takes of its two endpoint styles only (never with
+everything, as a standard graph would): entries ``A_i → T_{j+1}`` into the first half of ``T``,
+exits ``T_k → B_{l+1}`` from the second half, so a route always plays the recorded change.
 
 **Between styles of one behaviour** an interpolation space bridges the gap
-(:mod:`~motionlab.motion_graphs.registration`): intermediate motions M1…M4 at blend weights
-0.2…0.8, and transitions searched only between neighbours S1–M1, M1–M2, …, M4–S2. Which style
-pairs are bridged is a choice (``style_pairs``): ``"hub"`` links every style with the
-reference style (default ``normal``; the longest clip if that one is too short to loop),
-``"chain"`` links styles in name order, ``"all"`` every pair, ``"none"`` builds no
-interpolation space (as in the paper's build-time experiment).
+(:mod:`~motionlab.motion_graphs.registration`), built from *representative cycles*: the take
+with most whole cycles (:mod:`.cycles`) represents its style, the same number of whole cycles
+of both styles (at most ``rep_cycles``, from the middle of the take) are registered by DTW and
+blended into intermediate motions M1…M4 at weights 0.2…0.8, and transitions are searched only
+between neighbours S1–M1, M1–M2, …, M4–S2. Which style pairs are bridged is a choice
+(``style_pairs``): ``"hub"`` links every style with the reference style (default ``normal``),
+``"chain"`` links styles in name order, ``"all"`` every pair, ``"none"`` builds no space.
 
-**Pruning during construction** (local and fast, no global component search):
+**Pruning during construction** (local: one style at a time, never the whole graph):
 
-* every basic clip first gets its *self-loop points* (transitions back to an earlier frame of
-  the same clip, at least ``min_loop`` frames back); the part after the *last* self-loop point
-  is cut and every edge into the cut frames is removed, so no walk in a basic clip gets stuck;
-* in an interpolation space, a path that enters M1 but cannot reach the target clip through
-  M2…M4 is disabled by removing its first edge (and dead links inside are removed); every valid
-  path is recorded in the table, in both directions;
+* each style keeps the largest strongly connected part of its takes (frames, steps and jumps
+  inside the pool); the rest is cut and counted in the build report, so a search can never get
+  stuck inside a style; a style with no cycle at all under the threshold gets its best jump
+  back (counted as ``forced``);
+* in an interpolation space, a path that enters M1 but cannot reach the target pool through
+  M2…M4 is disabled by removing its first edge; every valid path is recorded in the table, in
+  both directions;
 * frames of intermediate and transition clips that lie on no recorded route are removed.
 
-When a basic clip has no self-loop under the threshold, the best local minimum is used and the
-table marks it ``forced`` (likewise for a transition clip without entries or exits); a clip
-with no loop at all is dropped, and ``info["dropped"]`` says why.
+Conditions met on the way (a take pruned, a forced pair, a missing link, an unused transition
+clip) are collected in ``info["conditions"]`` and counted once in the build report
+(:mod:`.report`).
 
 Taught in ``notebooks/05_motion_graphs.ipynb``.
 """
