@@ -105,3 +105,15 @@ def test_long_request_is_fast(sgraph):
     assert time.perf_counter() - t0 < 5.0
     assert r.achieved == r.requested
     sgraph.check_path(r.pieces[:50])
+
+
+def test_walk_takes_the_fewest_jumps():
+    import numpy as np
+
+    # two takes of 10 frames side by side (no step 9 -> 10); jumps 5->12, 3->15, 8->11, 2->3
+    step = np.array([True] * 9 + [False] + [True] * 9 + [False])
+    cw = search._Clip(0, 20, step, np.array([5, 3, 8, 2]), np.array([12, 15, 11, 3]), -1, -1)
+    pieces, _, n = search._walk(cw, 0, [15], [-1])
+    assert n == 15 and pieces == [(0, 0, 8), (0, 11, 16)]  # one jump; 0..5 -> 12..19 is a frame short
+    reach = search._reach(cw, 0, 15)
+    assert reach[14].min() == 1 and reach[5, 5] == 0 and reach[6, 12] == 1
