@@ -126,7 +126,8 @@ def _build(args: argparse.Namespace) -> int:
     io.save(out, g, overwrite=args.force)
     s = g.summary()
     styles = sum(len(v) for v in g.table.get("behaviours", {}).values())
-    pooled = f" ({len(motions)} clips, {styles} styles)" if styles else ""
+    n_trans = sum(c.kind == "transition" for c in g.clips)
+    pooled = f" ({len(motions) - n_trans} takes of {styles} styles, {n_trans} transition clips)" if styles else ""
     print(
         f"built {g.info['kind']} graph from {len(motions)} clips{pooled} in {dt:.2f} s: {s['alive']} frames alive, "
         f"{s['transitions']} transitions -> {out}"
