@@ -23,7 +23,8 @@ from motionlab.motion_graphs.graph import ClipInfo, GraphError, MotionGraph
 
 __all__ = ["save", "load", "FORMAT"]
 
-FORMAT = "motionlab-graph-1"
+FORMAT = "motionlab-graph-2"
+"""Version 2: style cells hold pooled takes (version 1 held one clip per style)."""
 
 
 def _jsonable(x):
@@ -107,7 +108,8 @@ def load(path: str | os.PathLike) -> MotionGraph:
         ) from None
     if not isinstance(meta, dict) or meta.get("format") != FORMAT:
         found = meta.get("format") if isinstance(meta, dict) else None
-        raise GraphError(f"{path}: unknown format {found!r}, expected {FORMAT!r}")
+        hint = "; rebuild it with motionlab graph-build" if str(found).startswith("motionlab-graph-") else ""
+        raise GraphError(f"{path}: unknown format {found!r}, expected {FORMAT!r}{hint}")
     need = ("local_rot", "root_pos", "alive", "src", "dst", "cost", "kind", "offsets", "parents")
     missing = [k for k in need if k not in arrays]
     if missing:

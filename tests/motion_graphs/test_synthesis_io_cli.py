@@ -125,3 +125,31 @@ def test_info_counts_the_clips_built_from(tmp_path, capsys):
     assert info["clips"] == n and info["intermediate_clips"] > 0
     rep = json.loads((tmp_path / "r.json").read_text())
     assert set(rep["behaviours"]) == {"idle", "walk", "run"}
+
+
+def test_interrupted_search_writes_nothing(tmp_path, capsys, monkeypatch):
+    g = tmp_path / "s.mlgraph"
+    assert main(["graph-build", "--synthetic", "-o", str(g)]) == 0
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(search, "search", interrupted)
+    out = tmp_path / "x.bvh"
+    assert main(["graph-search", str(g), "--request", "walk:normal:90", "-o", str(out)]) == 130
+    assert "interrupted" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == [g]
+
+
+def test_old_format_is_named(sgraph, tmp_path):
+    path = io.save(tmp_path / "g", sgraph)
+    with np.load(path) as z:
+        arrays = {k: z[k] for k in z.files}
+    meta = json.loads(str(arrays["meta"]))
+    meta["format"] = "motionlab-graph-1"
+    arrays["meta"] = np.array(json.dumps(meta))
+    old = tmp_path / "old.mlgraph"
+    with open(old, "wb") as fh:
+        np.savez(fh, **arrays)
+    with pytest.raises(ValueError, match="old.mlgraph.*motionlab-graph-1.*rebuild"):
+        io.load(old)
