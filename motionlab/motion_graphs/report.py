@@ -1,7 +1,8 @@
 """The build report of a structured motion graph: one table instead of a wall of warnings.
 
-Per behaviour and style: takes, recorded frames, whole gait cycles, transitions (edges that
-leave the style's frames), the share of its frames in the behaviour's largest strongly
+Per behaviour and style: takes, recorded frames, whole gait cycles, transitions (jump edges
+that start at the style's frames: inside the style, into interpolation spaces and transition
+clips), the share of its frames in the behaviour's largest strongly
 connected component, and the frames pruned. Conditions met while building (a take pruned, a
 forced transition, a missing link …) are counted once, with an example. Below the table, the
 summary lines scripts may read::
