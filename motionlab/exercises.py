@@ -192,9 +192,7 @@ def _run_check(student, reference, cases, accept, mistakes, agrees, label: str |
                 "Replace the `raise` line with your code and run this cell again; the notebook goes on.",
             )
         except Exception as e:  # a student's bug: report it, keep the notebook running
-            return Result(
-                False, True, f"✗ {head}{fname} raised {type(e).__name__} on case {i + 1}: {e}", hint=None
-            )
+            return Result(False, True, f"✗ {head}{fname} raised {type(e).__name__} on case {i + 1}: {e}", hint=None)
     ok, why = agrees(outputs, reference, cases)
     if ok:
         return Result(True, True, f"✓ {head}{fname} is right on {len(cases)} case(s)")
@@ -379,8 +377,7 @@ hand_height = Exercise(
         ),
         Mistake(
             _hand_height_with("LeftShoulder", [0, 0, 1], np.pi / 2),
-            "you rotated LeftShoulder (the collarbone). The exercise rotates the shoulder joint, "
-            "`LeftArm`.",
+            "you rotated LeftShoulder (the collarbone). The exercise rotates the shoulder joint, `LeftArm`.",
         ),
         Mistake(
             _hand_height_with("LeftArm", [0, 0, 1], np.pi / 2, coord=0),
@@ -448,8 +445,7 @@ heading = Exercise(
         ),
         Mistake(
             _heading_variant("atan2(z, x)"),
-            "check the order of atan2's arguments: ψ = 0 means facing +z, and ψ grows from +z "
-            "towards +x.",
+            "check the order of atan2's arguments: ψ = 0 means facing +z, and ψ grows from +z towards +x.",
         ),
         Mistake(_heading_variant("degrees"), "return radians, not degrees."),
         Mistake(

@@ -204,7 +204,12 @@ def _window_count_ceil(n, window=120, stride=30):
 
 def _pose_error_loop(motion, reference):
     a, b = motion.global_positions(), reference.global_positions()
-    return np.array([np.mean([np.linalg.norm((a[t, j] - a[t, 0]) - (b[t, j] - b[t, 0])) for j in range(a.shape[1])]) for t in range(len(a))])
+    return np.array(
+        [
+            np.mean([np.linalg.norm((a[t, j] - a[t, 0]) - (b[t, j] - b[t, 0])) for j in range(a.shape[1])])
+            for t in range(len(a))
+        ]
+    )
 
 
 def _speed_forward(motion):
