@@ -19,7 +19,7 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 
 project = "motionlab"
 author = "the motionlab authors"
-copyright = "motionlab authors"
+copyright = "motionlab authors"  # noqa: A001 (the name Sphinx reads)
 
 extensions = [
     "myst_nb",
