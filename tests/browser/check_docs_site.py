@@ -35,7 +35,7 @@ import threading
 import time
 from html.parser import HTMLParser
 from pathlib import Path
-from urllib.parse import unquote, urldefrag, urljoin, urlparse
+from urllib.parse import unquote, urldefrag, urlparse
 
 REPO = Path(__file__).resolve().parents[2]
 SITE = REPO / "docs" / "_build" / "html"
@@ -66,7 +66,7 @@ class _Ids(HTMLParser):
                 self.ids.add(value)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _ids_of(path: Path) -> frozenset:
     parser = _Ids()
     parser.feed(path.read_text(encoding="utf-8", errors="replace"))
@@ -171,7 +171,9 @@ def check(out: Path, timeout_ms: int = 30_000) -> dict:
     missing_figures = [n for n in stored if report["figures_per_notebook"].get(n, 0) == 0]
     report["stored_notebooks_without_figures"] = missing_figures
     report["seconds"] = round(time.time() - start, 1)
-    report["ok"] = bool(report["pages"]) and not report["broken_images"] and not report["broken_links"] and not missing_figures
+    report["ok"] = (
+        bool(report["pages"]) and not report["broken_images"] and not report["broken_links"] and not missing_figures
+    )
     return report
 
 
