@@ -616,4 +616,7 @@ EXERCISES: dict[str, Exercise] = {
     "pose_error": pose_error,
     "joint_speed": joint_speed,
 }
-"""The named exercises of notebooks 00, 01 and 04, by the attribute name the notebooks use."""
+"""The named exercises of notebooks 00, 01 and 04, by the attribute name the notebooks use.
+
+:meta hide-value:
+"""
