@@ -26,15 +26,15 @@ Taught in ``notebooks/01_preprocessing.ipynb``.
 
 from __future__ import annotations
 
+import io
 import math
 import os
 import re
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from motionlab.core import quat
+from motionlab.core import files, quat
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
 
@@ -101,6 +101,10 @@ def _show(token: str | None) -> str:
 
 
 # ---------------------------------------------------------------------------------- header
+class _NeedMore(Exception):
+    """The header goes on past the part of the file read so far."""
+
+
 class _Tokens:
     """Whitespace-separated tokens of the header, read lazily line by line.
 
@@ -108,9 +112,10 @@ class _Tokens:
     at the first line of the motion block.
     """
 
-    def __init__(self, text: str, source: str) -> None:
+    def __init__(self, text: str, source: str, complete: bool = True) -> None:
         self.text = text
         self.source = source
+        self.complete = complete  # False: ``text`` is the start of a longer file
         self.pos = 0  # start of the next unread line
         self.line = 0  # number of the line the buffered tokens come from
         self.buf: list[str] = []
@@ -119,6 +124,8 @@ class _Tokens:
     def _fill(self) -> bool:
         while self.i >= len(self.buf):
             if self.pos > len(self.text) or (self.pos == len(self.text) and self.line > 0):
+                if not self.complete:
+                    raise _NeedMore
                 return False
             end = self.text.find("\n", self.pos)
             if end < 0:
@@ -496,73 +503,21 @@ def loads(text: str | bytes, scale: float = DEFAULT_SCALE, source: str = "<strin
     BVHError
         For any malformed input, naming ``source``, the line and what was expected.
     """
-    scale = _check_scale(scale)
     if isinstance(text, (bytes, bytearray, memoryview)):
         data = bytes(text)
-        try:
-            text = data.decode("utf-8")
-        except UnicodeDecodeError as exc:
-            line = data.count(b"\n", 0, exc.start) + 1
-            raise BVHError(source, line, f"expected UTF-8 text, found the byte {data[exc.start]:#04x}") from None
-    elif not isinstance(text, str):
+    elif isinstance(text, str):
+        data = text.encode("utf-8", "surrogatepass")  # a lone surrogate fails as bad UTF-8 below
+    else:
         raise TypeError(f"expected BVH text as str or bytes, got {type(text).__name__}")
-    if text.startswith("\ufeff"):
-        text = text[1:]
-    tok = _Tokens(text, source)
-    names, parents, offsets, channels, end_sites, n_frames, frames_line, ft = _parse_hierarchy(tok)
-    first_line = tok.line + 1
-    block = text[tok.pos :] if tok.pos <= len(text) else ""
-    n_channels = sum(len(c) for c in channels)
-    values = _read_block(block, n_frames, n_channels, first_line, frames_line, source)
-    return _to_motion(names, parents, offsets, channels, end_sites, values, ft, scale, name)
-
-
-def _to_motion(names, parents, offsets, channels, end_sites, values, ft, scale, name) -> Motion:
-    n_frames, n_joints = values.shape[0], len(names)
-    offsets = np.asarray(offsets, dtype=np.float64) * scale
-    local_rot = np.zeros((n_frames, n_joints, 4))
-    local_rot[..., 0] = 1.0
-    translations = np.broadcast_to(offsets, (n_frames, n_joints, 3)).copy()
-    moving = False  # does a non-root joint have position channels?
-    groups: dict[str, tuple[list[int], list[list[int]]]] = {}
-    column = 0
-    for j, layout in enumerate(channels):
-        rot_cols, axes = [], ""
-        for ch in layout:
-            key = ch.lower()
-            if key in _POSITION:
-                translations[:, j, _POSITION[key]] = values[:, column] * scale
-                moving = moving or j > 0
-            else:
-                axes += _ROTATION[key]
-                rot_cols.append(column)
-            column += 1
-        if axes:
-            joints, cols = groups.setdefault(axes, ([], []))
-            joints.append(j)
-            cols.append(rot_cols)
-    for axes, (joints, cols) in groups.items():
-        angles = np.deg2rad(values[:, np.asarray(cols)])  # (T, n, k)
-        local_rot[:, joints] = _axis_quats(angles, axes)
-    skeleton = Skeleton(
-        tuple(names),
-        np.asarray(parents),
-        offsets,
-        {j: np.asarray(o) * scale for j, o in end_sites.items()},
-        tuple(channels),
-    )
-    return Motion(
-        skeleton,
-        local_rot,
-        translations[:, 0].copy(),
-        1.0 / ft,
-        translations if moving else None,
-        name,
-    )
+    return _read(io.BytesIO(data), len(data), scale, source, name)
 
 
 def load(path: str | os.PathLike, scale: float = DEFAULT_SCALE, name: str | None = None) -> Motion:
     """Read a BVH file; see :func:`loads` for what the Motion holds.
+
+    The file is streamed: the motion block is converted :data:`CHUNK` bytes at a time straight
+    into the frame array, so memory stays near the size of the result (about the file's size)
+    instead of several times the text.
 
     Parameters
     ----------
@@ -578,8 +533,164 @@ def load(path: str | os.PathLike, scale: float = DEFAULT_SCALE, name: str | None
         The file cannot be read.
     """
     path = Path(path)
-    data = path.read_bytes()
-    return loads(data, scale=scale, source=str(path), name=path.stem if name is None else name)
+    with open(path, "rb") as f:
+        size = os.fstat(f.fileno()).st_size
+        return _read(f, size, scale, str(path), path.stem if name is None else name)
+
+
+CHUNK = 1 << 22
+"""Bytes of motion text converted per step while streaming (4 MiB)."""
+
+_HEADER_START = 1 << 16  # bytes read first for the header; doubled while the header goes on
+
+
+def _decode(data: bytes, source: str, first_line: int = 1) -> str:
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = first_line + data.count(b"\n", 0, exc.start)
+        raise BVHError(source, line, f"expected UTF-8 text, found the byte {data[exc.start]:#04x}") from None
+
+
+def _read(f, size: int, scale: float, source: str, name: str) -> Motion:
+    """Parse a binary stream of ``size`` bytes (header token by token, motion block in chunks)."""
+    scale = _check_scale(scale)
+    head = f.read(min(size, _HEADER_START))
+    bom = 3 if head.startswith(b"\xef\xbb\xbf") else 0
+    head, size = head[bom:], size - bom
+    # Old Mac files end lines with CR alone: read every CR as a line end when the start has no LF
+    cr_only = b"\r" in head and b"\n" not in head
+    while True:
+        if cr_only:
+            head = head.replace(b"\r", b"\n")
+        complete = len(head) >= size
+        cut = len(head) if complete else head.rfind(b"\n") + 1
+        tok = _Tokens(_decode(head[:cut], source), source, complete=complete)
+        try:
+            header = _parse_hierarchy(tok)
+            break
+        except _NeedMore:
+            more = f.read(max(len(head), _HEADER_START))
+            head += more
+    names, parents, offsets, channels, end_sites, n_frames, frames_line, ft = header
+    first_line = tok.line + 1
+    start = len(tok.text[: tok.pos].encode("utf-8")) if tok.pos <= len(tok.text) else len(head)
+    n_channels = sum(len(c) for c in channels)
+    values = _read_stream(f, head[start:], bom + start, n_frames, n_channels, first_line, frames_line, source, cr_only)
+    return _to_motion(names, parents, offsets, channels, end_sites, values, ft, scale, name)
+
+
+def _chunk_values(raw: bytes, n_channels: int) -> np.ndarray | None:
+    """Frame lines of one chunk (complete lines) as an array (k, C), or None if anything is off."""
+    if raw.translate(None, _NUMERIC_BYTES):  # anything left is neither a digit, sign, dot, e nor space
+        return None
+    buf = np.frombuffer(raw, dtype=np.uint8)
+    whitespace = buf <= 32  # the only bytes <= 32 that survived the check above are whitespace
+    starts = ~whitespace
+    starts[1:] &= whitespace[:-1]
+    newlines = np.flatnonzero(buf == 10)
+    per_line = np.bincount(np.searchsorted(newlines, np.flatnonzero(starts)), minlength=newlines.size + 1)
+    per_line = per_line[per_line > 0]
+    if np.any(per_line != n_channels):
+        return None
+    try:
+        values = np.fromstring(raw, dtype=np.float64, sep=" ")  # C parser; stops (ValueError) at bad text
+    except ValueError:
+        return None
+    if values.size != per_line.size * n_channels or not np.isfinite(values).all():
+        return None
+    return values.reshape(per_line.size, n_channels)
+
+
+def _read_stream(f, head: bytes, offset: int, n_frames, n_channels, first_line, frames_line, source, cr_only):
+    """The motion block, starting at byte ``offset`` of ``f`` (``head``: its part read already), as (T, C)."""
+    size = f.seek(0, io.SEEK_END) - offset  # bytes in the block
+    f.seek(offset + len(head))
+
+    def slow() -> np.ndarray:  # exact error with a line number: read the block again, whole
+        f.seek(offset)
+        block = f.read()
+        if cr_only:
+            block = block.replace(b"\r", b"\n")
+        text = _decode(block, source, first_line)
+        return _read_block(text, n_frames, n_channels, first_line, frames_line, source)
+
+    # every frame line needs C numbers and C whitespace bytes: a file too short for the count is truncated
+    if n_channels == 0 or n_frames > size // (2 * n_channels) + 1:
+        return slow()
+    values = np.empty((n_frames, n_channels))
+    row = 0
+    pending = head
+    done = False
+    while not done:
+        more = f.read(CHUNK)
+        done = not more
+        if cr_only:
+            more = more.replace(b"\r", b"\n")
+        pending += more
+        cut = len(pending) if done else pending.rfind(b"\n") + 1
+        if cut == 0 and not done:
+            continue  # a line longer than a chunk: read on
+        part = _chunk_values(pending[:cut], n_channels)
+        if part is None or row + len(part) > n_frames:
+            return slow()
+        values[row : row + len(part)] = part
+        row += len(part)
+        pending = pending[cut:]
+    if row != n_frames:
+        return slow()
+    return values
+
+
+_FRAMES_PER_STEP = 1 << 15  # frames converted to quaternions at a time (bounds the temporaries)
+
+
+def _to_motion(names, parents, offsets, channels, end_sites, values, ft, scale, name) -> Motion:
+    n_frames, n_joints = values.shape[0], len(names)
+    offsets = np.asarray(offsets, dtype=np.float64) * scale
+    local_rot = np.zeros((n_frames, n_joints, 4))
+    local_rot[..., 0] = 1.0
+    root_pos = np.broadcast_to(offsets[0], (n_frames, 3)).copy()
+    # per-frame translations only when a non-root joint has position channels
+    moving = any("position" in ch.lower() for layout in channels[1:] for ch in layout)
+    translations = np.broadcast_to(offsets, (n_frames, n_joints, 3)).copy() if moving else None
+    groups: dict[str, tuple[list[int], list[list[int]]]] = {}
+    column = 0
+    for j, layout in enumerate(channels):
+        rot_cols, axes = [], ""
+        for ch in layout:
+            key = ch.lower()
+            if key in _POSITION:
+                target = root_pos if j == 0 else translations[:, j]
+                target[:, _POSITION[key]] = values[:, column] * scale
+            else:
+                axes += _ROTATION[key]
+                rot_cols.append(column)
+            column += 1
+        if axes:
+            joints, cols = groups.setdefault(axes, ([], []))
+            joints.append(j)
+            cols.append(rot_cols)
+    for axes, (joints, cols) in groups.items():
+        cols = np.asarray(cols)
+        contiguous = joints == list(range(joints[0], joints[-1] + 1))
+        for t0 in range(0, n_frames, _FRAMES_PER_STEP):
+            t1 = min(t0 + _FRAMES_PER_STEP, n_frames)
+            q = _axis_quats(np.deg2rad(values[t0:t1, cols]), axes)  # (t, n, 4)
+            if contiguous:
+                local_rot[t0:t1, joints[0] : joints[-1] + 1] = q
+            else:
+                local_rot[t0:t1, joints] = q
+    if translations is not None:
+        translations[:, 0] = root_pos
+    skeleton = Skeleton(
+        tuple(names),
+        np.asarray(parents),
+        offsets,
+        {j: np.asarray(o) * scale for j, o in end_sites.items()},
+        tuple(channels),
+    )
+    return Motion(skeleton, local_rot, root_pos, 1.0 / ft, translations, name)
 
 
 # ---------------------------------------------------------------------------------- writing
@@ -629,19 +740,38 @@ def frame_time(motion_or_fps: Motion | float) -> float:
 def _check_layout(skeleton: Skeleton, translations: np.ndarray, pos_tol: float) -> tuple[tuple[str, ...], ...]:
     """Each joint's channel names for writing (``skeleton.channels`` or the default layout)."""
     if skeleton.channels is not None:
-        layouts = skeleton.channels
-        for j, layout in enumerate(layouts):
+        layouts = []
+        for j, layout in enumerate(skeleton.channels):
             keys = [str(c).lower() for c in layout]
             if any(k not in _POSITION and k not in _ROTATION for k in keys) or len(set(keys)) != len(keys):
                 raise ValueError(
                     f"joint {skeleton.names[j]!r} has channel layout {layout}; expected distinct names from {CHANNEL_NAMES}"
                 )
-        return layouts
+            layouts.append(_three_rotations(tuple(layout)))
+        return tuple(layouts)
     layouts = [_ROOT_LAYOUT]
     for j in range(1, skeleton.num_joints):
         moved = np.abs(translations[:, j] - skeleton.offsets[j]).max(initial=0.0) > pos_tol
         layouts.append(_ROOT_LAYOUT if moved else _JOINT_LAYOUT)
     return tuple(layouts)
+
+
+def _three_rotations(layout: tuple[str, ...]) -> tuple[str, ...]:
+    """``layout`` with exactly three rotation channels, as Blender's importer needs.
+
+    Missing rotation axes follow the joint's last rotation channel (a joint without any gets
+    ``Zrotation Yrotation Xrotation`` at the end); their angles are zero for motion that the
+    original channels could express, so nothing else changes.
+    """
+    rotations = [c for c in layout if c.lower() in _ROTATION]
+    if len(rotations) == 3:
+        return layout
+    have = {c[0].lower() for c in rotations}
+    missing = [f"{a}rotation" for a in ("Z", "Y", "X") if a.lower() not in have]
+    if not rotations:
+        return layout + tuple(missing)
+    last = max(i for i, c in enumerate(layout) if c.lower() in _ROTATION)
+    return layout[: last + 1] + tuple(missing) + layout[last + 1 :]
 
 
 def _check_name(name: str) -> None:
@@ -671,17 +801,24 @@ def dumps(motion: Motion, scale: float | None = None, precision: int = 6) -> str
         Joints are written depth-first (children in index order) with ``skeleton.channels``
         when set, else positions + ``Zrotation Yrotation Xrotation`` for the root (and for
         non-root joints whose ``local_pos`` moves), ``Zrotation Yrotation Xrotation`` for the
-        others. ``Frame Time:`` has the fewest digits that give ``fps`` back exactly.
+        others. Every joint gets exactly three rotation channels, as Blender's importer needs:
+        a layout with fewer is completed by the missing axes (zero angles where the original
+        axes expressed the motion). ``Frame Time:`` has the fewest digits that give ``fps`` back
+        exactly.
 
     Raises
     ------
     ValueError
-        Non-finite values, names BVH cannot hold, or a joint whose channel layout cannot
+        No frames (Blender cannot import a 0-frame file), non-finite values, names BVH cannot hold, or a joint whose channel layout cannot
         express its motion (rotation about an axis it has no channel for, or a translation
         away from its offset without position channels); the message names the joint.
     """
     if not isinstance(motion, Motion):
         raise TypeError(f"expected a Motion, got {type(motion).__name__}")
+    if motion.num_frames == 0:
+        raise ValueError(
+            f"cannot write motion {motion.name!r} with 0 frames as BVH: Blender and most importers need at least one frame"
+        )
     scale = 1.0 / DEFAULT_SCALE if scale is None else _check_scale(scale)
     if isinstance(precision, bool) or not isinstance(precision, (int, np.integer)) or not 0 <= precision <= 17:
         raise ValueError(f"expected precision as a whole number of decimals from 0 to 17, got {precision!r}")
@@ -793,7 +930,8 @@ def save(
     """Write a motion as a BVH file (see :func:`dumps` for the layout).
 
     The text is built in memory and written to a temporary file in the same folder that then
-    replaces ``path`` in one step, so a failure never leaves a partial file.
+    replaces ``path`` in one step (:func:`motionlab.core.files.atomic_write`), so a failure never
+    leaves a partial file, and temporary files of killed earlier writes are removed.
 
     Parameters
     ----------
@@ -811,28 +949,10 @@ def save(
     ------
     FileExistsError
         ``path`` exists and ``overwrite`` is False.
+    OSError
+        ``path`` is a folder, or its folder is missing or not writable (checked before writing).
     ValueError
         The motion cannot be written (see :func:`dumps`).
     """
-    path = Path(path)
-    if path.exists() and not overwrite:
-        raise FileExistsError(f"{path} already exists; pass overwrite=True to replace it")
     text = dumps(motion, scale=scale, precision=precision)
-    folder = path.parent
-    if path.exists():
-        mode = path.stat().st_mode & 0o777
-    else:
-        umask = os.umask(0)
-        os.umask(umask)
-        mode = 0o666 & ~umask
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
-            f.write(text)
-        os.chmod(tmp, mode)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
+    return files.atomic_write(path, lambda f: f.write(text), overwrite=overwrite, what="BVH file")

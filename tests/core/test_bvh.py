@@ -267,10 +267,13 @@ def test_scale_and_names():
 def test_zero_frames_and_zero_channels():
     m = bvh.loads(bvh_text("ROOT A\n{\nOFFSET 0 0 0\nCHANNELS 3 Xrotation Yrotation Zrotation\n}", []))
     assert m.local_rot.shape == (0, 1, 4) and m.root_pos.shape == (0, 3)
-    assert bvh.loads(bvh.dumps(m)).num_frames == 0
+    # read, but never written: Blender cannot import a 0-frame file
+    with pytest.raises(ValueError, match="0 frames"):
+        bvh.dumps(m)
     m = bvh.loads(bvh_text("ROOT A\n{\nOFFSET 1 0 0\nCHANNELS 0\n}", ["", "", ""]))
     assert m.num_frames == 3
-    assert bvh.loads(bvh.dumps(m)).num_frames == 3
+    back = bvh.loads(bvh.dumps(m))
+    assert back.num_frames == 3 and back.skeleton.channels == (("Zrotation", "Yrotation", "Xrotation"),)
 
 
 def test_load_uses_file_stem_and_names_the_file_in_errors(tmp_path):
@@ -432,7 +435,7 @@ def assert_same_motion(a: Motion, b: Motion, atol: float = 1e-8):
     assert sa.names == sb.names
     np.testing.assert_array_equal(sa.parents, sb.parents)
     np.testing.assert_allclose(sa.offsets, sb.offsets, atol=atol)
-    assert sa.channels == sb.channels
+    assert_written_layouts(sa.channels, sb.channels)
     assert sa.end_sites.keys() == sb.end_sites.keys()
     for j in sa.end_sites:
         np.testing.assert_allclose(sa.end_sites[j], sb.end_sites[j], atol=atol)
@@ -444,6 +447,29 @@ def assert_same_motion(a: Motion, b: Motion, atol: float = 1e-8):
     assert (a.local_pos is None) == (b.local_pos is None)
     if a.local_pos is not None:
         np.testing.assert_allclose(a.local_pos, b.local_pos, atol=atol)
+
+
+def assert_written_layouts(original, written):
+    """``written`` is ``original`` with the missing rotation axes added (three per joint, for Blender)."""
+    if original is None:
+        return
+    assert len(original) == len(written)
+    for a, b in zip(original, written):
+        assert [c for c in b if c in a] == list(a), (a, b)  # the original channels, in their order
+        assert sorted(c[0] for c in b if c.endswith("rotation")) == ["X", "Y", "Z"], b
+        assert [c for c in b if c.endswith("position")] == [c for c in a if c.endswith("position")]
+
+
+def test_written_files_have_three_rotation_channels_per_joint():
+    """Blender's importer fails on joints with one or two rotation channels: they get all three."""
+    m = bvh.loads(MIXED)
+    assert any(0 < sum(c.endswith("rotation") for c in layout) < 3 for layout in m.skeleton.channels)
+    text = bvh.dumps(m)
+    for line in text.splitlines():
+        if line.strip().startswith("CHANNELS"):
+            assert sum(w.endswith("rotation") for w in line.split()) == 3, line
+    assert "CHANNELS 2 Zrotation Xrotation" not in text
+    assert_same_motion(m, bvh.loads(text))
 
 
 def test_save_load_round_trip(tmp_path):
@@ -484,19 +510,15 @@ def test_failed_save_leaves_no_file(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["keep.bvh"]
 
 
-def test_rotation_outside_the_channel_layout_is_refused():
+def test_rotation_outside_the_read_channels_is_written():
+    """Written layouts have all three rotation axes, so rotations outside the read channels survive."""
     m = bvh.loads(MIXED)
     fixed = MIXED_NAMES.index("Fixed")
     turned = m.copy()
     turned.local_rot[0, fixed] = rot("x", [10])
-    with pytest.raises(ValueError, match="'Fixed'.*no rotation channels.*frame 0"):
-        bvh.dumps(turned)
+    assert_rot_close(bvh.loads(bvh.dumps(turned)).local_rot[0, fixed], turned.local_rot[0, fixed])
     leg = MIXED_NAMES.index("newVegas:LeftLeg")
-    turned = m.copy()
-    turned.local_rot[1, leg] = rot("y", [5])  # the leg only has Zrotation Xrotation
-    with pytest.raises(ValueError, match="'newVegas:LeftLeg'.*Zrotation Xrotation.*frame 1"):
-        bvh.dumps(turned)
-    turned.local_rot[1, leg] = rot("zx", [170, -120])  # expressible, however large
+    turned.local_rot[1, leg] = rot("y", [5])  # the leg only has Zrotation Xrotation in the file
     assert_rot_close(bvh.loads(bvh.dumps(turned)).local_rot[1, leg], turned.local_rot[1, leg])
 
 
@@ -589,7 +611,7 @@ def random_motions(draw):
         st.lists(st.text("abcXYZ_019:-.", min_size=1, max_size=6), min_size=n_joints, max_size=n_joints, unique=True)
     )
     names = [prefix + n for n in names]
-    n_frames = draw(st.integers(0, 4))
+    n_frames = draw(st.integers(1, 4))
     fps = draw(st.sampled_from([30.0, 60.0, 120.0, 1 / 0.016667, 1 / 0.0333333]) | st.floats(0.5, 1000.0))
     rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
     offsets = rng.uniform(-0.5, 0.5, size=(n_joints, 3))
@@ -689,7 +711,8 @@ def test_real_file_loads_and_round_trips(path, tmp_path):
     pos = m.global_positions()
     assert np.isfinite(pos).all()
     back = bvh.load(bvh.save(tmp_path / path.name, m))
-    assert back.skeleton.names == m.skeleton.names and back.skeleton.channels == m.skeleton.channels
+    assert back.skeleton.names == m.skeleton.names
+    assert_written_layouts(m.skeleton.channels, back.skeleton.channels)
     np.testing.assert_array_equal(back.skeleton.parents, m.skeleton.parents)
     np.testing.assert_allclose(back.skeleton.offsets, m.skeleton.offsets, atol=1e-8)
     assert back.fps == m.fps
