@@ -538,8 +538,8 @@ def load(path: str | os.PathLike, scale: float = DEFAULT_SCALE, name: str | None
         return _read(f, size, scale, str(path), path.stem if name is None else name)
 
 
-CHUNK = 1 << 22
-"""Bytes of motion text converted per step while streaming (4 MiB)."""
+CHUNK = 1 << 20
+"""Bytes of motion text converted per step while streaming (1 MiB)."""
 
 _HEADER_START = 1 << 16  # bytes read first for the header; doubled while the header goes on
 
@@ -642,7 +642,7 @@ def _read_stream(f, head: bytes, offset: int, n_frames, n_channels, first_line, 
     return values
 
 
-_FRAMES_PER_STEP = 1 << 15  # frames converted to quaternions at a time (bounds the temporaries)
+_ROTATIONS_PER_STEP = 1 << 13  # joint-frames converted to quaternions at a time (bounds the temporaries)
 
 
 def _to_motion(names, parents, offsets, channels, end_sites, values, ft, scale, name) -> Motion:
@@ -674,8 +674,9 @@ def _to_motion(names, parents, offsets, channels, end_sites, values, ft, scale, 
     for axes, (joints, cols) in groups.items():
         cols = np.asarray(cols)
         contiguous = joints == list(range(joints[0], joints[-1] + 1))
-        for t0 in range(0, n_frames, _FRAMES_PER_STEP):
-            t1 = min(t0 + _FRAMES_PER_STEP, n_frames)
+        step = max(1, _ROTATIONS_PER_STEP // len(joints))
+        for t0 in range(0, n_frames, step):
+            t1 = min(t0 + step, n_frames)
             q = _axis_quats(np.deg2rad(values[t0:t1, cols]), axes)  # (t, n, 4)
             if contiguous:
                 local_rot[t0:t1, joints[0] : joints[-1] + 1] = q

@@ -13,7 +13,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from motionlab.core import bvh, quat
+from motionlab.core import bvh, humanoid, quat
 from motionlab.core.bvh import BVHError
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
@@ -718,3 +718,53 @@ def test_real_file_loads_and_round_trips(path, tmp_path):
     assert back.fps == m.fps
     size = max(1.0, float(np.abs(pos).max()))
     np.testing.assert_allclose(back.global_positions(), pos, rtol=0, atol=1e-6 * size)
+
+
+# ------------------------------------------------------------------------------ line ends, memory
+def test_cr_only_line_ends_read_like_lf():
+    """Old Mac files end lines with CR alone; they used to fail on 'line 1'."""
+    lf = bvh.loads(MIXED)
+    cr = bvh.loads(MIXED.replace("\n", "\r"))
+    assert_identical(lf, cr)
+    bad = MIXED.replace("-1 89 -2", "-1 89").replace("\n", "\r")
+    line = next(i + 1 for i, s in enumerate(MIXED.split("\n")) if s.startswith("-1 89"))
+    with pytest.raises(BVHError, match=rf"line {line}: expected 21 values"):
+        bvh.loads(bad)
+
+
+def test_load_streams_with_memory_below_three_times_the_file(tmp_path):
+    import tracemalloc
+
+    from motionlab import synthetic
+
+    motion = synthetic.generate("walk", humanoid.canonical_skeleton(), num_frames=6000, fps=60, seed=0)
+    path = bvh.save(tmp_path / "long.bvh", motion)
+    size = path.stat().st_size
+    import motionlab.core.bvh as module
+
+    old = module.CHUNK
+    module.CHUNK = 1 << 16  # a file many chunks long (as a 200 MB file is with the default)
+    tracemalloc.start()
+    try:
+        back = bvh.load(path)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+        module.CHUNK = old
+    assert back.num_frames == 6000
+    assert peak <= 3 * size, f"peak {peak / 1e6:.1f} MB for a {size / 1e6:.1f} MB file"
+    # the streamed reader gives exactly what reading the text in one piece gives, across chunk borders
+    module.CHUNK = 1000  # borders inside lines
+    try:
+        assert_identical(back, bvh.loads(path.read_bytes(), name=back.name))
+        assert_identical(back, bvh.load(path))
+    finally:
+        module.CHUNK = old
+
+
+def assert_identical(a: Motion, b: Motion):
+    assert a.skeleton.names == b.skeleton.names and a.skeleton.channels == b.skeleton.channels
+    np.testing.assert_array_equal(a.skeleton.offsets, b.skeleton.offsets)
+    np.testing.assert_array_equal(a.local_rot, b.local_rot)
+    np.testing.assert_array_equal(a.root_pos, b.root_pos)
+    assert (a.local_pos is None) == (b.local_pos is None) and a.fps == b.fps
