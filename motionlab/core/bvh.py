@@ -193,8 +193,11 @@ def _joint_name(tok: _Tokens, keyword: str) -> str:
     n = rest.index("{") if "{" in rest else len(rest)
     if n == 0:
         raise tok.error(f"expected a joint name after {keyword}, found {_show(rest[0]) if rest else 'end of line'}")
+    name = " ".join(rest[:n])
+    if "{" in name or "}" in name:  # a brace would end the name when written back
+        raise tok.error(f"expected a joint name without braces after {keyword}, found {_show(name)}")
     tok.skip(n)
-    return " ".join(rest[:n])
+    return name
 
 
 def _channels(tok: _Tokens, joint_name: str) -> tuple[str, ...]:
@@ -783,8 +786,15 @@ def _check_name(name: str) -> None:
         )
 
 
+def _no_negative_zero(values: np.ndarray, precision: int) -> np.ndarray:
+    """Values that would print as ``-0.000…`` set to 0, so a rewrite gives the same text."""
+    values = np.array(values, dtype=np.float64)
+    values[np.abs(values) < 0.5 * 10.0**-precision] = 0.0
+    return values
+
+
 def _fmt(values, precision: int) -> str:
-    return " ".join(f"{v:.{precision}f}" for v in values)
+    return " ".join(f"{v:.{precision}f}" for v in _no_negative_zero(values, precision))
 
 
 def dumps(motion: Motion, scale: float | None = None, precision: int = 6) -> str:
@@ -858,8 +868,11 @@ def dumps(motion: Motion, scale: float | None = None, precision: int = 6) -> str
                 f"cannot write joint {names[joints[n]]!r}: its channels have {have}, but at frame {t} it rotates "
                 f"{np.degrees(error[t, n]):.4g} degrees outside them; give it rotation channels in skeleton.channels"
             )
+        # written angles lie in (-180, 180]: -180 and 180 (the same turn) must not flip between writes
+        degrees = np.degrees(split)
+        degrees[degrees <= -180.0 + 0.5 * 10.0**-precision] += 360.0
         for n, j in enumerate(joints):
-            angles[j] = np.degrees(split[:, n])
+            angles[j] = degrees[:, n]
     for j, layout in enumerate(layouts):
         keys = [c.lower() for c in layout]
         for axis in range(3):
@@ -912,6 +925,7 @@ def dumps(motion: Motion, scale: float | None = None, precision: int = 6) -> str
     starts = np.cumsum([0] + [len(layouts[j]) for j in range(len(names))])
     perm = [c for j in order for c in range(starts[j], starts[j + 1])]
     data = np.stack([columns[c] for c in perm], axis=1) if perm else np.zeros((n_frames, 0))
+    data = _no_negative_zero(data, precision)
     header = "\n".join(lines) + "\n"
     if n_frames == 0:
         return header
