@@ -768,3 +768,14 @@ def assert_identical(a: Motion, b: Motion):
     np.testing.assert_array_equal(a.local_rot, b.local_rot)
     np.testing.assert_array_equal(a.root_pos, b.root_pos)
     assert (a.local_pos is None) == (b.local_pos is None) and a.fps == b.fps
+
+
+@pytest.mark.parametrize("order", ["xyz", "xzy", "yxz", "yzx", "zxy", "zyx"])
+def test_closed_form_euler_matches_quat_from_euler(order):
+    angles = np.random.default_rng(0).uniform(-400, 400, size=(50, 3, 3))
+    out = np.empty((50, 3, 4))
+    bvh._euler_into(out, angles, order)
+    assert_rot_close(out, quat.from_euler(np.radians(angles), order), tol=1e-14)
+    small = angles[np.abs(angles).max(axis=(1, 2)) < 360]  # below a full turn: the same quaternion
+    bvh._euler_into(out[: len(small)], small, order)
+    np.testing.assert_allclose(out[: len(small)], quat.from_euler(np.radians(small), order), atol=1e-15)
