@@ -569,7 +569,9 @@ def load(path: str | os.PathLike, scale: float = DEFAULT_SCALE, name: str | None
 
 
 CHUNK = 1 << 20
-"""Bytes of motion text converted per step while streaming (1 MiB)."""
+"""Most bytes of motion text converted per step while streaming (1 MiB); a file smaller than
+16 MiB uses 1/16 of its size (at least 64 KiB), so the step's temporary arrays stay small
+beside the result for small files too."""
 
 _HEADER_START = 1 << 16  # bytes read first for the header; doubled while the header goes on
 
@@ -675,15 +677,16 @@ def _fixed_decimals(raw: bytes, buf: np.ndarray, whitespace: np.ndarray, first: 
     return whole / 10.0**k
 
 
-def _pieces(f, head: bytes, cr_only: bool):
+def _pieces(f, head: bytes, cr_only: bool, size: int):
     """The rest of ``f`` after ``head`` in pieces of about :data:`CHUNK` bytes that end at line ends."""
-    if not cr_only:  # readlines stops at the first line end after CHUNK bytes
-        yield head + b"".join(f.readlines(CHUNK))
-        while lines := f.readlines(CHUNK):
+    chunk = min(CHUNK, max(size // 16, 1 << 16))
+    if not cr_only:  # readlines stops at the first line end after `chunk` bytes
+        yield head + b"".join(f.readlines(chunk))
+        while lines := f.readlines(chunk):
             yield b"".join(lines)
         return
     pending = head.replace(b"\r", b"\n")
-    while more := f.read(CHUNK):
+    while more := f.read(chunk):
         pending += more.replace(b"\r", b"\n")
         cut = pending.rfind(b"\n") + 1
         if cut:
@@ -710,7 +713,7 @@ def _read_stream(f, head: bytes, offset: int, n_frames, n_channels, first_line, 
         return slow()
     values = np.empty((n_frames, n_channels))
     row = 0
-    for piece in _pieces(f, head, cr_only):
+    for piece in _pieces(f, head, cr_only, size):
         part = _chunk_values(piece, n_channels)
         if part is None or row + len(part) > n_frames:
             return slow()
@@ -753,7 +756,9 @@ def _to_motion(names, parents, offsets, channels, end_sites, values, ft, scale, 
     for axes, (joints, cols) in groups.items():
         cols = np.asarray(cols)
         contiguous = joints == list(range(joints[0], joints[-1] + 1))
-        step = max(1, _ROTATIONS_PER_STEP // len(joints))
+        # a small file converts in smaller steps, so temporaries stay small beside the result
+        per_step = min(_ROTATIONS_PER_STEP, max(1024, n_frames * n_joints // 16))
+        step = max(1, per_step // len(joints))
         for t0 in range(0, n_frames, step):
             t1 = min(t0 + step, n_frames)
             if len(axes) == 3 and contiguous:  # straight into the result
