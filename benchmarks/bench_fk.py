@@ -441,7 +441,7 @@ def bench_bvh(args, peer) -> None:
             big = _generated_bvh(path, Path(tmp), args.big_mb)
             print(f"\n## BVH parse: generated {big.name}, {big.stat().st_size / 1e6:.1f} MB\n")
             print(f"file: the frame lines of {path.name} repeated (Frames: updated), written to {tmp}\n")
-            _bvh_rows(big, peer, max(1, min(args.repeats, 3)), args.budget, peer_quats=False)
+            _bvh_rows(big, peer, max(1, min(args.repeats, 3)), 4 * args.budget, peer_quats=False)
 
 
 # ---------------------------------------------------------------------------------- main
