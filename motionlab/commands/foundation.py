@@ -100,6 +100,10 @@ def _synth(args) -> int:
     from motionlab.core import bvh, humanoid
 
     out = _check_output(args.output, args.force)
+    if args.behaviour != "mix" and int(args.seconds * args.fps) < 1:
+        from motionlab.cli import CLIError
+
+        raise CLIError(f"--seconds {args.seconds:g} at --fps {args.fps:g} is less than one frame")
     skeleton = humanoid.canonical_skeleton(args.height)
     skeleton = humanoid.scale_bones(skeleton, legs=args.legs, arms=args.arms)
     if args.behaviour == "mix":

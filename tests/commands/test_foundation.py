@@ -42,6 +42,12 @@ def test_synth_refuses_nonsense_numbers(tmp_path, capsys, option, value):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_synth_refuses_less_than_a_frame(tmp_path, capsys):
+    code, _, err = _run(capsys, "synth", "walk", "-o", tmp_path / "x.bvh", "--seconds", "0.001")
+    assert code == 2 and "--seconds" in err and "one frame" in err
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_synth_writes_an_upright_skeleton(tmp_path, capsys):
     code, _, err = _run(capsys, "synth", "walk", "-o", tmp_path / "w.bvh", "--height", "1.6", "--seconds", "0.5")
     assert code == 0, err
