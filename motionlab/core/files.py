@@ -22,7 +22,7 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
-__all__ = ["TMP_SUFFIX", "check_input", "check_output", "atomic_write", "remove_stale"]
+__all__ = ["TMP_SUFFIX", "check_input", "check_output", "atomic_write", "atomic_write_all", "remove_stale"]
 
 TMP_SUFFIX = ".motionlab-tmp"
 """Ending of every temporary file a motionlab writer creates."""
@@ -103,6 +103,53 @@ def remove_stale(path: str | os.PathLike) -> list[Path]:
     return removed
 
 
+def atomic_write_all(outputs: list[tuple], overwrite: bool = False) -> list[Path]:
+    """Write several files as one: every temporary file is complete before the first rename.
+
+    ``outputs`` holds ``(path, write, binary, what)`` tuples as for :func:`atomic_write`. If
+    any ``write`` fails, no destination is touched; the renames at the end cannot fail short
+    of a system failure.
+    """
+    checked = [(check_output(path, overwrite, what), write, binary) for path, write, binary, what in outputs]
+    temps: list[tuple[str, Path]] = []
+    try:
+        for path, write, binary in checked:
+            remove_stale(path)
+            temps.append((_write_temporary(path, write, binary), path))
+        for tmp, path in temps:
+            os.replace(tmp, path)
+    except BaseException:
+        for tmp, _ in temps:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+        raise
+    return [path for _, path in temps]
+
+
+def _write_temporary(path: Path, write: Callable, binary: bool) -> str:
+    """A complete temporary file beside ``path`` holding what ``write(f)`` wrote, with ``path``'s mode."""
+    if path.exists():
+        mode = path.stat().st_mode & 0o777
+    else:
+        umask = os.umask(0)
+        os.umask(umask)
+        mode = 0o666 & ~umask
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.{os.getpid()}.", suffix=TMP_SUFFIX)
+    try:
+        if binary:
+            with os.fdopen(fd, "wb") as f:
+                write(f)
+        else:
+            with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
+                write(f)
+        os.chmod(tmp, mode)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return tmp
+
+
 def atomic_write(
     path: str | os.PathLike, write: Callable, overwrite: bool = False, binary: bool = False, what: str = "output"
 ) -> Path:
@@ -121,21 +168,8 @@ def atomic_write(
     """
     path = check_output(path, overwrite, what)
     remove_stale(path)
-    if path.exists():
-        mode = path.stat().st_mode & 0o777
-    else:
-        umask = os.umask(0)
-        os.umask(umask)
-        mode = 0o666 & ~umask
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.{os.getpid()}.", suffix=TMP_SUFFIX)
+    tmp = _write_temporary(path, write, binary)
     try:
-        if binary:
-            with os.fdopen(fd, "wb") as f:
-                write(f)
-        else:
-            with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
-                write(f)
-        os.chmod(tmp, mode)
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):

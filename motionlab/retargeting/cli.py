@@ -106,9 +106,8 @@ def _cmd_retarget(args) -> int:
     ckpt = None if args.method == "copy" else _load_checkpoint(args.checkpoint, args.device)
     result = retarget(source, target, ckpt, args.method, _solver_config(args), args.root, progress=not args.quiet)
     text = bvh.dumps(result.motion)  # any error in the result shows before a file is written
-    existed = out.exists()
-    files.atomic_write(out, lambda f: f.write(text), overwrite=args.force, what="output")
-    if npz is not None:
+    outputs = [(out, lambda f: f.write(text), False, "output")]
+    if npz is not None:  # both files or neither
         arrays = dict(
             local_rot=result.motion.local_rot,
             root_pos=result.motion.root_pos,
@@ -117,12 +116,8 @@ def _cmd_retarget(args) -> int:
             parents=result.motion.skeleton.parents,
             fps=result.motion.fps,
         )
-        try:
-            files.atomic_write(npz, lambda f: np.savez(f, **arrays), args.force, binary=True, what="--npz file")
-        except BaseException:
-            if not existed:  # no half result: the BVH goes too
-                out.unlink(missing_ok=True)
-            raise
+        outputs.append((npz, lambda f: np.savez(f, **arrays), True, "--npz file"))
+    files.atomic_write_all(outputs, overwrite=args.force)
     if not args.quiet:
         msg = f"wrote {out} ({result.motion.num_frames} frames @ {result.motion.fps:g} fps, method {result.method}"
         if result.method == "full":
@@ -180,8 +175,6 @@ def _cmd_evaluate(args) -> int:
     if args.csv:  # refuse before hours of work, not after
         from motionlab.core import files
 
-        if Path(args.csv).suffix.lower() != ".csv":
-            raise _error(f"--csv {args.csv} must end in .csv")
         files.check_output(args.csv, args.force, "--csv file")
     if not folder.is_dir():
         raise _error(f"data folder {folder} not found")

@@ -93,3 +93,24 @@ def test_bvh_save_uses_the_same_rule(tmp_path):
     stale.write_text("HIERARCHY\nROOT")
     bvh.save(tmp_path / "idle.bvh", m)
     assert [p.name for p in tmp_path.iterdir()] == ["idle.bvh"]
+
+
+def test_atomic_write_all_writes_every_file_or_none(tmp_path):
+    old = tmp_path / "a.bvh"
+    old.write_text("old a")
+
+    def fail(f):
+        raise OSError(28, "No space left on device")
+
+    with pytest.raises(OSError, match="No space"):
+        files.atomic_write_all(
+            [(old, lambda f: f.write("new a"), False, "output"), (tmp_path / "b.npz", fail, True, "--npz file")],
+            overwrite=True,
+        )
+    assert old.read_text() == "old a"  # the first file was not replaced either
+    assert [p.name for p in tmp_path.iterdir()] == ["a.bvh"]
+    files.atomic_write_all(
+        [(old, lambda f: f.write("new a"), False, "output"), (tmp_path / "b.npz", lambda f: f.write(b"b"), True, "x")],
+        overwrite=True,
+    )
+    assert old.read_text() == "new a" and (tmp_path / "b.npz").read_bytes() == b"b"

@@ -64,6 +64,12 @@ def test_npz_failure_leaves_no_bvh(inputs, tmp_path, capsys, monkeypatch):
     )
     assert code == 2 and "no space left" in err.lower()
     assert list(tmp_path.iterdir()) == []
+    out.write_text("older result")  # with --force, a failing --npz keeps the old BVH as well
+    code, _, err = _run(
+        capsys, "retarget", src, "--target", tgt, "-o", out, "--method", "copy", "--npz", tmp_path / "a.npz", "--force"
+    )
+    assert code == 2 and out.read_text() == "older result"
+    assert [p.name for p in tmp_path.iterdir()] == ["out.bvh"]
 
 
 def test_rig_error_names_the_file_at_fault_and_no_python_option(inputs, tmp_path, capsys):
