@@ -110,12 +110,12 @@ def atomic_write_all(outputs: list[tuple], overwrite: bool = False) -> list[Path
     any ``write`` fails, no destination is touched; the renames at the end cannot fail short
     of a system failure.
     """
-    checked = [(check_output(path, overwrite, what), write, binary) for path, write, binary, what in outputs]
+    checked = [(check_output(path, overwrite, what), write, binary, what) for path, write, binary, what in outputs]
     temps: list[tuple[str, Path]] = []
     try:
-        for path, write, binary in checked:
+        for path, write, binary, what in checked:
             remove_stale(path)
-            temps.append((_write_temporary(path, write, binary), path))
+            temps.append((_write_temporary(path, write, binary, what), path))
         for tmp, path in temps:
             os.replace(tmp, path)
     except BaseException:
@@ -126,7 +126,7 @@ def atomic_write_all(outputs: list[tuple], overwrite: bool = False) -> list[Path
     return [path for _, path in temps]
 
 
-def _write_temporary(path: Path, write: Callable, binary: bool) -> str:
+def _write_temporary(path: Path, write: Callable, binary: bool, what: str) -> str:
     """A complete temporary file beside ``path`` holding what ``write(f)`` wrote, with ``path``'s mode."""
     if path.exists():
         mode = path.stat().st_mode & 0o777
@@ -134,7 +134,10 @@ def _write_temporary(path: Path, write: Callable, binary: bool) -> str:
         umask = os.umask(0)
         os.umask(umask)
         mode = 0o666 & ~umask
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.{os.getpid()}.", suffix=TMP_SUFFIX)
+    try:
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.{os.getpid()}.", suffix=TMP_SUFFIX)
+    except OSError as e:  # the folder refuses new files: say which output, not the temporary name
+        raise type(e)(f"cannot write the {what} {path}: {(e.strerror or str(e)).lower()}") from None
     try:
         if binary:
             with os.fdopen(fd, "wb") as f:
@@ -168,7 +171,7 @@ def atomic_write(
     """
     path = check_output(path, overwrite, what)
     remove_stale(path)
-    tmp = _write_temporary(path, write, binary)
+    tmp = _write_temporary(path, write, binary, what)
     try:
         os.replace(tmp, path)
     except BaseException:
