@@ -605,8 +605,12 @@ def _read(f, size: int, scale: float, source: str, name: str) -> Motion:
             more = f.read(max(len(head), _HEADER_START))
             head += more
     names, parents, offsets, channels, end_sites, n_frames, frames_line, ft = header
-    first_line = tok.line + 1
-    start = len(tok.text[: tok.pos].encode("utf-8")) if tok.pos <= len(tok.text) else len(head)
+    if tok.pos <= len(tok.text):
+        first_line = tok.line + 1
+        start = len(tok.text[: tok.pos].encode("utf-8"))
+    else:  # the file ends on the Frame Time line: a missing block is reported there, not past the end
+        first_line = tok.line
+        start = len(head)
     n_channels = sum(len(c) for c in channels)
     values = _read_stream(f, head[start:], bom + start, n_frames, n_channels, first_line, frames_line, source, cr_only)
     return _to_motion(names, parents, offsets, channels, end_sites, values, ft, scale, name)

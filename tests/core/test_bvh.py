@@ -779,3 +779,9 @@ def test_closed_form_euler_matches_quat_from_euler(order):
     small = angles[np.abs(angles).max(axis=(1, 2)) < 360]  # below a full turn: the same quaternion
     bvh._euler_into(out[: len(small)], small, order)
     np.testing.assert_allclose(out[: len(small)], quat.from_euler(np.radians(small), order), atol=1e-15)
+
+
+def test_a_file_ending_on_the_frame_time_line_names_that_line():
+    text = SMALL[: SMALL.index("Frame Time: 0.0333333") + len("Frame Time: 0.0333333")]
+    with pytest.raises(BVHError, match="line 18: expected 3 frame lines"):
+        bvh.loads(text)
