@@ -20,9 +20,13 @@ API takes: local rotations, root positions and (J, 3) offsets. Its output is che
 one-off warm-up (torch.compile) is excluded from the rows and printed separately.
 
 BVH: the largest ``.bvh`` under ``MOTIONLAB_DATA``, or without it a synthetic file written with
-``bvh.save`` to a temporary folder. MB/s is file bytes / seconds of ``bvh.load`` (motionlab: text
-to a Motion with quaternions). For the peer it is ``BVH().load`` (text to Euler arrays), then
-``get_data()`` on top (Euler to quaternions, the comparable output).
+``bvh.save`` to a temporary folder; then a generated file of ``--big-mb`` MB (default 200): that
+file's frame lines repeated. MB/s is file bytes / seconds of ``bvh.load`` (motionlab: text to a
+Motion with quaternions). For the peer it is ``BVH().load`` (text to Euler arrays, its parse-only
+load, the row the ratios use), then ``get_data()`` on top (Euler to quaternions, the comparable
+output; skipped for the big file). Rows run interleaved, one run of each per round; the table
+gives wall-clock and CPU-time medians. Memory: the peak resident set a second ``bvh.load`` adds
+in a fresh process (``VmHWM``, reset after a warm-up load), result included.
 
 Environment, set before torch is imported unless already set, and printed:
 
@@ -60,6 +64,7 @@ if _POLICY == "passive" or (_POLICY == "auto" and _BUSY):
 
 import argparse  # noqa: E402
 import platform  # noqa: E402
+import re  # noqa: E402
 import statistics  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
@@ -306,46 +311,137 @@ def bench_fk(args, peer) -> None:
 
 
 # ---------------------------------------------------------------------------------- BVH
+_MEMORY_PROBE = """
+import sys
+from motionlab.core import bvh
+
+def status(key):
+    for line in open("/proc/self/status"):
+        if line.startswith(key + ":"):
+            return int(line.split()[1])
+
+bvh.load(sys.argv[1])  # warm-up: touches the code and library pages a first call maps in
+try:  # reset the high-water mark to the current size (Linux >= 4.0)
+    with open("/proc/self/clear_refs", "w") as f:
+        f.write("5")
+except OSError:
+    pass
+before = status("VmHWM")
+motion = bvh.load(sys.argv[1])
+print(before, status("VmHWM"), motion.num_frames)
+"""
+
+
+def _load_memory(path: Path) -> tuple[float, int]:
+    """Peak resident memory added by ``bvh.load(path)`` in a fresh Python (bytes), and the frames read.
+
+    Linux's ``VmHWM`` (peak resident set, KiB) is reset after the imports and one warm-up load
+    (which maps in code and library pages once), then read after a second load: the growth is
+    what loading needed at its peak, result included.
+    """
+    import subprocess
+
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(Path(__file__).resolve().parents[1]), *sys.path]))
+    out = subprocess.run(
+        [sys.executable, "-c", _MEMORY_PROBE, str(path)], capture_output=True, text=True, env=env, check=True
+    ).stdout.split()
+    return (int(out[1]) - int(out[0])) * 1024.0, int(out[2])
+
+
+def _generated_bvh(source: Path, folder: Path, target_mb: float) -> Path:
+    """A ~``target_mb`` MB BVH: ``source``'s header and its frame lines repeated (Frames: updated)."""
+    raw = source.read_bytes()
+    cut = raw.find(b"\n", raw.find(b"Frame Time")) + 1
+    header, block = raw[:cut], raw[cut:]
+    if not block.endswith(b"\n"):
+        block += b"\n"
+    frames = sum(1 for line in block.split(b"\n") if line.strip())
+    repeats = max(1, round(target_mb * 1e6 / len(block)))
+    header = re.sub(rb"Frames:\s*\d+", b"Frames: %d" % (frames * repeats), header, count=1)
+    path = folder / f"generated_{target_mb:.0f}MB.bvh"
+    with open(path, "wb") as f:
+        f.write(header)
+        for _ in range(repeats):
+            f.write(block)
+    return path
+
+
+def _bvh_rows(path: Path, peer, repeats: int, budget: float, peer_quats: bool = True) -> None:
+    size_mb = path.stat().st_size / 1e6
+    ours = lambda: bvh.load(path)  # noqa: E731
+    cases = [("motionlab bvh.load (text -> Motion with quaternions)", ours, False)]
+    if peer is not None:
+
+        def peer_parse():
+            b = peer["BVH"]()
+            b.load(str(path))
+            return b
+
+        cases.append(("pymotion BVH().load (text -> Euler arrays)", peer_parse, True))
+        if peer_quats:
+            cases.append(("pymotion BVH().load + get_data() (-> quaternions)", lambda: peer_parse().get_data(), True))
+    # rows are interleaved (one run of each per round), so that a busy spell hits all of them alike;
+    # wall-clock and CPU seconds of this process (all rows are single-threaded) are both kept
+    wall: dict[str, list[float]] = {name: [] for name, _, _ in cases}
+    cpu: dict[str, list[float]] = {name: [] for name, _, _ in cases}
+    for _, fn, _ in cases:
+        fn()  # warm-up: file cache, imports
+    t_end = time.perf_counter() + budget * len(cases)
+    while min(len(t) for t in wall.values()) < repeats and (not all(wall.values()) or time.perf_counter() < t_end):
+        for name, fn, _ in cases:
+            t0, c0 = time.perf_counter(), time.process_time()
+            fn()
+            wall[name].append(time.perf_counter() - t0)
+            cpu[name].append(time.process_time() - c0)
+    med = {name: size_mb / statistics.median(wall[name]) for name in wall}
+    med_cpu = {name: size_mb / statistics.median(cpu[name]) for name in cpu}
+    peer_name = next((name for name, _, p in cases if p), None)
+    rows = []
+    for name, _, _ in cases:
+        ratio = f"{med[name] / med[peer_name]:.2f}x" if peer_name else "n/a"
+        ratio_cpu = f"{med_cpu[name] / med_cpu[peer_name]:.2f}x" if peer_name else "n/a"
+        best = size_mb / min(wall[name])
+        rows.append(
+            [name, f"{med[name]:.1f}", f"{best:.1f}", f"{med_cpu[name]:.1f}", str(len(wall[name])), ratio, ratio_cpu]
+        )
+    header = [
+        "implementation",
+        "MB/s (median)",
+        "best run",
+        "MB/s of CPU time",
+        "runs",
+        "ratio vs peer parse-only",
+        "same, CPU time",
+    ]
+    _print_table(header, rows)
+    peak, frames = _load_memory(path)
+    print(
+        f"\nmotionlab bvh.load memory: peak RSS +{peak / 1e6:.0f} MB for a {size_mb:.0f} MB file "
+        f"({peak / (size_mb * 1e6):.2f}x the file, result included; {frames} frames; fresh process)"
+    )
+    if peer_name:
+        ours_name = cases[0][0]
+        print(
+            f"parse speed: motionlab {med[ours_name] / med[peer_name]:.2f}x pymotion's parse-only load "
+            f"(median wall-clock MB/s; {med_cpu[ours_name] / med_cpu[peer_name]:.2f}x in CPU time)"
+        )
+    else:
+        print(f"\npeer not installed: {PEER_HINT}  (then rerun for the ratio column)")
+
+
 def bench_bvh(args, peer) -> None:
     rng = np.random.default_rng(1)
     with tempfile.TemporaryDirectory(prefix="motionlab_bench_") as tmp:
         path, what = _bvh_file(Path(tmp), rng)
-        size_mb = path.stat().st_size / 1e6
-        print(f"\n## BVH parse: {path.name}, {size_mb:.2f} MB\n")
+        print(f"\n## BVH parse: {path.name}, {path.stat().st_size / 1e6:.2f} MB\n")
         print(f"file: {what}")
-        repeats = max(1, min(args.repeats, 5))
-        motion = bvh.load(path)
-        print(f"motionlab reads {motion!r}")
-        cases = [("motionlab bvh.load (text -> Motion with quaternions)", lambda: bvh.load(path), False)]
-        if peer is not None:
-
-            def peer_parse():
-                b = peer["BVH"]()
-                b.load(str(path))
-                return b
-
-            def peer_quats():
-                return peer_parse().get_data()
-
-            cases += [
-                ("pymotion BVH().load (text -> Euler arrays)", peer_parse, True),
-                ("pymotion BVH().load + get_data() (-> quaternions)", peer_quats, True),
-            ]
-        results = []
-        for name, fn, is_peer in cases:
-            times = _time(fn, repeats, args.budget)
-            results.append((name, size_mb / statistics.median(times), size_mb / min(times), len(times), is_peer))
-        peer_best = max((r[1] for r in results if r[4]), default=None)
-        rows = []
-        for name, med, best, runs, _ in results:
-            ratio = f"{med / peer_best:.2f}x" if peer_best else "n/a"
-            rows.append([name, f"{med:.1f}", f"{best:.1f}", str(runs), ratio])
-        print()
-        _print_table(["implementation", "MB/s (median)", "best run", "runs", "ratio vs peer"], rows)
-        if peer_best:
-            print("\nratio = median MB/s / the faster pymotion row's median MB/s (its parse-only row).")
-        else:
-            print(f"\npeer not installed: {PEER_HINT}  (then rerun for the ratio column)")
+        print(f"motionlab reads {bvh.load(path)!r}\n")
+        _bvh_rows(path, peer, max(1, min(args.repeats, 7)), args.budget)
+        if args.big_mb > 0:
+            big = _generated_bvh(path, Path(tmp), args.big_mb)
+            print(f"\n## BVH parse: generated {big.name}, {big.stat().st_size / 1e6:.1f} MB\n")
+            print(f"file: the frame lines of {path.name} repeated (Frames: updated), written to {tmp}\n")
+            _bvh_rows(big, peer, max(1, min(args.repeats, 3)), 4 * args.budget, peer_quats=False)
 
 
 # ---------------------------------------------------------------------------------- main
@@ -359,6 +455,10 @@ def main(argv=None) -> int:
     parser.add_argument("--threads", type=int, default=None, help="torch threads (default: the usable cores)")
     parser.add_argument("--budget", type=float, default=8.0, help="seconds after which a row stops repeating")
     parser.add_argument("--skip-bvh", action="store_true", help="FK only")
+    parser.add_argument(
+        "--big-mb", type=float, default=200.0, help="size of the generated BVH file, MB (default 200; 0: none)"
+    )
+    parser.add_argument("--skip-fk", action="store_true", help="BVH only")
     parser.add_argument(
         "--omp-wait-policy",
         choices=["auto", "passive", "default"],
@@ -396,7 +496,8 @@ def main(argv=None) -> int:
         )
     )
 
-    bench_fk(args, peer)
+    if not args.skip_fk:
+        bench_fk(args, peer)
     if not args.skip_bvh:
         bench_bvh(args, peer)
     print(f"\nload average at end: {_load()}; total time {time.perf_counter() - t_start:.0f} s")

@@ -1,13 +1,25 @@
-"""In-betweening benchmark, LaFAN1 protocol, on any folder(s) of BVH files.
+"""In-betweening benchmark on LaFAN1's protocol, one skeleton at a time.
 
-    python benchmarks/bench_inbetween.py                       # inbetween_test + behaviours in $MOTIONLAB_DATA
-    python benchmarks/bench_inbetween.py path/to/folder [more folders or files] [--k 3]
+    python benchmarks/bench_inbetween.py                # the two groups below, from $MOTIONLAB_DATA
+    python benchmarks/bench_inbetween.py --k 1
 
-Rows: zero-velocity, interpolation (SLERP + linear root, the LaFAN1 baseline), Hermite root, and
-motionlab's key-pose-guided filling (MotionLibrary, leave-one-clip-out: a window is never filled
-from its own clip). Columns: transition lengths 5, 15, 30 frames at 30 fps. The numbers are NOT
-LaFAN1 numbers: the data used is printed with the table. Also measures the throughput of the
-plain interpolation (filled frames per second, batched over windows).
+LaFAN1 itself is not in the shared data (see its README), so two stand-in groups are scored, each
+on its own skeleton, each with its L2P statistics from a fixed set of clips of that skeleton kept
+apart from the scored windows (LaFAN1 uses its training subjects):
+
+* **Bandai Namco** (proportion-aligned 22-joint rig, 30 fps): scored = ``bandai_namco/dataset-2``
+  (the 8 ``inbetween_test`` clips); apart = the normal-style clips of ``dataset-1`` and the normal
+  walk takes 4–12 of ``sessions/walk`` (takes 1–3 are the scored walks);
+* **Mixamo Aj** (60 fps resampled to 30): scored = the 9 Aj behaviour clips; apart = every third
+  of the other Aj clips (sorted by name).
+
+Rows: zero-velocity, interpolation (SLERP + linear root, LaFAN1's baseline), Hermite root + SLERP,
+and motionlab's key-pose-guided filling (MotionLibrary over the scored and the apart clips,
+leave-one-clip-out: a window is never filled from its own clip; Bandai: only recordings of the
+window's own action), without and with a matching-cost limit above which a gap is interpolated
+instead; the limit is chosen on the apart clips' own windows (:func:`choose_max_cost`), never on
+the scored ones. Columns: transition lengths 5, 15, 30, 45. Outputs are made sign-continuous
+with the last context frame before FK; nothing is flipped at scoring. NOT LaFAN1 numbers.
 """
 
 from __future__ import annotations
@@ -23,29 +35,24 @@ import numpy as np
 from motionlab.interpolation import benchmark as bm
 from motionlab.interpolation.library import MotionLibrary
 
-BEHAVIOURS = [
-    "bandai_namco/dataset-1/walk/dataset-1_walk_normal_002.bvh",
-    "bandai_namco/dataset-1/walk-back/dataset-1_walk-back_normal_001.bvh",
-    "bandai_namco/dataset-1/walk-left/dataset-1_walk-left_normal_001.bvh",
-    "bandai_namco/dataset-1/walk-right/dataset-1_walk-right_normal_001.bvh",
-    "bandai_namco/dataset-1/kick/dataset-1_kick_normal_001.bvh",
-    "bandai_namco/dataset-1/punch/dataset-1_punch_normal_001.bvh",
-    "bandai_namco/dataset-1/punch/dataset-1_punch_normal_002.bvh",
-    "bandai_namco/dataset-1/bow/dataset-1_bow_normal_001.bvh",
-    "mixamo_ganimator/Joe/Walk-In-Circle.bvh",
-] + [
+AJ_SCORED = [
     f"mixamo/Aj/{c}.bvh"
     for c in ("Running", "Jumping", "Body_Jab_Cross", "Standing_To_Crouch", "Catwalk_Idle_To_Walk_Forward",
               "Injured_Walk_Left_Turn", "Idle", "Combo_Punch", "Standing_To_Crouched")
 ]  # fmt: skip
 
 
-def default_paths() -> list[Path]:
-    root = os.environ.get("MOTIONLAB_DATA")
-    if not root:
-        sys.exit("give BVH folders/files, or set MOTIONLAB_DATA (e.g. export MOTIONLAB_DATA=/path/to/shared/data)")
-    root = Path(root)
-    return [root / "bandai_namco/dataset-2"] + [root / p for p in BEHAVIOURS if (root / p).exists()]
+def groups(root: Path) -> list[tuple[str, list[Path], list[Path], bool]]:
+    """``(name, scored files, apart files, same_action)`` per skeleton."""
+    d1 = root / "bandai_namco/dataset-1"
+    bandai_scored = sorted((root / "bandai_namco/dataset-2").rglob("*.bvh"))
+    bandai_apart = sorted(d1.rglob("*_normal_*.bvh"))
+    bandai_apart += [root / f"bandai_namco/sessions/walk/dataset-2_walk_normal_{i:03d}.bvh" for i in range(4, 13)]
+    aj_scored = [root / p for p in AJ_SCORED]
+    skip = {p.name for p in aj_scored} | {"std_bvh.bvh"}
+    aj_apart = [p for p in sorted((root / "mixamo/Aj").glob("*.bvh")) if p.name not in skip][::3]
+    out = [("Bandai Namco", bandai_scored, bandai_apart, True), ("Mixamo Aj", aj_scored, aj_apart, False)]
+    return [(n, [p for p in sc if p.exists()], [p for p in ap if p.exists()], same) for n, sc, ap, same in out]
 
 
 def throughput(windows: bm.Windows, gap: int = 30, repeat: int = 5, target: int = 2000) -> float:
@@ -60,45 +67,66 @@ def throughput(windows: bm.Windows, gap: int = 30, repeat: int = 5, target: int 
     return len(big) * gap / best
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("paths", nargs="*", help="BVH files or folders (default: inbetween_test + behaviours)")
-    ap.add_argument("--k", type=int, default=3, help="library stretches averaged per gap (default 3)")
-    ap.add_argument("--fps", type=float, default=30.0)
-    args = ap.parse_args(argv)
-    paths = [Path(p) for p in args.paths] or default_paths()
-    t0 = time.perf_counter()
-    clips = bm.load_clips(paths, fps=args.fps)
-    if not clips:
-        sys.exit(f"no usable BVH clips under {[str(p) for p in paths]}")
+def run_group(name, scored, apart, same_action, k, fps):
+    clips = bm.load_clips(scored, fps=fps)
+    held = bm.load_clips(apart, fps=fps)
     windows = bm.make_windows(clips)
-    stats = bm.position_stats(clips)
-    lib = MotionLibrary(clips, labels=[bm.action_label(c.name) for c in clips])
+    stats = bm.position_stats(held)
+    everything = clips + held
+    lib = MotionLibrary(everything, labels=[bm.action_label(c.name) for c in everything])
+    key = f"motionlab key-pose (k={k})"
+    apart_windows = bm.make_windows(held)
+    max_cost = bm.choose_max_cost(apart_windows, lib, stats, k=k, same_action=same_action)
     methods = {
         "zero-velocity": bm.method_zero_velocity,
         "interpolation (SLERP+lin)": bm.method_interpolation,
         "Hermite root + SLERP": bm.method_hermite,
-        f"motionlab key-pose (k={args.k})": bm.method_library(lib, k=args.k),
+        f"key-pose, no cost limit (k={k})": bm.method_library(lib, k=k, same_action=same_action),
+        key: bm.method_library(lib, k=k, same_action=same_action, max_cost=max_cost),
     }
     res = bm.evaluate(windows, methods, stats)
-    elapsed = time.perf_counter() - t0
-    print("In-betweening benchmark, LaFAN1 protocol (windows of 65 frames every 40, 10 context frames,")
-    print("target = first frame after the gap). NOT LaFAN1 data; computed on:")
-    for p in paths:
-        print(f"  {p}")
     frames = sum(c.num_frames for c in clips)
-    print(f"{len(clips)} clips, {frames} frames at {args.fps:g} fps, {len(windows)} windows, 22-joint skeleton;")
-    print("L2P normalised with mean/std of these clips' global positions. motionlab row: leave-one-clip-out,")
-    print("searching only other recordings of the same action (label from the file name); gaps whose action")
-    print("has no other recording fall back to plain interpolation.")
-    labels = sorted({bm.action_label(c.name) for c in clips})
-    print(f"actions: {', '.join(labels)}\n")
+    print(f"--- {name}: {len(clips)} scored clips, {frames} frames at {fps:g} fps, {len(windows)} windows;")
+    print(f"    L2P statistics from {len(held)} clips kept apart ({sum(c.num_frames for c in held)} frames); "
+          f"library: both sets ({lib.num_frames} frames), leave-one-clip-out"
+          + (", same action only" if same_action else ""))  # fmt: skip
+    print(f"    cost limit {max_cost:.3g} chosen on the {len(apart_windows)} windows of the apart clips (gaps 15, 30;")
+    print("    above it a gap is interpolated: no recording matches its ends)")
+    print("    scored: " + ", ".join(c.name for c in clips))
+    print("    apart:  " + ", ".join(c.name for c in held))
+    print()
     print(bm.format_table(res))
     for gap in (15, 30):
-        a, b = res[("interpolation (SLERP+lin)", "L2P", gap)], res[(list(methods)[-1], "L2P", gap)]
-        print(f"L2P at {gap}: motionlab {b:.3f} vs interpolation {a:.3f} ({100 * (1 - b / a):+.0f}% lower)")
-    print(f"\nplain interpolation throughput: {throughput(windows):,.0f} filled frames/s (gap 30, batched)")
-    print(f"total time {elapsed:.1f} s")
+        a, b = res[("interpolation (SLERP+lin)", "L2P", gap)], res[(key, "L2P", gap)]
+        qa, qb = res[("interpolation (SLERP+lin)", "L2Q", gap)], res[(key, "L2Q", gap)]
+        print(f"gap {gap}: L2P key-pose {b:.3f} vs interpolation {a:.3f} ({100 * (1 - b / a):+.0f}% lower: "
+              f"{'ahead' if b < a else 'tied' if b == a else 'BEHIND'}); L2Q {qb:.3f} vs {qa:.3f} "
+              f"({'match or beat' if qb <= qa else 'WORSE'})")  # fmt: skip
+    print()
+    return windows
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--k", type=int, default=3, help="library stretches averaged per gap (default 3)")
+    ap.add_argument("--fps", type=float, default=30.0)
+    args = ap.parse_args(argv)
+    root = os.environ.get("MOTIONLAB_DATA")
+    if not root:
+        sys.exit("set MOTIONLAB_DATA to the shared data folder (e.g. export MOTIONLAB_DATA=/path/to/shared/data)")
+    t0 = time.perf_counter()
+    print("In-betweening benchmark, LaFAN1 protocol (windows of 65 frames every 40, 10 context frames, target =")
+    print("first frame after the gap; outputs sign-continuous with the last context frame before FK, no flip at")
+    print("scoring; L2P statistics from clips kept apart, one skeleton at a time). NOT LaFAN1 data.\n")
+    windows = None
+    for name, scored, apart, same in groups(Path(root)):
+        if not scored or not apart:
+            print(f"--- {name}: skipped (files missing under {root})")
+            continue
+        windows = run_group(name, scored, apart, same, args.k, args.fps)
+    if windows is not None:
+        print(f"plain interpolation throughput: {throughput(windows):,.0f} filled frames/s (gap 30, batched)")
+    print(f"total time {time.perf_counter() - t0:.1f} s")
     return 0
 
 

@@ -110,9 +110,8 @@ def experiment_build(set19, source: str, thr: float) -> None:
         f"speed-up over the paper: standard {140 * 60 / t_std:,.0f}x, structured {57 * 60 / t_plain:,.0f}x "
         f"({57 * 60 / t_st:,.0f}x with the interpolation space)"
     )
-    for key in ("forced", "missing_links", "dropped"):
-        if st.info.get(key):
-            print(f"  {key}: {len(st.info[key])} (e.g. {st.info[key][0]})")
+    for key, lines in sorted(st.info.get("conditions", {}).items()):
+        print(f"  {key}: {len(lines)} (e.g. {lines[0]})")
 
 
 def experiment_connectivity(set6, source: str, thr: float) -> None:

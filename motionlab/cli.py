@@ -11,10 +11,10 @@ import argparse
 import importlib
 import sys
 
-__all__ = ["main", "build_parser", "CLIError"]
+__all__ = ["main", "build_parser", "CLIError", "rig_error"]
 
 _PARTS = (
-    "motionlab.core.cli",
+    "motionlab.commands.foundation",
     "motionlab.retargeting.cli",
     "motionlab.motion_graphs.cli",
     "motionlab.interpolation.cli",
@@ -24,6 +24,16 @@ _PARTS = (
 
 class CLIError(Exception):
     """A user-facing error: printed as ``motionlab: error: …`` with exit status 2, no traceback."""
+
+
+def rig_error(error, role: str, path) -> Exception:
+    """A CLIError saying which file (``role``: source, target, input) does not map onto the humanoid."""
+    from motionlab.core.humanoid import PROFILES
+
+    return CLIError(
+        f"{role} file {path}: {error.reason} Its joint names must follow one of the rig profiles "
+        f"{', '.join(PROFILES)}; `motionlab info {path} --joints` lists its joints."
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -44,6 +54,14 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _os_message(e: OSError) -> str:
+    """``[Errno 13] Permission denied: 'x.bvh'`` as ``x.bvh: permission denied``; our own messages unchanged."""
+    if e.strerror and e.filename is not None:
+        where = f"{e.filename} -> {e.filename2}" if e.filename2 else str(e.filename)
+        return f"{where}: {e.strerror[0].lower()}{e.strerror[1:]}"
+    return str(e) or type(e).__name__
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -55,8 +73,11 @@ def main(argv: list[str] | None = None) -> int:
     except CLIError as e:
         print(f"motionlab: error: {e}", file=sys.stderr)
         return 2
-    except (FileNotFoundError, FileExistsError, ValueError) as e:
+    except ValueError as e:
         print(f"motionlab: error: {e}", file=sys.stderr)
+        return 2
+    except OSError as e:  # unreadable input, unwritable folder, a folder where a file was expected, ...
+        print(f"motionlab: error: {_os_message(e)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("motionlab: interrupted", file=sys.stderr)

@@ -20,9 +20,13 @@ from pathlib import Path
 import numpy as np
 from tqdm.auto import tqdm
 
-from motionlab.core import bvh, humanoid, metrics
+from motionlab.core import bvh, files, humanoid, metrics
 
-__all__ = ["run_demo", "SEGMENTS"]
+__all__ = ["run_demo", "SEGMENTS", "MARKER"]
+
+MARKER = ".motionlab-demo"
+"""File the demo leaves in its output folder: a folder holding it belongs to the demo, and a
+re-run replaces the demo's own files there without ``force``."""
 
 SEGMENTS = [("idle", 40), ("walk", 140), ("run", 110), ("jump", 70), ("walk", 80), ("squat", 100)]
 """The demo performance: (behaviour, frames at 60 fps)."""
@@ -40,18 +44,36 @@ def _row(name: str, pos: np.ndarray, ref: np.ndarray, fps: float, height: float,
     }
 
 
+def _claim(out_dir: Path, planned: list[Path], force: bool) -> None:
+    """Make ``out_dir`` the demo's folder; refuse (without ``force``) to replace files the demo did not write."""
+    if out_dir.exists() and not out_dir.is_dir():
+        raise NotADirectoryError(f"output folder {out_dir} is a file; expected a folder")
+    owned = (out_dir / MARKER).is_file()
+    clash = [p for p in planned if p.exists()]
+    if clash and not owned and not force:
+        raise FileExistsError(
+            f"{clash[0]} exists (and {len(clash) - 1} more) in {out_dir}, which an earlier demo did not write; "
+            "pass --force to overwrite, or choose another --out"
+        )
+    out_dir.mkdir(parents=True, exist_ok=True)
+    files.atomic_write(
+        out_dir / MARKER, lambda f: f.write("written by `motionlab demo`; a re-run replaces its files\n"), True
+    )
+
+
 def run_demo(out_dir: str | Path = "outputs/demo", characters: int = 4, seed: int = 0, force: bool = False) -> int:
-    """Run the demo; returns 0. Existing files in ``out_dir`` are only replaced with ``force``."""
+    """Run the demo; returns 0.
+
+    ``out_dir`` belongs to the demo once it ran there (a :data:`MARKER` file): running again replaces
+    the demo's files. Files in a folder the demo did not write are only replaced with ``force``.
+    """
     from motionlab import synthetic
     from motionlab.retargeting import load_default, retarget
 
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
     planned = [out_dir / "source.bvh", out_dir / "foot_heights.png", out_dir / "summary.md"]
     planned += [out_dir / f"character_{i}.bvh" for i in range(characters)]
-    clash = [p for p in planned if p.exists()]
-    if clash and not force:
-        raise FileExistsError(f"{clash[0]} exists (and {len(clash) - 1} more); pass --force to overwrite")
+    _claim(out_dir, planned, force)
 
     checkpoint = load_default()
     source_skeleton = checkpoint.skeleton
@@ -108,7 +130,7 @@ def run_demo(out_dir: str | Path = "outputs/demo", characters: int = 4, seed: in
             f"| {method} | {m['mpjpe_cm']:.2f} | {m['pen_pct']:.3f} | {m['skate']:.3f} | {m['smooth']:.3f} | {m['seconds']:.2f} |"
         )
     table = "\n".join(lines)
-    (out_dir / "summary.md").write_text("# motionlab demo\n\n" + table + "\n")
+    files.atomic_write(out_dir / "summary.md", lambda f: f.write("# motionlab demo\n\n" + table + "\n"), True)
     print()
     print(table)
 
@@ -127,7 +149,7 @@ def run_demo(out_dir: str | Path = "outputs/demo", characters: int = 4, seed: in
     ax.set_title("character 0: lowest toe height per frame (below 0 = through the floor)")
     ax.legend()
     fig.tight_layout()
-    fig.savefig(out_dir / "foot_heights.png", dpi=110)
+    files.atomic_write(out_dir / "foot_heights.png", lambda f: fig.savefig(f, format="png", dpi=110), True, binary=True)
     plt.close(fig)
     print(f"\nwrote {len(planned)} files to {out_dir}/ (open the .bvh files in Blender or `motionlab view`)")
     return 0

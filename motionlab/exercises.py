@@ -1,33 +1,226 @@
 """Check cells for the notebooks' exercises.
 
-Every exercise asks the student to write a function the package already has; :func:`check`
-runs both on the same inputs and says plainly whether the student's answer agrees::
+Every exercise asks the student to write a small function. Its check runs the student's
+function and a reference on the same inputs and answers in one line, without ever stopping the
+notebook:
+
+* ``✓`` the answer agrees (with the reference, or with another correct convention the exercise
+  accepts, e.g. a forward difference where the reference uses a central one);
+* ``…`` the stub still raises ``NotImplementedError``: the exercise is not attempted yet, and
+  *Run All* goes on to the next cell;
+* ``✗`` the answer disagrees. When it matches a *typical mistake* the exercise knows about, the
+  message gives that mistake's hint (what to look at, never the solution); otherwise it says
+  which case failed and by how much, without printing the expected value.
+
+Put the check last in its cell: the returned :class:`Result` displays as its message::
 
     def my_conj(q):
         ...
-    exercises.check(my_conj, quat.conj, [q1, q2])   # prints "✓ my_conj agrees on 2 cases"
+    exercises.conj.check(my_conj)          # ✓ my_conj is right on 3 cases
 
-A stub that still raises ``NotImplementedError`` is reported as not done (and re-raised, so the
-cell fails visibly in a notebook; CI marks these cells as expected to raise).
+The notebooks 00, 01 and 04 use the named exercises defined below (``conj``, ``slerp``,
+``hand_height``, ``heading``, ``window_count``, ``pose_error``, ``joint_speed``); their reference
+solutions, as a student would write them, are in ``notebooks/solutions/`` (the instructor's
+key), and ``tests/test_exercises.py`` runs every check against the key, a wrong answer and an
+alternative correct answer. :func:`check` is the same machinery for ad-hoc checks.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["check"]
+__all__ = [
+    "Exercise",
+    "Mistake",
+    "Result",
+    "check",
+    "conj",
+    "slerp",
+    "hand_height",
+    "heading",
+    "window_count",
+    "pose_error",
+    "joint_speed",
+    "EXERCISES",
+]
 
 
-def _as_array(x):
+# --------------------------------------------------------------------------- results and comparison
+@dataclass(frozen=True)
+class Result:
+    """Outcome of one check.
+
+    Attributes
+    ----------
+    passed : the answer agrees on every case
+    attempted : False while the stub still raises ``NotImplementedError``
+    message : the one-paragraph verdict shown in the notebook
+    hint : the matched typical mistake's hint, or None
+    """
+
+    passed: bool
+    attempted: bool
+    message: str
+    hint: str | None = None
+
+    def __bool__(self) -> bool:
+        return self.passed
+
+    def __repr__(self) -> str:
+        return self.message
+
+    def _repr_pretty_(self, p, cycle) -> None:  # IPython shows the message, not a dataclass repr
+        p.text(self.message)
+
+
+@dataclass(frozen=True)
+class Mistake:
+    """A typical wrong answer and the hint to give when a student's answer behaves like it.
+
+    ``answer`` is written as a student would write the mistake; an answer is recognised as this
+    mistake when it agrees with ``answer`` on every case (same tolerance as the check).
+    """
+
+    answer: Callable
+    hint: str
+
+
+def _as_array(x) -> np.ndarray:
     if hasattr(x, "detach"):
         x = x.detach().cpu().numpy()
     return np.asarray(x, dtype=np.float64)
 
 
-def check(student: Callable, reference: Callable, cases: Sequence, atol: float = 1e-6, sign_free: bool = False) -> None:
-    """Compare ``student(*case)`` with ``reference(*case)`` on every case.
+def _as_tuple(x) -> tuple:
+    return x if isinstance(x, tuple) else (x,)
+
+
+def _difference(got, want, atol: float, sign_free: bool, period: float | None) -> tuple[bool, str]:
+    """(agrees, what differs) for one case's outputs; never shows ``want`` itself."""
+    got_t, want_t = _as_tuple(got), _as_tuple(want)
+    if len(got_t) != len(want_t):
+        return False, f"returned {len(got_t)} value(s), expected {len(want_t)}"
+    for g, w in zip(got_t, want_t):
+        try:
+            g = _as_array(g)
+        except (TypeError, ValueError):
+            return False, f"returned {type(g).__name__}, expected numbers"
+        w = _as_array(w)
+        if g.shape != w.shape:
+            return False, f"returned shape {g.shape}, expected shape {w.shape}"
+        diff = g - w
+        if period is not None:  # angles: equal up to whole turns
+            diff = (diff + period / 2) % period - period / 2
+        err = np.abs(diff)
+        if sign_free:  # quaternions: q and -q are the same rotation
+            err = np.minimum(err.max(axis=-1), np.abs(g + w).max(axis=-1))
+        if not np.all(np.isfinite(g)):
+            return False, "returned NaN or infinite values"
+        if not np.all(err <= atol):
+            if w.size == 1:  # the size of the gap would give a single number away
+                return False, "is not the expected value"
+            return False, f"differs by up to {np.nanmax(err):.3g} (tolerance {atol:g})"
+    return True, ""
+
+
+def _call(fn: Callable, args: tuple):
+    return fn(*args)
+
+
+@dataclass
+class Exercise:
+    """One exercise: its reference, its test cases, accepted alternatives and typical mistakes.
+
+    Parameters
+    ----------
+    name : shown in messages (``"00 · exercise 1: quaternion conjugate"``)
+    reference : the correct answer (usually the package's own function)
+    cases : callable returning a list of argument tuples (built on demand, deterministic)
+    accept : other correct answers (e.g. another finite-difference scheme); agreeing with any
+        of them passes
+    mistakes : typical wrong answers with their hints, tried in order
+    atol : absolute tolerance per element
+    sign_free : compare quaternions up to sign
+    period : compare modulo this period (angles: ``2π``)
+    """
+
+    name: str
+    reference: Callable
+    cases: Callable[[], Sequence[tuple]]
+    accept: Sequence[Callable] = ()
+    mistakes: Sequence[Mistake] = ()
+    atol: float = 1e-6
+    sign_free: bool = False
+    period: float | None = None
+    _cache: dict = field(default_factory=dict, repr=False)
+
+    def _cases(self) -> list[tuple]:
+        if "cases" not in self._cache:
+            self._cache["cases"] = [_as_tuple(c) for c in self.cases()]
+        return self._cache["cases"]
+
+    def _agrees(self, outputs: list, fn: Callable, cases: list[tuple]) -> tuple[bool, str]:
+        for i, (args, got) in enumerate(zip(cases, outputs)):
+            ok, why = _difference(got, _call(fn, args), self.atol, self.sign_free, self.period)
+            if not ok:
+                return False, f"case {i + 1}: {why}"
+        return True, ""
+
+    def check(self, student: Callable) -> Result:
+        """Run ``student`` on every case; see the module docstring for the three outcomes."""
+        return _run_check(
+            student, self.reference, self._cases(), self.accept, self.mistakes, self._agrees, label=self.name
+        )
+
+
+def _run_check(student, reference, cases, accept, mistakes, agrees, label: str | None) -> Result:
+    fname = getattr(student, "__name__", "your function")
+    head = f"{label}: " if label else ""
+    outputs = []
+    for i, args in enumerate(cases):
+        try:
+            outputs.append(_call(student, args))
+        except NotImplementedError:
+            return Result(
+                False,
+                False,
+                f"… {head}{fname} is not written yet (it still raises NotImplementedError). "
+                "Replace the `raise` line with your code and run this cell again; the notebook goes on.",
+            )
+        except Exception as e:  # a student's bug: report it, keep the notebook running
+            return Result(False, True, f"✗ {head}{fname} raised {type(e).__name__} on case {i + 1}: {e}", hint=None)
+    ok, why = agrees(outputs, reference, cases)
+    if ok:
+        return Result(True, True, f"✓ {head}{fname} is right on {len(cases)} case(s)")
+    for alternative in accept:
+        if agrees(outputs, alternative, cases)[0]:
+            return Result(True, True, f"✓ {head}{fname} is right on {len(cases)} case(s) (an accepted variant)")
+    for mistake in mistakes:
+        try:
+            same = agrees(outputs, mistake.answer, cases)[0]
+        except Exception:  # a mistake that cannot run on these cases is simply not this one
+            same = False
+        if same:
+            return Result(False, True, f"✗ {head}{fname} is not right yet ({why}). Hint: {mistake.hint}", mistake.hint)
+    return Result(False, True, f"✗ {head}{fname} is not right yet ({why}).")
+
+
+def check(
+    student: Callable,
+    reference: Callable,
+    cases: Sequence,
+    atol: float = 1e-6,
+    sign_free: bool = False,
+    *,
+    accept: Sequence[Callable] = (),
+    mistakes: Sequence[Mistake] = (),
+    period: float | None = None,
+) -> Result:
+    """Compare ``student(*case)`` with ``reference(*case)`` on every case, without raising.
 
     Parameters
     ----------
@@ -35,32 +228,395 @@ def check(student: Callable, reference: Callable, cases: Sequence, atol: float =
     cases : list of argument tuples (a non-tuple case is passed as the single argument)
     atol : absolute tolerance
     sign_free : compare quaternions up to sign (``q`` and ``-q`` are the same rotation)
+    accept : other correct answers; agreeing with any of them also passes
+    mistakes : typical wrong answers with hints (see :class:`Mistake`)
+    period : compare modulo this period (angles)
 
-    Raises
-    ------
-    NotImplementedError if the exercise is not done yet; AssertionError naming the first case
-    that disagrees, with both answers.
+    Returns
+    -------
+    Result : ``passed``, ``attempted``, ``message`` (shown when it is the cell's last value), ``hint``
     """
-    name = getattr(student, "__name__", "your function")
-    for i, case in enumerate(cases):
-        args = case if isinstance(case, tuple) else (case,)
-        try:
-            got = student(*args)
-        except NotImplementedError:
-            print(f"✗ {name} is not written yet: replace the `raise NotImplementedError` line")
-            raise
-        want = reference(*args)
-        got_t = got if isinstance(got, tuple) else (got,)
-        want_t = want if isinstance(want, tuple) else (want,)
-        for g, w in zip(got_t, want_t):
-            g, w = _as_array(g), _as_array(w)
-            if g.shape != w.shape:
-                raise AssertionError(f"case {i}: {name} returned shape {g.shape}, expected {w.shape}")
-            err = np.abs(g - w)
-            if sign_free:
-                err = np.minimum(err.max(axis=-1), np.abs(g + w).max(axis=-1))
-            if not np.all(err <= atol):
-                raise AssertionError(
-                    f"case {i}: {name} differs by {np.nanmax(err):.3g} (atol {atol:g})\n got {g}\n want {w}"
-                )
-    print(f"✓ {name} agrees with the package on {len(cases)} case(s)")
+    ex = Exercise("", reference, lambda: list(cases), accept, mistakes, atol, sign_free, period)
+    return _run_check(student, reference, ex._cases(), accept, mistakes, ex._agrees, label=None)
+
+
+# --------------------------------------------------------------------------- notebook 00
+def _quat_cases():
+    rng = np.random.default_rng(100)
+    from motionlab.core import quat
+
+    unit = quat.normalize(rng.normal(size=(5, 4)))
+    not_unit = rng.normal(size=(2, 3, 4)) * 2.0  # conj is defined for any quaternion
+    return [(unit,), (quat.IDENTITY.copy(),), (not_unit,)]
+
+
+def _conj_ref(q):
+    from motionlab.core import quat
+
+    return quat.conj(q)
+
+
+conj = Exercise(
+    "00 · exercise 1 (conjugate)",
+    _conj_ref,
+    _quat_cases,
+    mistakes=[
+        Mistake(
+            lambda q: -np.asarray(q),
+            "you changed the sign of all four components. That is the same rotation as q, "
+            "not its conjugate: which part of (w, x, y, z) keeps its sign?",
+        ),
+        Mistake(lambda q: np.asarray(q), "your function returns q unchanged."),
+        Mistake(
+            lambda q: _conj_ref(q) / np.sum(np.asarray(q) ** 2, axis=-1, keepdims=True),
+            "you divided by |q|²: that is the inverse q⁻¹. It equals the conjugate only for unit "
+            "quaternions, and case 3 is not a unit quaternion.",
+        ),
+    ],
+)
+
+
+def _slerp_cases():
+    rng = np.random.default_rng(101)
+    from motionlab.core import quat
+
+    cases = []
+    for k in range(6):
+        q0, q1 = quat.normalize(rng.normal(size=4)), quat.normalize(rng.normal(size=4))
+        if k % 2 == 0 and np.dot(q0, q1) > 0:  # half of the pairs need the short-arc flip
+            q1 = -q1
+        if k % 2 == 1 and np.dot(q0, q1) < 0:
+            q1 = -q1
+        for t in (0.0, 0.25, 0.5, 1.0):
+            cases.append((q0, q1, t))
+    return cases
+
+
+def _slerp_ref(q0, q1, t):
+    from motionlab.core import quat
+
+    return quat.slerp(q0, q1, t)
+
+
+def _slerp_long_arc(q0, q1, t):
+    om = math.acos(float(np.clip(np.dot(q0, q1), -1.0, 1.0)))
+    if om < 1e-9:
+        return np.asarray(q0, dtype=float)
+    return (math.sin((1 - t) * om) * np.asarray(q0) + math.sin(t * om) * np.asarray(q1)) / math.sin(om)
+
+
+def _nlerp(q0, q1, t):
+    q1 = np.asarray(q1) if np.dot(q0, q1) >= 0 else -np.asarray(q1)
+    q = (1 - t) * np.asarray(q0) + t * q1
+    return q / np.linalg.norm(q)
+
+
+slerp = Exercise(
+    "00 · exercise 2 (slerp)",
+    _slerp_ref,
+    _slerp_cases,
+    sign_free=True,
+    mistakes=[
+        Mistake(
+            _slerp_long_arc,
+            "right when q0·q1 > 0, wrong otherwise: q1 and -q1 are the same rotation, and "
+            "slerp must take the shorter of the two arcs between q0 and ±q1.",
+        ),
+        Mistake(
+            _nlerp,
+            "right at t = 0, 0.5 and 1 only: normalising a straight-line blend follows the arc "
+            "but not at constant angular speed. Weight q0 and q1 by sines of the angle.",
+        ),
+        Mistake(
+            lambda q0, q1, t: _slerp_ref(q0, q1, 1 - t),
+            "at t = 0 the answer must be q0 and at t = 1 it must be q1: yours is the other way round.",
+        ),
+    ],
+)
+
+
+def _hand_height_ref(skeleton):
+    from motionlab.core import fk, quat
+
+    rot = np.tile(quat.IDENTITY, (skeleton.num_joints, 1))
+    rot[skeleton.index("LeftArm")] = quat.from_axis_angle([0, 0, 1], np.pi / 2)
+    return float(fk.fk(rot, skeleton.offsets, skeleton.parents)[1][skeleton.index("LeftHand"), 1])
+
+
+def _hand_height_with(joint: str, axis, angle: float, coord: int = 1):
+    def wrong(skeleton):
+        from motionlab.core import fk, quat
+
+        rot = np.tile(quat.IDENTITY, (skeleton.num_joints, 1))
+        rot[skeleton.index(joint)] = quat.from_axis_angle(axis, angle)
+        return float(fk.fk(rot, skeleton.offsets, skeleton.parents)[1][skeleton.index("LeftHand"), coord])
+
+    return wrong
+
+
+def _hand_height_cases():
+    from motionlab.core import humanoid
+
+    base = humanoid.canonical_skeleton(1.75)
+    return [(base,), (humanoid.canonical_skeleton(1.60),), (humanoid.scale_bones(base, arms=1.2, legs=0.9),)]
+
+
+hand_height = Exercise(
+    "00 · exercise 3 (hand height)",
+    _hand_height_ref,
+    _hand_height_cases,
+    mistakes=[
+        Mistake(
+            _hand_height_with("LeftArm", [0, 0, 1], -np.pi / 2),
+            "your hand ends up below the shoulder. Which way does a positive rotation about +z "
+            "turn the +x axis (right-hand rule)?",
+        ),
+        Mistake(
+            _hand_height_with("LeftArm", [0, 0, 1], 90.0),
+            "angles in motionlab are radians: 90 radians is not a quarter turn.",
+        ),
+        Mistake(
+            _hand_height_with("LeftShoulder", [0, 0, 1], np.pi / 2),
+            "you rotated LeftShoulder (the collarbone). The exercise rotates the shoulder joint, `LeftArm`.",
+        ),
+        Mistake(
+            _hand_height_with("LeftArm", [0, 0, 1], np.pi / 2, coord=0),
+            "that is the hand's x coordinate. Height is measured along the up axis: which axis is up?",
+        ),
+        Mistake(
+            lambda s: float(s.rest_positions()[s.index("LeftHand"), 1]),
+            "that is the hand's height in the rest pose: the arm has not been raised yet.",
+        ),
+    ],
+)
+
+
+# --------------------------------------------------------------------------- notebook 01
+def _heading_cases():
+    from motionlab import synthetic
+    from motionlab.core import humanoid, quat
+
+    walk = synthetic.generate("walk", humanoid.canonical_skeleton(), num_frames=40, fps=30, seed=3)
+    pos = walk.global_positions()
+    cases = []
+    for k, yaw in enumerate(np.radians([0, 40, 100, 170, -135, -60])):  # every quadrant, both signs
+        q = quat.from_axis_angle([0, 1, 0], yaw)
+        cases.append((quat.rotate(q, pos[5 * k]),))
+    return cases
+
+
+def _heading_ref(pose):
+    from motionlab.core import preprocess
+
+    return preprocess.heading(pose)
+
+
+def _heading_variant(mode: str):
+    def wrong(pose):
+        from motionlab.core import humanoid
+
+        p = np.asarray(pose)
+        ix = humanoid.JOINTS.index
+        hips = p[ix("LeftUpLeg")] - p[ix("RightUpLeg")]
+        shoulders = p[ix("LeftArm")] - p[ix("RightArm")]
+        across = hips if mode == "hips only" else hips + shoulders
+        up = np.array([0.0, 1.0, 0.0])
+        f = np.cross(up, across) if mode == "up x across" else np.cross(across, up)
+        if mode == "atan2(z, x)":
+            return np.arctan2(f[2], f[0])
+        if mode == "degrees":
+            return np.degrees(np.arctan2(f[0], f[2]))
+        return np.arctan2(f[0], f[2])
+
+    return wrong
+
+
+heading = Exercise(
+    "01 · exercise 1 (heading)",
+    _heading_ref,
+    _heading_cases,
+    period=2 * np.pi,
+    atol=1e-6,
+    mistakes=[
+        Mistake(
+            _heading_variant("up x across"),
+            "off by half a turn: the cross product is not commutative. With the right-hand rule, "
+            "which order of `across` and `up` points to the character's front?",
+        ),
+        Mistake(
+            _heading_variant("atan2(z, x)"),
+            "check the order of atan2's arguments: ψ = 0 means facing +z, and ψ grows from +z towards +x.",
+        ),
+        Mistake(_heading_variant("degrees"), "return radians, not degrees."),
+        Mistake(
+            _heading_variant("hips only"),
+            "close but not equal: `across` uses the shoulders as well as the hips.",
+        ),
+    ],
+)
+
+
+def _window_count_ref(num_frames, window=120, stride=30):
+    from motionlab.core import preprocess
+
+    return len(preprocess.sliding_windows(num_frames, window, stride))
+
+
+def _window_cases():
+    return [(500,), (120,), (121,), (50,), (480,), (1000, 120, 60), (300, 64, 16)]
+
+
+window_count = Exercise(
+    "01 · exercise 2 (window count)",
+    _window_count_ref,
+    _window_cases,
+    mistakes=[
+        Mistake(
+            lambda n, w=120, s=30: max(1, (n - w) // s + 1),
+            "you counted the windows that start every `stride` frames, but not the extra one moved "
+            "back to end on the last frame when frames are left over.",
+        ),
+        Mistake(
+            lambda n, w=120, s=30: max(0, -(-(n - w) // s) + 1) if n >= w else 0,
+            "a clip shorter than one window still gives one (padded) window.",
+        ),
+        Mistake(
+            lambda n, w=120, s=30: (n - w) // s + 1,
+            "a clip shorter than one window still gives one (padded) window, and look again at "
+            "the last window when frames are left over.",
+        ),
+    ],
+)
+
+
+# --------------------------------------------------------------------------- notebook 04
+def _pose_cases():
+    from motionlab import synthetic
+    from motionlab.core import humanoid, quat
+
+    skeleton = humanoid.canonical_skeleton()
+    walk = synthetic.generate("walk", skeleton, num_frames=30, fps=30.0, seed=0)
+    other = synthetic.generate("run", skeleton, num_frames=30, fps=30.0, seed=1)
+    turned = walk.copy(local_rot=quat.mul(quat.from_axis_angle([0, 1, 0], 0.3), walk.local_rot))
+    return [(other, walk), (walk, walk), (turned, walk)]
+
+
+def _pose_error_ref(motion, reference):
+    from motionlab.viz import compare
+
+    return compare.joint_errors(motion, reference, relative_to_root=True).mean(axis=1)
+
+
+def _pose_error_variant(mode: str):
+    def wrong(motion, reference):
+        a, b = motion.global_positions(), reference.global_positions()
+        if mode != "no root":
+            a, b = a - a[:, :1], b - b[:, :1]
+        d = np.linalg.norm(a - b, axis=-1)
+        if mode == "squared":
+            return (d**2).mean(axis=1)
+        if mode == "over frames":
+            return d.mean(axis=0)
+        if mode == "components":
+            return np.abs(a - b).mean(axis=(1, 2))
+        return d.mean(axis=1)
+
+    return wrong
+
+
+pose_error = Exercise(
+    "04 · exercise 1 (pose error)",
+    _pose_error_ref,
+    _pose_cases,
+    mistakes=[
+        Mistake(
+            _pose_error_variant("no root"),
+            "the two motions are compared as poses: subtract each motion's own root position from "
+            "its joints first (frame by frame).",
+        ),
+        Mistake(_pose_error_variant("squared"), "average the distances, not the squared distances."),
+        Mistake(
+            _pose_error_variant("over frames"),
+            "the result has one value per frame, shape (T,): which axis holds the joints?",
+        ),
+        Mistake(
+            _pose_error_variant("components"),
+            "the error of a joint is the length of the difference vector (a norm over x, y, z), "
+            "not the mean of its coordinates' differences.",
+        ),
+    ],
+)
+
+
+def _speed_cases():
+    from motionlab import synthetic
+    from motionlab.core import humanoid
+
+    skeleton = humanoid.canonical_skeleton()
+    return [
+        (synthetic.generate("walk", skeleton, num_frames=45, fps=30.0, seed=0),),
+        (synthetic.generate("run", skeleton, num_frames=40, fps=60.0, seed=2),),
+    ]
+
+
+def _speed_central(motion):
+    return np.linalg.norm(np.gradient(motion.global_positions(), axis=0), axis=-1) * motion.fps
+
+
+def _speed_forward(motion):  # p[t+1] - p[t], the last frame repeats the one before it
+    v = np.diff(motion.global_positions(), axis=0)
+    v = np.concatenate([v, v[-1:]], axis=0)
+    return np.linalg.norm(v, axis=-1) * motion.fps
+
+
+def _speed_backward(motion):  # p[t] - p[t-1], the first frame repeats the one after it
+    v = np.diff(motion.global_positions(), axis=0)
+    v = np.concatenate([v[:1], v], axis=0)
+    return np.linalg.norm(v, axis=-1) * motion.fps
+
+
+joint_speed = Exercise(
+    "04 · exercise 2 (joint speed)",
+    _speed_central,
+    _speed_cases,
+    accept=[_speed_forward, _speed_backward],
+    mistakes=[
+        Mistake(
+            lambda m: _speed_central(m) / m.fps,
+            "your speeds are in metres per frame; the exercise asks for metres per second "
+            "(a frame lasts 1/fps seconds).",
+        ),
+        Mistake(
+            lambda m: _speed_forward(m) / m.fps,
+            "your speeds are in metres per frame; the exercise asks for metres per second "
+            "(a frame lasts 1/fps seconds).",
+        ),
+        Mistake(
+            lambda m: _speed_central(m) / m.fps**2,
+            "a frame lasts 1/fps seconds: do you multiply or divide by fps?",
+        ),
+        Mistake(
+            lambda m: np.linalg.norm(np.diff(m.global_positions(), axis=0), axis=-1) * m.fps,
+            "a finite difference has one frame fewer than the motion: return shape (T, J), e.g. by "
+            "repeating the last difference (or use a central difference).",
+        ),
+        Mistake(
+            lambda m: np.gradient(m.global_positions(), axis=0) * m.fps,
+            "that is the velocity (T, J, 3); the speed is its length, shape (T, J).",
+        ),
+    ],
+)
+
+EXERCISES: dict[str, Exercise] = {
+    "conj": conj,
+    "slerp": slerp,
+    "hand_height": hand_height,
+    "heading": heading,
+    "window_count": window_count,
+    "pose_error": pose_error,
+    "joint_speed": joint_speed,
+}
+"""The named exercises of notebooks 00, 01 and 04, by the attribute name the notebooks use.
+
+:meta hide-value:
+"""

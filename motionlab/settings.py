@@ -1,8 +1,10 @@
 """Package-wide settings read from the environment.
 
-``MOTIONLAB_DATA``  folder of real BVH files (see :mod:`motionlab.data`).
-``MOTIONLAB_QUICK`` when set to 1/true/yes, notebooks and long-running demos use a reduced mode
-                    (fewer training steps, fewer clips) through the same code path. CI sets it.
+``MOTIONLAB_DATA``
+    folder of real BVH files (see :mod:`motionlab.data`).
+``MOTIONLAB_QUICK``
+    when set to 1/true/yes, notebooks and long-running demos use a reduced mode
+    (fewer training steps, fewer clips) through the same code path. CI sets it.
 """
 
 from __future__ import annotations

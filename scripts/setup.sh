@@ -16,6 +16,6 @@ if ! "$PY" -c "import torch" >/dev/null 2>&1; then
     "$PY" -m pip install -q torch==2.13.0
   fi
 fi
-"$PY" -m pip install -q -e ".[dev,notebooks,bench,cluster]"
+"$PY" -m pip install -q -e ".[dev,notebooks,bench,docs,cluster]"
 "$PY" -m ipykernel install --sys-prefix --name python3 >/dev/null 2>&1 || true
 echo "motionlab is installed in $VENV (activate with: source $VENV/bin/activate)"

@@ -26,15 +26,15 @@ Taught in ``notebooks/01_preprocessing.ipynb``.
 
 from __future__ import annotations
 
+import io
 import math
 import os
 import re
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from motionlab.core import quat
+from motionlab.core import files, quat
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
 
@@ -101,6 +101,10 @@ def _show(token: str | None) -> str:
 
 
 # ---------------------------------------------------------------------------------- header
+class _NeedMore(Exception):
+    """The header goes on past the part of the file read so far."""
+
+
 class _Tokens:
     """Whitespace-separated tokens of the header, read lazily line by line.
 
@@ -108,9 +112,10 @@ class _Tokens:
     at the first line of the motion block.
     """
 
-    def __init__(self, text: str, source: str) -> None:
+    def __init__(self, text: str, source: str, complete: bool = True) -> None:
         self.text = text
         self.source = source
+        self.complete = complete  # False: ``text`` is the start of a longer file
         self.pos = 0  # start of the next unread line
         self.line = 0  # number of the line the buffered tokens come from
         self.buf: list[str] = []
@@ -119,6 +124,8 @@ class _Tokens:
     def _fill(self) -> bool:
         while self.i >= len(self.buf):
             if self.pos > len(self.text) or (self.pos == len(self.text) and self.line > 0):
+                if not self.complete:
+                    raise _NeedMore
                 return False
             end = self.text.find("\n", self.pos)
             if end < 0:
@@ -186,8 +193,11 @@ def _joint_name(tok: _Tokens, keyword: str) -> str:
     n = rest.index("{") if "{" in rest else len(rest)
     if n == 0:
         raise tok.error(f"expected a joint name after {keyword}, found {_show(rest[0]) if rest else 'end of line'}")
+    name = " ".join(rest[:n])
+    if "{" in name or "}" in name:  # a brace would end the name when written back
+        raise tok.error(f"expected a joint name without braces after {keyword}, found {_show(name)}")
     tok.skip(n)
-    return " ".join(rest[:n])
+    return name
 
 
 def _channels(tok: _Tokens, joint_name: str) -> tuple[str, ...]:
@@ -443,6 +453,33 @@ def _axis_quats(angles: np.ndarray, axes: str) -> np.ndarray:
     return q
 
 
+def _euler_into(out: np.ndarray, degrees: np.ndarray, axes: str) -> None:
+    """``out[...] = R_i(a) R_j(b) R_k(c)`` as quaternions (w, x, y, z) for three distinct axes ``ijk``.
+
+    The product of the three half-angle quaternions written out (what ``quat.from_euler``
+    computes, without its intermediate arrays); ``s`` is +1 for a cyclic order (xyz, yzx,
+    zxy) and -1 otherwise. ``degrees`` (..., 3), ``out`` (..., 4). Angles of a full turn or
+    more are wrapped first, so the result may be ``-q`` of ``quat.from_euler``'s (same rotation).
+    """
+    i, j, k = (_AXIS_INDEX[a] for a in axes)
+    s = 1.0 if (j - i) % 3 == 1 else -1.0
+    radians = np.radians(degrees)
+    if np.abs(radians).max(initial=0.0) >= 2.0 * np.pi:  # one turn or more: wrap (q may flip to -q)
+        radians = np.remainder(radians + np.pi, 2.0 * np.pi) - np.pi
+    # cos and sin of the half angle from t = tan(angle / 4): one trig call instead of two
+    t = np.tan(radians * 0.25)
+    t2 = t * t
+    inv = 1.0 / (1.0 + t2)
+    c, n = (1.0 - t2) * inv, 2.0 * t * inv
+    ca, cb, cc = c[..., 0], c[..., 1], c[..., 2]
+    sa, sb, sc = n[..., 0], n[..., 1], n[..., 2]
+    cbc, sbs, sbc, cbs = cb * cc, sb * sc, sb * cc, cb * sc
+    out[..., 0] = ca * cbc - s * sa * sbs
+    out[..., 1 + i] = sa * cbc + s * ca * sbs
+    out[..., 1 + j] = ca * sbc - s * sa * cbs
+    out[..., 1 + k] = ca * cbs + s * sa * sbc
+
+
 def _split_axes(q: np.ndarray, axes: str) -> np.ndarray:
     """Angles (..., k) in radians with ``_axis_quats(angles, axes) == ±q`` when possible.
 
@@ -496,73 +533,21 @@ def loads(text: str | bytes, scale: float = DEFAULT_SCALE, source: str = "<strin
     BVHError
         For any malformed input, naming ``source``, the line and what was expected.
     """
-    scale = _check_scale(scale)
     if isinstance(text, (bytes, bytearray, memoryview)):
         data = bytes(text)
-        try:
-            text = data.decode("utf-8")
-        except UnicodeDecodeError as exc:
-            line = data.count(b"\n", 0, exc.start) + 1
-            raise BVHError(source, line, f"expected UTF-8 text, found the byte {data[exc.start]:#04x}") from None
-    elif not isinstance(text, str):
+    elif isinstance(text, str):
+        data = text.encode("utf-8", "surrogatepass")  # a lone surrogate fails as bad UTF-8 below
+    else:
         raise TypeError(f"expected BVH text as str or bytes, got {type(text).__name__}")
-    if text.startswith("\ufeff"):
-        text = text[1:]
-    tok = _Tokens(text, source)
-    names, parents, offsets, channels, end_sites, n_frames, frames_line, ft = _parse_hierarchy(tok)
-    first_line = tok.line + 1
-    block = text[tok.pos :] if tok.pos <= len(text) else ""
-    n_channels = sum(len(c) for c in channels)
-    values = _read_block(block, n_frames, n_channels, first_line, frames_line, source)
-    return _to_motion(names, parents, offsets, channels, end_sites, values, ft, scale, name)
-
-
-def _to_motion(names, parents, offsets, channels, end_sites, values, ft, scale, name) -> Motion:
-    n_frames, n_joints = values.shape[0], len(names)
-    offsets = np.asarray(offsets, dtype=np.float64) * scale
-    local_rot = np.zeros((n_frames, n_joints, 4))
-    local_rot[..., 0] = 1.0
-    translations = np.broadcast_to(offsets, (n_frames, n_joints, 3)).copy()
-    moving = False  # does a non-root joint have position channels?
-    groups: dict[str, tuple[list[int], list[list[int]]]] = {}
-    column = 0
-    for j, layout in enumerate(channels):
-        rot_cols, axes = [], ""
-        for ch in layout:
-            key = ch.lower()
-            if key in _POSITION:
-                translations[:, j, _POSITION[key]] = values[:, column] * scale
-                moving = moving or j > 0
-            else:
-                axes += _ROTATION[key]
-                rot_cols.append(column)
-            column += 1
-        if axes:
-            joints, cols = groups.setdefault(axes, ([], []))
-            joints.append(j)
-            cols.append(rot_cols)
-    for axes, (joints, cols) in groups.items():
-        angles = np.deg2rad(values[:, np.asarray(cols)])  # (T, n, k)
-        local_rot[:, joints] = _axis_quats(angles, axes)
-    skeleton = Skeleton(
-        tuple(names),
-        np.asarray(parents),
-        offsets,
-        {j: np.asarray(o) * scale for j, o in end_sites.items()},
-        tuple(channels),
-    )
-    return Motion(
-        skeleton,
-        local_rot,
-        translations[:, 0].copy(),
-        1.0 / ft,
-        translations if moving else None,
-        name,
-    )
+    return _read(io.BytesIO(data), len(data), scale, source, name)
 
 
 def load(path: str | os.PathLike, scale: float = DEFAULT_SCALE, name: str | None = None) -> Motion:
     """Read a BVH file; see :func:`loads` for what the Motion holds.
+
+    The file is streamed: the motion block is converted :data:`CHUNK` bytes at a time straight
+    into the frame array, so memory stays near the size of the result (about the file's size)
+    instead of several times the text.
 
     Parameters
     ----------
@@ -578,8 +563,226 @@ def load(path: str | os.PathLike, scale: float = DEFAULT_SCALE, name: str | None
         The file cannot be read.
     """
     path = Path(path)
-    data = path.read_bytes()
-    return loads(data, scale=scale, source=str(path), name=path.stem if name is None else name)
+    with open(path, "rb") as f:
+        size = os.fstat(f.fileno()).st_size
+        return _read(f, size, scale, str(path), path.stem if name is None else name)
+
+
+CHUNK = 1 << 20
+"""Most bytes of motion text converted per step while streaming (1 MiB); a file smaller than
+16 MiB uses 1/16 of its size (at least 64 KiB), so the step's temporary arrays stay small
+beside the result for small files too."""
+
+_HEADER_START = 1 << 16  # bytes read first for the header; doubled while the header goes on
+
+
+def _decode(data: bytes, source: str, first_line: int = 1) -> str:
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = first_line + data.count(b"\n", 0, exc.start)
+        raise BVHError(source, line, f"expected UTF-8 text, found the byte {data[exc.start]:#04x}") from None
+
+
+def _read(f, size: int, scale: float, source: str, name: str) -> Motion:
+    """Parse a binary stream of ``size`` bytes (header token by token, motion block in chunks)."""
+    scale = _check_scale(scale)
+    head = f.read(min(size, _HEADER_START))
+    bom = 3 if head.startswith(b"\xef\xbb\xbf") else 0
+    head, size = head[bom:], size - bom
+    # Old Mac files end lines with CR alone: read every CR as a line end when the start has no LF
+    cr_only = b"\r" in head and b"\n" not in head
+    while True:
+        if cr_only:
+            head = head.replace(b"\r", b"\n")
+        complete = len(head) >= size
+        cut = len(head) if complete else head.rfind(b"\n") + 1
+        tok = _Tokens(_decode(head[:cut], source), source, complete=complete)
+        try:
+            header = _parse_hierarchy(tok)
+            break
+        except _NeedMore:
+            more = f.read(max(len(head), _HEADER_START))
+            head += more
+    names, parents, offsets, channels, end_sites, n_frames, frames_line, ft = header
+    if tok.pos <= len(tok.text):
+        first_line = tok.line + 1
+        start = len(tok.text[: tok.pos].encode("utf-8"))
+    else:  # the file ends on the Frame Time line: a missing block is reported there, not past the end
+        first_line = tok.line
+        start = len(head)
+    n_channels = sum(len(c) for c in channels)
+    values = _read_stream(f, head[start:], bom + start, n_frames, n_channels, first_line, frames_line, source, cr_only)
+    return _to_motion(names, parents, offsets, channels, end_sites, values, ft, scale, name)
+
+
+def _chunk_values(raw: bytes, n_channels: int) -> np.ndarray | None:
+    """Frame lines of one chunk (complete lines) as an array (k, C), or None if anything is off."""
+    if raw.translate(None, _NUMERIC_BYTES):  # anything left is neither a digit, sign, dot, e nor space
+        return None
+    buf = np.frombuffer(raw, dtype=np.uint8)
+    whitespace = buf <= 32  # the only bytes <= 32 that survived the check above are whitespace
+    starts = ~whitespace
+    starts[1:] &= whitespace[:-1]
+    newlines = np.flatnonzero(buf == 10)
+    first = np.flatnonzero(starts)  # first byte of each number
+    # numbers per line: how many start before each line end (a search per line, not per number)
+    before = np.searchsorted(first, np.append(newlines, buf.size))
+    per_line = np.diff(before, prepend=0)
+    per_line = per_line[per_line > 0]
+    if np.any(per_line != n_channels):
+        return None
+    values = _fixed_decimals(raw, buf, whitespace, first)
+    if values is None:
+        try:
+            values = np.fromstring(raw, dtype=np.float64, sep=" ")  # C parser; stops (ValueError) at bad text
+        except ValueError:
+            return None
+    if values.size != per_line.size * n_channels or not np.isfinite(values).all():
+        return None
+    return values.reshape(per_line.size, n_channels)
+
+
+_EXACT = 2**53  # integers below this, divided by 10**k (k <= 22), give the correctly rounded float
+
+
+def _fixed_decimals(raw: bytes, buf: np.ndarray, whitespace: np.ndarray, first: np.ndarray) -> np.ndarray | None:
+    """Fast path for numbers written with one fixed count of decimals (``-12.345678``), or None.
+
+    Most BVH writers print every value with the same number of decimals ``k``. Then each
+    number is an integer (its digits without the dot) divided by ``10**k``: the dots are
+    dropped in one bytes call and the integers are read by NumPy's C integer parser, about five
+    times faster than parsing floats. With fewer than 16 digits the division is exact to the
+    last bit (the same float ``float(text)`` gives). Anything else returns None.
+    """
+    dots = np.flatnonzero(buf == 46)
+    if dots.size != first.size or first.size == 0:
+        return None
+    ends = ~whitespace
+    ends[:-1] &= whitespace[1:]
+    last = np.flatnonzero(ends)  # last byte of each number
+    decimals = last - dots
+    k = int(decimals[0])
+    if np.any(decimals != k) or np.any(dots < first) or k > 22:  # one dot inside each number, k decimals
+        return None
+    lead = buf[first]
+    signed = (lead == 45) | (lead == 43)
+    if np.any(last - first + 1 - signed < 2):
+        return None  # a number without digits ('-.', '.')
+    # Now every number has exactly one dot and a digit or letter besides sign and dot. A sign or
+    # letter inside a number makes the integer parser fail or read one number too many: the
+    # count check below catches both (no number can read as zero numbers to make up for it).
+    try:
+        whole = np.fromstring(raw.translate(None, b"."), dtype=np.int64, sep=" ")
+    except ValueError:
+        return None
+    if whole.size != first.size or np.any(np.abs(whole) >= _EXACT):
+        return None
+    return whole / 10.0**k
+
+
+def _pieces(f, head: bytes, cr_only: bool, size: int):
+    """The rest of ``f`` after ``head`` in pieces of about :data:`CHUNK` bytes that end at line ends."""
+    chunk = min(CHUNK, max(size // 16, 1 << 16))
+    if not cr_only:  # readlines stops at the first line end after `chunk` bytes
+        yield head + b"".join(f.readlines(chunk))
+        while lines := f.readlines(chunk):
+            yield b"".join(lines)
+        return
+    pending = head.replace(b"\r", b"\n")
+    while more := f.read(chunk):
+        pending += more.replace(b"\r", b"\n")
+        cut = pending.rfind(b"\n") + 1
+        if cut:
+            yield pending[:cut]
+            pending = pending[cut:]
+    yield pending
+
+
+def _read_stream(f, head: bytes, offset: int, n_frames, n_channels, first_line, frames_line, source, cr_only):
+    """The motion block, starting at byte ``offset`` of ``f`` (``head``: its part read already), as (T, C)."""
+    size = f.seek(0, io.SEEK_END) - offset  # bytes in the block
+    f.seek(offset + len(head))
+
+    def slow() -> np.ndarray:  # exact error with a line number: read the block again, whole
+        f.seek(offset)
+        block = f.read()
+        if cr_only:
+            block = block.replace(b"\r", b"\n")
+        text = _decode(block, source, first_line)
+        return _read_block(text, n_frames, n_channels, first_line, frames_line, source)
+
+    # every frame line needs C numbers and C whitespace bytes: a file too short for the count is truncated
+    if n_channels == 0 or n_frames > size // (2 * n_channels) + 1:
+        return slow()
+    values = np.empty((n_frames, n_channels))
+    row = 0
+    for piece in _pieces(f, head, cr_only, size):
+        part = _chunk_values(piece, n_channels)
+        if part is None or row + len(part) > n_frames:
+            return slow()
+        values[row : row + len(part)] = part
+        row += len(part)
+    if row != n_frames:
+        return slow()
+    return values
+
+
+_ROTATIONS_PER_STEP = 1 << 14  # joint-frames converted to quaternions at a time (bounds the temporaries)
+
+
+def _to_motion(names, parents, offsets, channels, end_sites, values, ft, scale, name) -> Motion:
+    n_frames, n_joints = values.shape[0], len(names)
+    offsets = np.asarray(offsets, dtype=np.float64) * scale
+    local_rot = np.zeros((n_frames, n_joints, 4))
+    local_rot[..., 0] = 1.0
+    root_pos = np.broadcast_to(offsets[0], (n_frames, 3)).copy()
+    # per-frame translations only when a non-root joint has position channels
+    moving = any("position" in ch.lower() for layout in channels[1:] for ch in layout)
+    translations = np.broadcast_to(offsets, (n_frames, n_joints, 3)).copy() if moving else None
+    groups: dict[str, tuple[list[int], list[list[int]]]] = {}
+    column = 0
+    for j, layout in enumerate(channels):
+        rot_cols, axes = [], ""
+        for ch in layout:
+            key = ch.lower()
+            if key in _POSITION:
+                target = root_pos if j == 0 else translations[:, j]
+                target[:, _POSITION[key]] = values[:, column] * scale
+            else:
+                axes += _ROTATION[key]
+                rot_cols.append(column)
+            column += 1
+        if axes:
+            joints, cols = groups.setdefault(axes, ([], []))
+            joints.append(j)
+            cols.append(rot_cols)
+    for axes, (joints, cols) in groups.items():
+        cols = np.asarray(cols)
+        contiguous = joints == list(range(joints[0], joints[-1] + 1))
+        # a small file converts in smaller steps, so temporaries stay small beside the result
+        per_step = min(_ROTATIONS_PER_STEP, max(1024, n_frames * n_joints // 16))
+        step = max(1, per_step // len(joints))
+        for t0 in range(0, n_frames, step):
+            t1 = min(t0 + step, n_frames)
+            if len(axes) == 3 and contiguous:  # straight into the result
+                _euler_into(local_rot[t0:t1, joints[0] : joints[-1] + 1], values[t0:t1, cols], axes)
+            elif len(axes) == 3:
+                q = np.empty((t1 - t0, len(joints), 4))
+                _euler_into(q, values[t0:t1, cols], axes)
+                local_rot[t0:t1, joints] = q
+            else:
+                local_rot[t0:t1, joints] = _axis_quats(np.deg2rad(values[t0:t1, cols]), axes)
+    if translations is not None:
+        translations[:, 0] = root_pos
+    skeleton = Skeleton(
+        tuple(names),
+        np.asarray(parents),
+        offsets,
+        {j: np.asarray(o) * scale for j, o in end_sites.items()},
+        tuple(channels),
+    )
+    return Motion(skeleton, local_rot, root_pos, 1.0 / ft, translations, name)
 
 
 # ---------------------------------------------------------------------------------- writing
@@ -629,19 +832,38 @@ def frame_time(motion_or_fps: Motion | float) -> float:
 def _check_layout(skeleton: Skeleton, translations: np.ndarray, pos_tol: float) -> tuple[tuple[str, ...], ...]:
     """Each joint's channel names for writing (``skeleton.channels`` or the default layout)."""
     if skeleton.channels is not None:
-        layouts = skeleton.channels
-        for j, layout in enumerate(layouts):
+        layouts = []
+        for j, layout in enumerate(skeleton.channels):
             keys = [str(c).lower() for c in layout]
             if any(k not in _POSITION and k not in _ROTATION for k in keys) or len(set(keys)) != len(keys):
                 raise ValueError(
                     f"joint {skeleton.names[j]!r} has channel layout {layout}; expected distinct names from {CHANNEL_NAMES}"
                 )
-        return layouts
+            layouts.append(_three_rotations(tuple(layout)))
+        return tuple(layouts)
     layouts = [_ROOT_LAYOUT]
     for j in range(1, skeleton.num_joints):
         moved = np.abs(translations[:, j] - skeleton.offsets[j]).max(initial=0.0) > pos_tol
         layouts.append(_ROOT_LAYOUT if moved else _JOINT_LAYOUT)
     return tuple(layouts)
+
+
+def _three_rotations(layout: tuple[str, ...]) -> tuple[str, ...]:
+    """``layout`` with exactly three rotation channels, as Blender's importer needs.
+
+    Missing rotation axes follow the joint's last rotation channel (a joint without any gets
+    ``Zrotation Yrotation Xrotation`` at the end); their angles are zero for motion that the
+    original channels could express, so nothing else changes.
+    """
+    rotations = [c for c in layout if c.lower() in _ROTATION]
+    if len(rotations) == 3:
+        return layout
+    have = {c[0].lower() for c in rotations}
+    missing = [f"{a}rotation" for a in ("Z", "Y", "X") if a.lower() not in have]
+    if not rotations:
+        return layout + tuple(missing)
+    last = max(i for i, c in enumerate(layout) if c.lower() in _ROTATION)
+    return layout[: last + 1] + tuple(missing) + layout[last + 1 :]
 
 
 def _check_name(name: str) -> None:
@@ -652,8 +874,15 @@ def _check_name(name: str) -> None:
         )
 
 
+def _no_negative_zero(values: np.ndarray, precision: int) -> np.ndarray:
+    """Values that would print as ``-0.000…`` set to 0, so a rewrite gives the same text."""
+    values = np.array(values, dtype=np.float64)
+    values[np.abs(values) < 0.5 * 10.0**-precision] = 0.0
+    return values
+
+
 def _fmt(values, precision: int) -> str:
-    return " ".join(f"{v:.{precision}f}" for v in values)
+    return " ".join(f"{v:.{precision}f}" for v in _no_negative_zero(values, precision))
 
 
 def dumps(motion: Motion, scale: float | None = None, precision: int = 6) -> str:
@@ -671,17 +900,24 @@ def dumps(motion: Motion, scale: float | None = None, precision: int = 6) -> str
         Joints are written depth-first (children in index order) with ``skeleton.channels``
         when set, else positions + ``Zrotation Yrotation Xrotation`` for the root (and for
         non-root joints whose ``local_pos`` moves), ``Zrotation Yrotation Xrotation`` for the
-        others. ``Frame Time:`` has the fewest digits that give ``fps`` back exactly.
+        others. Every joint gets exactly three rotation channels, as Blender's importer needs:
+        a layout with fewer is completed by the missing axes (zero angles where the original
+        axes expressed the motion). ``Frame Time:`` has the fewest digits that give ``fps`` back
+        exactly.
 
     Raises
     ------
     ValueError
-        Non-finite values, names BVH cannot hold, or a joint whose channel layout cannot
+        No frames (Blender cannot import a 0-frame file), non-finite values, names BVH cannot hold, or a joint whose channel layout cannot
         express its motion (rotation about an axis it has no channel for, or a translation
         away from its offset without position channels); the message names the joint.
     """
     if not isinstance(motion, Motion):
         raise TypeError(f"expected a Motion, got {type(motion).__name__}")
+    if motion.num_frames == 0:
+        raise ValueError(
+            f"cannot write motion {motion.name!r} with 0 frames as BVH: Blender and most importers need at least one frame"
+        )
     scale = 1.0 / DEFAULT_SCALE if scale is None else _check_scale(scale)
     if isinstance(precision, bool) or not isinstance(precision, (int, np.integer)) or not 0 <= precision <= 17:
         raise ValueError(f"expected precision as a whole number of decimals from 0 to 17, got {precision!r}")
@@ -720,8 +956,11 @@ def dumps(motion: Motion, scale: float | None = None, precision: int = 6) -> str
                 f"cannot write joint {names[joints[n]]!r}: its channels have {have}, but at frame {t} it rotates "
                 f"{np.degrees(error[t, n]):.4g} degrees outside them; give it rotation channels in skeleton.channels"
             )
+        # written angles lie in (-180, 180]: -180 and 180 (the same turn) must not flip between writes
+        degrees = np.degrees(split)
+        degrees[degrees <= -180.0 + 0.5 * 10.0**-precision] += 360.0
         for n, j in enumerate(joints):
-            angles[j] = np.degrees(split[:, n])
+            angles[j] = degrees[:, n]
     for j, layout in enumerate(layouts):
         keys = [c.lower() for c in layout]
         for axis in range(3):
@@ -774,6 +1013,7 @@ def dumps(motion: Motion, scale: float | None = None, precision: int = 6) -> str
     starts = np.cumsum([0] + [len(layouts[j]) for j in range(len(names))])
     perm = [c for j in order for c in range(starts[j], starts[j + 1])]
     data = np.stack([columns[c] for c in perm], axis=1) if perm else np.zeros((n_frames, 0))
+    data = _no_negative_zero(data, precision)
     header = "\n".join(lines) + "\n"
     if n_frames == 0:
         return header
@@ -793,7 +1033,8 @@ def save(
     """Write a motion as a BVH file (see :func:`dumps` for the layout).
 
     The text is built in memory and written to a temporary file in the same folder that then
-    replaces ``path`` in one step, so a failure never leaves a partial file.
+    replaces ``path`` in one step (:func:`motionlab.core.files.atomic_write`), so a failure never
+    leaves a partial file, and temporary files of killed earlier writes are removed.
 
     Parameters
     ----------
@@ -811,28 +1052,10 @@ def save(
     ------
     FileExistsError
         ``path`` exists and ``overwrite`` is False.
+    OSError
+        ``path`` is a folder, or its folder is missing or not writable (checked before writing).
     ValueError
         The motion cannot be written (see :func:`dumps`).
     """
-    path = Path(path)
-    if path.exists() and not overwrite:
-        raise FileExistsError(f"{path} already exists; pass overwrite=True to replace it")
     text = dumps(motion, scale=scale, precision=precision)
-    folder = path.parent
-    if path.exists():
-        mode = path.stat().st_mode & 0o777
-    else:
-        umask = os.umask(0)
-        os.umask(umask)
-        mode = 0o666 & ~umask
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
-            f.write(text)
-        os.chmod(tmp, mode)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
-    return path
+    return files.atomic_write(path, lambda f: f.write(text), overwrite=overwrite, what="BVH file")

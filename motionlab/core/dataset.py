@@ -13,8 +13,6 @@ Taught in ``notebooks/01_preprocessing.ipynb``.
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -23,6 +21,7 @@ import torch
 from torch.utils.data import Dataset
 from tqdm.auto import tqdm
 
+from motionlab.core import files
 from motionlab.core.motion import Motion
 from motionlab.core.preprocess import NormStats, features, prepare, window_stack
 
@@ -109,15 +108,8 @@ class MotionDataset(Dataset):
             "index": self.index,
             "stats": self.stats.to_dict(),
         }
-        fd, tmp = tempfile.mkstemp(suffix=".npz", dir=path.parent or ".")
-        os.close(fd)
-        try:
-            np.savez_compressed(tmp, x=self.x, offsets=self.offsets, character=self.character, meta=json.dumps(meta))
-            os.replace(tmp, path)
-        finally:
-            if os.path.exists(tmp):
-                os.remove(tmp)
-        return path
+        arrays = dict(x=self.x, offsets=self.offsets, character=self.character, meta=json.dumps(meta))
+        return files.atomic_write(path, lambda f: np.savez_compressed(f, **arrays), True, binary=True, what="dataset")
 
     @classmethod
     def load(cls, path: str | Path) -> MotionDataset:

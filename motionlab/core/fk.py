@@ -1,7 +1,8 @@
 """Forward kinematics and friends, in NumPy.
 
 FK walks the joints once in topological order; every step is vectorised over all leading
-dimensions (frames, batches), so there is no Python loop over frames::
+dimensions (frames, batches), so there is no Python loop over frames (:func:`fk` works on
+blocks of frames laid out component by component, so each step is one long vector operation)::
 
     global_rot[j] = global_rot[parent[j]] ⊗ local_rot[j]
     global_pos[j] = global_pos[parent[j]] + rotate(global_rot[parent[j]], local_pos[j])
@@ -10,6 +11,8 @@ Taught in ``notebooks/00_quaternions_and_fk.ipynb``. ``fk_torch`` is the torch t
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -57,17 +60,81 @@ def fk(local_rot, local_pos, parents) -> tuple[np.ndarray, np.ndarray]:
         )
     parents = _check_parents(parents, num_joints)
     batch = np.broadcast_shapes(local_rot.shape[:-2], local_pos.shape[:-2])
-    local_rot = np.broadcast_to(local_rot, batch + local_rot.shape[-2:])
-    local_pos = np.broadcast_to(local_pos, batch + local_pos.shape[-2:])
-    global_rot = np.empty(batch + (num_joints, 4), dtype=local_rot.dtype)
-    global_pos = np.empty(batch + (num_joints, 3), dtype=local_rot.dtype)
-    global_rot[..., 0, :] = local_rot[..., 0, :]
-    global_pos[..., 0, :] = local_pos[..., 0, :]
+    n = math.prod(batch)
+    rot = np.broadcast_to(local_rot, batch + (num_joints, 4)).reshape(n, num_joints, 4)
+    pos = np.broadcast_to(local_pos, batch + (num_joints, 3)).reshape(n, num_joints, 3)
+    global_rot = np.empty((n, num_joints, 4), dtype=local_rot.dtype)
+    global_pos = np.empty((n, num_joints, 3), dtype=local_rot.dtype)
+    for start in range(0, n, _CHUNK):
+        stop = min(start + _CHUNK, n)
+        _fk_block(rot[start:stop], pos[start:stop], parents, global_rot[start:stop], global_pos[start:stop])
+    return global_rot.reshape(batch + (num_joints, 4)), global_pos.reshape(batch + (num_joints, 3))
+
+
+_CHUNK = 2048
+"""Frames per block of :func:`fk`: a 22-joint block's rows stay in the CPU cache."""
+
+
+def _fk_block(rot, pos, parents, out_rot, out_pos) -> None:
+    """FK of ``m`` frames, component-major: each quaternion or vector component of a joint is one
+    contiguous row of ``m`` frames, so every step is one long vector operation.
+
+    ``rot`` (m, J, 4) and ``pos`` (m, J, 3) in; ``out_rot`` (m, J, 4) and ``out_pos`` (m, J, 3)
+    are written. Per joint ``j`` with parent ``p``: ``g[j] = g[p] ⊗ q[j]`` and
+    ``x[j] = x[p] + v + w t + u × t`` with ``t = 2 u × v``, ``(w, u) = g[p]``, ``v`` = local offset.
+    """
+    m, num_joints = rot.shape[:2]
+    q = np.ascontiguousarray(rot.reshape(m, num_joints * 4).T).reshape(num_joints, 4, m)
+    v = np.ascontiguousarray(pos.reshape(m, num_joints * 3).T).reshape(num_joints, 3, m)
+    g = np.empty_like(q)
+    x = np.empty_like(v)
+    g[0] = q[0]
+    x[0] = v[0]
+    t = np.empty((3, m), dtype=q.dtype)
+    tmp = np.empty(m, dtype=q.dtype)
     for j in range(1, num_joints):
         p = parents[j]
-        global_rot[..., j, :] = quat.mul(global_rot[..., p, :], local_rot[..., j, :])
-        global_pos[..., j, :] = global_pos[..., p, :] + quat.rotate(global_rot[..., p, :], local_pos[..., j, :])
-    return global_rot, global_pos
+        aw, ax, ay, az = g[p]
+        bw, bx, by, bz = q[j]
+        vx, vy, vz = v[j]
+        # t = 2 u × v
+        np.multiply(ay, vz, out=t[0])
+        t[0] -= np.multiply(az, vy, out=tmp)
+        np.multiply(az, vx, out=t[1])
+        t[1] -= np.multiply(ax, vz, out=tmp)
+        np.multiply(ax, vy, out=t[2])
+        t[2] -= np.multiply(ay, vx, out=tmp)
+        t *= 2.0
+        # x[j] = x[p] + v + w t + u × t
+        xj = x[j]
+        np.add(x[p], v[j], out=xj)
+        xj += np.multiply(aw, t, out=np.empty_like(t))
+        xj[0] += np.multiply(ay, t[2], out=tmp)
+        xj[0] -= np.multiply(az, t[1], out=tmp)
+        xj[1] += np.multiply(az, t[0], out=tmp)
+        xj[1] -= np.multiply(ax, t[2], out=tmp)
+        xj[2] += np.multiply(ax, t[1], out=tmp)
+        xj[2] -= np.multiply(ay, t[0], out=tmp)
+        # g[j] = g[p] ⊗ q[j]  (Hamilton product, as quat.mul)
+        gw, gx, gy, gz = g[j]
+        np.multiply(aw, bw, out=gw)
+        gw -= np.multiply(ax, bx, out=tmp)
+        gw -= np.multiply(ay, by, out=tmp)
+        gw -= np.multiply(az, bz, out=tmp)
+        np.multiply(aw, bx, out=gx)
+        gx += np.multiply(ax, bw, out=tmp)
+        gx += np.multiply(ay, bz, out=tmp)
+        gx -= np.multiply(az, by, out=tmp)
+        np.multiply(aw, by, out=gy)
+        gy -= np.multiply(ax, bz, out=tmp)
+        gy += np.multiply(ay, bw, out=tmp)
+        gy += np.multiply(az, bx, out=tmp)
+        np.multiply(aw, bz, out=gz)
+        gz += np.multiply(ax, by, out=tmp)
+        gz -= np.multiply(ay, bx, out=tmp)
+        gz += np.multiply(az, bw, out=tmp)
+    out_rot.reshape(m, num_joints * 4).T[...] = g.reshape(num_joints * 4, m)
+    out_pos.reshape(m, num_joints * 3).T[...] = x.reshape(num_joints * 3, m)
 
 
 def fk_positions(local_rot, local_pos, parents) -> np.ndarray:

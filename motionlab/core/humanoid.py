@@ -67,7 +67,17 @@ FEET: tuple[str, ...] = ("LeftFoot", "RightFoot", "LeftToeBase", "RightToeBase")
 
 
 class RigMappingError(ValueError):
-    """A skeleton that cannot be mapped onto the 22-joint humanoid."""
+    """A skeleton that cannot be mapped onto the 22-joint humanoid.
+
+    Attributes
+    ----------
+    reason : str   what is wrong, without the hint on how to fix it from Python (the command
+                   line shows this and its own hint)
+    """
+
+    def __init__(self, reason: str, hint: str = "") -> None:
+        super().__init__(f"{reason} {hint}".strip())
+        self.reason = reason
 
 
 def strip_prefix(name: str) -> str:
@@ -182,8 +192,8 @@ def find_mapping(skeleton: Skeleton, profile: str | dict[str, str | None] | None
     assert best is not None
     raise RigMappingError(
         f"skeleton with root {skeleton.names[0]!r} ({skeleton.num_joints} joints) does not map onto the "
-        f"22-joint humanoid: closest profile {best[1]!r} misses {', '.join(best[2])}. "
-        "Pass profile={canonical: rig name} to map it by hand."
+        f"22-joint humanoid: closest profile {best[1]!r} misses {', '.join(best[2])}.",
+        "Pass profile={canonical: rig name} to map it by hand.",
     )
 
 

@@ -63,7 +63,8 @@ def plot_trajectory(positions, joint: int = 0, ax=None, **kw):
     ax = _axes(ax)
     ax.plot(pos[:, joint, 0], pos[:, joint, 2], **kw)
     ax.scatter(pos[:1, joint, 0], pos[:1, joint, 2], marker="o", color="k", zorder=3, label="start")
-    ax.set_aspect("equal")
+    # equal scales, but a straight path must not shrink the panel to zero width: widen the limits
+    ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("z (m)")
     return ax

@@ -35,7 +35,8 @@ class Skeleton:
         BVH ``End Site`` offsets (metres), kept so that files round-trip and heads have a top.
     channels : tuple of tuple of str, or None
         The BVH channel layout of each joint (e.g. ``("Xposition", ..., "Zrotation")``);
-        used by ``bvh.save`` to write a file back in its own layout. ``None``: the default
+        used by ``bvh.save`` to write a file back in its own layout (with the missing rotation
+        axes added: three rotation channels per joint, for Blender). ``None``: the default
         layout (root: positions + ZYX rotations, others: ZYX rotations).
     """
 

@@ -10,14 +10,30 @@ Modules, one concept each:
 * :mod:`.keyposes`     segmentation into action nodes and key-frame extraction
 * :mod:`.action_graph` the finite-state action graph, best transition frames, paths
 * :mod:`.library`      key-pose-guided in-betweening from recorded clips
-* :mod:`.gaps`         missing-frame detection and filling
+* :mod:`.labels`       does a clip show what its action label says (hip height, speed, flight)
+* :mod:`.detect`       dropped-frame detection (stream vs graph, stream vs itself) and counts
+* :mod:`.gaps`         inserting and filling missing frames
+* :mod:`.gap_eval`     measuring detection and filling on clips with frames removed
+* :mod:`.paper`        the paper's experiments (§4: Fig. 6/7 walk, Fig. 8 run → squat)
 * :mod:`.benchmark`    LaFAN1-style benchmark (L2Q, L2P, NPSS)
 * :mod:`.plots`        figures (matplotlib imported lazily)
 
 Taught in ``notebooks/06_keypose_interpolation.ipynb``.
 """
 
-from motionlab.interpolation import alignment, features, gaps, inbetween, keyposes, ppca, slerp
+from motionlab.interpolation import (
+    alignment,
+    detect,
+    features,
+    gap_eval,
+    gaps,
+    inbetween,
+    keyposes,
+    labels,
+    paper,
+    ppca,
+    slerp,
+)
 from motionlab.interpolation.action_graph import ActionGraph
 from motionlab.interpolation.library import MotionLibrary
 from motionlab.interpolation.ppca import PCA, PPCA
@@ -30,6 +46,10 @@ __all__ = [
     "features",
     "keyposes",
     "gaps",
+    "detect",
+    "labels",
+    "gap_eval",
+    "paper",
     "ActionGraph",
     "MotionLibrary",
     "PCA",

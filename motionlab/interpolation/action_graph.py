@@ -5,8 +5,10 @@
 * **Edges** are allowed transitions ``a → b``. They come from data — wherever one action follows
   another in a recording (:meth:`ActionGraph.add_transitions_from`) — and from a user-editable list
   (:meth:`ActionGraph.allow`, :meth:`ActionGraph.forbid`, ``"walk -> stand"`` strings).
-* **Best transition frames** between two nodes: the frame pair ``(i, j)`` of the two clips with the
-  smallest inter-frame distance ``D(f_a(i), f_b(j))`` (eq. 2).
+* **Key frames** of a node: :func:`.keyposes.node_key_frames` (PPCA latent, medoids of k-means
+  sub-clusters), the one PPCA implementation of :mod:`.ppca`.
+* **Best transition frames** between two nodes: the pair ``(i, j)`` of *key frames* of the two clips
+  with the smallest inter-frame distance ``D(f_a(i), f_b(j))`` (eq. 2, §3.1).
 * **Paths**: the shortest chain of allowed transitions from one action to another (breadth-first),
   e.g. run → walk → stand → squat.
 
@@ -23,8 +25,7 @@ import numpy as np
 
 from motionlab.core.motion import Motion
 from motionlab.interpolation.features import distance_matrix, pose_features
-from motionlab.interpolation.keyposes import key_frames
-from motionlab.interpolation.ppca import PCA
+from motionlab.interpolation.keyposes import node_key_frames
 
 __all__ = ["ActionNode", "ActionGraph", "GraphError", "parse_transition"]
 
@@ -75,9 +76,8 @@ class ActionGraph:
     def add_node(self, name: str, motion: Motion, num_keys: int = 5, seed: int = 0) -> ActionNode:
         """Add (or replace) the action ``name`` recorded by ``motion`` (at least 2 frames)."""
         feats = pose_features(motion)
-        q = min(4, feats.shape[1] - 1, max(1, len(feats) - 1))
-        latent = PCA(q).fit(feats).transform(feats)
-        node = ActionNode(str(name), motion, feats, key_frames(latent, num_keys, seed=seed))
+        keys, _ = node_key_frames(feats, num_keys, q=4, seed=seed)
+        node = ActionNode(str(name), motion, feats, keys)
         self.nodes[node.name] = node
         self._best = {k: v for k, v in self._best.items() if name not in k}
         self._library = None
@@ -141,13 +141,17 @@ class ActionGraph:
         raise GraphError(f"no chain of allowed transitions leads from {start!r} to {goal!r}")
 
     def best_transition(self, a: str, b: str) -> tuple[int, int, float]:
-        """``(i, j, D)``: frame ``i`` of ``a``'s clip and ``j`` of ``b``'s clip with the smallest
-        inter-frame distance ``D`` (cached)."""
+        """``(i, j, D)``: key frame ``i`` of ``a``'s clip and key frame ``j`` of ``b``'s clip with the
+        smallest inter-frame distance ``D`` (eq. 2; cached). Only the nodes' key frames
+        (:attr:`ActionNode.keys`, from PPCA) are searched, as in the paper's §3.1."""
         self._need(a, b)
         if (a, b) not in self._best:
-            d = distance_matrix(self.nodes[a].features, self.nodes[b].features)
+            ka, kb = self.nodes[a].keys, self.nodes[b].keys
+            if ka.size == 0 or kb.size == 0:
+                raise GraphError(f"action {a if ka.size == 0 else b!r} has no key frames")
+            d = distance_matrix(self.nodes[a].features[ka], self.nodes[b].features[kb])
             i, j = np.unravel_index(int(np.argmin(d)), d.shape)
-            self._best[(a, b)] = (int(i), int(j), float(d[i, j]))
+            self._best[(a, b)] = (int(ka[i]), int(kb[j]), float(d[i, j]))
         return self._best[(a, b)]
 
     def classify(self, features) -> list[str]:

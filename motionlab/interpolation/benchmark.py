@@ -5,14 +5,19 @@ Protocol (as in the LaFAN1 evaluation code, restated):
 * clips at 30 fps, cut into windows of 65 frames every 40 frames; each window is moved so the
   root's mean ground position over the window is the origin, and turned about +Y so that the root
   of the last context frame (frame 9) faces +Z; local quaternions are made sign-continuous in time;
-* for a transition length ``N`` in {5, 15, 30}: frames 0–9 are the context, frames 10 … 9+N are to
-  be filled, frame 10+N is the target (only that one future frame is given);
+* for a transition length ``N`` in {5, 15, 30, 45}: frames 0–9 are the context, frames 10 … 9+N
+  are to be filled, frame 10+N is the target (only that one future frame is given);
+* every method's output (local quaternions) is made sign-continuous with the last context frame
+  (:func:`continuous` over ``[frame 9, outputs …]``) *before* FK, as LaFAN1's inputs are; nothing
+  is flipped at scoring time — a method whose quaternions jump to the other hemisphere pays for
+  it in L2Q and NPSS, exactly as in the official code;
 * **L2Q**: mean over windows and filled frames of ``‖q̂ − q‖₂`` over all joints' *global*
-  quaternions stacked (each predicted quaternion takes the sign closer to the truth, so the
-  arbitrary ±q choice never counts as an error);
+  quaternions stacked (the truth: FK of the sign-continuous local quaternions);
 * **L2P**: mean over windows and frames of ``‖(x̂ − μ)/σ − (x − μ)/σ‖₂`` over all joints' global
   positions stacked, with per-coordinate μ, σ of global positions. LaFAN1 takes them from its
-  training subjects; we take them from all windows (50 frames every 20) of the evaluated clips;
+  training subjects; here they come from a fixed set of clips of the *same skeleton* kept apart
+  from the scored windows (``benchmarks/bench_inbetween.py`` names both sets), one skeleton at a
+  time (statistics mixing two rigs mean nothing for either);
 * **NPSS** (Gopalakrishnan et al. 2019): per dimension of the stacked global quaternions, the
   earth mover's distance between the normalised power spectra (real FFT part squared, cumulative)
   of truth and prediction, averaged with the truth's total power as weights.
@@ -46,6 +51,7 @@ __all__ = [
     "load_clips",
     "make_windows",
     "continuous",
+    "continue_from_context",
     "position_stats",
     "l2q",
     "l2p",
@@ -54,12 +60,13 @@ __all__ = [
     "method_interpolation",
     "method_hermite",
     "method_library",
+    "choose_max_cost",
     "action_label",
     "evaluate",
     "format_table",
 ]
 
-GAPS = (5, 15, 30)
+GAPS = (5, 15, 30, 45)
 N_PAST = 10
 
 
@@ -182,10 +189,17 @@ def position_stats(motions: Sequence[Motion]) -> tuple[np.ndarray, np.ndarray]:
 
 
 def l2q(pred_global_rot, true_global_rot) -> float:
-    """Mean over windows and frames of ‖q̂ − q‖ over all joints (W, N, J, 4); sign-aligned."""
+    """Mean over windows and frames of ‖q̂ − q‖ over all joints (W, N, J, 4), as given: no sign is
+    flipped here (make the prediction sign-continuous with its context first, see :func:`evaluate`)."""
     p, t = np.asarray(pred_global_rot), np.asarray(true_global_rot)
-    p = np.where(np.sum(p * t, axis=-1, keepdims=True) < 0, -p, p)
     return float(np.mean(np.sqrt(np.sum((p - t) ** 2, axis=(-2, -1)))))
+
+
+def continue_from_context(rot, last_context) -> np.ndarray:
+    """Local quaternions (W, N, J, 4) made sign-continuous in time starting from the last context
+    frame (W, J, 4), which keeps its sign (LaFAN1's treatment of inputs, applied to outputs)."""
+    seq = np.concatenate([np.asarray(last_context)[:, None], np.asarray(rot, dtype=np.float64)], axis=1)
+    return continuous(seq, axis=1)[:, 1:]
 
 
 def l2p(pred_global_pos, true_global_pos, mean, std) -> float:
@@ -255,33 +269,83 @@ def action_label(name: str) -> str:
     return re.sub(r"[_-]?\d+$", "", name).lower()
 
 
-def method_library(library, k: int = 1, leave_one_out: bool = True, same_action: bool = True) -> Method:
+def method_library(
+    library, k: int = 1, leave_one_out: bool = True, same_action: bool = True, max_cost: float | None = None
+) -> Method:
     """motionlab's key-pose-guided filling (:class:`~.library.MotionLibrary`) as a benchmark method.
 
     With ``leave_one_out`` the library clip with the window's own clip name is never used. With
     ``same_action`` a gap is filled only from recordings of its own action node (the library's
-    labels against :func:`action_label` of the window's clip); when the node holds no other
-    recording the gap falls back to plain interpolation, which is what the paper does inside a node.
+    labels against :func:`action_label` of the window's clip). A gap whose best stretch costs more
+    than ``max_cost`` (no recording matches its ends well; see :func:`choose_max_cost`), or whose
+    node holds no other recording, falls back to plain interpolation, which is what the paper does
+    inside a node.
     """
 
     def run(w: Windows, n_past: int, gap: int):
-        a, b = n_past - 1, n_past + gap
-        exclude = None
-        if leave_one_out:
-            index = {name: i for i, name in enumerate(library.names)}
-            exclude = np.array([index.get(w.names[c], -1) for c in w.clip])
-        labels = [action_label(w.names[c]) for c in w.clip] if same_action else None
-        rot, trans, cost = library.fill(
-            w.local_rot[:, a - 1 : a + 1], w.trans[:, a - 1 : a + 1], w.local_rot[:, b], w.trans[:, b], gap,
-            k=k, exclude_clip=exclude, query_labels=labels,
-        )  # fmt: skip
-        none = ~np.isfinite(cost)
+        rot, trans, cost = _library_fill(library, w, n_past, gap, k, leave_one_out, same_action)
+        none = ~np.isfinite(cost) if max_cost is None else ~(cost <= max_cost)
         if np.any(none):
             i_rot, i_trans = method_interpolation(w, n_past, gap)
             rot[none], trans[none] = i_rot[none], i_trans[none]
         return rot, trans
 
     return run
+
+
+def _library_fill(library, w: Windows, n_past: int, gap: int, k: int, leave_one_out: bool, same_action: bool):
+    a, b = n_past - 1, n_past + gap
+    exclude = None
+    if leave_one_out:
+        index = {name: i for i, name in enumerate(library.names)}
+        exclude = np.array([index.get(w.names[c], -1) for c in w.clip])
+    labels = [action_label(w.names[c]) for c in w.clip] if same_action else None
+    return library.fill(
+        w.local_rot[:, a - 1 : a + 1], w.trans[:, a - 1 : a + 1], w.local_rot[:, b], w.trans[:, b], gap,
+        k=k, exclude_clip=exclude, query_labels=labels,
+    )  # fmt: skip
+
+
+def _window_l2p(w: Windows, rot, trans, n_past: int, gap: int, stats) -> np.ndarray:
+    """L2P of each window (W,) (the mean over its filled frames)."""
+    mean, std = stats
+    sl = slice(n_past, n_past + gap)
+    _, true_pos = fk(w.local_rot[:, sl], w.trans[:, sl], w.parents)
+    _, pos = fk(rot, trans, w.parents)
+    d = (pos - true_pos).reshape(pos.shape[:2] + (-1,)) / std
+    return np.sqrt(np.sum(d * d, axis=-1)).mean(axis=1)
+
+
+def choose_max_cost(
+    windows: Windows,
+    library,
+    stats,
+    gaps: Sequence[int] = (15, 30),
+    k: int = 1,
+    same_action: bool = True,
+    n_past: int = N_PAST,
+) -> float:
+    """The matching cost above which the library fill is not trusted, chosen on ``windows`` that
+    must be kept apart from any scored window (leave-one-clip-out fills).
+
+    Every window's best-stretch cost and its L2P with the library fill and with plain
+    interpolation are computed at each gap; the threshold is the one (among the observed costs,
+    and ``inf``) that minimises the summed L2P when windows above it are interpolated instead.
+    """
+    costs, lib_err, int_err = [], [], []
+    for gap in gaps:
+        rot, trans, cost = _library_fill(library, windows, n_past, gap, k, True, same_action)
+        i_rot, i_trans = method_interpolation(windows, n_past, gap)
+        ok = np.isfinite(cost)
+        rot[~ok], trans[~ok] = i_rot[~ok], i_trans[~ok]
+        costs.append(np.where(ok, cost, np.inf))
+        lib_err.append(_window_l2p(windows, rot, trans, n_past, gap, stats))
+        int_err.append(_window_l2p(windows, i_rot, i_trans, n_past, gap, stats))
+    c, lib, itp = np.concatenate(costs), np.concatenate(lib_err), np.concatenate(int_err)
+    candidates = np.concatenate([[-np.inf], np.unique(c[np.isfinite(c)]), [np.inf]])
+    total = [np.sum(np.where(c <= t, lib, itp)) for t in candidates]
+    best = float(candidates[int(np.argmin(total))])
+    return max(best, 0.0)
 
 
 def evaluate(
@@ -300,11 +364,10 @@ def evaluate(
             raise ValueError(f"windows of {T} frames cannot hold {n_past} context + {gap} gap + 1 target frames")
         sl = slice(n_past, n_past + gap)
         true_rot, true_pos = fk(windows.local_rot[:, sl], windows.trans[:, sl], windows.parents)
-        true_rot = continuous(true_rot, axis=1)
         for name, method in methods.items():
             rot, trans = method(windows, n_past, gap)
+            rot = continue_from_context(rot, windows.local_rot[:, n_past - 1])
             g_rot, g_pos = fk(rot, trans, windows.parents)
-            g_rot = np.where(np.sum(g_rot * true_rot, axis=-1, keepdims=True) < 0, -g_rot, g_rot)
             res[(name, "L2Q", gap)] = l2q(g_rot, true_rot)
             res[(name, "L2P", gap)] = l2p(g_pos, true_pos, mean, std)
             flat = lambda x: x.reshape(x.shape[0], x.shape[1], -1)  # noqa: E731
@@ -318,9 +381,9 @@ def format_table(res: dict, gaps: Sequence[int] = GAPS) -> str:
     lines = []
     for metric, fmt in (("L2Q", "{:7.3f}"), ("L2P", "{:7.3f}"), ("NPSS", "{:7.4f}")):
         lines.append(f"=== {metric} ===")
-        lines.append(f"{'gap (frames)':<28}" + "".join(f"{g:>8d}" for g in gaps))
+        lines.append(f"{'gap (frames)':<32}" + "".join(f"{g:>8d}" for g in gaps))
         for m in methods:
-            lines.append(f"{m:<28}" + "".join(" " + fmt.format(res[(m, metric, g)]) for g in gaps))
+            lines.append(f"{m:<32}" + "".join(" " + fmt.format(res[(m, metric, g)]) for g in gaps))
         lines.append("")
     return "\n".join(lines)
 

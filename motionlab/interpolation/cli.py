@@ -3,14 +3,18 @@
 Examples::
 
     motionlab fill-gaps take.bvh -o take_filled.bvh
-    motionlab fill-gaps take.bvh -o out.bvh --method hermite --factor 5
+    motionlab fill-gaps take.bvh -o out.bvh --method hermite --delta 3
     motionlab fill-gaps take.bvh -o out.bvh --method graph \\
         --action run=Running.bvh --action walk=Walk.bvh --action stand=Idle.bvh \\
         --allow "run -> walk" --allow "walk -> stand"
 
-Dropped frames are found with the ``D > Δ`` rule (:func:`motionlab.interpolation.gaps.distance_gaps`),
-the missing count is estimated from the size of the jump, and the frames are inserted and filled.
-A report lists every gap and how it was filled.
+Dropped frames are found with the ``D > Δ`` rule of :mod:`motionlab.interpolation.detect`: against
+the action graph when ``--action`` clips are given (the stream tracked in the graph, §3.3), else
+against the stream's own neighbouring steps. The missing count is estimated from the motion on
+both sides (ground speed, travel direction), the frames are inserted and filled; the root follows
+a Hermite curve with the velocities on both sides (``--root linear`` for the LaFAN1 baseline).
+A clean clip (nothing found) is copied byte for byte. A report lists every gap and how it was
+filled.
 """
 
 from __future__ import annotations
@@ -33,8 +37,11 @@ def register(subparsers) -> None:
     p.add_argument("--method", choices=("slerp", "hermite", "graph"), default="slerp",
                    help="slerp: SLERP + linear root; hermite: velocity-matched; graph: key-pose guided (needs --action)")  # fmt: skip
     p.add_argument("--curve", choices=("linear", "ease", "smoothstep"), default="linear", help="α(k) curve")
-    p.add_argument("--factor", type=float, default=4.0, help="Δ = factor × median frame distance (default 4)")
-    p.add_argument("--threshold", type=float, default=None, help="absolute Δ instead of --factor")
+    p.add_argument("--root", choices=("hermite", "linear"), default="hermite",
+                   help="root path across a gap: Hermite with the velocities on both sides (default) or linear")  # fmt: skip
+    p.add_argument("--delta", "--threshold", "--factor", dest="delta", type=str, default=None, metavar="Δ",
+                   help="Δ: a step this many times the typical step means dropped frames (a number above 1; "
+                   "default 2.5, or derived from the graph's speed spread with --action)")  # fmt: skip
     p.add_argument("--action", action="append", default=[], metavar="NAME=FILE.bvh",
                    help="an action node of the graph and a clip of it (repeat)")  # fmt: skip
     p.add_argument("--allow", action="append", default=[], metavar="'A -> B'",
@@ -69,11 +76,33 @@ def _graph(actions: list[str], allow: list[str]):
     return g
 
 
+def _copy(src: Path, dst: Path) -> None:
+    """Copy ``src`` to ``dst`` byte for byte, atomically (temporary file beside ``dst``, then rename)."""
+    import os
+    import shutil
+    import tempfile
+
+    fd, tmp = tempfile.mkstemp(prefix=f".{dst.name}.", suffix=".tmp", dir=dst.parent or ".")
+    os.close(fd)
+    try:
+        shutil.copyfile(src, tmp)
+        os.replace(tmp, dst)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
 def run_fill_gaps(args: argparse.Namespace) -> int:
     from motionlab.cli import CLIError
     from motionlab.core import bvh
-    from motionlab.interpolation import gaps
+    from motionlab.interpolation import detect, gaps
 
+    delta = None
+    if args.delta is not None:
+        try:
+            delta = detect.check_delta(args.delta, name="--delta (--threshold)")
+        except ValueError as e:
+            raise CLIError(str(e)) from None
     src, dst = Path(args.input), Path(args.output)
     if not src.is_file():
         raise CLIError(f"input file {src} does not exist")
@@ -86,14 +115,22 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
     except bvh.BVHError as e:
         raise CLIError(str(e)) from None
     graph = _graph(args.action, args.allow) if args.method == "graph" else None
-    missing = gaps.distance_gaps(motion, factor=args.factor, threshold=args.threshold)
+    try:
+        missing = detect.detect(motion, graph=graph, delta=delta)
+    except ValueError as e:
+        raise CLIError(str(e)) from None
+    print(f"{src}: {motion.num_frames} frames at {motion.fps:g} fps")
+    if not missing:
+        _copy(src, dst)
+        print("no dropped frames found (D > Δ nowhere); wrote an unchanged copy")
+        print(f"wrote {dst} ({motion.num_frames} frames)")
+        return 0
     expanded, _ = gaps.insert_missing(motion, missing)
     try:
-        filled, report = gaps.fill(expanded, method=args.method, graph=graph, curve=args.curve)
+        filled, report = gaps.fill(expanded, method=args.method, graph=graph, curve=args.curve, root=args.root)
     except ValueError as e:
         raise CLIError(str(e)) from None
     bvh.save(dst, filled, overwrite=args.force)
-    print(f"{src}: {motion.num_frames} frames at {motion.fps:g} fps")
     if not report:
         print("no dropped frames found (D > Δ nowhere); wrote an unchanged copy")
     else:

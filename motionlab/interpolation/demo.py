@@ -8,20 +8,45 @@ from __future__ import annotations
 
 import warnings
 
+import numpy as np
+
 from motionlab import data
 from motionlab.core.motion import Motion
 
-__all__ = ["BEHAVIOUR_CLIPS", "behaviours", "walk_clip", "benchmark_clips"]
+__all__ = [
+    "BEHAVIOUR_CLIPS",
+    "trim_frozen",
+    "behaviours",
+    "walk_clip",
+    "walk_takes",
+    "paper_walk",
+    "benchmark_clips",
+    "benchmark_apart_clips",
+]
 
 BEHAVIOUR_CLIPS = {
-    "run": "mixamo/Aj/Running",
-    "walk": "mixamo/Aj/Injured_Walk_Left_Turn",
-    "stand": "mixamo/Aj/Idle",
+    "run": "mixamo/Aj/Run_Arc_Left",
+    "walk": "mixamo/Aj/Catwalk_Walk",
+    "stand": "mixamo/Aj/Ready_Idle",
     "squat": "mixamo/Aj/Standing_To_Crouched",
 }
-"""The real clips (Mixamo Aj, one skeleton) used for each action when data is available."""
+"""The real clips (Mixamo Aj, one skeleton) used for each action when data is available, chosen by
+content (:func:`motionlab.interpolation.labels.check`), not by file name: ``Running.bvh`` is a dive
+roll (hips at 9% of standing height) and ``Idle.bvh`` a crouched idle (58%); ``behaviours()``
+checks every clip against its label and refuses a mismatch."""
 
 _SYNTHETIC = {"run": "run", "walk": "walk", "stand": "idle", "squat": "squat"}
+
+
+def trim_frozen(motion: Motion) -> Motion:
+    """``motion`` without the trailing frames that repeat the frame before them exactly (some Mixamo
+    exports pad a clip with a frozen pose: ``Run_Arc_Left`` stops moving after 33 of its 60 frames)."""
+    same = (motion.local_rot[1:] == motion.local_rot[:-1]).all(axis=(1, 2)) & (
+        motion.root_pos[1:] == motion.root_pos[:-1]
+    ).all(axis=1)
+    moving = np.flatnonzero(~same)
+    last = int(moving[-1]) + 2 if moving.size else 1
+    return motion[: max(last, 2)] if last < motion.num_frames else motion
 
 
 def _load(rel: str, fps: float) -> Motion:
@@ -30,7 +55,7 @@ def _load(rel: str, fps: float) -> Motion:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)
         m = humanoid.to_canonical(bvh.load(data.clip_path(*rel.split("/"))))
-    return m.resample(fps)
+    return trim_frozen(m).resample(fps)
 
 
 def behaviours(fps: float = 30.0, frames: int = 90, seed: int = 0) -> tuple[dict[str, Motion], str]:
@@ -40,9 +65,12 @@ def behaviours(fps: float = 30.0, frames: int = 90, seed: int = 0) -> tuple[dict
     with ``frames`` frames each.
     """
     if data.has_data("mixamo", "Aj"):
-        return {k: _load(v, fps) for k, v in BEHAVIOUR_CLIPS.items()}, "real: Mixamo Aj clips " + ", ".join(
-            v.split("/")[-1] for v in BEHAVIOUR_CLIPS.values()
-        )
+        from motionlab.interpolation import labels
+
+        clips = {k: _load(v, fps) for k, v in BEHAVIOUR_CLIPS.items()}
+        for k, m in clips.items():
+            labels.check(m, k)
+        return clips, "real: Mixamo Aj clips " + ", ".join(v.split("/")[-1] for v in BEHAVIOUR_CLIPS.values())
     from motionlab import synthetic
 
     clips = {k: synthetic.generate(b, None, frames, fps, seed=seed + i) for i, (k, b) in enumerate(_SYNTHETIC.items())}
@@ -76,3 +104,44 @@ def benchmark_clips(fps: float = 30.0) -> tuple[list[Motion], str]:
         m.name = f"synthetic_{b}_{i:03d}"
         clips.append(m)
     return clips, "synthetic walks and runs (set MOTIONLAB_DATA for real mocap)"
+
+
+def walk_takes(takes=(4, 5, 6), style: str = "normal", fps: float = 30.0) -> list[Motion]:
+    """Walk takes of ``bandai_namco/sessions/walk`` (canonical, at ``fps``), other recordings than
+    :func:`walk_clip`'s; an empty list without real data."""
+    if not data.has_data("bandai_namco", "sessions", "walk"):
+        return []
+    return [_load(f"bandai_namco/sessions/walk/dataset-2_walk_{style}_{t:03d}", fps) for t in takes]
+
+
+def benchmark_apart_clips(fps: float = 30.0) -> tuple[list[Motion], str]:
+    """Clips of the benchmark's skeleton kept apart from :func:`benchmark_clips` (L2P statistics
+    and extra library material): Bandai Namco dataset-1 normal-style clips, or synthetic ones with
+    other seeds."""
+    if data.has_data("bandai_namco", "dataset-1"):
+        from motionlab.interpolation.benchmark import load_clips
+
+        files = sorted((data.data_root() / "bandai_namco" / "dataset-1").rglob("*_normal_*.bvh"))
+        return load_clips(files, fps=fps), "real: bandai_namco/dataset-1 normal-style clips"
+    from motionlab import synthetic
+
+    clips = []
+    for i, b in enumerate(["walk", "walk", "run", "run"]):
+        m = synthetic.generate(b, None, 200, fps, seed=50 + i)
+        m.name = f"synthetic_apart_{b}_{i:03d}"
+        clips.append(m)
+    return clips, "synthetic walks and runs with other seeds"
+
+
+def paper_walk() -> tuple[Motion, str]:
+    """The walk of the paper's Fig. 6/7 experiment: ``xia/walk/normal_ganimator.bvh`` (CMU skeleton,
+    120 Hz, 360 frames: the nearest real walk to the paper's 495 CMU frames), or a synthetic 120 Hz
+    walk of the same length."""
+    rel = "xia/walk/normal_ganimator"
+    if data.has_data("xia", "walk"):
+        return _load(rel, 120.0), f"real: {rel}.bvh (120 Hz)"
+    from motionlab import synthetic
+
+    return synthetic.generate(
+        "walk", None, 360, 120.0, seed=3
+    ), "synthetic 120 Hz walk (set MOTIONLAB_DATA for real mocap)"

@@ -5,9 +5,9 @@
 * NaN rows (a capture system that knows it lost the markers): :func:`nan_gaps`;
 * timestamps that jump by more than one frame period: :func:`timestamp_gaps`;
 * nothing at all — the frames were just dropped, as in a BVH file with a constant frame time.
-  Then the paper's rule applies: the distance ``D`` between consecutive frames is compared with a
-  threshold ``Δ``; ``D > Δ`` means frames are missing (:func:`distance_gaps`). We set
-  ``Δ = factor × median(D)`` and estimate how many frames are missing from ``D / median(D)``.
+  Then the paper's rule ``D > Δ`` applies, the stream tracked in the action graph or against its
+  own neighbouring steps, and the missing count comes from the motion on both sides: see
+  :mod:`.detect`.
 
 **Filling** (:func:`fill`). Each gap ``[start, stop)`` is bounded by known frames ``a = start − 1``
 and ``b = stop``:
@@ -16,9 +16,12 @@ and ``b = stop``:
   linear root, or Hermite variants, or, when an :class:`~.action_graph.ActionGraph` is given, the
   key-pose-guided filling of :mod:`.library` with the node's recordings;
 * *across nodes*: find the path ``a's action → … → b's action`` in the graph, place one key pose of
-  every intermediate action (its best transition frame from the previous action, root-aligned onto
-  the straight line from ``a`` to ``b``) at evenly spaced frames inside the gap, and interpolate
-  the rest between consecutive anchors.
+  every intermediate action (its best transition frame from the previous action — a PPCA key frame,
+  :meth:`~.action_graph.ActionGraph.best_transition` — root-aligned onto the straight line from
+  ``a`` to ``b``) at evenly spaced frames inside the gap, and fill each piece between consecutive
+  anchors with eq. 4's moving SLERP (:func:`moving_slerp`): the earlier node's clip running on
+  from its frame at the first anchor, blended into the later node's clip running into its frame at
+  the second.
 
 Pieces filled one after another meet at the anchors with different velocities: the root path
 would have corners there. With the graph, :func:`smooth_root` therefore bends the root through the
@@ -38,6 +41,8 @@ from motionlab.core import quat
 from motionlab.core.motion import Motion
 from motionlab.interpolation import inbetween
 from motionlab.interpolation.action_graph import ActionGraph
+from motionlab.interpolation.alignment import apply as apply_rigid
+from motionlab.interpolation.alignment import estimate as estimate_rigid
 from motionlab.interpolation.alignment import reference_joint, reference_transform
 from motionlab.interpolation.features import pose_features
 from motionlab.interpolation.library import MotionLibrary
@@ -48,11 +53,12 @@ __all__ = [
     "FilledGap",
     "nan_gaps",
     "timestamp_gaps",
-    "distance_gaps",
     "insert_missing",
     "fill",
     "fill_rows",
     "smooth_root",
+    "lift_above_floor",
+    "moving_slerp",
 ]
 
 METHODS = ("slerp", "hermite", "graph")
@@ -108,29 +114,6 @@ def timestamp_gaps(times, fps: float) -> list[tuple[int, int]]:
         raise ValueError("expected strictly increasing timestamps (T,) in seconds")
     steps = np.rint(np.diff(t) * fps).astype(np.int64)
     return [(int(i), int(s - 1)) for i, s in enumerate(steps) if s > 1]
-
-
-def distance_gaps(motion: Motion, factor: float = 4.0, threshold: float | None = None) -> list[tuple[int, int]]:
-    """Dropped frames by the paper's ``D > Δ`` rule: ``(after frame i, estimated missing count)``.
-
-    ``D(t)`` is the distance between frames ``t`` and ``t+1``: heading-frame joint positions plus
-    the reference joint's ground displacement (scaled by √J so it weighs like the whole body).
-    ``Δ = threshold`` if given, else ``factor × median(D)``; the missing count is
-    ``round(D / median(D)) − 1`` (at least 1).
-    """
-    if motion.num_frames < 3:
-        return []
-    if factor <= 1 and threshold is None:
-        raise ValueError(f"factor must exceed 1 (a multiple of the typical frame step), got {factor}")
-    f = pose_features(motion, velocity_weight=0.0)[:, : 3 * motion.skeleton.num_joints]
-    _, ground = reference_transform(motion)
-    ground = ground * np.array([1.0, 0.0, 1.0]) * np.sqrt(motion.skeleton.num_joints)
-    d = np.linalg.norm(np.diff(np.concatenate([f, ground], axis=1), axis=0), axis=1)
-    typical = float(np.median(d))
-    if typical <= 1e-9:
-        return []
-    delta = factor * typical if threshold is None else float(threshold)
-    return [(int(i), max(1, int(round(d[i] / typical)) - 1)) for i in np.flatnonzero(d > delta)]
 
 
 def insert_missing(motion: Motion, missing: list[tuple[int, int]]) -> tuple[Motion, list[tuple[int, int]]]:
@@ -244,6 +227,73 @@ def _place_key_pose(out: Motion, slot: int, node_motion: Motion, frame: int, a: 
         out.local_pos[slot, 0] = out.root_pos[slot]
 
 
+def _node_frame(graph: ActionGraph, name: str, feats: np.ndarray) -> int:
+    """The frame of node ``name``'s clip nearest to the feature row ``feats`` (D,)."""
+    f = graph.nodes[name].features
+    return int(np.argmin(np.sum((f - feats[None]) ** 2, axis=1)))
+
+
+def _clip_run(clip: Motion, start: int, count: int, out: Motion, at: int, anchor: int, ref: int):
+    """Frames ``start … start+count-1`` of ``clip`` (clamped to the clip: a run past its end holds
+    the last frame), moved rigidly (eq. 3: yaw about +Y and a ground translation) so that clip frame
+    ``anchor`` lands on frame ``at`` of ``out``. Returns rotations (count, J, 4) and translations
+    (count, J, 3), metres."""
+    idx = np.clip(np.arange(start, start + count), 0, clip.num_frames - 1)
+    ra, pa = reference_transform(out, [at], joint=ref)
+    rb, pb = reference_transform(clip, [anchor], joint=ref)
+    seg = apply_rigid(clip[idx], estimate_rigid(ra[0], pa[0], rb[0], pb[0]))
+    return seg.local_rot, seg.translations()
+
+
+def moving_slerp(rot_a, trans_a, rot_b, trans_b, curve: str = "linear") -> tuple[np.ndarray, np.ndarray]:
+    """Eq. 4 with its moving indices: a blend between two *running* sequences.
+
+    ``s_k = slerp(q_A[m+k], q_B[n−L+k], α(k))``, ``k = 0 … L``: sequence A runs on from its
+    transition frame ``A(m)`` while sequence B runs into its transition frame ``B(n)``, and the
+    weight moves from A to B (``α(0) = 0``, ``α(L) = 1``; between them ``α`` from ``curve``). Both
+    ends move, so the in-between keeps the motion of the two actions instead of sliding between
+    two frozen poses; when each sequence holds one repeated frame it is plain SLERP. (algorithms.md
+    §C.6 leaves the index directions open; this reading keeps both sequences in forward time.)
+
+    Parameters
+    ----------
+    rot_a, rot_b : array (L+1, J, 4)      local rotations of A's frames m … m+L and B's n−L … n
+    trans_a, trans_b : array (L+1, J, 3)  their translations (root: world position), metres,
+                                          already root-aligned (:mod:`.alignment`)
+    curve : α curve (:func:`~.slerp.alphas`)
+
+    Returns
+    -------
+    rot : ndarray (L+1, J, 4), trans : ndarray (L+1, J, 3)
+    """
+    rot_a, rot_b = quat.check(rot_a, "rot_a"), quat.check(rot_b, "rot_b")
+    if rot_a.shape != rot_b.shape or rot_a.ndim != 3 or len(rot_a) < 2:
+        raise ValueError(f"expected two (L+1, J, 4) sequences with L >= 1, got {rot_a.shape} and {rot_b.shape}")
+    L = len(rot_a) - 1
+    w = np.concatenate([[0.0], alphas(L - 1, curve), [1.0]])
+    rot = quat.slerp(rot_a, rot_b, w[:, None])
+    trans = np.asarray(trans_a) + w[:, None, None] * (np.asarray(trans_b) - np.asarray(trans_a))
+    return rot, trans
+
+
+def _moving_piece(out: Motion, lo: int, hi: int, run_a, run_b, curve: str) -> None:
+    """Fill ``out[lo+1 … hi-1]`` with :func:`moving_slerp` of the aligned runs, then blend the
+    remaining mismatch at both ends away (as :class:`~.library.MotionLibrary` does), so the piece
+    meets ``out[lo]`` and ``out[hi]`` exactly."""
+    rot, trans = moving_slerp(run_a[0], run_a[1], run_b[0], run_b[1], curve)
+    L = hi - lo
+    u = np.arange(L + 1) / L
+    t_all = out.translations()
+    d_a = quat.mul(out.local_rot[lo], quat.conj(rot[0]))
+    d_b = quat.mul(out.local_rot[hi], quat.conj(rot[L]))
+    rot = quat.mul(quat.slerp(d_a[None], d_b[None], u[:, None]), rot)
+    trans = trans + (1 - u)[:, None, None] * (t_all[lo] - trans[0]) + u[:, None, None] * (t_all[hi] - trans[L])
+    out.local_rot[lo + 1 : hi] = rot[1:L]
+    out.root_pos[lo + 1 : hi] = trans[1:L, 0]
+    if out.local_pos is not None:
+        out.local_pos[lo + 1 : hi] = trans[1:L]
+
+
 def _known_reference_joint(motion: Motion) -> int:
     """:func:`~.alignment.reference_joint` judged on the known frames only (NaN rows would hide a
     moving hips channel and make every rig look root-driven)."""
@@ -338,6 +388,28 @@ def _floor_guard(motion: Motion, a: int, b: int, drop: np.ndarray) -> np.ndarray
     return np.maximum(drop, np.minimum(0.0, floor - low[1:-1]))
 
 
+def lift_above_floor(motion: Motion, a: int, b: int) -> Motion:
+    """A copy of ``motion`` whose frames ``a+1 … b-1`` are raised (root translation, +Y) just enough
+    that no joint but the root goes below the floor of the gap's known ends ``a`` and ``b`` (the
+    lower of their lowest joints).
+
+    SLERP between two strides swings a leg through the floor half-way (measured on the Bandai
+    walks: up to 7 cm); lifting the whole body by the overshoot keeps the feet on the floor at
+    the cost of a small vertical bob, which the eye forgives far more readily than a foot in the
+    ground. Frames already above the floor are untouched.
+    """
+    out = motion.copy()
+    if b - a < 2:
+        return out
+    height = motion[a : b + 1].global_positions()[..., 1]  # (F+2, J)
+    low = (height[:, 1:] if height.shape[1] > 1 else height).min(axis=-1)
+    lift = np.maximum(0.0, min(low[0], low[-1]) - low[1:-1])
+    out.root_pos[a + 1 : b, 1] += lift
+    if out.local_pos is not None:
+        out.local_pos[a + 1 : b, 0] = out.root_pos[a + 1 : b]
+    return out
+
+
 def smooth_root(motion: Motion, anchors, joint: int | None = None) -> Motion:
     """A copy of ``motion`` whose root path through ``anchors`` is C1 (no corners).
 
@@ -409,6 +481,7 @@ def fill(
     method: str = "slerp",
     graph: ActionGraph | None = None,
     curve: str = "linear",
+    root: str = "linear",
 ) -> tuple[Motion, list[FilledGap]]:
     """Fill every NaN frame of ``motion``; returns the filled copy and a report per gap.
 
@@ -421,9 +494,17 @@ def fill(
         ends and key poses is then made C1 by :func:`smooth_root`)
     graph : ActionGraph whose node clips use ``motion``'s skeleton
     curve : α(k) curve for the interpolated parts
+    root : ``"linear"`` (the LaFAN1 baseline) or ``"hermite"``: for ``"slerp"``/``"hermite"``, the
+        reference joint's path across each gap is then the cubic Hermite curve whose end tangents
+        are the velocities measured just outside the gap (:func:`smooth_root` with the gap's two
+        ends as anchors), so a walking character keeps walking through it at the speed it had on
+        both sides; the foot-through-floor guard of :func:`smooth_root` applies. (The ``"graph"``
+        method always does this.)
     """
     if method not in METHODS:
         raise ValueError(f"unknown filling method {method!r}; expected one of {METHODS}")
+    if root not in ("linear", "hermite"):
+        raise ValueError(f"unknown root mode {root!r}; expected 'linear' or 'hermite'")
     if method == "graph":
         if graph is None or not graph.nodes:
             raise ValueError("method='graph' needs an ActionGraph with at least one action")
@@ -446,6 +527,9 @@ def fill(
             mode = "hermite" if method == "hermite" else "linear"
             out = inbetween.fill_between(out, start, stop, curve=curve, root=mode,
                                          rotation="hermite" if method == "hermite" else "slerp")  # fmt: skip
+            if root == "hermite":
+                out = smooth_root(out, [a, b], joint=ref)
+            out = lift_above_floor(out, a, b)
             report.append(FilledGap(start, stop, method))
             continue
         node_a = graph.classify(_frame_features(out, a, before=True)[None])[0]
@@ -458,22 +542,29 @@ def fill(
         if len(slots) < len(inner) or len(set(slots)) < len(slots):
             inner, slots = [], []  # gap too short for the intermediate key poses: plain filling
         prev = path[0]
+        placed = {a: (path[0], _node_frame(graph, path[0], _frame_features(out, a, before=True)))}
         for name, slot in zip(inner, slots):
             _, j, _ = graph.best_transition(prev, name)
             _place_key_pose(out, slot, graph.nodes[name].motion, j, a, b, ref)
+            placed[slot] = (name, j)
             prev = name
+        placed[b] = (path[-1], _node_frame(graph, path[-1], _frame_features(out, b, before=False)))
         anchors = [a] + slots + [b]
         used = "library"
-        for i, (lo, hi) in enumerate(zip(anchors[:-1], anchors[1:])):
+        for lo, hi in zip(anchors[:-1], anchors[1:]):
             if hi - lo < 2:
                 continue
-            labels = (
-                sorted({path[min(i, len(path) - 1)], path[min(i + 1, len(path) - 1)]}) if inner else sorted(set(path))
-            )
-            ok = _library_fill(out, lo, hi, lib, labels, prev_frame=None if lo == a else lo)
+            if inner:  # across nodes: eq. 4, node lo's clip running on, node hi's clip running in
+                (na, m), (nb, n) = placed[lo], placed[hi]
+                L = hi - lo
+                run_a = _clip_run(graph.nodes[na].motion, m, L + 1, out, lo, m, ref)
+                run_b = _clip_run(graph.nodes[nb].motion, n - L, L + 1, out, hi, n, ref)
+                _moving_piece(out, lo, hi, run_a, run_b, curve)
+                continue
+            ok = _library_fill(out, lo, hi, lib, sorted(set(path)), prev_frame=None if lo == a else lo)
             if not ok:
                 out = inbetween.fill_between(out, lo + 1, hi, curve=curve)
                 used = "graph+slerp"
-        out = smooth_root(out, anchors, joint=ref)
+        out = lift_above_floor(smooth_root(out, anchors, joint=ref), a, b)
         report.append(FilledGap(start, stop, "graph" if inner else used, path, slots))
     return out, report

@@ -27,7 +27,17 @@ import numpy as np
 
 from motionlab.interpolation.ppca import PPCA
 
-__all__ = ["kmeans", "clean_labels", "runs", "window_stats", "Segmentation", "segment", "key_frames", "purity"]
+__all__ = [
+    "kmeans",
+    "clean_labels",
+    "runs",
+    "window_stats",
+    "Segmentation",
+    "segment",
+    "node_key_frames",
+    "key_frames",
+    "purity",
+]
 
 
 def window_stats(z, window: int) -> np.ndarray:
@@ -190,6 +200,30 @@ def segment(
     labels, centres = kmeans(stats, k, seed=seed)
     labels = clean_labels(labels, stats, centres, min_length)
     return Segmentation(labels, runs(labels), z, centres, model, mean, std, window)
+
+
+def node_key_frames(features, n: int = 5, q: int = 4, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """Key frames of one action node's clip: z-score its features, project them with :class:`PPCA`
+    (the one implementation used for segmentation too) and take :func:`key_frames` of the latent.
+
+    Parameters
+    ----------
+    features : array (T, D)   per-frame features of the node's clip (:func:`~.features.pose_features`)
+    n : int                   key frames wanted
+    q : int                   PPCA latent size (capped at ``D-1`` and ``T-1``)
+
+    Returns
+    -------
+    keys : ndarray (<= n,) of int   frame indices into the clip, increasing
+    latent : ndarray (T, q)         the PPCA posterior means
+    """
+    f = np.asarray(features, dtype=np.float64)
+    if f.ndim != 2 or len(f) < 2:
+        raise ValueError(f"expected (T, D) features of at least 2 frames, got shape {f.shape}")
+    zs = (f - f.mean(axis=0)) / np.maximum(f.std(axis=0), 1e-6)
+    q = max(1, min(int(q), f.shape[1] - 1, len(f) - 1))
+    latent = PPCA(q, seed=seed).fit(zs).transform(zs)
+    return key_frames(latent, n, seed=seed), latent
 
 
 def key_frames(latent, n: int, seed: int = 0) -> np.ndarray:

@@ -102,9 +102,9 @@ class PPCA:
     tol : float         EM stops when the log-likelihood per sample rises by less than this
     seed : int          EM's random initial ``W``
 
-    Attributes (after :meth:`fit`)
-    ------------------------------
-    mean : ndarray (D,)       μ
+    Attributes
+    ----------
+    mean : ndarray (D,)       μ (this and the following are set by :meth:`fit`)
     W : ndarray (D, q)        loading matrix
     sigma2 : float            noise variance σ²
     history : list of float   log-likelihood per sample after each EM step (closed form: one entry)

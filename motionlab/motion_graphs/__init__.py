@@ -3,7 +3,8 @@
 * :mod:`.distance` — Kovar's point-cloud frame distance for whole clip pairs, transition candidates;
 * :mod:`.graph` — the graph data structure, the standard graph and its pruning;
 * :mod:`.registration` — DTW time registration, root alignment and blends;
-* :mod:`.structured` — structure table, transition clips, interpolation space, local pruning;
+* :mod:`.structured` — structure table of pooled takes, transition clips, interpolation space,
+  local pruning; :mod:`.cycles` — gait cycles from foot contacts; :mod:`.report` — the build report;
 * :mod:`.search` — requests of (behaviour, style, frames) segments; the standard-graph baseline;
 * :mod:`.synthesis` — a path turned into one continuous, blended motion;
 * :mod:`.io` — save/load (``.mlgraph``, npz + JSON); :mod:`.naming` — clip-name labels;
@@ -12,7 +13,7 @@
 Taught in ``notebooks/05_motion_graphs.ipynb``.
 """
 
-from motionlab.motion_graphs import clips, distance, io, naming, registration, search, synthesis
+from motionlab.motion_graphs import clips, cycles, distance, io, naming, registration, report, search, synthesis
 from motionlab.motion_graphs.graph import ClipInfo, GraphError, MotionGraph, build_standard
 from motionlab.motion_graphs.search import SearchError, SearchResult, Segment, parse_request, search_standard
 from motionlab.motion_graphs.search import search as search_path
@@ -27,6 +28,8 @@ __all__ = [
     "io",
     "naming",
     "clips",
+    "cycles",
+    "report",
     "ClipInfo",
     "GraphError",
     "MotionGraph",

@@ -67,18 +67,24 @@ def prepare(motion: Motion, fps: float) -> Motion:
 
 
 def load_folder(
-    folder: str | os.PathLike, fps: float = 30.0, name_map: Mapping[str, str] | None = None, strict: bool = False
+    folder: str | os.PathLike, fps: float = 30.0, name_map=None, strict: bool = False, progress: bool = False
 ) -> list[Motion]:
-    """Every ``.bvh`` under ``folder`` (recursively), reduced, resampled and named by label.
+    """Every ``.bvh`` under ``folder`` (recursively), reduced, resampled and named by label
+    (``walk_angry_001``: behaviour, style and take, see :mod:`.naming`).
 
-    Files whose names give no label (see :mod:`.naming`) are skipped, or raise with
-    ``strict=True``.
+    ``name_map``: ``{stem: label text}`` or a callable (:func:`.naming.parse_name`). Files whose
+    names give no label are skipped, or raise with ``strict=True``. ``progress``: a tqdm bar.
     """
     folder = Path(folder)
     if not folder.is_dir():
         raise FileNotFoundError(f"{folder} is not a folder of BVH files")
     out = []
-    for path in sorted(folder.rglob("*.bvh")):
+    paths = sorted(folder.rglob("*.bvh"))
+    if progress:
+        from tqdm.auto import tqdm
+
+        paths = tqdm(paths, desc="loading", unit="file", leave=False)
+    for path in paths:
         try:
             label = parse_name(path.stem, name_map)
         except NamingError:

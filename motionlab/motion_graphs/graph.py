@@ -69,6 +69,7 @@ class ClipInfo:
     start: int = 0
     num_frames: int = 0
     synthetic: bool = False
+    take: str | None = None
 
     @property
     def stop(self) -> int:
@@ -197,10 +198,13 @@ class MotionGraph:
         a = self.alive[info.start : info.stop]
         return int(np.argmin(a)) if not a.all() else info.num_frames
 
-    def next_in_clip(self) -> np.ndarray:
-        """(N,) bool: frame ``f`` is followed by ``f + 1`` (same clip, both alive)."""
+    def next_in_clip(self, alive: np.ndarray | None = None) -> np.ndarray:
+        """(N,) bool: frame ``f`` is followed by ``f + 1`` (same clip, both alive).
+
+        ``alive``: use this (N,) mask instead of the graph's own (for sub-graphs)."""
+        alive = self.alive if alive is None else alive
         ok = np.zeros(self.num_frames, dtype=bool)
-        ok[:-1] = self.alive[:-1] & self.alive[1:]
+        ok[:-1] = alive[:-1] & alive[1:]
         last = np.array([c.stop - 1 for c in self.clips if c.num_frames > 0], dtype=np.int64)
         ok[last] = False
         return ok
@@ -224,61 +228,83 @@ class MotionGraph:
         return bool(np.any((self.src == a) & (self.dst == b)))
 
     # ------------------------------------------------------------------ compressed graph
-    def segments(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def segments(self, alive: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Runs of alive frames between transition points.
+
+        ``alive``: an (N,) mask of the frames taking part (default: the graph's alive frames);
+        only edges between such frames count.
 
         Returns ``first`` and ``last`` global frame of each segment (S,) and ``seg`` (N,): the
         segment of every frame (-1 if removed).
         """
+        alive = self.alive if alive is None else alive
         n = self.num_frames
-        live = self.alive[self.src] & self.alive[self.dst]
+        live = alive[self.src] & alive[self.dst]
         begin = np.zeros(n + 1, dtype=bool)
         begin[self.starts()] = True
-        begin[1:n] |= ~self.alive[:-1]
+        begin[1:n] |= ~alive[:-1]
         begin[self.dst[live]] = True
         begin[self.src[live] + 1] = True
-        begin = begin[:n] & self.alive
+        begin = begin[:n] & alive
         seg = np.cumsum(begin) - 1
-        seg = np.where(self.alive, seg, -1)
+        seg = np.where(alive, seg, -1)
         first = np.flatnonzero(begin)
-        nxt = self.next_in_clip()
+        nxt = self.next_in_clip(alive)
         # a segment ends where the next frame begins another segment or does not follow
-        end = self.alive & ~(nxt & np.concatenate([~begin[1:], [False]]))
+        end = alive & ~(nxt & np.concatenate([~begin[1:], [False]]))
         last = np.flatnonzero(end)
         return first, last, seg
 
-    def segment_graph(self) -> nx.DiGraph:
+    def segment_graph(self, alive: np.ndarray | None = None) -> nx.DiGraph:
         """The compressed graph: one node per segment (attributes clip, first, last, frames)."""
-        first, last, seg = self.segments()
+        alive = self.alive if alive is None else alive
+        first, last, seg = self.segments(alive)
         g = nx.DiGraph()
         clip = self.clip_of(first)
         for k in range(first.size):
             g.add_node(k, clip=int(clip[k]), first=int(first[k]), last=int(last[k]), frames=int(last[k] - first[k] + 1))
-        nxt = self.next_in_clip()
+        nxt = self.next_in_clip(alive)
         follow = nxt[last]
         g.add_edges_from(zip(np.flatnonzero(follow).tolist(), seg[last[follow] + 1].tolist()), kind="clip")
-        live = self.alive[self.src] & self.alive[self.dst]
+        live = alive[self.src] & alive[self.dst]
         for s, d, k in zip(seg[self.src[live]].tolist(), seg[self.dst[live]].tolist(), self.kind[live].tolist()):
             g.add_edge(s, d, kind=EDGE_KINDS[k])
         return g
 
-    def largest_component(self) -> np.ndarray:
-        """(N,) bool: frames of the largest strongly connected component (by frame count)."""
-        g = self.segment_graph()
-        first, last, seg = self.segments()
-        frames = last - first + 1
-        best, best_frames = None, -1
-        for comp in nx.strongly_connected_components(g):
-            comp = list(comp)
-            if len(comp) == 1 and not g.has_edge(comp[0], comp[0]):
-                continue  # a single segment without a cycle is no component worth keeping
-            total = int(frames[comp].sum())
-            if total > best_frames:
-                best, best_frames = comp, total
-        keep = np.zeros(first.size, dtype=bool)
-        if best is not None:
-            keep[best] = True
-        return np.where(seg >= 0, keep[np.maximum(seg, 0)], False)
+    def largest_component(self, mask: np.ndarray | None = None) -> np.ndarray:
+        """(N,) bool: frames of the largest strongly connected component (by frame count).
+
+        ``mask``: (N,) bool, look only at the sub-graph of these (alive) frames and the edges
+        between them (e.g. one behaviour, or one style's takes).
+
+        Forward-backward search on frames: the component of a seed frame is the set of frames
+        it reaches and that reach it, two breadth-first searches vectorised over their
+        frontiers. Seeds are drawn from the frames not yet placed until no remaining set can
+        hold a larger component; a component of more than half the frames is found at the first
+        seed it contains. Runs of a single frame with no edge back to themselves do not count.
+        """
+        alive = self.alive if mask is None else self.alive & mask
+        live = alive[self.src] & alive[self.dst]
+        step = np.flatnonzero(self.next_in_clip(alive))
+        src = np.concatenate([step, self.src[live]])
+        dst = np.concatenate([step + 1, self.dst[live]])
+        n = self.num_frames
+        fwd, bwd = _csr(src, dst, n), _csr(dst, src, n)
+        remaining = alive.copy()
+        best = np.zeros(n, dtype=bool)
+        best_size = 0
+        while int(remaining.sum()) > best_size:
+            seed = int(np.argmax(remaining))
+            start = np.zeros(n, dtype=bool)
+            start[seed] = True
+            comp = _reach(fwd, start, remaining) & _reach(bwd, start, remaining)
+            size = int(comp.sum())
+            if size == 1 and not np.any((src == seed) & (dst == seed)):
+                size = 0  # a frame on no cycle
+            if size > best_size:
+                best, best_size = comp, size
+            remaining &= ~comp
+        return best
 
     def prune_to_largest_component(self) -> MotionGraph:
         """Kovar's pruning: keep only the largest strongly connected component (a new graph)."""
@@ -321,14 +347,17 @@ class MotionGraph:
             prev = g1
 
     def summary(self) -> dict:
-        """Counts for tables: clips, frames, alive frames, transitions, largest component."""
+        """Counts for tables: clips (the recorded clips the graph was built from), intermediate
+        clips (made by the build), frames, alive frames, transitions, largest component."""
         comp = self.largest_component()
         kinds = {
             k: int(np.sum((self.kind == i) & self.alive[self.src] & self.alive[self.dst]))
             for i, k in enumerate(EDGE_KINDS)
         }
+        recorded = [c for c in self.clips if c.kind != "intermediate"]
         return dict(
-            clips=len(self.clips),
+            clips=int(self.info.get("input_clips", len(recorded))),
+            intermediate_clips=len(self.clips) - len(recorded),
             frames=self.num_frames,
             alive=self.num_alive,
             transitions=self.num_transitions,
@@ -336,6 +365,34 @@ class MotionGraph:
             largest_scc=int(comp.sum()),
             dead_ends=int(self.dead_ends().size),
         )
+
+
+def _csr(src: np.ndarray, dst: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Adjacency of directed edges as (indptr (n+1,), indices (E,)), sorted by source."""
+    order = np.argsort(src, kind="stable")
+    indptr = np.zeros(n + 1, dtype=np.int64)
+    np.cumsum(np.bincount(src, minlength=n), out=indptr[1:])
+    return indptr, dst[order]
+
+
+def _reach(adj: tuple[np.ndarray, np.ndarray], start: np.ndarray, allowed: np.ndarray) -> np.ndarray:
+    """(N,) bool: frames reachable from ``start`` through ``allowed`` frames (breadth-first,
+    one vectorised step per round)."""
+    indptr, indices = adj
+    seen = start & allowed
+    frontier = np.flatnonzero(seen)
+    while frontier.size:
+        lo, hi = indptr[frontier], indptr[frontier + 1]
+        counts = hi - lo
+        total = int(counts.sum())
+        if total == 0:
+            break
+        offs = np.repeat(lo - np.cumsum(counts) + counts, counts) + np.arange(total)
+        nb = indices[offs]
+        nb = np.unique(nb[allowed[nb] & ~seen[nb]])
+        seen[nb] = True
+        frontier = nb
+    return seen
 
 
 def check_motions(motions: Sequence[Motion]) -> tuple[Skeleton, float]:

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import json
 import os
+import zipfile
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -21,7 +23,8 @@ from motionlab.motion_graphs.graph import ClipInfo, GraphError, MotionGraph
 
 __all__ = ["save", "load", "FORMAT"]
 
-FORMAT = "motionlab-graph-1"
+FORMAT = "motionlab-graph-2"
+"""Version 2: style cells hold pooled takes (version 1 held one clip per style)."""
 
 
 def _jsonable(x):
@@ -76,39 +79,63 @@ def save(path: str | os.PathLike, graph: MotionGraph, overwrite: bool = False) -
 
 
 def load(path: str | os.PathLike) -> MotionGraph:
-    """Read a graph written by :func:`save`. Raises :class:`GraphError` for other files."""
+    """Read a graph written by :func:`save`.
+
+    Raises :class:`GraphError` naming the file for anything else: a file that is not a zip
+    archive, a truncated or damaged one, or an archive without the graph's entries.
+    """
     path = Path(path)
+    if path.is_dir():
+        raise GraphError(f"{path} is a folder, not a motion graph file (.mlgraph)")
     if not path.is_file():
         raise FileNotFoundError(f"no motion graph file at {path}")
+    with open(path, "rb") as fh:
+        magic = fh.read(4)
+    if magic != b"PK\x03\x04":
+        raise GraphError(
+            f"{path} is not a motion graph file: expected the zip archive that graph-build writes "
+            f"(it starts with PK), found {magic!r}"
+        )
     try:
         with np.load(path, allow_pickle=False) as z:
             arrays = {k: z[k] for k in z.files}
-    except (ValueError, OSError) as e:
-        raise GraphError(f"{path} is not a motion graph file ({e})") from None
-    if "meta" not in arrays:
-        raise GraphError(f"{path} is not a motion graph file (no 'meta' entry)")
-    meta = json.loads(str(arrays["meta"]))
-    if meta.get("format") != FORMAT:
-        raise GraphError(f"{path}: unknown format {meta.get('format')!r}, expected {FORMAT!r}")
-    sk = Skeleton(
-        tuple(meta["names"]),
-        arrays["parents"],
-        arrays["offsets"],
-        {int(k): np.array(v) for k, v in meta["end_sites"].items()},
-    )
-    rot = arrays["local_rot"].astype(np.float64)
-    rot /= np.linalg.norm(rot, axis=-1, keepdims=True)
-    return MotionGraph(
-        sk,
-        float(meta["fps"]),
-        [ClipInfo(**c) for c in meta["clips"]],
-        rot,
-        arrays["root_pos"],
-        arrays["alive"].astype(bool),
-        arrays["src"].astype(np.int64),
-        arrays["dst"].astype(np.int64),
-        arrays["cost"].astype(np.float64),
-        arrays["kind"].astype(np.int8),
-        meta["table"],
-        meta["info"],
-    )
+        meta = json.loads(str(arrays["meta"]))
+    except KeyError:
+        raise GraphError(f"{path} is not a motion graph file (no 'meta' entry)") from None
+    except (ValueError, OSError, EOFError, zipfile.BadZipFile, zlib.error) as e:
+        raise GraphError(
+            f"{path} is truncated or damaged and cannot be read as a motion graph ({type(e).__name__})"
+        ) from None
+    if not isinstance(meta, dict) or meta.get("format") != FORMAT:
+        found = meta.get("format") if isinstance(meta, dict) else None
+        hint = "; rebuild it with motionlab graph-build" if str(found).startswith("motionlab-graph-") else ""
+        raise GraphError(f"{path}: unknown format {found!r}, expected {FORMAT!r}{hint}")
+    need = ("local_rot", "root_pos", "alive", "src", "dst", "cost", "kind", "offsets", "parents")
+    missing = [k for k in need if k not in arrays]
+    if missing:
+        raise GraphError(f"{path} is not a complete motion graph file (missing {missing})")
+    try:
+        sk = Skeleton(
+            tuple(meta["names"]),
+            arrays["parents"],
+            arrays["offsets"],
+            {int(k): np.array(v) for k, v in meta["end_sites"].items()},
+        )
+        rot = arrays["local_rot"].astype(np.float64)
+        rot /= np.linalg.norm(rot, axis=-1, keepdims=True)
+        return MotionGraph(
+            sk,
+            float(meta["fps"]),
+            [ClipInfo(**c) for c in meta["clips"]],
+            rot,
+            arrays["root_pos"],
+            arrays["alive"].astype(bool),
+            arrays["src"].astype(np.int64),
+            arrays["dst"].astype(np.int64),
+            arrays["cost"].astype(np.float64),
+            arrays["kind"].astype(np.int8),
+            meta["table"],
+            meta["info"],
+        )
+    except (KeyError, TypeError, ValueError) as e:
+        raise GraphError(f"{path}: damaged motion graph metadata ({type(e).__name__}: {e})") from None

@@ -9,13 +9,17 @@ name                                        label
 ``Walk_creepingly``                         basic clip: behaviour ``walk``, style ``creepingly``
 ``Walk_happily_to_Run_fast``                transition clip from walk/happily to run/fast
 ``Transition_Walk_normal_Run_slowly``       the same, in the paper's other spelling
-``dataset-1_walk_angry_001``                Bandai Namco dataset-1: walk/angry (take 1)
-``dataset-1_walk_normal_002``               a second take becomes style ``normal-2``
+``dataset-2_walk_angry_001``                Bandai Namco: walk/angry, take ``001``
+``dataset-2_walk_angry_017``                the same style, take ``017`` (pooled with take 001)
+``Walk_angry_3``                            walk/angry, take ``3``
 ==========================================  =========================================
 
-Labels are lower case. Names that fit none of these forms (most Mixamo clips) are looked up in
-a small *name map* ``{clip stem: "behaviour_style" or "b1_s1_to_b2_s2"}``; :data:`MIXAMO_AJ`
-maps the Mixamo Aj clips of the shared data that the experiments use.
+A take number never creates a style: a recording session delivers many takes of one behaviour
+in one style, and the structured graph pools them (every take of ``walk/angry`` is material of
+that one style). Labels are lower case. Names that fit none of these forms (most Mixamo clips)
+are looked up in a *name map* ``{clip stem: "behaviour_style[_take]" or "b1_s1_to_b2_s2"}``,
+or passed through a callable ``name_map(stem) -> label text | ClipLabel | None`` for other
+naming schemes; :data:`MIXAMO_AJ` maps the Mixamo Aj clips of the shared data.
 
 Taught in ``notebooks/05_motion_graphs.ipynb``.
 """
@@ -23,10 +27,10 @@ Taught in ``notebooks/05_motion_graphs.ipynb``.
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
-__all__ = ["ClipLabel", "NamingError", "parse_name", "MIXAMO_AJ", "label_name"]
+__all__ = ["ClipLabel", "NamingError", "NameMap", "parse_name", "MIXAMO_AJ", "label_name"]
 
 
 class NamingError(ValueError):
@@ -42,6 +46,8 @@ class ClipLabel:
     kind : ``"basic"`` (one behaviour in one style) or ``"transition"`` (a recorded change)
     behaviour, style : labels of the clip (the *source* for a transition clip)
     to_behaviour, to_style : the target of a transition clip (``None`` for basic clips)
+    take : the take's name within its style (``"001"``), ``None`` when the name has none; never
+        part of :attr:`key`, so takes of one style share a key
     """
 
     kind: str
@@ -49,6 +55,7 @@ class ClipLabel:
     style: str
     to_behaviour: str | None = None
     to_style: str | None = None
+    take: str | None = None
 
     @property
     def key(self) -> tuple[str, str]:
@@ -77,25 +84,53 @@ _TRANSITION = re.compile(
     rf"^transition[_ ](?P<b1>{_TOKEN})_(?P<s1>{_TOKEN})[_ ](?P<b2>{_TOKEN})_(?P<s2>{_TOKEN})$", re.IGNORECASE
 )
 _BASIC = re.compile(rf"^(?P<b>{_TOKEN})_(?P<s>{_TOKEN})$")
+_TAKE = re.compile(rf"^(?P<b>{_TOKEN})_(?P<s>{_TOKEN})_(?P<take>\d+)$")
 
 
 def _label(text: str) -> ClipLabel | None:
     m = _TRANSITION.match(text) or _TO.match(text)
     if m:
         return ClipLabel("transition", m["b1"].lower(), m["s1"].lower(), m["b2"].lower(), m["s2"].lower())
+    m = _TAKE.match(text)
+    if m and m["b"].lower() not in ("to", "transition"):
+        return ClipLabel("basic", m["b"].lower(), m["s"].lower(), take=m["take"])
     m = _BASIC.match(text)
     if m and m["b"].lower() not in ("to", "transition"):
         return ClipLabel("basic", m["b"].lower(), m["s"].lower())
     return None
 
 
-def parse_name(name: str, name_map: Mapping[str, str] | None = None) -> ClipLabel:
+NameMap = Mapping[str, str] | Callable[[str], "str | ClipLabel | None"]
+"""A name map: ``{stem: label text}`` or a callable ``stem -> label text | ClipLabel | None``."""
+
+
+def _mapped(stem: str, name_map: NameMap) -> ClipLabel | None:
+    if callable(name_map):
+        text = name_map(stem)
+    elif stem in name_map:
+        text = name_map[stem]
+    else:
+        return None
+    if text is None or isinstance(text, ClipLabel):
+        return text
+    label = _label(str(text))
+    if label is None:
+        raise NamingError(
+            f"name map gives {text!r} for {stem!r}, which is not 'behaviour_style', "
+            "'behaviour_style_take' or 'b1_s1_to_b2_s2'"
+        )
+    return label
+
+
+def parse_name(name: str, name_map: NameMap | None = None) -> ClipLabel:
     """The label a clip name stands for.
 
     Parameters
     ----------
     name : clip name or file stem (a ``.bvh`` suffix and folders are ignored)
-    name_map : optional ``{stem: label text}``; looked up first (exact stem)
+    name_map : optional ``{stem: label text}`` (exact stem) or a callable ``stem -> label
+        text | ClipLabel | None``; consulted first, ``None`` / a missing stem falls back to the
+        built-in forms
 
     Raises
     ------
@@ -104,30 +139,28 @@ def parse_name(name: str, name_map: Mapping[str, str] | None = None) -> ClipLabe
     stem = re.split(r"[\\/]", str(name))[-1]
     if stem.lower().endswith(".bvh"):
         stem = stem[:-4]
-    if name_map and stem in name_map:
-        label = _label(name_map[stem])
-        if label is None:
-            raise NamingError(
-                f"name map gives {name_map[stem]!r} for {stem!r}, which is not 'behaviour_style' or 'b1_s1_to_b2_s2'"
-            )
-        return label
+    if name_map is not None:
+        label = _mapped(stem, name_map)
+        if label is not None:
+            return label
     m = _BANDAI.match(stem)
     if m:
-        take = int(m["take"])
-        style = m["s"].lower() if take == 1 else f"{m['s'].lower()}-{take}"
-        return ClipLabel("basic", m["b"].lower(), style)
+        return ClipLabel("basic", m["b"].lower(), m["s"].lower(), take=m["take"])
     label = _label(stem)
     if label is None:
         raise NamingError(
             f"cannot read behaviour and style from clip name {stem!r}: expected 'Behaviour_style' "
-            "(Walk_creepingly), 'B1_s1_to_B2_s2' or 'Transition_B1_s1_B2_s2' for transition clips, "
+            "(Walk_creepingly), 'Behaviour_style_take' (Walk_creepingly_2), 'B1_s1_to_B2_s2' or 'Transition_B1_s1_B2_s2' for transition clips, "
             "'dataset-1_<behaviour>_<style>_<take>' (Bandai Namco), or an entry in the name map"
         )
     return label
 
 
 def label_name(label: ClipLabel) -> str:
-    """Canonical text of a label: ``walk_angry`` or ``walk_angry_to_run_normal``."""
+    """Canonical text of a label: ``walk_angry``, ``walk_angry_001`` (with a take) or
+    ``walk_angry_to_run_normal``; :func:`parse_name` reads it back to the same label."""
     if label.kind == "transition":
         return f"{label.behaviour}_{label.style}_to_{label.to_behaviour}_{label.to_style}"
+    if label.take is not None:
+        return f"{label.behaviour}_{label.style}_{label.take}"
     return f"{label.behaviour}_{label.style}"

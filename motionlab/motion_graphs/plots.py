@@ -16,7 +16,7 @@ from motionlab.motion_graphs.structured import structure_rows
 
 __all__ = ["structure_table_text", "plot_structure_table", "plot_graph", "plot_distance"]
 
-_COLUMNS = ("behaviour", "style", "clip", "start", "length", "loops", "links")
+_COLUMNS = ("behaviour", "style", "takes", "start", "frames", "alive", "links")
 
 
 def structure_table_text(graph: MotionGraph) -> str:

@@ -7,20 +7,21 @@ frames it got. A segment runs from its first frame in its clip up to the first f
 next segment's clip, so the frames of a transition count towards the segment it leaves and the
 segment lengths add up to the path length.
 
-**Structured graph** (paper B). The structure table gives each segment's clip and the
-recorded routes out of it, so the search never explores the graph. Within a clip the walk from
-the entry frame ``e`` to an exit frame ``x`` may repeat parts through self-loops; which
-lengths are possible is a reachability recursion over frame counts,
+**Structured graph** (paper B). The structure table gives each segment's style pool (its
+takes, side by side) and the recorded routes out of it, so the search never explores the whole
+graph. Within a pool the walk from the entry frame ``e`` to an exit frame ``x`` steps along a
+take or jumps (between takes, or back inside one); which lengths are possible is a
+reachability recursion over frame counts,
 
-.. math:: R_{c+1} = \operatorname{shift}(R_c) \,\lor\, \operatorname{loops}(R_c), \qquad R_0 = \{e\},
+.. math:: R_{c+1} = \operatorname{shift}(R_c) \,\lor\, \operatorname{jumps}(R_c), \qquad R_0 = \{e\},
 
 (``R_c``: frames where a walk of ``c + 1`` frames can be) run once per segment. The exit whose
 route length ``r`` satisfies ``c + 1 + r = n`` wins (exactly, or else the closest). Long
-segments first repeat the clip's main cycle (the last self-loop) so the recursion stays short:
-the *iterative choice of self-loop and transition points*. Clips crossed on the way to the next
-segment (a style bridge before a transition clip) are passed as quickly as possible, walking
-forward and looping back at the last self-loop point; the **loop guard** stops with an error
-when the last self-loop point is passed twice without finding the exit.
+segments first take the shortest way to the pool's main cycle (its longest jump back inside
+one take) and repeat it, so the recursion stays short: the *iterative choice of self-loop and
+transition points*. Pools crossed on the way to the next segment are passed by the shortest walk
+to an exit (a breadth-first search); the **loop guard** stops it with an error once every frame
+it can reach has been visited. A request may ask for at most :data:`MAX_FRAMES` frames.
 
 **Standard graph** (for comparison). Dijkstra's shortest path (in frames) on the compressed
 graph from the current frame to any frame of the requested clip, then the same in-clip
@@ -40,7 +41,21 @@ import numpy as np
 
 from motionlab.motion_graphs.graph import GraphError, MotionGraph
 
-__all__ = ["Segment", "SearchResult", "parse_request", "search", "search_standard", "SearchError", "TOLERANCE"]
+__all__ = [
+    "Segment",
+    "SearchResult",
+    "parse_request",
+    "search",
+    "search_standard",
+    "SearchError",
+    "TOLERANCE",
+    "MAX_FRAMES",
+]
+
+MAX_FRAMES = 100_000
+"""Longest request, frames in all segments together (55 minutes at 30 fps). The synthesised
+motion is held in memory and written as one BVH file; longer requests are refused, naming this
+limit, rather than running for minutes and filling the disk."""
 
 TOLERANCE = 0.05
 """Documented accuracy: a reachable segment length is met exactly when the clip's loops allow,
@@ -113,13 +128,29 @@ def parse_request(text: str) -> list[Segment]:
         segs.append(Segment(bits[0].strip().lower(), bits[1].strip().lower(), n))
     if not segs:
         raise ValueError("empty request: give segments like walk:angry:300,run:normal:200")
+    _check_total(segs)
     return segs
 
 
-# ---------------------------------------------------------------------------- in-clip walks
+def _check_total(segs: list[Segment]) -> None:
+    total = sum(s.frames for s in segs)
+    if total > MAX_FRAMES:
+        raise ValueError(
+            f"the request asks for {total} frames in all; the limit is {MAX_FRAMES} frames "
+            f"(search.MAX_FRAMES, {MAX_FRAMES / 30 / 60:.0f} minutes at 30 fps): split it into shorter requests"
+        )
+
+
+# ---------------------------------------------------------------------------- in-pool walks
 @dataclass
 class _Clip:
-    """One clip's walkable frames: ``step[f]``: f → f+1 allowed; loops ``src → dst``."""
+    """The walkable frames of one style's takes (a *pool*: a run of clips stored side by side).
+
+    Frames are pool-local (``0 … length-1`` from the pool's first frame). ``step[f]``: f → f+1
+    allowed (same take, both alive); jumps ``loop_src → loop_dst`` (transitions inside the pool,
+    self-loops included); the *main cycle* ``cycle_dst … cycle_src`` is the longest jump back
+    inside one take whose frames in between are all steps (``-1`` when there is none).
+    """
 
     index: int
     length: int
@@ -128,73 +159,166 @@ class _Clip:
     loop_dst: np.ndarray
     last_src: int
     last_dst: int
+    clips: np.ndarray = field(default_factory=lambda: np.zeros(1, dtype=np.int64))
+    offsets: np.ndarray = field(default_factory=lambda: np.zeros(1, dtype=np.int64))
+    alive: np.ndarray | None = None
+
+    def first_alive(self) -> int:
+        """The first alive frame, preferring one on the main cycle."""
+        if self.last_dst >= 0:
+            return self.last_dst
+        return int(np.argmax(self.alive)) if self.alive is not None else 0
 
     @property
     def cycle(self) -> int:
         return self.last_src - self.last_dst + 1
 
+    def succ(self, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """All (from, to) moves out of ``frames`` (steps and jumps)."""
+        f = frames[self.step[frames]]
+        m = np.isin(self.loop_src, frames)
+        return np.concatenate([f, self.loop_src[m]]), np.concatenate([f + 1, self.loop_dst[m]])
 
-def _clip_walker(graph: MotionGraph, c: int) -> _Clip:
-    info = graph.clips[c]
-    n = info.num_frames
-    alive = graph.alive[info.start : info.stop]
-    step = alive.copy()
-    step[:-1] &= alive[1:]
-    step[-1] = False
-    m = (graph.src >= info.start) & (graph.src < info.stop) & (graph.dst >= info.start) & (graph.dst < info.stop)
+
+def _pool_walker(graph: MotionGraph, clips: list[int], index: int = 0) -> _Clip:
+    """Walker over the consecutive clips ``clips`` (one style's takes)."""
+    first, last = graph.clips[clips[0]], graph.clips[clips[-1]]
+    st, sp = first.start, last.stop
+    step = graph.next_in_clip()[st:sp].copy()
+    m = (graph.src >= st) & (graph.src < sp) & (graph.dst >= st) & (graph.dst < sp)
     m &= graph.alive[graph.src] & graph.alive[graph.dst]
-    src, dst = graph.src[m] - info.start, graph.dst[m] - info.start
-    back = dst <= src
-    src, dst = src[back], dst[back]
-    if src.size:
-        k = int(np.argmax(src - 1e-6 * (src - dst)))  # the last loop point (the longest of its loops)
+    src, dst = graph.src[m] - st, graph.dst[m] - st
+    # the main cycle: a jump back whose frames dst..src are all steps (one take, all alive)
+    run = np.concatenate([[0], np.cumsum(step)])  # run[f] = steps among 0..f-1
+    back = (dst <= src) & (run[src] - run[dst] == src - dst)
+    if back.any():
+        k = int(np.flatnonzero(back)[np.argmax((src - dst)[back])])
         last_src, last_dst = int(src[k]), int(dst[k])
     else:
         last_src, last_dst = -1, -1
-    return _Clip(c, n, step, src, dst, last_src, last_dst)
+    offsets = np.array([graph.clips[c].start - st for c in clips], dtype=np.int64)
+    return _Clip(
+        index, sp - st, step, src, dst, last_src, last_dst, np.asarray(clips, dtype=np.int64), offsets,
+        graph.alive[st:sp].copy(),
+    )  # fmt: skip
+
+
+def _clip_walker(graph: MotionGraph, c: int) -> _Clip:
+    """Walker over one clip (the standard graph's search)."""
+    return _pool_walker(graph, [c], c)
+
+
+def _distances(cw: _Clip, start: int, targets: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Breadth-first search from ``start``: fewest moves to every frame (-1: unreachable) and
+    the parent of each reached frame. Stops early once every frame of ``targets`` is reached.
+
+    Vectorised over the frontier; the number of rounds is the depth of the search.
+    """
+    dist = np.full(cw.length, -1, dtype=np.int64)
+    parent = np.full(cw.length, -1, dtype=np.int64)
+    dist[start] = 0
+    frontier = np.array([start], dtype=np.int64)
+    d = 0
+    while frontier.size:
+        if targets is not None and np.all(dist[targets] >= 0):
+            break
+        a, b = cw.succ(frontier)
+        new = dist[b] < 0
+        a, b = a[new], b[new]
+        b, first = np.unique(b, return_index=True)
+        d += 1
+        dist[b] = d
+        parent[b] = a[first]
+        frontier = b
+    return dist, parent
+
+
+def _path(cw: _Clip, start: int, targets, name: str) -> tuple[list[int], int]:
+    """Frames of a shortest walk from ``start`` to the nearest of ``targets`` (the ``r``-th).
+
+    The *loop guard*: when the search has seen every frame reachable from ``start`` without
+    meeting a target, it stops with an error instead of walking on for ever.
+    """
+    targets = np.asarray(targets, dtype=np.int64)
+    dist, parent = _distances(cw, start, None)
+    d = np.where(dist[targets] >= 0, dist[targets], np.iinfo(np.int64).max)
+    r = int(np.argmin(d))
+    if dist[targets[r]] < 0:
+        raise SearchError(
+            f"loop guard: every frame of {name!r} reachable from frame {start} was visited "
+            f"({int((dist >= 0).sum())} frames) without reaching the way on"
+        )
+    frames = [int(targets[r])]
+    while frames[-1] != start:
+        frames.append(int(parent[frames[-1]]))
+    return frames[::-1], r
+
+
+def _runs(cw: _Clip | int, frames: list[int]) -> list[tuple[int, int, int]]:
+    """Pool-local frames -> ``(clip, first, last)`` pieces in clip frames."""
+    out = []
+    a = prev = frames[0]
+    for f in frames[1:]:
+        if f != prev + 1:
+            out.append((a, prev))
+            a = f
+        prev = f
+    out.append((a, prev))
+    if isinstance(cw, (int, np.integer)):
+        return [(int(cw), x, y) for x, y in out]
+    res = []
+    for x, y in out:
+        k = int(np.searchsorted(cw.offsets, x, side="right") - 1)
+        res.append((int(cw.clips[k]), int(x - cw.offsets[k]), int(y - cw.offsets[k])))
+    return res
+
+
+_NEVER = np.iinfo(np.int16).max
 
 
 def _reach(cw: _Clip, start: int, steps: int) -> np.ndarray:
-    """(steps, L) bool: frames where a walk of ``c + 1`` frames from ``start`` can be."""
-    out = np.zeros((max(steps, 1), cw.length), dtype=bool)
-    out[0, start] = True
+    """(steps, L) int16: fewest jumps of a walk of ``c + 1`` frames from ``start`` that ends at
+    each frame (``_NEVER`` where no walk of that length ends there).
+
+    The reachability recursion with a count: ``J[c+1, f+1] = J[c, f]`` for a step,
+    ``J[c+1, d] = min over jumps s → d of J[c, s] + 1``; the jump part is one
+    ``np.minimum.reduceat`` over the jumps sorted by destination, so each row is vectorised.
+    """
+    out = np.full((max(steps, 1), cw.length), _NEVER, dtype=np.int16)
+    out[0, start] = 0
     step_ok = cw.step[:-1]
-    src, dst = cw.loop_src, cw.loop_dst
-    loops = src.size > 0
+    order = np.argsort(cw.loop_dst, kind="stable")
+    src, dst = cw.loop_src[order], cw.loop_dst[order]
+    if dst.size:
+        heads = np.flatnonzero(np.concatenate([[True], dst[1:] != dst[:-1]]))
+        targets = dst[heads]
     for c in range(1, steps):
         prev, cur = out[c - 1], out[c]
-        np.logical_and(prev[:-1], step_ok, out=cur[1:])
-        if loops:
-            cur[dst[prev[src]]] = True
+        cur[1:] = np.where(step_ok, prev[:-1], _NEVER)
+        if dst.size:
+            via = np.minimum.reduceat(prev[src], heads)
+            via = np.where(via < _NEVER, via + 1, _NEVER).astype(np.int16)
+            cur[targets] = np.minimum(cur[targets], via)
     return out
 
 
 def _backtrack(cw: _Clip, reach: np.ndarray, c: int, x: int) -> list[int]:
-    """Frames of one walk reaching ``x`` after ``c + 1`` frames (reverse-engineered from ``reach``)."""
+    """Frames of a walk with the fewest jumps reaching ``x`` after ``c + 1`` frames
+    (reverse-engineered from ``reach``, see :func:`_reach`); each jump is a blend in the
+    synthesised motion, so fewer is better."""
     frames = [x]
     while c > 0:
-        if x > 0 and cw.step[x - 1] and reach[c - 1, x - 1]:
+        j = int(reach[c, x])
+        if x > 0 and cw.step[x - 1] and reach[c - 1, x - 1] == j:
             x -= 1
         else:
-            cand = cw.loop_src[(cw.loop_dst == x) & reach[c - 1, cw.loop_src]]
+            cand = cw.loop_src[(cw.loop_dst == x) & (reach[c - 1, cw.loop_src] == j - 1)]
             if cand.size == 0:
                 raise GraphError("internal: walk reconstruction failed")
             x = int(cand[0])
         frames.append(x)
         c -= 1
     return frames[::-1]
-
-
-def _runs(clip: int, frames: list[int]) -> list[tuple[int, int, int]]:
-    out = []
-    a = prev = frames[0]
-    for f in frames[1:]:
-        if f != prev + 1:
-            out.append((clip, a, prev))
-            a = f
-        prev = f
-    out.append((clip, a, prev))
-    return out
 
 
 def _deltas(n: int):
@@ -205,28 +329,35 @@ def _deltas(n: int):
         yield -d
 
 
-def _walk(cw: _Clip, start: int, need: list[int], exits: list[int]) -> tuple[list[tuple[int, int, int]], int, int]:
+def _walk(
+    cw: _Clip, start: int, need: list[int], exits: list[int], name: str = "clip"
+) -> tuple[list[tuple[int, int, int]], int, int]:
     """A walk from ``start`` of about ``need[r]`` frames ending at ``exits[r]`` (``-1``: any frame).
 
     Returns pieces, the chosen option ``r`` and the frames played.
     """
     pieces: list[tuple[int, int, int]] = []
     played = 0
-    budget = cw.length + 2 * max(cw.cycle, 1)
+    ex = np.array(exits)
     lo = min(need)
-    if cw.last_src >= 0 and lo > budget + (cw.length - start):
-        # long segment: play on to the last self-loop point, then whole main cycles
-        pieces.append((cw.index, start, cw.last_src))
-        played += cw.last_src - start + 1
-        reps = max(0, (lo - played - budget) // cw.cycle)
-        pieces.extend([(cw.index, cw.last_dst, cw.last_src)] * reps)
-        played += reps * cw.cycle
-        start = cw.last_dst
+    if cw.last_src >= 0:
+        fixed = ex[ex >= 0]
+        dist, _ = _distances(cw, cw.last_dst, fixed if fixed.size else None)
+        far = int(dist[fixed].max()) if fixed.size and (dist[fixed] >= 0).all() else 0
+        budget = far + 3 * cw.cycle + 2
+        if lo > 2 * budget:
+            # long segment: the shortest way to the main cycle, then whole cycles
+            frames, _ = _path(cw, start, [cw.last_src], name)
+            pieces.extend(_runs(cw, frames))
+            played += len(frames)
+            reps = max(0, (lo - played - budget) // cw.cycle)
+            pieces.extend(_runs(cw, list(range(cw.last_dst, cw.last_src + 1))) * reps)
+            played += reps * cw.cycle
+            start = cw.last_dst
     steps = max(n - played for n in need) + max(cw.cycle, 2)
     steps = max(steps, 2)
     reach = _reach(cw, start, steps)
     need_c = np.array(need) - played - 1
-    ex = np.array(exits)
     best = None
     for delta in _deltas(steps):
         c = need_c + delta
@@ -235,53 +366,38 @@ def _walk(cw: _Clip, start: int, need: list[int], exits: list[int]) -> tuple[lis
             continue
         anywhere = ok[ex[ok] < 0]
         for r in anywhere:
-            hit = np.flatnonzero(reach[c[r]])
-            if hit.size:
-                best = (int(r), int(c[r]), int(hit[-1]))
+            row = reach[c[r]]
+            if row.min() < _NEVER:  # any frame may end it: the one reached with the fewest jumps
+                best = (int(r), int(c[r]), int(np.argmin(row)))
                 break
         if best is not None:
             break
         fixed = ok[ex[ok] >= 0]
-        hits = fixed[reach[c[fixed], ex[fixed]]]
-        if hits.size:
-            r = int(hits[0])
+        jumps = reach[c[fixed], ex[fixed]]
+        if jumps.min(initial=_NEVER) < _NEVER:
+            r = int(fixed[np.argmin(jumps)])  # of the exits met, the one with the fewest jumps
             best = (r, int(c[r]), int(ex[r]))
             break
     if best is None:
-        raise SearchError(f"clip {cw.index}: no walk from frame {start} reaches any exit")
+        raise SearchError(f"{name}: no walk from frame {start} reaches any exit")
     r, c, x = best
     frames = _backtrack(cw, reach, c, x)
-    pieces.extend(_runs(cw.index, frames))
+    pieces.extend(_runs(cw, frames))
     return pieces, r, played + c + 1
 
 
 def _quick_exit(cw: _Clip, start: int, exits: list[int], name: str) -> tuple[list[tuple[int, int, int]], int, int]:
-    """Walk forward to the nearest exit, looping back at the last self-loop point.
+    """The shortest walk to the nearest exit (a breadth-first search with the loop guard)."""
+    frames, r = _path(cw, start, exits, name)
+    return _runs(cw, frames), r, len(frames)
 
-    The loop guard: passing the last self-loop point a second time means the whole clip was
-    searched, so the search stops with an error.
-    """
-    ex = np.array(exits)
-    pieces, played, f, passes = [], 0, start, 0
-    while True:
-        ahead = np.flatnonzero(ex >= f)
-        # reachable without loops only while the frames ahead are walkable
-        stop = f
-        while stop < cw.length - 1 and cw.step[stop]:
-            stop += 1
-        ahead = ahead[ex[ahead] <= stop]
-        if ahead.size:
-            r = int(ahead[np.argmin(ex[ahead])])
-            pieces.append((cw.index, f, int(ex[r])))
-            return pieces, r, played + int(ex[r]) - f + 1
-        if cw.last_src < 0 or passes >= 1:
-            raise SearchError(
-                f"loop guard: walked clip {name!r} through its last self-loop point twice without finding the way on"
-            )
-        passes += 1
-        pieces.append((cw.index, f, cw.last_src))
-        played += cw.last_src - f + 1
-        f = cw.last_dst
+
+def _next(cw: _Clip, f: int) -> int:
+    """A frame that may follow ``f`` (the next frame, or a jump)."""
+    a, b = cw.succ(np.array([f]))
+    if b.size == 0:
+        raise SearchError(f"frame {f} has no successor (the graph was not pruned)")
+    return int(b[0])
 
 
 # ---------------------------------------------------------------------------- structured search
@@ -298,10 +414,10 @@ class _Planner:
             self.links.setdefault(tuple(link["from"]), []).append(link)
 
     def walker(self, key: tuple[str, str]) -> _Clip:
-        c = self.entries[key[0]][key[1]]["clip"]
-        if c not in self.walkers:
-            self.walkers[c] = _clip_walker(self.g, c)
-        return self.walkers[c]
+        if key not in self.walkers:
+            cell = self.entries[key[0]][key[1]]
+            self.walkers[key] = _pool_walker(self.g, [t["clip"] for t in cell["takes"]])
+        return self.walkers[key]
 
     def check(self, seg: Segment) -> tuple[str, str]:
         if seg.behaviour not in self.entries:
@@ -377,7 +493,7 @@ class _Planner:
             cw = self.walker(key)
             routes = link["routes"]
             exits = [r["exit"] for r in routes]
-            p, r, n = _quick_exit(cw, enter, exits, self.entries[key[0]][key[1]]["name"])
+            p, r, n = _quick_exit(cw, enter, exits, f"{key[0]}/{key[1]}")
             route = routes[r]
             pieces.extend(p)
             pieces.extend(tuple(x) for x in route["pieces"])
@@ -386,14 +502,15 @@ class _Planner:
         return pieces, frames, enter
 
 
-def search(graph: MotionGraph, request) -> SearchResult:
+def search(graph: MotionGraph, request, progress: bool = False) -> SearchResult:
     """Meet a request on a structured graph (see the module docstring).
 
     Parameters
     ----------
     graph : a graph from :func:`~motionlab.motion_graphs.structured.build_structured`
     request : list of :class:`Segment` / ``(behaviour, style, frames)`` tuples, or the text form
-        ``"walk:angry:300,run:normal:200"``
+        ``"walk:angry:300,run:normal:200"``; at most :data:`MAX_FRAMES` frames in all
+    progress : show a tqdm bar over the segments (Ctrl-C stops the search between steps)
 
     Raises
     ------
@@ -408,24 +525,35 @@ def search(graph: MotionGraph, request) -> SearchResult:
     plans = [planner.hops(a, b) if a != b else [] for a, b in zip(keys[:-1], keys[1:])]
     pieces: list[tuple[int, int, int]] = []
     achieved: list[int] = []
-    enter = 0
+    enter = planner.walker(keys[0]).first_alive()
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=sum(s.frames for s in segs), desc="search", unit="frame", leave=False)
     for k, seg in enumerate(segs):
+        if bar is not None:
+            bar.update(seg.frames)
         cw = planner.walker(keys[k])
+        name = f"{seg.behaviour}/{seg.style}"
         if k == len(segs) - 1 or not plans[k]:
-            p, _, n = _walk(cw, enter, [seg.frames], [-1])
+            p, _, n = _walk(cw, enter, [seg.frames], [-1], name)
             pieces.extend(p)
             achieved.append(n)
-            if k < len(segs) - 1:  # the same clip again: continue from the next frame
-                last = p[-1][2]
-                enter = last + 1 if last + 1 < cw.length and cw.step[last] else cw.last_dst
+            if k < len(segs) - 1:  # the same style again: continue from a frame that follows
+                c_last, f_last = p[-1][0], p[-1][2]
+                local = int(cw.offsets[np.flatnonzero(cw.clips == c_last)[0]]) + f_last
+                enter = _next(cw, local)
             continue
         options, spent, exits = planner.options(plans[k])
-        p, r, n = _walk(cw, enter, np.maximum(seg.frames - spent, 1).tolist(), exits)
+        p, r, n = _walk(cw, enter, np.maximum(seg.frames - spent, 1).tolist(), exits, name)
         route, more, more_frames, enter = options[r]
         pieces.extend(p)
         pieces.extend(tuple(x) for x in route["pieces"])
         pieces.extend(more)
         achieved.append(n + route["frames"] + more_frames)
+    if bar is not None:
+        bar.close()
     return SearchResult(_merge(pieces), [s.frames for s in segs], achieved, segs)
 
 
@@ -440,6 +568,7 @@ def _segments(request) -> list[Segment]:
         out.append(s)
     if not out:
         raise ValueError("empty request")
+    _check_total(out)
     return out
 
 

@@ -1,37 +1,47 @@
-r"""The structured motion graph of paper B: a structure table, transition clips and an
-interpolation space, pruned while it is built.
+r"""The structured motion graph of paper B: a structure table of pooled takes, transition clips
+and an interpolation space, pruned while it is built.
 
-**Structure table.** Two levels: behaviour → style → where the clip lies in the graph (its
-clip index, global start frame, usable length, self-loops). Beside it, *links* between table
-entries, each with the recorded *routes* a search may take (exit frame in the source clip,
-the pieces of frames in between, entry frame in the target clip, frame count).
+**Structure table.** Two levels: behaviour → style → where the style's material lies in the
+graph. A style is the *pool* of all its takes (a recording session gives many; a take number
+never makes a new style, see :mod:`.naming`): the cell records the pool's first frame and size
+and, per take, its clip index, take name, span (offset and frames), alive frames and whole
+gait cycles. Beside it, *links* between cells, each with the recorded *routes* a search may
+take (exit frame in the source pool, the pieces of frames in between, entry frame in the target
+pool, frame count; pool frames count from the pool's first frame).
+
+**Within a style** every take is compared with itself (jumps at least ``min_loop`` frames away)
+and with its ``neighbours`` next takes in take order, cyclically (:func:`_ring_pairs`), so the
+work grows linearly with the number of takes and the ring joins them all; takes of one style are
+similar by construction, so they meet at many frames.
 
 **Between behaviours** only recorded transition clips ``B1_s1_to_B2_s2`` are used. A
-transition clip is compared with its two endpoint clips only (never with everything, as a
-standard graph would): entries ``A_i → T_{j+1}`` from the first half of ``T``, exits
-``T_k → B_{l+1}`` from the second half, so a route always plays the recorded change.
+transition clip is compared with the takes of its two endpoint styles only (never with
+everything, as a standard graph would): entries ``A_i → T_{j+1}`` into the first half of ``T``,
+exits ``T_k → B_{l+1}`` from the second half, so a route always plays the recorded change.
 
 **Between styles of one behaviour** an interpolation space bridges the gap
-(:mod:`~motionlab.motion_graphs.registration`): intermediate motions M1…M4 at blend weights
-0.2…0.8, and transitions searched only between neighbours S1–M1, M1–M2, …, M4–S2. Which style
-pairs are bridged is a choice (``style_pairs``): ``"hub"`` links every style with the
-reference style (default ``normal``; the longest clip if that one is too short to loop),
-``"chain"`` links styles in name order, ``"all"`` every pair, ``"none"`` builds no
-interpolation space (as in the paper's build-time experiment).
+(:mod:`~motionlab.motion_graphs.registration`), built from *representative cycles*: the take
+with most whole cycles (:mod:`.cycles`) represents its style, the same number of whole cycles
+of both styles (at most ``rep_cycles``, from the middle of the take) are registered by DTW and
+blended into intermediate motions M1…M4 at weights 0.2…0.8, and transitions are searched only
+between neighbours S1–M1, M1–M2, …, M4–S2. Which style pairs are bridged is a choice
+(``style_pairs``): ``"hub"`` links every style with the reference style (default ``normal``),
+``"chain"`` links styles in name order, ``"all"`` every pair, ``"none"`` builds no space.
 
-**Pruning during construction** (local and fast, no global component search):
+**Pruning during construction** (local: one style at a time, never the whole graph):
 
-* every basic clip first gets its *self-loop points* (transitions back to an earlier frame of
-  the same clip, at least ``min_loop`` frames back); the part after the *last* self-loop point
-  is cut and every edge into the cut frames is removed, so no walk in a basic clip gets stuck;
-* in an interpolation space, a path that enters M1 but cannot reach the target clip through
-  M2…M4 is disabled by removing its first edge (and dead links inside are removed); every valid
-  path is recorded in the table, in both directions;
+* each style keeps the largest strongly connected part of its takes (frames, steps and jumps
+  inside the pool); the rest is cut and counted in the build report, so a search can never get
+  stuck inside a style; a style with no cycle at all under the threshold gets its best jump
+  back (counted as ``forced``);
+* in an interpolation space, a path that enters M1 but cannot reach the target pool through
+  M2…M4 is disabled by removing its first edge; every valid path is recorded in the table, in
+  both directions;
 * frames of intermediate and transition clips that lie on no recorded route are removed.
 
-When a basic clip has no self-loop under the threshold, the best local minimum is used and the
-table marks it ``forced`` (likewise for a transition clip without entries or exits); a clip
-with no loop at all is dropped, and ``info["dropped"]`` says why.
+Conditions met on the way (a take pruned, a forced pair, a missing link, an unused transition
+clip) are collected in ``info["conditions"]`` and counted once in the build report
+(:mod:`.report`).
 
 Taught in ``notebooks/05_motion_graphs.ipynb``.
 """
@@ -45,14 +55,22 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from motionlab.core.motion import Motion
+from motionlab.motion_graphs import cycles as _cycles
 from motionlab.motion_graphs import distance as _distance
 from motionlab.motion_graphs import registration as _registration
-from motionlab.motion_graphs.graph import ClipInfo, GraphError, MotionGraph, check_motions
+from motionlab.motion_graphs.graph import EDGE_KINDS, ClipInfo, GraphError, MotionGraph, check_motions, pair_edges
 from motionlab.motion_graphs.naming import ClipLabel, label_name, parse_name
 
 __all__ = ["build_structured", "build_wcmg", "structure_rows", "STYLE_PAIRS"]
 
 STYLE_PAIRS = ("hub", "chain", "all", "none")
+
+NEIGHBOURS = 3
+"""Takes of one style each compared with the next 3 takes (cyclically, in take order)."""
+
+REP_CYCLES = 4
+"""Whole cycles of each representative take registered and blended into an interpolation space
+(fewer when one of the two takes has fewer)."""
 
 
 def _style_pairs(
@@ -76,37 +94,48 @@ def _style_pairs(
     raise ValueError(f"style_pairs must be one of {STYLE_PAIRS}, got {how!r}")
 
 
-class _Builder:
-    def __init__(self, graph: MotionGraph, feats: list, threshold: float, window: int, dtype):
-        self.g = graph
-        self.feats = feats
-        self.threshold = threshold
-        self.window = window
-        self.dtype = dtype
-        self.comparisons = 0
+class _Notes:
+    """Build conditions, each kind counted once with its examples (for the build report)."""
 
-    def cands(
-        self, a: int, b: int | None, rows: int, cols: int | None = None, threshold=None, min_gap=0, row0=0, col0=0
-    ):
-        fa = self.feats[a]
-        fb = None if b is None else self.feats[b]
-        cols = rows if cols is None else cols
-        self.comparisons += (rows - row0) * (cols - col0)
-        return _distance.candidates(
-            fa,
-            fb,
-            self.threshold if threshold is None else threshold,
-            self.window,
-            min_gap=min_gap,
-            rows=slice(row0, rows),
-            cols=slice(col0, cols),
-        )
+    def __init__(self):
+        self.lines: dict[str, list[str]] = {}
+
+    def add(self, kind: str, text: str) -> None:
+        self.lines.setdefault(kind, []).append(text)
+
+
+def _progress(iterable, desc: str, total: int | None = None, enabled: bool = False):
+    if not enabled:
+        return iterable
+    from tqdm.auto import tqdm
+
+    return tqdm(iterable, desc=desc, total=total, leave=False)
+
+
+def _ring_pairs(n: int, neighbours: int) -> list[tuple[int, int]]:
+    """Pairs of takes compared within one style: each take with the next ``neighbours`` takes
+    (cyclically), so the work grows linearly with the number of takes; all pairs when few."""
+    if n <= neighbours + 1:
+        return list(itertools.combinations(range(n), 2))
+    out = set()
+    for a in range(n):
+        for d in range(1, neighbours + 1):
+            b = (a + d) % n
+            out.add((min(a, b), max(a, b)))
+    return sorted(out)
+
+
+def _best_only(i, j, cost):
+    if cost.size == 0:
+        return i, j, cost
+    k = int(np.argmin(cost))
+    return i[k : k + 1], j[k : k + 1], cost[k : k + 1]
 
 
 def build_structured(
     motions: Sequence[Motion],
     threshold: float,
-    name_map: Mapping[str, str] | None = None,
+    name_map=None,
     labels: Sequence[ClipLabel] | None = None,
     window: int = _distance.DEFAULT_WINDOW,
     min_loop: int | None = None,
@@ -116,30 +145,40 @@ def build_structured(
     force: bool = True,
     synthetic: Sequence[bool] | None = None,
     dwell: int | None = None,
-    dtype=np.float64,
+    dtype=np.float32,
+    neighbours: int = NEIGHBOURS,
+    rep_cycles: int = REP_CYCLES,
+    progress: bool = False,
 ) -> MotionGraph:
     """Build the structured motion graph (see the module docstring).
 
     Parameters
     ----------
-    motions : canonical clips (22 joints, one fps), named ``Behaviour_style`` or
-        ``B1_s1_to_B2_s2`` (or through ``name_map`` / ``labels``)
+    motions : canonical clips (22 joints, one fps), named ``Behaviour_style[_take]`` or
+        ``B1_s1_to_B2_s2`` (or through ``name_map`` / ``labels``); clips with one label are
+        takes of one style and are pooled
     threshold : largest frame distance of a transition, m² (:func:`distance.threshold_from`)
-    name_map : ``{clip name: label text}`` for names that do not parse, see :mod:`.naming`
+    name_map : ``{clip name: label text}`` or a callable, see :func:`.naming.parse_name`
     labels : one :class:`ClipLabel` per clip, instead of parsing names
     window : frames per point cloud
-    min_loop : shortest self-loop, frames (default: half a second)
+    min_loop : shortest jump back within one take, frames (default: half a second)
     weights : blend weights of the intermediate motions
     style_pairs : ``"hub"``, ``"chain"``, ``"all"`` or ``"none"`` (which styles get an interpolation space)
     reference_style : the hub style
-    force : accept the best local minimum when nothing passes the threshold (marked ``forced``)
+    force : accept the best local minimum when nothing passes the threshold inside an
+        interpolation space or a transition clip (counted as ``forced``)
     synthetic : per clip, True if it is a synthetic stand-in (shown in tables)
     dwell : fewest frames a style route spends in each intermediate motion (default fps/5)
-    dtype : float type of the distance products
+    dtype : float type of the distance products (float32: half the memory, ~1e-6 m² error)
+    neighbours : each take is compared with itself and the next ``neighbours`` takes of its style
+    rep_cycles : whole cycles of each representative take that the interpolation space blends
+    progress : show a tqdm bar per stage
 
     Returns
     -------
-    MotionGraph with ``table`` (structure table and links) and ``info`` (timings, counts).
+    MotionGraph with ``table`` (structure table and links) and ``info`` (timings, counts,
+    ``conditions``). Clips are stored style by style, each style's takes side by side (their
+    order in the graph is not the input order).
     """
     t0 = time.perf_counter()
     skeleton, fps = check_motions(motions)
@@ -149,215 +188,309 @@ def build_structured(
     synthetic = list(synthetic) if synthetic is not None else [False] * len(motions)
     min_loop = int(round(fps / 2)) if min_loop is None else int(min_loop)
     dwell = max(1, int(round(fps / 5)) if dwell is None else int(dwell))
+    notes = _Notes()
 
-    basics: dict[tuple[str, str], int] = {}
+    # ---- pools: the takes of each (behaviour, style), stored side by side
+    pools_in: dict[tuple[str, str], list[int]] = {}
     for k, lab in enumerate(labels):
         if lab.kind == "basic":
-            if lab.key in basics:
-                raise GraphError(
-                    f"two basic clips are labelled {label_name(lab)}: {motions[basics[lab.key]].name!r} and "
-                    f"{motions[k].name!r}; rename one (e.g. a second take as style 'normal-2')"
-                )
-            basics[lab.key] = k
-    transitions = [k for k, lab in enumerate(labels) if lab.kind == "transition"]
+            pools_in.setdefault(lab.key, []).append(k)
+    for key in pools_in:
+        pools_in[key].sort(key=lambda k: (labels[k].take or "", k))
+    order = [k for key in sorted(pools_in) for k in pools_in[key]]
+    order += [k for k, lab in enumerate(labels) if lab.kind == "transition"]
+    where = {k: n for n, k in enumerate(order)}  # input index -> graph clip index
+    pools = {key: [where[k] for k in ks] for key, ks in pools_in.items()}
+    transitions = [where[k] for k, lab in enumerate(labels) if lab.kind == "transition"]
+    glabels = [labels[k] for k in order]
+    gmotions = [motions[k] for k in order]
+    take_frames = [m.num_frames for m in gmotions]
 
-    # ---- interpolation spaces: intermediate motions between styles of one behaviour
+    # ---- cycles and representative cycles of every style
+    t_cyc = time.perf_counter()
+    cyc = {}
+    for _key, ks in _progress(sorted(pools.items()), "cycles", enabled=progress):
+        for c in ks:
+            try:
+                cyc[c] = _cycles.segment_cycles(gmotions[c])
+            except ValueError:
+                cyc[c] = None
+    rep: dict[tuple[str, str], int] = {}
+    for key, ks in pools.items():
+        # the take with the most whole cycles (ties: the first take) represents the style
+        rep[key] = max(ks, key=lambda c: (cyc[c].count if cyc[c] is not None else -1, -c))
+        if cyc[rep[key]] is None or cyc[rep[key]].count == 0:
+            notes.add("no whole cycle", f"{gmotions[rep[key]].name}: the whole take represents its style")
+
+    def rep_span(key, n: int) -> tuple[int, int]:
+        """``n`` whole cycles from the middle of the representative take (all of it without cycles)."""
+        cy = cyc[rep[key]]
+        if cy is None or cy.count == 0:
+            return (0, take_frames[rep[key]])
+        n = min(n, cy.count)
+        mid = (cy.count - n) // 2
+        return int(cy.bounds[mid, 0]), int(cy.bounds[mid + n - 1, 1])
+
+    def rep_count(key) -> int:
+        cy = cyc[rep[key]]
+        return rep_cycles if cy is None or cy.count == 0 else min(rep_cycles, cy.count)
+
+    t_cyc = time.perf_counter() - t_cyc
+
+    # ---- interpolation spaces between representative cycles of styles of one behaviour
     t_reg = time.perf_counter()
     by_behaviour: dict[str, list[str]] = {}
-    for b, s in basics:
+    for b, s in pools:
         by_behaviour.setdefault(b, []).append(s)
     extra: list[Motion] = []
     extra_infos: list[ClipInfo] = []
-    spaces = []  # (behaviour, s1, s2, [intermediate indices into the final clip list])
-    n_input = len(motions)
-    positions = {k: motions[k].global_positions() for k in basics.values()}
-    tracks: dict[int, _registration.RootTrack] = {}
+    spaces = []  # (behaviour, s1, s2, [intermediate clip indices])
+    n_input = len(gmotions)
+    pairs_todo = []
     for b, styles in sorted(by_behaviour.items()):
-        lengths = {s: motions[basics[(b, s)]].num_frames for s in styles}
-        for s1, s2 in _style_pairs(styles, style_pairs, reference_style, lengths, 4 * min_loop):
-            k1, k2 = basics[(b, s1)], basics[(b, s2)]
-            m1, m2 = motions[k1], motions[k2]
-            for k in (k1, k2):
-                if k not in tracks:
-                    tracks[k] = _registration.root_track(motions[k], positions[k])
-            reg = _registration.dtw(_distance.distance_matrix(positions[k1], positions[k2], window))
-            ids = []
-            for w in weights:
-                mid = _registration.blend(m1, m2, reg, w, name=f"{b}_{s1}~{s2}@{w:g}", tracks=(tracks[k1], tracks[k2]))
-                if mid.num_frames < 3:
-                    continue
-                ids.append(n_input + len(extra))
-                extra.append(mid)
-                extra_infos.append(ClipInfo(mid.name, "intermediate", b, f"{s1}~{s2}@{w:g}", b, s2))
-            spaces.append((b, s1, s2, ids))
+        lengths = {s: gmotions[rep[(b, s)]].num_frames for s in styles}
+        pairs_todo += [(b, s1, s2) for s1, s2 in _style_pairs(styles, style_pairs, reference_style, lengths, 0)]
+    for b, s1, s2 in _progress(pairs_todo, "interpolation spaces", enabled=progress):
+        # the same number of whole cycles of both styles, so registration pairs cycle with cycle
+        n = min(rep_count((b, s1)), rep_count((b, s2)))
+        cut = []
+        for key in ((b, s1), (b, s2)):
+            f0, f1 = rep_span(key, n)
+            m = gmotions[rep[key]][f0:f1]
+            pos = m.global_positions()
+            cut.append((m, pos, _registration.root_track(m, pos)))
+        (m1, p1, r1), (m2, p2, r2) = cut
+        # the registration must cover (nearly) both spans: 90% of the longer one
+        reg = _registration.dtw(_distance.distance_matrix(p1, p2, window), int(0.9 * max(len(p1), len(p2))))
+        ids = []
+        for w in weights:
+            mid = _registration.blend(m1, m2, reg, w, name=f"{b}_{s1}~{s2}@{w:g}", tracks=(r1, r2))
+            if mid.num_frames < 3:
+                continue
+            ids.append(n_input + len(extra))
+            extra.append(mid)
+            extra_infos.append(ClipInfo(mid.name, "intermediate", b, f"{s1}~{s2}@{w:g}", b, s2))
+        spaces.append((b, s1, s2, ids))
     t_reg = time.perf_counter() - t_reg
 
-    infos = []
-    for m, lab, syn in zip(motions, labels, synthetic):
-        infos.append(
-            ClipInfo(
-                m.name or label_name(lab),
-                lab.kind,
-                lab.behaviour,
-                lab.style,
-                lab.to_behaviour,
-                lab.to_style,
-                synthetic=syn,
-            )
-        )
-    all_motions = list(motions) + extra
-    graph = MotionGraph.from_motions(all_motions, infos + extra_infos)
-    feats = [
-        _distance.cloud_features(positions[k] if k in positions else m.global_positions(), window, dtype=dtype)
-        for k, m in enumerate(all_motions)
-    ]
-    bld = _Builder(graph, feats, threshold, window, dtype)
-    table: dict = {"behaviours": {}, "links": []}
-    info: dict = {"forced": [], "dropped": [], "unused": [], "missing_links": []}
-    length: dict[int, int] = {}
+    infos = [
+        ClipInfo(m.name or label_name(lab), lab.kind, lab.behaviour, lab.style, lab.to_behaviour, lab.to_style,
+                 synthetic=bool(synthetic[k]), take=lab.take)
+        for k, m, lab in zip(order, gmotions, glabels)
+    ]  # fmt: skip
+    graph = MotionGraph.from_motions(gmotions + extra, infos + extra_infos)
+    del gmotions
+    clips = graph.clips
+    comparisons = 0
+    feats_cache: dict[int, _distance.CloudFeatures] = {}
 
-    # ---- basic clips: self-loop points, cut after the last one
-    for (b, s), k in sorted(basics.items()):
-        c = graph.clips[k]
-        n = c.num_frames
-        i, j, cost = bld.cands(k, None, n, min_gap=min_loop)
-        back = j < i
-        i, j, cost = i[back], j[back], cost[back]
-        forced = False
-        if i.size == 0 and force:
-            i, j, cost = bld.cands(k, None, n, threshold=np.inf, min_gap=min_loop)
-            back = j < i
-            i, j, cost = i[back], j[back], cost[back]
-            if i.size:
-                best = int(np.argmin(cost))
-                i, j, cost = i[best : best + 1], j[best : best + 1], cost[best : best + 1]
-                forced = True
-        if i.size == 0:
-            graph.alive[c.start : c.stop] = False
-            info["dropped"].append(f"{c.name}: no self-loop point (clip too short for a loop of {min_loop} frames)")
-            continue
-        last = int(i.max())
-        graph.alive[c.start + last + 1 : c.stop] = False
-        length[k] = last + 1
-        graph.add_edges(c.start + i, c.start + j + 1, cost, "loop")
-        if forced:
-            info["forced"].append(f"{c.name}: self-loop {last}->{int(j[i == last][0]) + 1} above threshold")
+    def feats(c: int) -> _distance.CloudFeatures:
+        if c not in feats_cache:
+            st, sp = clips[c].start, clips[c].stop
+            m = Motion(graph.skeleton, graph.local_rot[st:sp], graph.root_pos[st:sp], graph.fps, None, clips[c].name)
+            feats_cache[c] = _distance.cloud_features(m.global_positions(), window, dtype=dtype)
+        return feats_cache[c]
+
+    def cands(x, y, rows=None, cols=None, thr=None, min_gap=0):
+        nonlocal comparisons
+        fa, fb = feats(x), (None if y is None else feats(y))
+        r = rows or slice(0, len(fa))
+        cl = cols or slice(0, len(fb if fb is not None else fa))
+        comparisons += (r.stop - r.start) * (cl.stop - cl.start)
+        return _distance.candidates(fa, fb, threshold if thr is None else thr, window, min_gap, r, cl)
+
+    # ---- within each style: every take with itself and its neighbouring takes
+    t_pool = time.perf_counter()
+    table: dict = {"behaviours": {}, "links": []}
+    loop_kind = EDGE_KINDS.index("loop")
+    for key, ks in _progress(sorted(pools.items()), "takes", enabled=progress):
+        found = {"loop": [], "transition": []}  # (src, dst, cost) global, added at once
+        for c in ks:
+            i, j, cost = cands(c, None, min_gap=min_loop)
+            ok = j + 1 < clips[c].num_frames
+            found["loop"].append((clips[c].start + i[ok], clips[c].start + j[ok] + 1, cost[ok]))
+        for x, y in _ring_pairs(len(ks), neighbours):
+            a, z = ks[x], ks[y]
+            i, j, cost = cands(a, z)
+            src, dst, which = pair_edges(i, j, clips[a].start, clips[z].start, clips[z].num_frames,
+                                         clips[a].num_frames, False)  # fmt: skip
+            found["transition"].append((src, dst, cost[which]))
+        for kind, parts in found.items():
+            if parts:
+                graph.add_edges(*(np.concatenate(p) for p in zip(*parts)), kind)
+        for c in ks:
+            if c != rep[key]:
+                feats_cache.pop(c, None)
+        # pruning: keep the largest strongly connected part of the style's takes
+        st, sp = clips[ks[0]].start, clips[ks[-1]].stop
+        mask = np.zeros(graph.num_frames, dtype=bool)
+        mask[st:sp] = True
+        keep = graph.largest_component(mask)
+        if not keep[st:sp].any() and force:
+            # no cycle under the threshold: the best jump back inside a take (a forced loop)
+            best = None
+            for c in ks:
+                i, j, cost = cands(c, None, thr=np.inf, min_gap=min_loop)
+                ok = (j < i) & (j + 1 < clips[c].num_frames)
+                if ok.any():
+                    k = int(np.argmin(np.where(ok, cost, np.inf)))
+                    if best is None or cost[k] < best[2]:
+                        best = (clips[c].start + int(i[k]), clips[c].start + int(j[k]) + 1, float(cost[k]), c)
+            if best is not None:
+                graph.add_edges([best[0]], [best[1]], [best[2]], "loop")
+                notes.add("forced", f"{clips[best[3]].name}: no loop under the threshold, best jump back used")
+                keep = graph.largest_component(mask)
+        graph.alive[st:sp] = keep[st:sp]
+        for c in ks:
+            if not graph.alive[clips[c].start : clips[c].stop].any():
+                notes.add("take pruned", f"{clips[c].name}: no transition under the threshold joins it to its style")
+    graph.drop_dead_edges()
+    t_pool = time.perf_counter() - t_pool
+
+    def pool_start(key) -> int:
+        return clips[pools[key][0]].start
+
+    for (b, s), ks in sorted(pools.items()):
+        st, sp = clips[ks[0]].start, clips[ks[-1]].stop
+        live = graph.alive[graph.src] & graph.alive[graph.dst]
+        inside = live & (graph.src >= st) & (graph.src < sp) & (graph.dst >= st) & (graph.dst < sp)
+        takes = []
+        for c in ks:
+            ci, cy = clips[c], cyc[c]
+            takes.append(
+                {
+                    "clip": c,
+                    "name": ci.name,
+                    "take": ci.take,
+                    "offset": ci.start - st,
+                    "frames": ci.num_frames,
+                    "alive": int(graph.alive[ci.start : ci.stop].sum()),
+                    "cycles": 0 if cy is None else cy.count,
+                    "cycle_span": [0, 0] if cy is None else list(cy.span),
+                }
+            )
         table["behaviours"].setdefault(b, {})[s] = {
-            "clip": k,
-            "name": c.name,
-            "start": c.start,
-            "length": last + 1,
-            "last_loop": last,
-            "loops": int(i.size),
-            "forced": forced,
-            "synthetic": bool(c.synthetic),
+            "start": st,
+            "frames": sp - st,
+            "alive": int(graph.alive[st:sp].sum()),
+            "takes": takes,
+            "representative": rep[(b, s)],
+            "representative_cycles": list(rep_span((b, s), rep_cycles)),
+            "transitions": int(inside.sum()),
+            "loops": int((inside & (graph.kind == loop_kind)).sum()),
+            "synthetic": bool(any(clips[c].synthetic for c in ks)),
         }
 
     # ---- interpolation spaces: neighbours only, validity, recorded routes in both directions
+    t_links = time.perf_counter()
     on_route = np.zeros(graph.num_frames, dtype=bool)
-    for b, s1, s2, ids in spaces:
-        k1, k2 = basics[(b, s1)], basics[(b, s2)]
-        if k1 not in length or k2 not in length or not ids:
-            info["missing_links"].append(f"{b}: {s1} <-> {s2} (a clip was dropped)")
+    for b, s1, s2, ids in _progress(spaces, "style links", enabled=progress):
+        k1, k2 = rep[(b, s1)], rep[(b, s2)]
+        if not ids:
+            notes.add("missing link", f"{b}: {s1} <-> {s2} (no intermediate motion)")
             continue
         chain = [k1, *ids, k2]
         fwd, bwd = [], []  # per neighbour pair: (src, dst, cost) global
         for x, y in zip(chain[:-1], chain[1:]):
-            nx_, ny_ = length.get(x, graph.clips[x].num_frames), length.get(y, graph.clips[y].num_frames)
-            i, j, cost = bld.cands(x, y, nx_, ny_)
+            cx, cy_ = clips[x], clips[y]
+            i, j, cost = cands(x, y)
+            # both ends must be alive frames of the (pruned) style takes
+            ok = graph.alive[cx.start + i] & graph.alive[cy_.start + j]
+            i, j, cost = i[ok], j[ok], cost[ok]
             if i.size == 0 and force:
-                i, j, cost = bld.cands(x, y, nx_, ny_, threshold=np.inf)
+                i, j, cost = cands(x, y, thr=np.inf)
+                ok = graph.alive[cx.start + i] & graph.alive[cy_.start + j]
+                i, j, cost = i[ok], j[ok], cost[ok]
                 if i.size:
-                    best = int(np.argmin(cost))
-                    i, j, cost = i[best : best + 1], j[best : best + 1], cost[best : best + 1]
-                    info["forced"].append(f"{graph.clips[x].name} -> {graph.clips[y].name}: best pair above threshold")
-            cx, cy = graph.clips[x], graph.clips[y]
-            ok = j + 1 < ny_
-            fwd.append((cx.start + i[ok], cy.start + j[ok] + 1, cost[ok]))
-            ok = i + 1 < nx_
-            bwd.append((cy.start + j[ok], cx.start + i[ok] + 1, cost[ok]))
-        for direction, edges, order in (("forward", fwd, chain), ("backward", [e for e in reversed(bwd)], chain[::-1])):
-            routes, kept = _bridge_routes(graph, order, edges, dwell)
+                    i, j, cost = _best_only(i, j, cost)
+                    notes.add("forced", f"{cx.name} -> {cy_.name}: best pair above threshold")
+            ok = (j + 1 < cy_.num_frames) & graph.alive[np.minimum(cy_.start + j + 1, cy_.stop - 1)]
+            fwd.append((cx.start + i[ok], cy_.start + j[ok] + 1, cost[ok]))
+            ok = (i + 1 < cx.num_frames) & graph.alive[np.minimum(cx.start + i + 1, cx.stop - 1)]
+            bwd.append((cy_.start + j[ok], cx.start + i[ok] + 1, cost[ok]))
+        for direction, edges, seq in (("forward", fwd, chain), ("backward", list(reversed(bwd)), chain[::-1])):
+            sa, sz = (s1, s2) if direction == "forward" else (s2, s1)
+            routes, kept = _bridge_routes(graph, seq, edges, dwell, pool_start((b, sa)), pool_start((b, sz)))
             for src, dst, cost in kept:
                 graph.add_edges(src, dst, cost, "bridge")
-            a, z = order[0], order[-1]
             for r in routes:
                 for clip, f0, f1 in r["pieces"]:
-                    st = graph.clips[clip].start
+                    st = clips[clip].start
                     on_route[st + f0 : st + f1 + 1] = True
-            link = {
-                "from": [graph.clips[a].behaviour, graph.clips[a].style],
-                "to": [graph.clips[z].behaviour, graph.clips[z].style],
-                "via": "interpolation",
-                "routes": routes,
-            }
             if routes:
-                table["links"].append(link)
+                table["links"].append({"from": [b, sa], "to": [b, sz], "via": "interpolation", "routes": routes})
             else:
-                info["missing_links"].append(
-                    f"{b}: {graph.clips[a].style} -> {graph.clips[z].style} ({direction}: no valid path)"
-                )
+                notes.add("missing link", f"{b}: {sa} -> {sz} ({direction}: no valid path through the space)")
 
-    # ---- transition clips: compared with their two endpoint clips only
-    for k in transitions:
-        c, lab = graph.clips[k], labels[k]
-        a, z = basics.get(lab.key), basics.get(lab.to_key)
-        if a is None or z is None or a not in length or z not in length:
-            missing = (
-                label_name(ClipLabel("basic", *lab.key))
-                if a is None or a not in length
-                else label_name(ClipLabel("basic", *lab.to_key))
-            )
-            info["unused"].append(f"{c.name}: no basic clip {missing}")
+    # ---- transition clips: compared with the takes of their two endpoint styles only
+    clip_edges: list[tuple[int, int, float]] = []
+    for k in _progress(transitions, "transition clips", enabled=progress):
+        c, lab = clips[k], glabels[k]
+        if lab.key not in pools or lab.to_key not in pools:
+            missing = lab.key if lab.key not in pools else lab.to_key
+            notes.add("unused transition clip", f"{c.name}: no basic clip {missing[0]}_{missing[1]}")
             graph.alive[c.start : c.stop] = False
             continue
         half = c.num_frames // 2
         forced = False
-        # entries: A_i ~ T_j, j in the first half
-        i, j, cost = bld.cands(a, k, length[a], half)
-        if i.size == 0 and force:
-            i, j, cost = bld.cands(a, k, length[a], half, threshold=np.inf)
-            if i.size:
-                best = int(np.argmin(cost))
-                i, j, cost = i[best : best + 1], j[best : best + 1], cost[best : best + 1]
-                forced = True
-        # exits: T_k ~ B_l, k in the second half, l + 1 inside B's usable frames
-        ti, tl, tcost = bld.cands(k, z, c.num_frames, length[z] - 1, row0=half)
-        if ti.size == 0 and force:
-            ti, tl, tcost = bld.cands(k, z, c.num_frames, length[z] - 1, threshold=np.inf, row0=half)
-            if ti.size:
-                best = int(np.argmin(tcost))
-                ti, tl, tcost = ti[best : best + 1], tl[best : best + 1], tcost[best : best + 1]
-                forced = True
-        if i.size == 0 or ti.size == 0:
-            info["unused"].append(f"{c.name}: no entry or exit frames")
+        ent = []  # (pool-local exit frame, transition frame entered, cost)
+        for a in pools[lab.key]:
+            i, j, cost = cands(a, k, cols=slice(0, half))
+            ok = graph.alive[clips[a].start + i]
+            ent.append((clips[a].start + i[ok] - pool_start(lab.key), j[ok] + 1, cost[ok]))
+        ei, ej, ec = (np.concatenate(x) for x in zip(*ent))
+        ext = []  # (transition frame left, pool-local target frame entered, cost)
+        for z in pools[lab.to_key]:
+            cz = clips[z]
+            i, j, cost = cands(k, z, rows=slice(half, c.num_frames), cols=slice(0, cz.num_frames - 1))
+            ok = graph.alive[cz.start + j + 1]
+            ext.append((i[ok], cz.start + j[ok] + 1 - pool_start(lab.to_key), cost[ok]))
+        xi, xj, xc = (np.concatenate(x) for x in zip(*ext))
+        if force and ei.size == 0:
+            ent = []
+            for a in pools[lab.key]:
+                i, j, cost = cands(a, k, cols=slice(0, half), thr=np.inf)
+                ok = graph.alive[clips[a].start + i]
+                ent.append((clips[a].start + i[ok] - pool_start(lab.key), j[ok] + 1, cost[ok]))
+            ei, ej, ec = _best_only(*(np.concatenate(x) for x in zip(*ent)))
+            forced = True
+        if force and xi.size == 0:
+            ext = []
+            for z in pools[lab.to_key]:
+                cz = clips[z]
+                i, j, cost = cands(k, z, rows=slice(half, c.num_frames), cols=slice(0, cz.num_frames - 1), thr=np.inf)
+                ok = graph.alive[cz.start + j + 1]
+                ext.append((i[ok], cz.start + j[ok] + 1 - pool_start(lab.to_key), cost[ok]))
+            xi, xj, xc = _best_only(*(np.concatenate(x) for x in zip(*ext)))
+            forced = True
+        if ei.size == 0 or xi.size == 0:
+            notes.add("unused transition clip", f"{c.name}: no entry or exit frames")
             graph.alive[c.start : c.stop] = False
             continue
         if forced:
-            info["forced"].append(f"{c.name}: entry or exit above threshold")
-        order = np.argsort(ti, kind="stable")
-        ti, tl, tcost = ti[order], tl[order], tcost[order]
-        ca, cz = graph.clips[a], graph.clips[z]
+            notes.add("forced", f"{c.name}: entry or exit above threshold")
+        srt = np.argsort(xi, kind="stable")
+        xi, xj, xc = xi[srt], xj[srt], xc[srt]
+        p0, p1 = pool_start(lab.key), pool_start(lab.to_key)
         routes = []
-        for ii, jj, cc in zip(i.tolist(), j.tolist(), cost.tolist()):
-            first = jj + 1
-            e = int(np.searchsorted(ti, first))  # first exit at or after the entry frame
-            if e >= ti.size:
+        for ii, first, cc in zip(ei.tolist(), ej.tolist(), ec.tolist()):
+            e = int(np.searchsorted(xi, first))  # first exit at or after the entry frame
+            if e >= xi.size:
                 continue
             routes.append(
                 {
                     "exit": ii,
-                    "enter": int(tl[e]) + 1,
-                    "pieces": [[k, first, int(ti[e])]],
-                    "frames": int(ti[e]) - first + 1,
-                    "cost": float(max(cc, tcost[e])),
+                    "enter": int(xj[e]),
+                    "pieces": [[k, first, int(xi[e])]],
+                    "frames": int(xi[e]) - first + 1,
+                    "cost": float(max(cc, xc[e])),
                 }
             )
-            graph.add_edges([ca.start + ii], [c.start + first], [cc], "clip")
-            graph.add_edges([c.start + int(ti[e])], [cz.start + int(tl[e]) + 1], [tcost[e]], "clip")
-            on_route[c.start + first : c.start + int(ti[e]) + 1] = True
+            clip_edges.append((p0 + ii, c.start + first, cc))
+            clip_edges.append((c.start + int(xi[e]), p1 + int(xj[e]), float(xc[e])))
+            on_route[c.start + first : c.start + int(xi[e]) + 1] = True
         if not routes:
-            info["unused"].append(f"{c.name}: every entry lies after the last exit")
+            notes.add("unused transition clip", f"{c.name}: every entry lies after the last exit")
             continue
         routes.sort(key=lambda r: r["cost"])
         table["links"].append(
@@ -370,16 +503,19 @@ def build_structured(
                 "forced": forced,
             }
         )
+    if clip_edges:
+        src, dst, cost = (np.array(x) for x in zip(*clip_edges))
+        graph.add_edges(src, dst, cost, "clip")
+    t_links = time.perf_counter() - t_links
 
     # ---- intermediate and transition frames live only on recorded routes
-    for c in graph.clips:
+    for c in clips:
         if c.kind in ("intermediate", "transition"):
             graph.alive[c.start : c.stop] &= on_route[c.start : c.stop]
     graph.drop_dead_edges()
-    # the same pair found twice (e.g. two routes through one exit) is one edge
     _dedupe(graph)
     graph.table = table
-    info.update(
+    graph.info = dict(
         kind="structured",
         threshold=float(threshold),
         window=window,
@@ -387,12 +523,18 @@ def build_structured(
         dwell=dwell,
         style_pairs=style_pairs,
         weights=list(weights),
-        comparisons=bld.comparisons,
+        neighbours=neighbours,
+        rep_cycles=rep_cycles,
+        comparisons=comparisons,
+        input_clips=len(motions),
+        cycles_seconds=t_cyc,
         registration_seconds=t_reg,
+        takes_seconds=t_pool,
+        links_seconds=t_links,
         intermediates=len(extra),
+        conditions=notes.lines,
         build_seconds=time.perf_counter() - t0,
     )
-    graph.info = info
     return graph
 
 
@@ -404,7 +546,9 @@ def _dedupe(graph: MotionGraph) -> None:
     graph.keep_edges(mask)
 
 
-def _bridge_routes(graph: MotionGraph, order: list[int], edges: list, dwell: int = 1):
+def _bridge_routes(
+    graph: MotionGraph, order: list[int], edges: list, dwell: int = 1, s0: int | None = None, t0: int | None = None
+):
     """Valid paths through one direction of an interpolation space.
 
     ``order``: clip indices source, M…, target; ``edges[k]``: (src, dst, cost) global arrays from
@@ -459,7 +603,8 @@ def _bridge_routes(graph: MotionGraph, order: list[int], edges: list, dwell: int
     ok = np.isfinite(reach)
     kept[0] = (src[ok], dst[ok], cost[ok])
     routes = []
-    s0 = graph.clips[order[0]].start
+    s0 = graph.clips[order[0]].start if s0 is None else s0  # exits count from here (the style's first take)
+    t0 = graph.clips[order[-1]].start if t0 is None else t0
     for e in np.flatnonzero(ok):
         pieces, worst = [], float(cost[e])
         g = int(dst[e])
@@ -476,11 +621,10 @@ def _bridge_routes(graph: MotionGraph, order: list[int], edges: list, dwell: int
             worst = max(worst, float(c_[ed]))
             g = int(d_[ed])
             pos += 1
-        tgt = graph.clips[order[-1]]
         routes.append(
             {
                 "exit": int(src[e]) - s0,
-                "enter": g - tgt.start,
+                "enter": g - t0,
                 "pieces": pieces,
                 "frames": int(sum(p[2] - p[1] + 1 for p in pieces)),
                 "cost": worst,
@@ -491,7 +635,7 @@ def _bridge_routes(graph: MotionGraph, order: list[int], edges: list, dwell: int
 
 
 def structure_rows(graph: MotionGraph) -> list[dict]:
-    """The structure table as rows (behaviour, style, clip, start, length, loops, links out)."""
+    """The structure table as rows (behaviour, style, takes, first frame, frames, alive, links out)."""
     links_out: dict[tuple[str, str], list[str]] = {}
     for link in graph.table.get("links", []):
         links_out.setdefault(tuple(link["from"]), []).append(
@@ -503,11 +647,11 @@ def structure_rows(graph: MotionGraph) -> list[dict]:
             rows.append(
                 dict(
                     behaviour=b,
-                    style=s,
-                    clip=e["name"] + (" (synthetic)" if e.get("synthetic") else ""),
+                    style=s + (" (synthetic)" if e.get("synthetic") else ""),
+                    takes=len(e["takes"]),
                     start=e["start"],
-                    length=e["length"],
-                    loops=e["loops"],
+                    frames=e["frames"],
+                    alive=e["alive"],
                     links=", ".join(links_out.get((b, s), [])) or "-",
                 )
             )

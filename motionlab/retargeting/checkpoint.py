@@ -13,13 +13,13 @@ Taught in ``notebooks/02_training_autoencoder.ipynb``.
 from __future__ import annotations
 
 import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import torch
 
+from motionlab.core import files
 from motionlab.core.preprocess import NormStats
 from motionlab.core.skeleton import Skeleton
 from motionlab.retargeting.model import ModelConfig, RetargetNet
@@ -83,6 +83,40 @@ def _skeleton_from(d: dict) -> Skeleton:
     )
 
 
+def _check_contents(path: Path, ckpt: Checkpoint) -> None:
+    """Refuse a checkpoint that loads but cannot work: non-finite weights, statistics of the wrong
+    size, or a stored skeleton that is not a 22-joint humanoid with finite bones."""
+    from motionlab.core import humanoid
+    from motionlab.retargeting.model import FEATURE_DIM
+
+    for name, tensor in ckpt.model.state_dict().items():
+        if tensor.is_floating_point() and not torch.isfinite(tensor).all():
+            bad = int((~torch.isfinite(tensor)).sum())
+            raise CheckpointError(f"{path}: damaged checkpoint: weight {name!r} has {bad} non-finite values (NaN/inf)")
+    for name in ("mean", "std"):
+        array = getattr(ckpt.stats, name)
+        if array.shape != (FEATURE_DIM,):
+            raise CheckpointError(
+                f"{path}: damaged checkpoint: statistics {name!r} should have {FEATURE_DIM} values, got shape {array.shape}"
+            )
+        if not np.isfinite(array).all():
+            raise CheckpointError(f"{path}: damaged checkpoint: statistics {name!r} hold non-finite values")
+    if not (ckpt.stats.std > 0).all():
+        raise CheckpointError(f"{path}: damaged checkpoint: statistics 'std' should be > 0 everywhere")
+    sk = ckpt.skeleton
+    if not humanoid.is_canonical(sk):
+        raise CheckpointError(
+            f"{path}: damaged checkpoint: the stored skeleton should be the {len(humanoid.JOINTS)}-joint humanoid "
+            f"({', '.join(humanoid.JOINTS[:3])}, ...), got {sk.num_joints} joints ({', '.join(sk.names[:3])}, ...)"
+        )
+    if not np.isfinite(sk.offsets).all() or sk.height() <= 0:
+        raise CheckpointError(f"{path}: damaged checkpoint: the stored skeleton has non-finite or zero bone offsets")
+    if not (np.isfinite(ckpt.fps) and ckpt.fps > 0) or ckpt.window < 1:
+        raise CheckpointError(
+            f"{path}: damaged checkpoint: expected fps > 0 and window >= 1, got fps {ckpt.fps}, window {ckpt.window}"
+        )
+
+
 def save(path: str | os.PathLike, checkpoint: Checkpoint, overwrite: bool = True) -> Path:
     """Write ``checkpoint`` to ``path`` atomically (temporary file, then rename).
 
@@ -103,15 +137,7 @@ def save(path: str | os.PathLike, checkpoint: Checkpoint, overwrite: bool = True
         "info": dict(checkpoint.info),
     }
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(suffix=".pt.tmp", dir=path.parent)
-    os.close(fd)
-    try:
-        torch.save(payload, tmp)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-    return path
+    return files.atomic_write(path, lambda f: torch.save(payload, f), overwrite, binary=True, what="checkpoint")
 
 
 def load(path: str | os.PathLike, device: str | torch.device | None = None) -> Checkpoint:
@@ -147,6 +173,7 @@ def load(path: str | os.PathLike, device: str | torch.device | None = None) -> C
         )
     except (KeyError, TypeError, RuntimeError, ValueError) as e:
         raise CheckpointError(f"{path}: damaged retargeting checkpoint ({type(e).__name__}: {e})") from None
+    _check_contents(path, ckpt)
     if device is None:
         device = "cuda" if torch.cuda.is_available() else "cpu"
     model.to(device).eval()

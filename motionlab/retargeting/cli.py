@@ -40,12 +40,9 @@ def _positive(text: str) -> float:
 
 
 def _load_bvh(path: str, what: str):
-    from motionlab.core import bvh
+    from motionlab.core import bvh, files
 
-    p = Path(path)
-    if not p.is_file():
-        raise _error(f"{what} file {p} not found")
-    return bvh.load(p)
+    return bvh.load(files.check_input(path, what))
 
 
 def _load_checkpoint(path: str | None, device: str | None):
@@ -74,21 +71,31 @@ def _add_solver_args(p: argparse.ArgumentParser) -> None:
 
 # ---------------------------------------------------------------------------- retarget
 def _cmd_retarget(args) -> int:
-    from motionlab.core import bvh, humanoid
+    from motionlab.cli import rig_error
+    from motionlab.core import bvh, files, humanoid
     from motionlab.retargeting.pipeline import retarget
 
     out = Path(args.output)
     if out.suffix.lower() != ".bvh":
         raise _error(f"output {out} must end in .bvh")
-    if out.exists() and not args.force:
-        raise _error(f"{out} exists; pass --force to overwrite it")
+    files.check_output(out, args.force)
+    npz = Path(args.npz) if args.npz else None
+    if npz is not None:  # checked before any work: np.savez would silently add '.npz' to another name
+        if npz.suffix.lower() != ".npz":
+            raise _error(f"--npz {npz} must end in .npz")
+        if npz.resolve() == out.resolve():
+            raise _error(f"--npz {npz} is the BVH output too")
+        files.check_output(npz, args.force, "--npz file")
     source = _load_bvh(args.source, "source")
     try:
         humanoid.find_mapping(source.skeleton)
-        base = _load_bvh(args.target, "target").skeleton if args.target else source.skeleton
+    except humanoid.RigMappingError as e:
+        raise rig_error(e, "source", args.source) from None
+    base = _load_bvh(args.target, "target").skeleton if args.target else source.skeleton
+    try:
         target = humanoid.to_canonical_skeleton(base)
     except humanoid.RigMappingError as e:
-        raise _error(str(e)) from None
+        raise rig_error(e, "target", args.target) from None
     scales = dict(
         legs=args.scale_legs, arms=args.scale_arms, spine=args.scale_spine, neck=args.scale_neck, overall=args.scale
     )
@@ -98,13 +105,10 @@ def _cmd_retarget(args) -> int:
         raise _error("give --target TARGET.bvh and/or a --scale-* factor: otherwise the target is the source itself")
     ckpt = None if args.method == "copy" else _load_checkpoint(args.checkpoint, args.device)
     result = retarget(source, target, ckpt, args.method, _solver_config(args), args.root, progress=not args.quiet)
-    bvh.save(out, result.motion, overwrite=args.force)
-    if args.npz:
-        npz = Path(args.npz)
-        if npz.exists() and not args.force:
-            raise _error(f"{npz} exists; pass --force to overwrite it")
-        np.savez(
-            npz,
+    text = bvh.dumps(result.motion)  # any error in the result shows before a file is written
+    outputs = [(out, lambda f: f.write(text), False, "output")]
+    if npz is not None:  # both files or neither
+        arrays = dict(
             local_rot=result.motion.local_rot,
             root_pos=result.motion.root_pos,
             positions=result.positions,
@@ -112,6 +116,8 @@ def _cmd_retarget(args) -> int:
             parents=result.motion.skeleton.parents,
             fps=result.motion.fps,
         )
+        outputs.append((npz, lambda f: np.savez(f, **arrays), True, "--npz file"))
+    files.atomic_write_all(outputs, overwrite=args.force)
     if not args.quiet:
         msg = f"wrote {out} ({result.motion.num_frames} frames @ {result.motion.fps:g} fps, method {result.method}"
         if result.method == "full":
@@ -166,6 +172,10 @@ def _cmd_evaluate(args) -> int:
     from motionlab.retargeting.train import TrainConfig, train
 
     folder = Path(args.data) if args.data else mdata.data_root() / "mixamo"
+    if args.csv:  # refuse before hours of work, not after
+        from motionlab.core import files
+
+        files.check_output(args.csv, args.force, "--csv file")
     if not folder.is_dir():
         raise _error(f"data folder {folder} not found")
     path = Path(args.checkpoint) if args.checkpoint else Path(tempfile.gettempdir()) / f"motionlab_{args.source}.pt"
@@ -203,10 +213,16 @@ def _cmd_evaluate(args) -> int:
     if args.csv:
         import csv
 
-        with open(args.csv, "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=list(result.records[0]))
+        from motionlab.core import files
+
+        def write(f):
+            w = csv.DictWriter(f, fieldnames=list(result.records[0]), lineterminator="\n")
             w.writeheader()
             w.writerows(result.records)
+
+        files.atomic_write(args.csv, write, overwrite=args.force, what="--csv file")
+        if not args.quiet:
+            print(f"wrote {args.csv}")
     return 0
 
 
@@ -291,6 +307,7 @@ def register(subparsers) -> None:
     p.add_argument("--train-steps", type=int, default=1500)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--csv", help="write the per-clip records to this CSV")
+    p.add_argument("--force", action="store_true", help="overwrite an existing --csv file")
     p.add_argument(
         "--root",
         choices=ROOT_MODES,

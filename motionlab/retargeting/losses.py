@@ -4,9 +4,9 @@
 loss                   formula                                                      unit
 =====================  ===========================================================  ==========
 ``recon_loss``         λ/(3TJ) Σ_t Σ_j ‖p_t^j − p'_t^j‖₂, λ = 0.5 (eq. 8)           metres
-``angle_loss``         1/(22T) Σ_t Σ_i ‖θ_i,t(A) − θ_i,t(B')‖₂, θ = joint rotations   unitless
+``angle_loss``         1/(22T) Σ_t Σ_i ‖θ_i,t(A) − θ_i,t(B')‖₂, θ = joint angles      unitless
 ``direction_loss``     the same with θ = unit bone directions (from positions)      unitless
-``foot_loss``          1/(4T) Σ_t Σ_{i ∈ feet} |min(y_i,t, 0)|                      metres
+``foot_loss``          1/(4T) Σ_t Σ_{i ∈ feet} max(−y_i,t, 0)                       metres
 ``rotation_loss``      mean over frames and joints of 1 − ⟨q, q̂⟩²                   unitless
 =====================  ===========================================================  ==========
 

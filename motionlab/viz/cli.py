@@ -6,8 +6,8 @@ Examples::
     motionlab view Running.bvh --out running.mp4 --camera follow          # movie, off-screen
     motionlab view Running.bvh --out running.gif --size 480x360 --force   # replace an old GIF
 
-Without a display and without ``--out`` the movie goes to ``<file stem>.mp4`` in the current
-folder. Existing files are never overwritten without ``--force``.
+Without a display, ``--out`` is needed (nothing is written that was not asked for). Existing
+files are never overwritten without ``--force``.
 """
 
 from __future__ import annotations
@@ -82,25 +82,21 @@ def _open_window(scene) -> None:
 
 
 def _cmd_view(args) -> int:
-    from motionlab.core import bvh
+    from motionlab.core import bvh, files
     from motionlab.viz import backend
     from motionlab.viz.export import MOVIE_SUFFIXES, save_movie
     from motionlab.viz.scene import Scene
 
-    source = Path(args.file)
-    if not source.is_file():
-        raise _error(f"BVH file {source} not found")
+    source = files.check_input(args.file, "BVH")
     out = Path(args.out) if args.out else None
-    if out is None and not backend.has_display():
-        out = Path.cwd() / f"{source.stem}.mp4"
-        print(f"no display found: writing a movie to {out} instead of opening a window")
+    if out is None and not backend.has_display():  # never write into the current folder unasked
+        raise _error(
+            f"no display found to open a window for {source}; write a movie instead with --out {source.stem}.mp4"
+        )
     if out is not None:
         if out.suffix.lower() not in MOVIE_SUFFIXES:
             raise _error(f"--out must end in .mp4 or .gif, got {str(out)!r}")
-        if out.exists() and not args.force:
-            raise _error(f"{out} exists; add --force to overwrite it")
-        if not out.parent.exists():
-            raise _error(f"folder {out.parent} does not exist")
+        files.check_output(out, args.force, "movie")
     try:
         motion = bvh.load(source, scale=args.scale)
     except bvh.BVHError as e:
@@ -111,7 +107,9 @@ def _cmd_view(args) -> int:
         try:
             motion = humanoid.to_canonical(motion)
         except humanoid.RigMappingError as e:
-            raise _error(str(e)) from None
+            from motionlab.cli import rig_error
+
+            raise rig_error(e, "input", source) from None
     if args.start < 0:
         raise _error(f"--start must be 0 or more, got {args.start}")
     if args.start or args.stop is not None:
@@ -142,7 +140,7 @@ def register(subparsers) -> None:
         "view",
         help="play a BVH file in 3D, or write it to an MP4/GIF movie",
         description="Play FILE.bvh in a 3D window (where a display exists) or render it off-screen to a movie "
-        "(--out, or <stem>.mp4 when there is no display). Foot contacts light up red.",
+        "with --out (needed where there is no display). Foot contacts light up red.",
     )
     p.add_argument("file", help="BVH file to play")
     p.add_argument("--out", metavar="MOVIE", help="write a movie instead of opening a window (.mp4 or .gif)")

@@ -82,16 +82,16 @@ def contact_labels(
 ) -> np.ndarray:
     """Foot-contact labels (T, J): True where a foot joint is near the ground and nearly still.
 
+    A foot joint counts as touching when its height is below its own standing height (rest pose,
+    relative to the lowest joint) plus 2 % of the body height, and it moves slower than 0.3 body
+    heights per second (see :func:`motionlab.core.metrics.foot_contacts`).
+
     Parameters
     ----------
     skeleton : the rig (its rest pose sets how high each foot joint sits when standing)
     positions : ndarray, shape (T, J, 3)   world joint positions, metres, ground at y = 0
     fps : frames per second
     feet : foot joint indices; default :func:`foot_joints`
-
-    A foot joint counts as touching when its height is below its own standing height (rest pose,
-    relative to the lowest joint) plus 2 % of the body height, and it moves slower than 0.3 body
-    heights per second (see :func:`motionlab.core.metrics.foot_contacts`).
     """
     positions = np.asarray(positions, dtype=np.float64)
     if positions.ndim != 3 or positions.shape[1:] != (skeleton.num_joints, 3):

@@ -9,8 +9,8 @@ about a minute); run it by hand or in a CI job that has both::
 
 What it does:
 
-1. copies the notebook to a temporary folder (so JupyterLab's autosave never writes outputs
-   into the repository) and starts JupyterLab there on 127.0.0.1 with a random token and port;
+1. copies the notebook without its stored outputs to a temporary folder (so the sentinel must
+   come from this run, and JupyterLab's autosave never writes into the repository) and starts JupyterLab there on 127.0.0.1 with a random token and port;
 2. opens ``/lab/tree/<notebook>?token=…&reset`` in headless chromium through playwright,
    runs *Run → Run All Cells* and waits for the sentinel ``NOTEBOOK 04 DONE``;
 3. checks that output images (``.jp-RenderedImage img``) and widget images loaded, that the
@@ -46,6 +46,15 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[2]
 NOTEBOOK = REPO / "notebooks" / "04_playback_and_bone_proportions.ipynb"
 SENTINEL = "NOTEBOOK 04 DONE"
+
+
+def _copy_without_outputs(source: Path, target: Path) -> None:
+    """The notebook is committed with outputs (the sentinel among them): the browser must make its own."""
+    nb = json.loads(source.read_text(encoding="utf-8"))
+    for cell in nb["cells"]:
+        if cell["cell_type"] == "code":
+            cell["outputs"], cell["execution_count"] = [], None
+    target.write_text(json.dumps(nb, indent=1), encoding="utf-8")
 
 
 def _free_port() -> int:
@@ -242,7 +251,7 @@ def main(argv: list[str] | None = None) -> int:
         print("chromium not found: apt-get install -y chromium", file=sys.stderr)
         return 1
     folder = Path(tempfile.mkdtemp(prefix="motionlab_nb04_"))
-    shutil.copy(NOTEBOOK, folder / NOTEBOOK.name)
+    _copy_without_outputs(NOTEBOOK, folder / NOTEBOOK.name)
     port, token = _free_port(), secrets.token_hex(16)
     log_path = folder / "jupyterlab.log"
     with open(log_path, "w") as log:

@@ -13,7 +13,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from motionlab.core import bvh, quat
+from motionlab.core import bvh, humanoid, quat
 from motionlab.core.bvh import BVHError
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
@@ -267,10 +267,13 @@ def test_scale_and_names():
 def test_zero_frames_and_zero_channels():
     m = bvh.loads(bvh_text("ROOT A\n{\nOFFSET 0 0 0\nCHANNELS 3 Xrotation Yrotation Zrotation\n}", []))
     assert m.local_rot.shape == (0, 1, 4) and m.root_pos.shape == (0, 3)
-    assert bvh.loads(bvh.dumps(m)).num_frames == 0
+    # read, but never written: Blender cannot import a 0-frame file
+    with pytest.raises(ValueError, match="0 frames"):
+        bvh.dumps(m)
     m = bvh.loads(bvh_text("ROOT A\n{\nOFFSET 1 0 0\nCHANNELS 0\n}", ["", "", ""]))
     assert m.num_frames == 3
-    assert bvh.loads(bvh.dumps(m)).num_frames == 3
+    back = bvh.loads(bvh.dumps(m))
+    assert back.num_frames == 3 and back.skeleton.channels == (("Zrotation", "Yrotation", "Xrotation"),)
 
 
 def test_load_uses_file_stem_and_names_the_file_in_errors(tmp_path):
@@ -432,7 +435,7 @@ def assert_same_motion(a: Motion, b: Motion, atol: float = 1e-8):
     assert sa.names == sb.names
     np.testing.assert_array_equal(sa.parents, sb.parents)
     np.testing.assert_allclose(sa.offsets, sb.offsets, atol=atol)
-    assert sa.channels == sb.channels
+    assert_written_layouts(sa.channels, sb.channels)
     assert sa.end_sites.keys() == sb.end_sites.keys()
     for j in sa.end_sites:
         np.testing.assert_allclose(sa.end_sites[j], sb.end_sites[j], atol=atol)
@@ -444,6 +447,29 @@ def assert_same_motion(a: Motion, b: Motion, atol: float = 1e-8):
     assert (a.local_pos is None) == (b.local_pos is None)
     if a.local_pos is not None:
         np.testing.assert_allclose(a.local_pos, b.local_pos, atol=atol)
+
+
+def assert_written_layouts(original, written):
+    """``written`` is ``original`` with the missing rotation axes added (three per joint, for Blender)."""
+    if original is None:
+        return
+    assert len(original) == len(written)
+    for a, b in zip(original, written):
+        assert [c for c in b if c in a] == list(a), (a, b)  # the original channels, in their order
+        assert sorted(c[0] for c in b if c.endswith("rotation")) == ["X", "Y", "Z"], b
+        assert [c for c in b if c.endswith("position")] == [c for c in a if c.endswith("position")]
+
+
+def test_written_files_have_three_rotation_channels_per_joint():
+    """Blender's importer fails on joints with one or two rotation channels: they get all three."""
+    m = bvh.loads(MIXED)
+    assert any(0 < sum(c.endswith("rotation") for c in layout) < 3 for layout in m.skeleton.channels)
+    text = bvh.dumps(m)
+    for line in text.splitlines():
+        if line.strip().startswith("CHANNELS"):
+            assert sum(w.endswith("rotation") for w in line.split()) == 3, line
+    assert "CHANNELS 2 Zrotation Xrotation" not in text
+    assert_same_motion(m, bvh.loads(text))
 
 
 def test_save_load_round_trip(tmp_path):
@@ -484,19 +510,15 @@ def test_failed_save_leaves_no_file(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["keep.bvh"]
 
 
-def test_rotation_outside_the_channel_layout_is_refused():
+def test_rotation_outside_the_read_channels_is_written():
+    """Written layouts have all three rotation axes, so rotations outside the read channels survive."""
     m = bvh.loads(MIXED)
     fixed = MIXED_NAMES.index("Fixed")
     turned = m.copy()
     turned.local_rot[0, fixed] = rot("x", [10])
-    with pytest.raises(ValueError, match="'Fixed'.*no rotation channels.*frame 0"):
-        bvh.dumps(turned)
+    assert_rot_close(bvh.loads(bvh.dumps(turned)).local_rot[0, fixed], turned.local_rot[0, fixed])
     leg = MIXED_NAMES.index("newVegas:LeftLeg")
-    turned = m.copy()
-    turned.local_rot[1, leg] = rot("y", [5])  # the leg only has Zrotation Xrotation
-    with pytest.raises(ValueError, match="'newVegas:LeftLeg'.*Zrotation Xrotation.*frame 1"):
-        bvh.dumps(turned)
-    turned.local_rot[1, leg] = rot("zx", [170, -120])  # expressible, however large
+    turned.local_rot[1, leg] = rot("y", [5])  # the leg only has Zrotation Xrotation in the file
     assert_rot_close(bvh.loads(bvh.dumps(turned)).local_rot[1, leg], turned.local_rot[1, leg])
 
 
@@ -589,7 +611,7 @@ def random_motions(draw):
         st.lists(st.text("abcXYZ_019:-.", min_size=1, max_size=6), min_size=n_joints, max_size=n_joints, unique=True)
     )
     names = [prefix + n for n in names]
-    n_frames = draw(st.integers(0, 4))
+    n_frames = draw(st.integers(1, 4))
     fps = draw(st.sampled_from([30.0, 60.0, 120.0, 1 / 0.016667, 1 / 0.0333333]) | st.floats(0.5, 1000.0))
     rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
     offsets = rng.uniform(-0.5, 0.5, size=(n_joints, 3))
@@ -689,9 +711,77 @@ def test_real_file_loads_and_round_trips(path, tmp_path):
     pos = m.global_positions()
     assert np.isfinite(pos).all()
     back = bvh.load(bvh.save(tmp_path / path.name, m))
-    assert back.skeleton.names == m.skeleton.names and back.skeleton.channels == m.skeleton.channels
+    assert back.skeleton.names == m.skeleton.names
+    assert_written_layouts(m.skeleton.channels, back.skeleton.channels)
     np.testing.assert_array_equal(back.skeleton.parents, m.skeleton.parents)
     np.testing.assert_allclose(back.skeleton.offsets, m.skeleton.offsets, atol=1e-8)
     assert back.fps == m.fps
     size = max(1.0, float(np.abs(pos).max()))
     np.testing.assert_allclose(back.global_positions(), pos, rtol=0, atol=1e-6 * size)
+
+
+# ------------------------------------------------------------------------------ line ends, memory
+def test_cr_only_line_ends_read_like_lf():
+    """Old Mac files end lines with CR alone; they used to fail on 'line 1'."""
+    lf = bvh.loads(MIXED)
+    cr = bvh.loads(MIXED.replace("\n", "\r"))
+    assert_identical(lf, cr)
+    bad = MIXED.replace("-1 89 -2", "-1 89").replace("\n", "\r")
+    line = next(i + 1 for i, s in enumerate(MIXED.split("\n")) if s.startswith("-1 89"))
+    with pytest.raises(BVHError, match=rf"line {line}: expected 21 values"):
+        bvh.loads(bad)
+
+
+def test_load_streams_with_memory_below_three_times_the_file(tmp_path):
+    import tracemalloc
+
+    from motionlab import synthetic
+
+    motion = synthetic.generate("walk", humanoid.canonical_skeleton(), num_frames=6000, fps=60, seed=0)
+    path = bvh.save(tmp_path / "long.bvh", motion)
+    size = path.stat().st_size
+    import motionlab.core.bvh as module
+
+    old = module.CHUNK
+    module.CHUNK = 1 << 16  # a file many chunks long (as a 200 MB file is with the default)
+    tracemalloc.start()
+    try:
+        back = bvh.load(path)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+        module.CHUNK = old
+    assert back.num_frames == 6000
+    assert peak <= 3 * size, f"peak {peak / 1e6:.1f} MB for a {size / 1e6:.1f} MB file"
+    # the streamed reader gives exactly what reading the text in one piece gives, across chunk borders
+    module.CHUNK = 1000  # borders inside lines
+    try:
+        assert_identical(back, bvh.loads(path.read_bytes(), name=back.name))
+        assert_identical(back, bvh.load(path))
+    finally:
+        module.CHUNK = old
+
+
+def assert_identical(a: Motion, b: Motion):
+    assert a.skeleton.names == b.skeleton.names and a.skeleton.channels == b.skeleton.channels
+    np.testing.assert_array_equal(a.skeleton.offsets, b.skeleton.offsets)
+    np.testing.assert_array_equal(a.local_rot, b.local_rot)
+    np.testing.assert_array_equal(a.root_pos, b.root_pos)
+    assert (a.local_pos is None) == (b.local_pos is None) and a.fps == b.fps
+
+
+@pytest.mark.parametrize("order", ["xyz", "xzy", "yxz", "yzx", "zxy", "zyx"])
+def test_closed_form_euler_matches_quat_from_euler(order):
+    angles = np.random.default_rng(0).uniform(-400, 400, size=(50, 3, 3))
+    out = np.empty((50, 3, 4))
+    bvh._euler_into(out, angles, order)
+    assert_rot_close(out, quat.from_euler(np.radians(angles), order), tol=1e-14)
+    small = angles[np.abs(angles).max(axis=(1, 2)) < 360]  # below a full turn: the same quaternion
+    bvh._euler_into(out[: len(small)], small, order)
+    np.testing.assert_allclose(out[: len(small)], quat.from_euler(np.radians(small), order), atol=1e-15)
+
+
+def test_a_file_ending_on_the_frame_time_line_names_that_line():
+    text = SMALL[: SMALL.index("Frame Time: 0.0333333") + len("Frame Time: 0.0333333")]
+    with pytest.raises(BVHError, match="line 18: expected 3 frame lines"):
+        bvh.loads(text)

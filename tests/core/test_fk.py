@@ -308,3 +308,27 @@ def test_fk_does_not_modify_inputs(rng):
     fk_torch.bone_directions(tpos, parents)
     np.testing.assert_array_equal(trot.numpy(), saved[0])
     np.testing.assert_array_equal(tpos.numpy(), saved[1])
+
+
+def test_blocked_fk_matches_the_per_joint_definition_across_block_borders():
+    """fk works on blocks of frames laid out component by component; the result must not notice."""
+    from motionlab.core import fk as fk_module
+
+    rng = np.random.default_rng(3)
+    parents = np.array([-1, 0, 1, 1, 3, 0, 5])
+    n = 2 * fk_module._CHUNK + 17
+    local_rot = quat.normalize(rng.normal(size=(n, 7, 4)))
+    local_pos = rng.normal(size=(n, 7, 3))
+    g_rot, g_pos = fk_module.fk(local_rot, local_pos, parents)
+    ref_rot, ref_pos = local_rot.copy(), local_pos.copy()
+    for j in range(1, 7):  # the definition, one joint at a time
+        p = parents[j]
+        ref_rot[:, j] = quat.mul(ref_rot[:, p], local_rot[:, j])
+        ref_pos[:, j] = ref_pos[:, p] + quat.rotate(ref_rot[:, p], local_pos[:, j])
+    np.testing.assert_allclose(g_rot, ref_rot, atol=1e-12)
+    np.testing.assert_allclose(g_pos, ref_pos, atol=1e-12)
+    # leading batch shapes and shared offsets broadcast as before
+    b_rot, b_pos = fk_module.fk(local_rot[:12].reshape(3, 4, 7, 4), local_pos[0], parents)
+    s_rot, s_pos = fk_module.fk(local_rot[:12], np.broadcast_to(local_pos[0], (12, 7, 3)), parents)
+    np.testing.assert_allclose(b_pos.reshape(12, 7, 3), s_pos, atol=1e-12)
+    np.testing.assert_allclose(b_rot.reshape(12, 7, 4), s_rot, atol=1e-12)

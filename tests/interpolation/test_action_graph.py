@@ -1,5 +1,6 @@
 """The action graph: edges from data and from a user list, shortest paths, best transition frames."""
 
+import numpy as np
 import pytest
 
 from motionlab.interpolation.action_graph import ActionGraph, GraphError, parse_transition
@@ -45,12 +46,33 @@ def test_path_is_shortest_chain(graph):
         graph.path("squat", "run")
 
 
-def test_best_transition_is_the_minimum_distance(graph):
+def test_best_transition_is_the_minimum_distance_between_key_frames(graph):
     i, j, d = graph.best_transition("run", "walk")
+    ka, kb = graph.nodes["run"].keys, graph.nodes["walk"].keys
+    assert i in ka and j in kb
     full = distance_matrix(graph.nodes["run"].features, graph.nodes["walk"].features)
-    assert d == pytest.approx(full.min())
-    assert full[i, j] == pytest.approx(full.min())
+    assert d == pytest.approx(full[np.ix_(ka, kb)].min())
+    assert full[i, j] == pytest.approx(d)
     assert graph.best_transition("run", "walk") == (i, j, d)  # cached
+
+
+def test_key_frames_come_from_ppca(monkeypatch):
+    """add_node's key frames are the PPCA latent's medoids: swapping PPCA out changes nothing else."""
+    from motionlab.interpolation import keyposes
+
+    calls = []
+
+    class Spy(keyposes.PPCA):
+        def fit(self, x):
+            calls.append(np.shape(x))
+            return super().fit(x)
+
+    monkeypatch.setattr(keyposes, "PPCA", Spy)
+    g = ActionGraph()
+    node = g.add_node("walk", toy_motion(40))
+    assert calls and calls[0] == node.features.shape
+    keys, latent = keyposes.node_key_frames(node.features, 5)
+    np.testing.assert_array_equal(node.keys, keys)
 
 
 def test_classify_frames_of_known_nodes(graph):

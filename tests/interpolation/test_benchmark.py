@@ -68,7 +68,7 @@ def test_metrics_known_answers():
     rng = np.random.default_rng(0)
     q = rng.normal(size=(4, 6, 3, 4))
     assert bm.l2q(q, q) == 0.0
-    assert bm.l2q(-q, q) == 0.0  # sign never counts
+    assert bm.l2q(-q, q) > 0.0  # no sign flip at scoring (LaFAN1's protocol)
     x = rng.normal(size=(4, 6, 3, 3))
     mean, std = np.zeros(9), np.full(9, 2.0)
     shifted = x + np.array([1.0, 0.0, 0.0])
@@ -113,3 +113,32 @@ def test_continuous_removes_sign_flips():
     q[3] *= -1
     out = bm.continuous(q, axis=0)
     assert np.all(out[..., 0] > 0)
+
+
+def test_outputs_continue_the_context_sign_before_scoring(windows):
+    """A method returning -q scores exactly like one returning q (made continuous with the last
+    context frame before FK), while l2q itself flips nothing."""
+
+    def negated(w, n_past, gap):
+        rot, trans = bm.method_interpolation(w, n_past, gap)
+        return -rot, trans
+
+    stats = (np.zeros(7 * 3), np.ones(7 * 3))
+    res = bm.evaluate(windows, {"interp": bm.method_interpolation, "neg": negated}, stats, gaps=(15, 45))
+    for gap in (15, 45):
+        assert res[("neg", "L2Q", gap)] == pytest.approx(res[("interp", "L2Q", gap)], abs=1e-12)
+    last = windows.local_rot[:, bm.N_PAST - 1]
+    out = bm.continue_from_context(-np.repeat(last[:, None], 3, axis=1), last)
+    np.testing.assert_allclose(out, np.repeat(last[:, None], 3, axis=1))
+
+
+def test_cost_limit_chosen_on_apart_windows(clips, windows):
+    lib = MotionLibrary(clips, labels=[bm.action_label(c.name) for c in clips])
+    stats = bm.position_stats(clips)
+    limit = bm.choose_max_cost(windows, lib, stats, gaps=(15,), k=1)
+    assert limit >= 0.0
+    capped = bm.method_library(lib, k=1, max_cost=-1.0)  # nothing trusted: plain interpolation
+    rot, trans = capped(windows, bm.N_PAST, 15)
+    i_rot, i_trans = bm.method_interpolation(windows, bm.N_PAST, 15)
+    np.testing.assert_allclose(rot, i_rot)
+    np.testing.assert_allclose(trans, i_trans)

@@ -49,3 +49,21 @@ def test_fill_gaps_with_graph(dropped, tmp_path, capsys):
     out = tmp_path / "g.bvh"
     assert main(["fill-gaps", str(dropped), "-o", str(out), "--method", "graph", "--action", f"walk={clip}"]) == 0
     assert "via walk" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("flag", ["--threshold", "--delta", "--factor"])
+@pytest.mark.parametrize("value", ["-1", "0", "nan"])
+def test_fill_gaps_refuses_nonsense_delta(dropped, tmp_path, capsys, flag, value):
+    out = tmp_path / "o.bvh"
+    assert main(["fill-gaps", str(dropped), "-o", str(out), flag, value]) == 2
+    assert "--delta (--threshold) must be a finite number above 1" in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_fill_gaps_on_a_clean_clip_writes_an_unchanged_copy(tmp_path, capsys):
+    clean = tmp_path / "clean.bvh"
+    bvh.save(clean, toy_motion(120))
+    out = tmp_path / "copy.bvh"
+    assert main(["fill-gaps", str(clean), "-o", str(out)]) == 0
+    assert "unchanged copy" in capsys.readouterr().out
+    assert out.read_bytes() == clean.read_bytes()

@@ -40,12 +40,14 @@ def test_fill_rows_linear_and_edges():
         gaps.fill_rows(np.full((3, 2), np.nan))
 
 
-def test_distance_rule_finds_dropped_frames():
+def test_detected_gap_is_inserted():
+    from motionlab.interpolation import detect
+
     m = toy_motion(120)
     keep = np.r_[0:40, 48:120]
-    found = gaps.distance_gaps(m[keep])
+    found = detect.detect(m[keep])
     assert [i for i, _ in found] == [39]
-    assert abs(found[0][1] - 8) <= 2
+    assert abs(found[0][1] - 8) <= 1
     expanded, where = gaps.insert_missing(m[keep], found)
     assert where == [(40, 40 + found[0][1])]
     assert expanded.num_frames == len(keep) + found[0][1]
@@ -80,6 +82,27 @@ def test_graph_fill_across_actions_places_key_poses():
     assert np.all(np.isfinite(out.local_rot))
     with pytest.raises(ValueError, match="ActionGraph"):
         gaps.fill(joined, method="graph")
+
+
+def test_graph_fill_passes_through_the_key_pose_at_the_best_transition_frame():
+    """Fails if the fill bypasses the key poses: the anchor holds the intermediate node's key frame,
+    and moving that node's key frames moves what the fill inserts."""
+    from motionlab.interpolation.inbetween import concatenate
+
+    g, run, walk, stand = _run_walk_stand()
+    joined, _ = gaps.insert_missing(concatenate([run[:30], stand[:20]]), [(29, 20)])
+    out, report = gaps.fill(joined, method="graph", graph=g)
+    (slot,) = report[0].anchors
+    _, j, _ = g.best_transition("run", "walk")
+    assert j in g.nodes["walk"].keys
+    np.testing.assert_allclose(out.local_rot[slot, 1:], walk.local_rot[j, 1:])
+    other = next(
+        k for k in range(walk.num_frames) if k != j and not np.allclose(walk.local_rot[k, 1:], walk.local_rot[j, 1:])
+    )
+    g.nodes["walk"].keys = np.array([other])
+    g._best.clear()
+    out2, _ = gaps.fill(joined, method="graph", graph=g)
+    np.testing.assert_allclose(out2.local_rot[slot, 1:], walk.local_rot[other, 1:])
 
 
 @pytest.mark.realdata
@@ -228,3 +251,31 @@ def test_graph_fill_root_is_c1_through_key_poses(monkeypatch):
     assert old[at].max() > 3.0 * np.median(old[inside])  # the unsmoothed fill has corners
     assert new[at].max() < 0.5 * old[at].max()
     assert np.all(new[at] <= 1.25 * np.maximum(new[at - 1], new[at + 1]))
+
+
+def test_moving_slerp_ends_and_frozen_case():
+    from motionlab.core import quat
+
+    rng = np.random.default_rng(1)
+    a = quat.normalize(rng.normal(size=(6, 3, 4)))
+    b = quat.normalize(rng.normal(size=(6, 3, 4)))
+    ta, tb = rng.normal(size=(6, 3, 3)), rng.normal(size=(6, 3, 3))
+    rot, trans = gaps.moving_slerp(a, ta, b, tb)
+    np.testing.assert_allclose(rot[0], a[0])
+    np.testing.assert_allclose(np.abs(np.sum(rot[-1] * b[-1], axis=-1)), 1.0)
+    np.testing.assert_allclose(trans[[0, -1]], [ta[0], tb[-1]])
+    frozen, _ = gaps.moving_slerp(np.repeat(a[:1], 6, 0), ta, np.repeat(b[:1], 6, 0), tb)
+    plain = quat.slerp(a[0][None], b[0][None], (np.arange(6) / 5)[:, None])
+    np.testing.assert_allclose(np.abs(np.sum(frozen * plain, axis=-1)), 1.0, atol=1e-12)
+
+
+def test_across_nodes_pieces_move_rather_than_slide_between_two_poses():
+    """Fails if the pieces between anchors were plain SLERP between the anchor poses."""
+    from motionlab.interpolation.inbetween import concatenate, fill_between
+
+    g, run, walk, stand = _run_walk_stand()
+    joined, _ = gaps.insert_missing(concatenate([run[:30], stand[:20]]), [(29, 20)])
+    out, report = gaps.fill(joined, method="graph", graph=g)
+    (slot,) = report[0].anchors
+    plain = fill_between(out, 30, slot)
+    assert not np.allclose(out.local_rot[30:slot, 1:], plain.local_rot[30:slot, 1:], atol=1e-3)

@@ -1,25 +1,33 @@
-"""Clip names -> labels."""
+"""Clip names -> labels; a take number never makes a style."""
 
 from __future__ import annotations
 
 import pytest
 
-from motionlab.motion_graphs.naming import MIXAMO_AJ, NamingError, label_name, parse_name
+from motionlab.motion_graphs.naming import MIXAMO_AJ, ClipLabel, NamingError, label_name, parse_name
 
 
 @pytest.mark.parametrize(
-    "name, text",
+    "name, text, take",
     [
-        ("Walk_creepingly", "walk_creepingly"),
-        ("Walk_happily_to_Run_fast", "walk_happily_to_run_fast"),
-        ("Transition_Walk_normal_Run_slowly", "walk_normal_to_run_slowly"),
-        ("dataset-1_walk_angry_001.bvh", "walk_angry"),
-        ("data/dataset-1_walk-back_not-confident_001", "walk-back_not-confident"),
-        ("dataset-1_walk_normal_002", "walk_normal-2"),
+        ("Walk_creepingly", "walk_creepingly", None),
+        ("Walk_happily_to_Run_fast", "walk_happily_to_run_fast", None),
+        ("Transition_Walk_normal_Run_slowly", "walk_normal_to_run_slowly", None),
+        ("dataset-1_walk_angry_001.bvh", "walk_angry_001", "001"),
+        ("data/dataset-1_walk-back_not-confident_001", "walk-back_not-confident_001", "001"),
+        ("dataset-2_walk_normal_017", "walk_normal_017", "017"),
+        ("Walk_angry_3", "walk_angry_3", "3"),
     ],
 )
-def test_forms(name, text):
-    assert label_name(parse_name(name)) == text
+def test_forms(name, text, take):
+    lab = parse_name(name)
+    assert label_name(lab) == text and lab.take == take
+    assert parse_name(label_name(lab)) == lab  # the canonical text reads back to the same label
+
+
+def test_takes_share_a_style():
+    a, b = parse_name("dataset-2_walk_normal_001"), parse_name("dataset-2_walk_normal_050")
+    assert a.key == b.key == ("walk", "normal") and a.take != b.take
 
 
 def test_name_map_and_errors():
@@ -29,3 +37,15 @@ def test_name_map_and_errors():
         parse_name("Jazz_Dancing_Twice")
     with pytest.raises(NamingError, match="name map"):
         parse_name("X", {"X": "not a label"})
+
+
+def test_callable_name_map():
+    # another naming scheme: "<subject>-<style>-<behaviour>-take<k>"
+    def scheme(stem):
+        bits = stem.split("-")
+        return f"{bits[2]}_{bits[1]}_{bits[3][4:]}" if len(bits) == 4 else None
+
+    lab = parse_name("s07-proud-walk-take12", scheme)
+    assert lab == ClipLabel("basic", "walk", "proud", take="12")
+    assert parse_name("Walk_sad", scheme).key == ("walk", "sad")  # None falls back to the built-in forms
+    assert parse_name("x", lambda s: ClipLabel("basic", "run", "fast")).key == ("run", "fast")

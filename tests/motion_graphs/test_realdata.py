@@ -26,3 +26,30 @@ def test_bandai_walk_styles_end_to_end():
     g.check_path(r.pieces)
     for req, got in zip(r.requested, r.achieved):
         assert abs(got - req) <= max(2, search.TOLERANCE * req)
+
+
+def test_session_takes_pool_and_connect():
+    """Four takes each of three dataset-2 walk styles: one style per name, whatever the take;
+    the behaviour's largest component holds >= 90% of its frames; every style reaches every other."""
+    from motionlab.core import bvh
+    from motionlab.motion_graphs import distance, report
+
+    if not data.has_data("bandai_namco", "sessions", "walk"):
+        pytest.skip(f"needs real mocap (bandai_namco/sessions/walk): {data.HOW_TO}")
+    root = data.data_root() / "bandai_namco" / "sessions" / "walk"
+    ms = []
+    for style in ("normal", "elderly", "feminine"):
+        for path in sorted(root.glob(f"dataset-2_walk_{style}_*.bvh"))[:4]:
+            ms.append(clips.prepare(bvh.load(path), 30.0).copy(name=path.stem))
+    g = structured.build_structured(ms, distance.threshold_from(0.03))
+    assert sorted(g.table["behaviours"]["walk"]) == ["elderly", "feminine", "normal"]
+    assert all(len(c["takes"]) == 4 for c in g.table["behaviours"]["walk"].values())
+    rep = report.build_report(g)
+    assert rep["behaviours"]["walk"]["percent"] >= 90.0, report.format_report(rep)
+    for a in ("normal", "elderly", "feminine"):
+        for b in ("normal", "elderly", "feminine"):
+            if a != b:
+                r = search.search(g, f"walk:{a}:150,walk:{b}:150")
+                g.check_path(r.pieces)
+                for req, got in zip(r.requested, r.achieved):
+                    assert abs(got - req) <= max(2, search.TOLERANCE * req)

@@ -52,11 +52,14 @@ def test_parse_request_errors():
 def test_loop_guard():
     import numpy as np
 
+    # frames 0..9, one jump back 9 -> 4: from frame 5 the frames 0..3 can never be reached
     cw = search._Clip(0, 10, np.array([True] * 9 + [False]), np.array([9]), np.array([4]), 9, 4)
     with pytest.raises(search.SearchError, match="loop guard"):
         search._quick_exit(cw, 5, [2], "clip")
     pieces, r, n = search._quick_exit(cw, 5, [2, 7], "clip")
-    assert pieces == [(0, 5, 7)] and n == 3
+    assert pieces == [(0, 5, 7)] and n == 3 and r == 1
+    pieces, r, n = search._quick_exit(cw, 8, [5], "clip")  # the way round through the jump
+    assert pieces == [(0, 8, 9), (0, 4, 5)] and n == 4
 
 
 def test_standard_search_follows_edges(library):
@@ -67,3 +70,50 @@ def test_standard_search_follows_edges(library):
     r = search.search_standard(g, req)
     g.check_path(r.pieces)
     assert r.num_frames == sum(r.achieved)
+
+
+def test_search_crosses_three_styles():
+    """happy -> sad has no interpolation space of its own (hub: normal): the path must pass
+    through both spaces and the normal takes, and still meet the frame counts."""
+    from motionlab.motion_graphs import clips
+
+    styles = {"walk": {k: v for k, v in clips.SYNTHETIC_STYLES["walk"].items() if k in ("normal", "happy", "sad")}}
+    g = structured.build_structured(clips.synthetic_library(fps=30.0, seconds=4.0, styles=styles), THRESHOLD)
+    assert not any({tuple(l["from"]), tuple(l["to"])} == {("walk", "happy"), ("walk", "sad")} for l in g.table["links"])
+    r = search.search(g, "walk:happy:150,walk:sad:150")
+    g.check_path(r.pieces)
+    _within(r)
+    visited = [g.clips[c] for c, _, _ in r.pieces]
+    assert {c.style for c in visited if c.kind == "basic"} == {"happy", "normal", "sad"}
+    spaces = {c.style.split("@")[0] for c in visited if c.kind == "intermediate"}
+    assert spaces == {"normal~happy", "normal~sad"}
+
+
+def test_request_limit_is_named():
+    with pytest.raises(ValueError, match=rf"limit is {search.MAX_FRAMES} frames"):
+        search.parse_request("walk:angry:100000000")
+    with pytest.raises(ValueError, match="MAX_FRAMES"):
+        search.search(None, [("walk", "angry", search.MAX_FRAMES // 2 + 1)] * 2)
+    assert search.parse_request(f"walk:angry:{search.MAX_FRAMES}")[0].frames == search.MAX_FRAMES
+
+
+def test_long_request_is_fast(sgraph):
+    import time
+
+    t0 = time.perf_counter()
+    r = search.search(sgraph, [("walk", "happy", 30_000), ("walk", "normal", 30_000)])
+    assert time.perf_counter() - t0 < 5.0
+    assert r.achieved == r.requested
+    sgraph.check_path(r.pieces[:50])
+
+
+def test_walk_takes_the_fewest_jumps():
+    import numpy as np
+
+    # two takes of 10 frames side by side (no step 9 -> 10); jumps 5->12, 3->15, 8->11, 2->3
+    step = np.array([True] * 9 + [False] + [True] * 9 + [False])
+    cw = search._Clip(0, 20, step, np.array([5, 3, 8, 2]), np.array([12, 15, 11, 3]), -1, -1)
+    pieces, _, n = search._walk(cw, 0, [15], [-1])
+    assert n == 15 and pieces == [(0, 0, 8), (0, 11, 16)]  # one jump; 0..5 -> 12..19 is a frame short
+    reach = search._reach(cw, 0, 15)
+    assert reach[14].min() == 1 and reach[5, 5] == 0 and reach[6, 12] == 1

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -77,3 +79,77 @@ def test_cli_build_search(tmp_path, capsys):
     assert (
         main(["graph-search", str(gs), "--request", "walk:normal:60,walk:happy:60", "-o", str(tmp_path / "s.bvh")]) == 0
     )
+
+
+def test_damaged_graph_files_are_named(sgraph, tmp_path, capsys):
+    good = io.save(tmp_path / "g", sgraph)
+    raw = good.read_bytes()
+    cases = {
+        "truncated.mlgraph": raw[: len(raw) // 3],
+        "garbage.mlgraph": b"\x93NUMPY garbage that is no zip" * 10,
+        "empty.mlgraph": b"",
+    }
+    for name, payload in cases.items():
+        path = tmp_path / name
+        path.write_bytes(payload)
+        with pytest.raises(ValueError, match=name) as e:
+            io.load(path)
+        assert "allow_pickle" not in str(e.value)
+        for argv in (["graph-info", str(path)], ["graph-search", str(path), "--request", "walk:normal:10",
+                                                  "-o", str(tmp_path / "x.bvh")]):  # fmt: skip
+            assert main(argv) == 2
+            err = capsys.readouterr().err
+            assert name in err and "Traceback" not in err and "allow_pickle" not in err
+    assert not (tmp_path / "x.bvh").exists()
+
+
+def test_cli_refuses_overlong_request(tmp_path, capsys):
+    g = tmp_path / "s.mlgraph"
+    assert main(["graph-build", "--synthetic", "-o", str(g)]) == 0
+    capsys.readouterr()
+    assert main(["graph-search", str(g), "--request", "walk:angry:100000000", "-o", str(tmp_path / "x.bvh")]) == 2
+    err = capsys.readouterr().err
+    assert "limit is 100000 frames" in err
+    assert not (tmp_path / "x.bvh").exists()
+
+
+def test_info_counts_the_clips_built_from(tmp_path, capsys):
+    g = tmp_path / "s.mlgraph"
+    assert main(["graph-build", "--synthetic", "-o", str(g), "--report", str(tmp_path / "r.json")]) == 0
+    out = capsys.readouterr().out
+    n = int(out.split("using ")[1].split()[0])
+    assert f"from {n} clips" in out
+    assert "largest strongly connected component: " in out and "largest strongly connected component of walk: " in out
+    assert main(["graph-info", str(g)]) == 0
+    info = json.loads("{" + capsys.readouterr().out.split("\n{", 1)[1])
+    assert info["clips"] == n and info["intermediate_clips"] > 0
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert set(rep["behaviours"]) == {"idle", "walk", "run"}
+
+
+def test_interrupted_search_writes_nothing(tmp_path, capsys, monkeypatch):
+    g = tmp_path / "s.mlgraph"
+    assert main(["graph-build", "--synthetic", "-o", str(g)]) == 0
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(search, "search", interrupted)
+    out = tmp_path / "x.bvh"
+    assert main(["graph-search", str(g), "--request", "walk:normal:90", "-o", str(out)]) == 130
+    assert "interrupted" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == [g]
+
+
+def test_old_format_is_named(sgraph, tmp_path):
+    path = io.save(tmp_path / "g", sgraph)
+    with np.load(path) as z:
+        arrays = {k: z[k] for k in z.files}
+    meta = json.loads(str(arrays["meta"]))
+    meta["format"] = "motionlab-graph-1"
+    arrays["meta"] = np.array(json.dumps(meta))
+    old = tmp_path / "old.mlgraph"
+    with open(old, "wb") as fh:
+        np.savez(fh, **arrays)
+    with pytest.raises(ValueError, match="old.mlgraph.*motionlab-graph-1.*rebuild"):
+        io.load(old)

@@ -38,12 +38,13 @@ def test_view_gif(can_render, clip, tmp_path):
     assert out.read_bytes()[:3] == b"GIF"
 
 
-def test_view_without_display_writes_stem_mp4(can_render, clip, tmp_path, monkeypatch, capsys):
+def test_view_without_display_needs_out_and_writes_nothing(clip, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr("motionlab.viz.backend.has_display", lambda: False)
-    assert main(["view", str(clip), "--stop", "4", *FAST]) == 0
-    assert (tmp_path / "walk.mp4").is_file()
-    assert "no display" in capsys.readouterr().out
+    assert main(["view", str(clip), "--stop", "4", *FAST]) == 2
+    err = capsys.readouterr().err
+    assert "no display" in err and "--out walk.mp4" in err
+    assert not list(tmp_path.glob("*.mp4")) and not list(tmp_path.glob("*.gif"))  # nothing written here
 
 
 @pytest.mark.parametrize(

@@ -3,29 +3,49 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
-__all__ = ["register"]
+__all__ = ["register", "positive"]
 
 
-def _load(path: str):
-    from motionlab.core import bvh
+def positive(text: str) -> float:
+    """argparse type: a finite number > 0 (``--fps 0`` or ``--height -1.7`` are refused by name)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
+    return value
 
-    p = Path(path)
-    if not p.is_file():
-        raise FileNotFoundError(f"{path}: no such file")
-    return bvh.load(p)
+
+def _rig_error(error, role, path):
+    from motionlab.cli import rig_error
+
+    return rig_error(error, role, path)
+
+
+def _load(path: str, what: str = "input"):
+    from motionlab.core import bvh, files
+
+    return bvh.load(files.check_input(path, what))
+
+
+def _count(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected 1 or more, got {text!r}")
+    return value
 
 
 def _check_output(path: str, force: bool) -> Path:
-    from motionlab.cli import CLIError
+    from motionlab.core import files
 
-    out = Path(path)
-    if out.exists() and not force:
-        raise CLIError(f"{out} exists; pass --force to overwrite it")
-    if not out.parent.exists():
-        raise CLIError(f"{out.parent} does not exist")
-    return out
+    return files.check_output(path, force)
 
 
 def _info(args) -> int:
@@ -45,7 +65,7 @@ def _info(args) -> int:
             f"leg length {humanoid.leg_length(canon):.4f} m"
         )
     except humanoid.RigMappingError as e:
-        print(f"humanoid  {e}")
+        print(f"humanoid  does not map: {e.reason}")
     if args.joints:
         depth = sk.depth()
         for j, name in enumerate(sk.names):
@@ -59,9 +79,16 @@ def _convert(args) -> int:
 
     m = _load(args.input)
     out = _check_output(args.output, args.force)
+    if out.resolve() == Path(args.input).resolve():
+        from motionlab.cli import CLIError
+
+        raise CLIError(f"the output {out} is the input file; write to another file")
     if args.canonical:
-        m = humanoid.to_canonical(m)
-    if args.fps:
+        try:
+            m = humanoid.to_canonical(m)
+        except humanoid.RigMappingError as e:
+            raise _rig_error(e, "input", args.input) from None
+    if args.fps is not None:
         m = m.resample(args.fps)
     bvh.save(out, m, overwrite=args.force)
     print(f"wrote {out}: {m.num_frames} frames at {m.fps:g} fps, {m.skeleton.num_joints} joints")
@@ -73,6 +100,10 @@ def _synth(args) -> int:
     from motionlab.core import bvh, humanoid
 
     out = _check_output(args.output, args.force)
+    if args.behaviour != "mix" and int(args.seconds * args.fps) < 1:
+        from motionlab.cli import CLIError
+
+        raise CLIError(f"--seconds {args.seconds:g} at --fps {args.fps:g} is less than one frame")
     skeleton = humanoid.canonical_skeleton(args.height)
     skeleton = humanoid.scale_bones(skeleton, legs=args.legs, arms=args.arms)
     if args.behaviour == "mix":
@@ -104,18 +135,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("input", help="input .bvh")
     p.add_argument("-o", "--output", required=True, help="output .bvh")
     p.add_argument("--canonical", action="store_true", help="reduce to the canonical 22 joints")
-    p.add_argument("--fps", type=float, default=None, help="resample to this frame rate")
+    p.add_argument("--fps", type=positive, default=None, help="resample to this frame rate (frames per second)")
     p.add_argument("--force", action="store_true", help="overwrite the output if it exists")
     p.set_defaults(func=_convert)
 
     p = sub.add_parser("synth", help="write synthetic motion (idle, walk, run, jump, squat or mix) as BVH")
     p.add_argument("behaviour", choices=["idle", "walk", "run", "jump", "squat", "mix"])
     p.add_argument("-o", "--output", required=True, help="output .bvh")
-    p.add_argument("--seconds", type=float, default=4.0, help="length (ignored for mix)")
-    p.add_argument("--fps", type=float, default=60.0)
-    p.add_argument("--height", type=float, default=1.75, help="character height, metres")
-    p.add_argument("--legs", type=float, default=1.0, help="leg length factor")
-    p.add_argument("--arms", type=float, default=1.0, help="arm length factor")
+    p.add_argument("--seconds", type=positive, default=4.0, help="length (ignored for mix)")
+    p.add_argument("--fps", type=positive, default=60.0)
+    p.add_argument("--height", type=positive, default=1.75, help="character height, metres")
+    p.add_argument("--legs", type=positive, default=1.0, help="leg length factor")
+    p.add_argument("--arms", type=positive, default=1.0, help="arm length factor")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--force", action="store_true", help="overwrite the output if it exists")
     p.set_defaults(func=_synth)
@@ -124,7 +155,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         "demo", help="the main job on built-in data: retarget a synthetic performance onto new characters"
     )
     p.add_argument("--out", default="outputs/demo", help="output folder (default: outputs/demo)")
-    p.add_argument("--characters", type=int, default=4, help="how many new characters")
+    p.add_argument("--characters", type=_count, default=4, help="how many new characters (1 or more)")
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--force", action="store_true", help="overwrite files in the output folder")
+    p.add_argument(
+        "--force",
+        action="store_true",
+        help="replace files in an output folder that an earlier demo did not write (a demo folder is always re-used)",
+    )
     p.set_defaults(func=_demo)

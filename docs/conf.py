@@ -1,0 +1,85 @@
+"""Sphinx configuration of motionlab's documentation site.
+
+Build (from the repository root, warnings are errors):  bash scripts/build_docs.sh
+The notebooks are rendered with their stored outputs (myst-nb, execution off); the API reference
+is generated from the docstrings (autodoc + autosummary, numpydoc style through napoleon).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+os.environ.setdefault("PYVISTA_OFF_SCREEN", "true")  # importing motionlab.viz must not open a window
+os.environ.setdefault("MPLBACKEND", "Agg")
+
+project = "motionlab"
+author = "the motionlab authors"
+copyright = "motionlab authors"  # noqa: A001 (the name Sphinx reads)
+
+extensions = [
+    "myst_nb",
+    "sphinx.ext.autodoc",
+    "sphinx.ext.autosummary",
+    "sphinx.ext.napoleon",
+    "sphinx.ext.mathjax",
+    "sphinx-mathjax-offline",  # MathJax served from the site itself: formulas render offline too
+    "sphinx.ext.viewcode",
+]
+
+# --- sources --------------------------------------------------------------------------------
+# The site renders the notebooks as committed: they are copied from ../notebooks into
+# docs/notebooks (git-ignored) on every build. The instructor's key (notebooks/solutions) is not
+# copied: it stays out of the students' site.
+NOTEBOOKS = ROOT / "notebooks"
+_copies = Path(__file__).resolve().parent / "notebooks"
+_copies.mkdir(exist_ok=True)
+for _old in _copies.glob("*.ipynb"):
+    if not (NOTEBOOKS / _old.name).exists():
+        _old.unlink()
+for _nb in sorted(NOTEBOOKS.glob("*.ipynb")):
+    _target = _copies / _nb.name
+    if not _target.exists() or _target.read_bytes() != _nb.read_bytes():
+        shutil.copyfile(_nb, _target)
+
+exclude_patterns = ["_build", "**/.ipynb_checkpoints"]
+# .rst first: autosummary writes its generated API pages with the first suffix
+source_suffix = {".rst": "restructuredtext", ".md": "myst-nb", ".ipynb": "myst-nb"}
+
+# --- notebooks: stored outputs only ----------------------------------------------------------
+nb_execution_mode = "off"
+myst_enable_extensions = ["dollarmath", "amsmath"]
+myst_heading_anchors = 3
+# The players are ipywidgets: without a kernel their widget view is empty, so show the picture
+# each one stores beside it (its first frame) instead.
+nb_mime_priority_overrides = [("html", "application/vnd.jupyter.widget-view+json", None)]
+
+# --- API reference ---------------------------------------------------------------------------
+autosummary_generate = True
+autosummary_imported_members = False
+# each object once, on the page of the module that defines it (packages re-export names in __all__)
+autodoc_default_options = {"members": True, "ignore-module-all": True}
+autodoc_member_order = "bysource"
+autodoc_typehints = "none"  # the numpydoc sections state shapes and units
+napoleon_google_docstring = False
+napoleon_numpy_docstring = True
+napoleon_use_rtype = False
+
+# --- HTML ------------------------------------------------------------------------------------
+html_theme = "sphinx_book_theme"
+html_title = "motionlab"
+html_theme_options = {
+    "show_toc_level": 2,
+    "use_download_button": True,
+    "home_page_in_toc": True,
+}
+html_static_path: list[str] = []
+
+# numpydoc parameter types here describe shapes and components ("ndarray, shape (T, J, 4),
+# (w, x, y, z)"), not Python objects; Sphinx looks up words such as `x` or `start` in them and
+# warns when several attributes share the name. Those lookups are not links anyone wrote.
+suppress_warnings = ["ref.python"]

@@ -1,0 +1,181 @@
+"""Checked file paths and atomic writes, shared by every writer in the package.
+
+Reading: :func:`check_input` turns the usual surprises (no such file, a folder, no permission)
+into one clear ``OSError`` naming the file and what was expected.
+
+Writing: :func:`check_output` refuses a folder, an existing file without ``overwrite``, a
+missing or unwritable folder — before any work is done. :func:`atomic_write` then writes to a
+temporary file beside the destination and renames it over the destination in one step, so a
+reader never sees a half-written file.
+
+Temporary files are named ``.<name>.<pid>.<random>.motionlab-tmp``. A write that is killed
+(``kill -9``, power loss) cannot remove its own; the next write to the same destination removes
+every such file whose process no longer runs (:func:`remove_stale`), so they never pile up and
+a running writer's file is never touched.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+
+__all__ = ["TMP_SUFFIX", "check_input", "check_output", "atomic_write", "atomic_write_all", "remove_stale"]
+
+TMP_SUFFIX = ".motionlab-tmp"
+"""Ending of every temporary file a motionlab writer creates."""
+
+
+def check_input(path: str | os.PathLike, what: str = "input") -> Path:
+    """``path`` as a Path after checking it is a readable file.
+
+    Raises
+    ------
+    FileNotFoundError, IsADirectoryError, PermissionError
+        With a message naming ``what`` and the path.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise IsADirectoryError(f"{what} {path} is a folder; expected a file")
+    if not path.exists():
+        raise FileNotFoundError(f"{what} file {path} not found")
+    if not os.access(path, os.R_OK):
+        raise PermissionError(f"{what} file {path} is not readable (permission denied)")
+    return path
+
+
+def check_output(path: str | os.PathLike, overwrite: bool = False, what: str = "output") -> Path:
+    """``path`` as a Path after checking that a file can be written there.
+
+    Raises
+    ------
+    IsADirectoryError
+        ``path`` is a folder.
+    FileExistsError
+        ``path`` exists and ``overwrite`` is False.
+    FileNotFoundError
+        The folder ``path`` would go in does not exist.
+    PermissionError
+        That folder is not writable.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise IsADirectoryError(f"{what} {path} is a folder; expected a file name")
+    if path.exists() and not overwrite:
+        raise FileExistsError(f"{what} {path} exists; pass --force (overwrite=True) to replace it")
+    folder = path.parent
+    if not folder.is_dir():
+        raise FileNotFoundError(f"folder {folder} for the {what} {path.name} does not exist")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise PermissionError(f"cannot write the {what} {path.name} into {folder} (permission denied)")
+    return path
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, owned by someone else
+        return True
+    return True
+
+
+def remove_stale(path: str | os.PathLike) -> list[Path]:
+    """Remove temporary files left beside ``path`` by writers that no longer run; returns them."""
+    path = Path(path)
+    pattern = re.compile(rf"\.{re.escape(path.name)}\.(\d+)\.[^.]+{re.escape(TMP_SUFFIX)}\Z")
+    removed = []
+    try:
+        entries = list(path.parent.iterdir())
+    except OSError:
+        return removed
+    for entry in entries:
+        m = pattern.match(entry.name)
+        if m and int(m.group(1)) != os.getpid() and not _alive(int(m.group(1))):
+            try:
+                entry.unlink()
+                removed.append(entry)
+            except OSError:
+                pass
+    return removed
+
+
+def atomic_write_all(outputs: list[tuple], overwrite: bool = False) -> list[Path]:
+    """Write several files as one: every temporary file is complete before the first rename.
+
+    ``outputs`` holds ``(path, write, binary, what)`` tuples as for :func:`atomic_write`. If
+    any ``write`` fails, no destination is touched; the renames at the end cannot fail short
+    of a system failure.
+    """
+    checked = [(check_output(path, overwrite, what), write, binary, what) for path, write, binary, what in outputs]
+    temps: list[tuple[str, Path]] = []
+    try:
+        for path, write, binary, what in checked:
+            remove_stale(path)
+            temps.append((_write_temporary(path, write, binary, what), path))
+        for tmp, path in temps:
+            os.replace(tmp, path)
+    except BaseException:
+        for tmp, _ in temps:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+        raise
+    return [path for _, path in temps]
+
+
+def _write_temporary(path: Path, write: Callable, binary: bool, what: str) -> str:
+    """A complete temporary file beside ``path`` holding what ``write(f)`` wrote, with ``path``'s mode."""
+    if path.exists():
+        mode = path.stat().st_mode & 0o777
+    else:
+        umask = os.umask(0)
+        os.umask(umask)
+        mode = 0o666 & ~umask
+    try:
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.{os.getpid()}.", suffix=TMP_SUFFIX)
+    except OSError as e:  # the folder refuses new files: say which output, not the temporary name
+        raise type(e)(f"cannot write the {what} {path}: {(e.strerror or str(e)).lower()}") from None
+    try:
+        if binary:
+            with os.fdopen(fd, "wb") as f:
+                write(f)
+        else:
+            with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
+                write(f)
+        os.chmod(tmp, mode)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return tmp
+
+
+def atomic_write(
+    path: str | os.PathLike, write: Callable, overwrite: bool = False, binary: bool = False, what: str = "output"
+) -> Path:
+    """Write a file in one step: ``write(f)`` fills a temporary file that then replaces ``path``.
+
+    Parameters
+    ----------
+    path : str or PathLike      the destination
+    write : callable            ``write(f)`` with ``f`` an open file (text, UTF-8, ``\\n`` line ends,
+                                or binary when ``binary``)
+    overwrite : bool            replace an existing ``path`` (default: refuse)
+    what : str                  what messages call the file
+
+    The new file gets the old file's permissions, or the umask's for a new one. On any error
+    (also ``KeyboardInterrupt``) the temporary file is removed and ``path`` is unchanged.
+    """
+    path = check_output(path, overwrite, what)
+    remove_stale(path)
+    tmp = _write_temporary(path, write, binary, what)
+    try:
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return path

@@ -1,0 +1,375 @@
+"""Finding dropped frames in a motion stream, and how many went missing (paper C, §3.3).
+
+A BVH file with a constant frame time cannot say that frames are missing; the motion has to.
+One measure of "how far the body moved between stream frames ``t`` and ``t+1``" is used:
+
+* :func:`joint_steps` — the root-mean-square over joints of the *world* displacement of every
+  joint, metres per stream step. It is what the eye sees: a dive roll that turns the hips upside
+  down moves the joints a few centimetres per frame, however fast the hips' heading spins.
+  (A heading-frame distance — joints relative to a facing direction read off the hips — jumps
+  whenever that heading is ill-defined, which is how the old rule found "gaps" in clean rolls.)
+
+**Stream against the graph** (:func:`graph_gaps`, the paper's rule). Each incoming frame ``M_c`` is
+tracked to the graph frame ``M_i`` nearest to it in pose (heading-frame joint positions), and the
+distance compares how the stream moved into ``M_c`` with how the graph moves at ``M_i``:
+
+.. math::  r(t) = \\frac{s(t)}{\\bar s_{\\text{graph}}(i(t))}, \\qquad
+           D(M_c, M_i) = \\frac{r(t)}{\\operatorname{median}_{\\text{around } t}\\, r}
+
+with ``s(t)`` the stream's joint step into frame ``t`` (m/s) and ``s̄_graph(i)`` the graph clip's
+joint speed at the matched frame ``i`` (mean over ``i−2 … i+2``, never below ``STEP_FLOOR``). The
+graph predicts how fast the body moves *at this pose* (slow at a walk's double support, fast in
+swing); the running median of ``r`` (``WINDOW`` frames on each side, the larger side, and the
+two adjacent values, as in :func:`consecutive_gaps`, so only an isolated jump counts) removes
+the one factor by which this take is slower or faster than the graph's recordings (an exhausted
+walk moves far slower than a normal one; a raw ``r > Δ`` rule flagged many false gaps in clean
+takes of the other Bandai walk styles). With nothing missing ``D ≈ 1``;
+with ``n`` frames missing the stream moved ``n+1`` steps at once, ``D ≈ n+1``. ``D > Δ`` flags a
+gap. **Δ is chosen by principle, not fitted**: one missing frame doubles the step (``D = 2``), the
+largest ``D`` over all 418 clean shared files by the stream-only rule is 1.6, so ``Δ = 2.5``
+(``DELTA``); a single dropped frame can then go unreported, which SLERP fills unnoticed anyway.
+
+**Stream against itself** (:func:`consecutive_gaps`, no graph). The step into a frame is compared
+with the typical steps just before and after it (medians of ``WINDOW`` steps on each side, and
+the two adjacent steps; the largest of the four, so a motion that starts or stops sharply, or a
+brief burst like a cough, is judged by its moving side). A gap makes one isolated step ``n+1``
+times its neighbours; smooth motion, however fast, does not.
+``D = s(t) / max(median before, median after, s(t−1), s(t+1)) > Δ`` with the same ``Δ = 2.5`` default, and steps
+below ``STEP_FLOOR`` are never flagged (a body that hardly moves cannot reveal what it skipped,
+and nothing visible is lost there). This is what ``motionlab fill-gaps`` uses without ``--action``.
+
+**How many frames** (:func:`estimate_missing`). Not from the size of the jump alone — a jump in
+pose saturates once the gap exceeds half a step cycle — but from the motion on both sides: the
+ground distance the reference joint covered across the gap, against how far it travels per frame.
+Walking and running bodies speed up and slow down within every step (±10–20%), so a 10-frame gap
+cut at the fast phase holds more ground than the average speed says: where the ground speed on a
+side of the gap repeats with a step period ``P`` (autocorrelation ≥ 0.5 at a lag of 0.3–1.3 s),
+the gap is filled, in thought, with the last ``P`` steps before it repeated (or the first ``P``
+after it, backwards), and the count is where their cumulative distance reaches the gap's; else
+the mean ground speed over a second on each side is used. A body that does not travel (speed
+below ``STEP_FLOOR``) falls back to the joint-step ratio.
+Timestamps, where the input has them, give the count exactly (:func:`~.gaps.timestamp_gaps`).
+
+Taught in ``notebooks/06_keypose_interpolation.ipynb``; ``motionlab fill-gaps`` uses it.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from motionlab.core.motion import Motion
+from motionlab.interpolation.alignment import reference_joint
+from motionlab.interpolation.features import heading_frame
+
+__all__ = [
+    "DELTA",
+    "STEP_FLOOR",
+    "WINDOW",
+    "check_delta",
+    "body_height",
+    "joint_steps",
+    "consecutive_ratio",
+    "consecutive_gaps",
+    "GraphTrack",
+    "track",
+    "graph_gaps",
+    "estimate_missing",
+    "detect",
+]
+
+DELTA = 2.5
+"""Default Δ: a step 2.5× its neighbours' (one missing frame gives 2×; see the module docstring)."""
+
+STEP_FLOOR = 0.05
+"""Steps slower than this fraction of the body height per second are never flagged."""
+
+WINDOW = 8
+"""Steps on each side whose median is the typical step (:func:`consecutive_gaps`)."""
+
+
+def check_delta(delta, name: str = "delta") -> float:
+    """Δ as a float, or a ``ValueError`` naming ``name`` unless it is a finite number above 1.
+
+    Δ compares a step with the typical step; Δ <= 1 would flag ordinary motion as dropped frames.
+    """
+    try:
+        value = float(delta)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number above 1 (a multiple of the typical step), got {delta!r}") from None
+    if not np.isfinite(value) or value <= 1.0:
+        raise ValueError(f"{name} must be a finite number above 1 (a multiple of the typical step), got {delta!r}")
+    return value
+
+
+def body_height(motion: Motion) -> float:
+    """Highest minus lowest joint of the first frame (metres), at least 1 cm."""
+    pos = motion[:1].global_positions()[0]
+    return max(float(np.ptp(pos[:, 1])), float(np.ptp(pos, axis=0).max()) * 0.5, 0.01)
+
+
+def _positions(motion: Motion) -> np.ndarray:
+    return motion.global_positions()  # (T, J, 3)
+
+
+def joint_steps(motion: Motion) -> np.ndarray:
+    """RMS over joints of each joint's world displacement from frame ``t`` to ``t+1``.
+
+    Returns
+    -------
+    ndarray, shape (T-1,), metres per stream step
+    """
+    pos = _positions(motion)
+    return np.sqrt(np.mean(np.sum(np.diff(pos, axis=0) ** 2, axis=-1), axis=-1))
+
+
+def _side_medians(steps: np.ndarray, window: int) -> tuple[np.ndarray, np.ndarray]:
+    """Median of the ``window`` steps before and after each step (NaN where there are none)."""
+    n = len(steps)
+    pad = np.concatenate([np.full(window, np.nan), steps, np.full(window, np.nan)])
+    idx = np.arange(n)[:, None] + np.arange(window)[None, :]
+    with warnings.catch_warnings():  # an all-NaN window (clip edge) has no median: NaN is the answer
+        warnings.simplefilter("ignore", RuntimeWarning)
+        before = np.nanmedian(pad[idx], axis=1)
+        after = np.nanmedian(pad[idx + window + 1], axis=1)
+    return before, after
+
+
+def consecutive_ratio(motion: Motion, window: int = WINDOW) -> tuple[np.ndarray, np.ndarray]:
+    """``D(t) = s(t) / max(median before, median after, s(t−1), s(t+1))`` for every step, and the
+    steps ``s``.
+
+    Returns
+    -------
+    ratio : ndarray (T-1,)   dimensionless (0 where the step is below the floor)
+    steps : ndarray (T-1,)   metres per stream step (:func:`joint_steps`)
+    """
+    steps = joint_steps(motion)
+    before, after = _side_medians(steps, int(window))
+    prev = np.concatenate([[np.nan], steps[:-1]])
+    nxt = np.concatenate([steps[1:], [np.nan]])
+    typical = np.fmax(np.fmax(before, after), np.fmax(prev, nxt))
+    floor = STEP_FLOOR * body_height(motion) / motion.fps
+    typical = np.where(np.isfinite(typical), np.maximum(typical, floor), np.inf)
+    ratio = np.where(steps > floor, steps / typical, 0.0)
+    return ratio, steps
+
+
+def consecutive_gaps(motion: Motion, delta: float = DELTA, window: int = WINDOW) -> list[int]:
+    """Stream steps ``t → t+1`` (indices ``t``) where frames were dropped, judged against the stream
+    itself: ``D(t) > Δ`` (see the module docstring)."""
+    delta = check_delta(delta)
+    if motion.num_frames < 3:
+        return []
+    ratio, _ = consecutive_ratio(motion, window)
+    return [int(t) for t in np.flatnonzero(ratio > delta)]
+
+
+# ---------------------------------------------------------------------------- against the graph
+@dataclass
+class GraphTrack:
+    """The stream tracked in an action graph (:func:`track`).
+
+    Attributes
+    ----------
+    node : list of str          action node of each stream frame (T,)
+    frame : ndarray (T,)        frame of that node's clip it is matched to
+    distance : ndarray (T,)     ``D(M_c, M_i)`` of each frame (frame 0: 0), dimensionless
+    delta : float               Δ used
+    """
+
+    node: list
+    frame: np.ndarray
+    distance: np.ndarray
+    delta: float
+
+    def gaps(self) -> list[int]:
+        """Steps ``t → t+1`` with ``D > Δ`` at frame ``t+1``."""
+        return [int(t) - 1 for t in np.flatnonzero(self.distance > self.delta)]
+
+
+def _pose(motion: Motion, ref: int | None = None) -> np.ndarray:
+    """Heading-frame joint positions (T, 3J) with the reference joint's height kept."""
+    g_rot, g_pos = motion.fk()
+    j = reference_joint(motion) if ref is None else ref
+    local, _, _ = heading_frame(g_rot, g_pos, j)
+    return local.reshape(len(local), -1)
+
+
+def _graph_tables(graph) -> tuple[list[str], np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Per graph frame: node index, frame index, pose (N, 3J) and smoothed joint step (N,) in m/s."""
+    names = list(graph.nodes)
+    node, frame, pose, speed = [], [], [], []
+    for k, n in enumerate(names):
+        m = graph.nodes[n].motion
+        s = joint_steps(m) * m.fps
+        s = np.concatenate([s[:1], 0.5 * (s[1:] + s[:-1]), s[-1:]]) if len(s) > 1 else np.repeat(s, 2)
+        kernel = np.ones(5) / 5.0
+        s = np.convolve(np.pad(s, 2, mode="edge"), kernel, mode="valid")
+        node.append(np.full(m.num_frames, k))
+        frame.append(np.arange(m.num_frames))
+        pose.append(_pose(m))
+        speed.append(s)
+    return names, np.concatenate(node), np.concatenate(frame), np.concatenate(pose), np.concatenate(speed)
+
+
+def track(motion: Motion, graph, delta: float | None = None) -> GraphTrack:
+    """Track every stream frame in the graph and compute ``D(M_c, M_i)`` (module docstring).
+
+    Parameters
+    ----------
+    motion : Motion on the graph's skeleton, at any frame rate
+    graph : :class:`~.action_graph.ActionGraph`
+    delta : Δ; default :data:`DELTA`
+    """
+    if not graph.nodes:
+        raise ValueError("the action graph has no actions to track the stream in")
+    sk = next(iter(graph.nodes.values())).motion.skeleton
+    if sk.names != motion.skeleton.names:
+        raise ValueError("the stream uses another skeleton than the action graph's clips")
+    delta = check_delta(DELTA if delta is None else delta)
+    names, node, frame, pose, speed = _graph_tables(graph)
+    q = _pose(motion)
+    d2 = np.sum(q * q, axis=1)[:, None] + np.sum(pose * pose, axis=1)[None, :] - 2.0 * q @ pose.T
+    best = np.argmin(d2, axis=1)
+    floor = STEP_FLOOR * body_height(motion)
+    s = np.concatenate([[0.0], joint_steps(motion) * motion.fps])  # step INTO each frame, m/s
+    rel = s / np.maximum(speed[best], floor)  # the stream's speed over the graph's at the match
+    r = rel[1:]
+    before, after = _side_medians(r, WINDOW)
+    near = np.fmax(np.concatenate([[np.nan], r[:-1]]), np.concatenate([r[1:], [np.nan]]))
+    typical = np.concatenate([[np.inf], np.fmax(np.fmax(before, after), near)])
+    typical = np.where(np.isfinite(typical) & (typical > 0), typical, np.inf)
+    dist = np.where(s > floor, rel / typical, 0.0)
+    dist[0] = 0.0
+    return GraphTrack([names[k] for k in node[best]], frame[best], dist, delta)
+
+
+def graph_gaps(motion: Motion, graph, delta: float | None = None) -> list[int]:
+    """Steps ``t → t+1`` where frames were dropped, the stream tracked in ``graph`` (§3.3)."""
+    return track(motion, graph, delta).gaps()
+
+
+# ---------------------------------------------------------------------------- how many
+def _ground_path(motion: Motion) -> np.ndarray:
+    g_rot, g_pos = motion.fk()
+    j = reference_joint(motion)
+    return g_pos[:, j] * np.array([1.0, 0.0, 1.0])
+
+
+def _turn(ground: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> float:
+    """Change of travel direction (radians) between the ground displacements over ``lo`` and ``hi``
+    (index arrays of steps, each ``a → a+1``)."""
+    da = ground[lo[-1] + 1] - ground[lo[0]] if lo.size else np.zeros(3)
+    db = ground[hi[-1] + 1] - ground[hi[0]] if hi.size else np.zeros(3)
+    if np.linalg.norm(da) < 1e-9 or np.linalg.norm(db) < 1e-9:
+        return 0.0
+    return float(abs(np.angle(np.exp(1j * (np.arctan2(db[0], db[2]) - np.arctan2(da[0], da[2]))))))
+
+
+def _step_period(speed: np.ndarray, lo: int, hi: int) -> tuple[int | None, float]:
+    """The lag in ``lo … hi`` frames at which the speed signal (N,) best correlates with itself,
+    and that normalised autocorrelation (``None, -1`` when the signal is too short)."""
+    x = speed - speed.mean()
+    best, lag_best = -1.0, None
+    for lag in range(lo, min(hi, len(x) - 4) + 1):  # a loop over lags, not frames
+        a, b = x[:-lag], x[lag:]
+        r = float(np.sum(a * b) / np.sqrt(np.sum(a * a) * np.sum(b * b) + 1e-18))
+        if r > best:
+            best, lag_best = r, lag
+    return lag_best, best
+
+
+def _phase_count(gstep: np.ndarray, distance: float, before: np.ndarray, after: np.ndarray, fps: float):
+    """Frames ``n + 1`` spanning ``distance`` when the gap repeats the step cycle of its sides, or
+    ``None`` when neither side is periodic enough (see :func:`estimate_missing`)."""
+    lo, hi = max(2, int(round(0.3 * fps))), int(round(1.3 * fps))
+    estimates = []
+    for seq in (gstep[before], gstep[after][::-1]):  # after: predicted backwards from the gap's end
+        if len(seq) < hi + 4:
+            continue
+        period, r = _step_period(seq, lo, hi)
+        if period is None or r < 0.5:
+            continue
+        cycle = seq[-period:]  # the last cycle before the gap (or the first after, reversed)
+        reps = int(np.ceil(distance / max(float(cycle.sum()), 1e-12))) + 1
+        cum = np.concatenate([[0.0], np.cumsum(np.tile(cycle, reps))])
+        estimates.append(float(np.interp(distance, cum, np.arange(len(cum)))))
+    return float(np.mean(estimates)) if estimates else None
+
+
+def estimate_missing(motion: Motion, steps_at, seconds: float = 1.0) -> list[int]:
+    """How many frames went missing at each stream step ``t → t+1`` in ``steps_at``.
+
+    From the motion on both sides, not the jump alone:
+
+    * the ground distance across the gap is the chord ``|g(t+1) − g(t)|`` of the reference
+      joint's ground point, lengthened to the arc of a circle turning by the change ``ψ`` of travel
+      direction between the two sides, ``arc = chord · (ψ/2) / sin(ψ/2)``;
+    * **step phase**: where the ground speed on a side (up to two seconds, other gaps left out)
+      repeats with a period ``P`` of 0.3–1.3 s (normalised autocorrelation ≥ 0.5), the gap is taken
+      to repeat that side's last cycle (before) or first cycle (after, backwards) and ``n + 1`` is
+      where the cycle's cumulative ground distance reaches the arc; both sides are averaged;
+    * otherwise ``n + 1 = arc / v`` with ``v`` the mean ground speed (metres per frame) over
+      ``seconds`` on each side. (A straight-line fit of speed on each side, read at the gap's
+      edges, and a pose-matching phase estimate were tried on the choose set of
+      ``scripts/check_gaps.py`` and rejected.)
+
+    When the body does not travel (speed below ``STEP_FLOOR``), ``n + 1`` is the joint step across
+    the gap over the median joint step around it. Always at least 1.
+
+    Parameters
+    ----------
+    motion : Motion, the stream with the frames already missing (nothing inserted)
+    steps_at : sequence of int, steps ``t → t+1`` that hide missing frames
+    seconds : float, the mean-speed window on each side
+
+    Returns
+    -------
+    list of int, the estimated missing count per step, in the order of ``sorted(steps_at)``
+    """
+    at = sorted(int(t) for t in steps_at)
+    if not at:
+        return []
+    ground = _ground_path(motion)
+    gstep = np.linalg.norm(np.diff(ground, axis=0), axis=-1)  # (T-1,)
+    jsteps = joint_steps(motion)
+    half = max(3, int(round(seconds * motion.fps)))
+    far = max(half, int(round(2.0 * motion.fps)))
+    floor = STEP_FLOOR * body_height(motion) / motion.fps
+    out = []
+    for t in at:
+        start = max([g + 1 for g in at if g < t], default=0)  # known steps between neighbouring gaps
+        stop = min([g for g in at if g > t], default=len(gstep))
+        before = np.arange(max(start, t - half), t)
+        after = np.arange(t + 1, min(stop, t + 1 + half))
+        if before.size + after.size == 0:
+            out.append(1)
+            continue
+        speeds = [float(np.mean(gstep[w])) for w in (before, after) if w.size]
+        v = float(np.mean(speeds))
+        if v > floor:
+            psi = min(_turn(ground, before, after), 0.9 * np.pi)
+            arc = gstep[t] * ((0.5 * psi) / np.sin(0.5 * psi) if psi > 1e-6 else 1.0)
+            long_before = np.arange(max(start, t - far), t)
+            long_after = np.arange(t + 1, min(stop, t + 1 + far))
+            frames = _phase_count(gstep, arc, long_before, long_after, motion.fps)
+            n = (arc / v if frames is None else frames) - 1.0
+        else:
+            win = np.concatenate([before, after])
+            n = jsteps[t] / max(float(np.median(jsteps[win])), 1e-9) - 1.0
+        out.append(max(1, int(round(n))))
+    return out
+
+
+def detect(motion: Motion, graph=None, delta: float | None = None) -> list[tuple[int, int]]:
+    """Dropped frames as ``(after frame t, estimated missing count)``, ready for
+    :func:`~.gaps.insert_missing`: :func:`graph_gaps` with a graph, :func:`consecutive_gaps`
+    without, counts from :func:`estimate_missing`."""
+    if graph is not None:
+        at = graph_gaps(motion, graph, delta)
+    else:
+        at = consecutive_gaps(motion, DELTA if delta is None else delta)
+    return list(zip(at, estimate_missing(motion, at)))

@@ -1,0 +1,108 @@
+"""Measuring gap detection and filling on clips with frames removed on purpose.
+
+A clean clip has its frames ``start … start+n-1`` cut out; the shortened stream goes through what
+``motionlab fill-gaps`` does (:func:`.detect.detect`, :func:`.gaps.insert_missing`,
+:func:`.gaps.fill` with SLERP rotations and the Hermite root) and is compared with the clip:
+
+* **detection**: was the step ``start-1 → start`` flagged, and was anything else flagged;
+* **count**: the estimated missing count against ``n`` (within 10% or one frame is the goal);
+* **root**: the reference joint's path over the gap, the filled one resampled at the true frames'
+  fractions of the gap (the counts may differ), mean distance to the true path, relative to the
+  true displacement across the gap;
+* **floor**: how far the lowest non-root joint of the filled frames goes below the clip's floor.
+
+Used by ``scripts/check_gaps.py`` and notebook 06.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from motionlab.core.motion import Motion
+from motionlab.interpolation import detect, gaps
+from motionlab.interpolation.alignment import reference_joint, reference_transform
+
+__all__ = ["CutResult", "cut", "evaluate_cut", "summary"]
+
+
+@dataclass
+class CutResult:
+    """One clip with ``n`` frames cut at ``start`` (see the module docstring).
+
+    Attributes
+    ----------
+    name : str
+    n, start : int
+    hit : bool                  the gap's step was flagged
+    false : int                 other steps flagged
+    estimate : int or None      missing count (None when the gap was not found)
+    root_rel : float or None    mean root error over the gap / true displacement
+    below : float or None       lowest filled foot below the clip's floor, metres (>= 0)
+    """
+
+    name: str
+    n: int
+    start: int
+    hit: bool
+    false: int
+    estimate: int | None = None
+    root_rel: float | None = None
+    below: float | None = None
+
+    @property
+    def count_ok(self) -> bool:
+        return self.estimate is not None and abs(self.estimate - self.n) <= max(1.0, 0.1 * self.n)
+
+
+def cut(motion: Motion, start: int, n: int) -> Motion:
+    """``motion`` without frames ``start … start+n-1`` (at least one frame kept on each side)."""
+    if not (start >= 1 and start + n < motion.num_frames and n >= 1):
+        raise ValueError(f"cannot cut {n} frames at {start} from a {motion.num_frames}-frame motion")
+    return motion[np.r_[0:start, start + n : motion.num_frames]]
+
+
+def evaluate_cut(motion: Motion, start: int, n: int, graph=None) -> CutResult:
+    """Cut, detect (against ``graph`` if given, else the stream itself), fill, compare."""
+    stream = cut(motion, start, n)
+    found = detect.detect(stream, graph=graph)
+    steps = [t for t, _ in found]
+    hit = (start - 1) in steps
+    res = CutResult(motion.name, n, start, hit, len(steps) - int(hit))
+    if not hit:
+        return res
+    est = dict(found)[start - 1]
+    filled, _ = gaps.fill(gaps.insert_missing(stream, found)[0], method="slerp", root="hermite")
+    shift = sum(c for t, c in found if t < start - 1)  # frames inserted before this gap
+    a = start - 1 + shift
+    ref = reference_joint(motion)
+    _, truth = reference_transform(motion, joint=ref)
+    _, path = reference_transform(filled, np.arange(a, a + est + 2), joint=ref)
+    u = np.arange(1, n + 1) / (n + 1)
+    at = np.stack([np.interp(u, np.linspace(0.0, 1.0, est + 2), path[:, k]) for k in range(3)], axis=1)
+    err = float(np.linalg.norm(at - truth[start : start + n], axis=1).mean())
+    disp = float(np.linalg.norm(truth[start + n] - truth[start - 1]))
+    floor = float(motion.global_positions()[:, 1:, 1].min())
+    low = float(filled[a + 1 : a + est + 1].global_positions()[:, 1:, 1].min())
+    below = floor - low  # rounding below a nanometre is not a foot in the floor
+    res.estimate, res.root_rel, res.below = int(est), err / max(disp, 1e-9), below if below > 1e-9 else 0.0
+    return res
+
+
+def summary(results: list[CutResult]) -> dict:
+    """Precision, recall, fraction of counts within tolerance, root and floor figures of many cuts."""
+    tp = sum(r.hit for r in results)
+    fp = sum(r.false for r in results)
+    counted = [r for r in results if r.estimate is not None]
+    rel = np.array([r.root_rel for r in counted]) if counted else np.zeros(0)
+    below = np.array([r.below for r in counted]) if counted else np.zeros(0)
+    return {
+        "cases": len(results),
+        "precision": tp / max(tp + fp, 1),
+        "recall": tp / max(len(results), 1),
+        "count_ok": float(np.mean([r.count_ok for r in counted])) if counted else 0.0,
+        "root_rel_mean": float(rel.mean()) if rel.size else float("nan"),
+        "root_rel_max": float(rel.max()) if rel.size else float("nan"),
+        "below_max": float(below.max()) if below.size else float("nan"),
+    }

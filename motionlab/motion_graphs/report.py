@@ -1,0 +1,153 @@
+"""The build report of a structured motion graph: one table instead of a wall of warnings.
+
+Per behaviour and style: takes, recorded frames, whole gait cycles, transitions (jump edges
+that start at the style's frames: inside the style, into interpolation spaces and transition
+clips), the share of its frames in the behaviour's largest strongly
+connected component, and the frames pruned. Conditions met while building (a take pruned, a
+forced transition, a missing link …) are counted once, with an example. Below the table, the
+summary lines scripts may read::
+
+    largest strongly connected component: <frames> frames (<percent>%)
+    largest strongly connected component of <behaviour>: <frames> frames (<percent>%)
+
+Frames here are *recorded* frames (basic takes and transition clips, as loaded); the
+intermediate motions of the interpolation spaces carry the search between styles but are not
+counted, so a percentage says how much of the recorded material the search can use. The
+behaviour's component is taken in the sub-graph of that behaviour's frames (its takes and
+intermediate motions), its percentage is of that behaviour's takes.
+
+Taught in ``notebooks/05_motion_graphs.ipynb``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from motionlab.motion_graphs.graph import MotionGraph
+
+__all__ = ["build_report", "format_report", "write_report", "COLUMNS"]
+
+COLUMNS = ("behaviour", "style", "takes", "frames", "cycles", "transitions", "in largest", "pruned")
+
+
+def _pct(a: int, b: int) -> float:
+    return round(100.0 * a / b, 1) if b else 0.0
+
+
+def build_report(graph: MotionGraph) -> dict:
+    """The report's data (JSON-ready).
+
+    Returns
+    -------
+    dict with ``rows`` (one per behaviour/style: ``behaviour, style, takes, frames, cycles,
+    transitions, in_largest`` (frames), ``in_largest_percent``, ``pruned``), ``behaviours``
+    (per behaviour: ``frames, largest_scc, percent``), ``largest_scc`` and ``recorded_frames``
+    (whole graph), ``percent``, ``conditions`` (kind → ``count``, ``example``) and ``info``
+    (build times and counts).
+    """
+    n = graph.num_frames
+    recorded = np.zeros(n, dtype=bool)
+    behaviour_frames: dict[str, np.ndarray] = {}
+    style_clips: dict[tuple[str, str], list[int]] = {}
+    for k, c in enumerate(graph.clips):
+        if c.kind in ("basic", "transition", "clip"):
+            recorded[c.start : c.stop] = True
+        if c.behaviour is not None and c.kind in ("basic", "intermediate"):
+            m = behaviour_frames.setdefault(c.behaviour, np.zeros(n, dtype=bool))
+            m[c.start : c.stop] = True
+        if c.kind == "basic":
+            style_clips.setdefault((c.behaviour, c.style), []).append(k)
+    live = graph.alive[graph.src] & graph.alive[graph.dst]
+    cells = graph.table.get("behaviours", {})
+    rows, behaviours = [], {}
+    for b in sorted(behaviour_frames):
+        comp = graph.largest_component(behaviour_frames[b])
+        takes_b = np.zeros(n, dtype=bool)
+        for (bb, s), ks in sorted(style_clips.items()):
+            if bb != b:
+                continue
+            mine = np.zeros(n, dtype=bool)
+            for k in ks:
+                mine[graph.clips[k].start : graph.clips[k].stop] = True
+            takes_b |= mine
+            frames = int(mine.sum())
+            inside = int((comp & mine).sum())
+            cell = cells.get(b, {}).get(s, {})
+            cycles = sum(int(t.get("cycles", 0)) for t in cell.get("takes", []))
+            rows.append(
+                dict(
+                    behaviour=b,
+                    style=s,
+                    takes=len(ks),
+                    frames=frames,
+                    cycles=cycles,
+                    transitions=int(np.sum(live & mine[graph.src])),
+                    in_largest=inside,
+                    in_largest_percent=_pct(inside, frames),
+                    pruned=int((mine & ~graph.alive).sum()),
+                )
+            )
+        total = int(takes_b.sum())
+        got = int((comp & takes_b).sum())
+        behaviours[b] = dict(frames=total, largest_scc=got, percent=_pct(got, total))
+    comp = graph.largest_component()
+    got, total = int((comp & recorded).sum()), int(recorded.sum())
+    conditions = {
+        kind: dict(count=len(lines), example=lines[0])
+        for kind, lines in graph.info.get("conditions", {}).items()
+        if lines
+    }
+    info = {k: v for k, v in graph.info.items() if k != "conditions"}
+    return dict(
+        rows=rows,
+        behaviours=behaviours,
+        recorded_frames=total,
+        largest_scc=got,
+        percent=_pct(got, total),
+        conditions=conditions,
+        info=info,
+    )
+
+
+def format_report(report: dict) -> str:
+    """The report as text: the table, the conditions, the summary lines."""
+    cells = [list(COLUMNS)]
+    for r in report["rows"]:
+        cells.append(
+            [r["behaviour"], r["style"], str(r["takes"]), str(r["frames"]), str(r["cycles"]), str(r["transitions"]),
+             f"{r['in_largest_percent']:.1f}%", str(r["pruned"])]
+        )  # fmt: skip
+    widths = [max(len(row[i]) for row in cells) for i in range(len(COLUMNS))]
+    right = [False, False] + [True] * (len(COLUMNS) - 2)
+    lines = [
+        "  ".join((v.rjust(w) if rr else v.ljust(w)) for v, w, rr in zip(row, widths, right)).rstrip() for row in cells
+    ]
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    if report["conditions"]:
+        lines.append("conditions (each counted once):")
+        for kind, c in sorted(report["conditions"].items()):
+            lines.append(f"  {kind}: {c['count']} (e.g. {c['example']})")
+    else:
+        lines.append("conditions: none")
+    lines.append(f"largest strongly connected component: {report['largest_scc']} frames ({report['percent']:.1f}%)")
+    for b, v in sorted(report["behaviours"].items()):
+        lines.append(f"largest strongly connected component of {b}: {v['largest_scc']} frames ({v['percent']:.1f}%)")
+    return "\n".join(lines)
+
+
+def write_report(path: str | os.PathLike, report: dict, overwrite: bool = False) -> Path:
+    """Write the report as JSON (atomically); refuses to replace a file unless ``overwrite``."""
+    path = Path(path)
+    if path.exists() and not overwrite:
+        raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --force) to replace it")
+    tmp = path.with_name(f".{path.name}.tmp")
+    try:
+        tmp.write_text(json.dumps(report, indent=1, default=float))
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return path

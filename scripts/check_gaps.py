@@ -1,0 +1,144 @@
+"""Gap detection, missing counts and the root across gaps, measured on the shared real mocap.
+
+    MOTIONLAB_DATA=/path/to/shared/data python scripts/check_gaps.py [--quick]
+
+1. **False gaps**: every clean BVH under ``$MOTIONLAB_DATA`` through the detector that
+   ``motionlab fill-gaps`` uses without a graph (:func:`motionlab.interpolation.detect.consecutive_gaps`);
+   prints how many files get a gap flagged (should be 0) and the largest ``D/Δ``.
+2. **Removed frames**: real walks and runs with 10, 20 or 30 frames cut out at a random place
+   (seeded; at least 20 frames left on each side). For each case: was the gap found, and only it
+   (precision, recall), the estimated missing count against the truth (within 10% or one frame?),
+   and after filling (SLERP + Hermite root, what ``fill-gaps`` does) the mean root position error
+   over the gap relative to the true root displacement across it, and the lowest foot against
+   the clip's own floor.
+3. **Stream against the graph** (§3.3): walk takes of one style tracked in an action graph built
+   from *other* takes (normal style, takes 1–3), precision and recall.
+
+Rules were chosen on the CHOOSE set and are reported separately on the VALIDATE set:
+
+* CHOOSE: ``bandai_namco/sessions/walk`` takes of style ``normal`` and
+  ``bandai_namco/dataset-2/walk-turn-left``, ``dataset-2/run/…_001``;
+* VALIDATE: every other style's walk takes in ``sessions/walk`` (every 4th take), the 15
+  ``dataset-1/run`` styles, ``dataset-2/run/…_002, 003`` and ``dataset-2/walk-turn-right``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from motionlab.core import bvh
+from motionlab.interpolation import detect, gap_eval
+from motionlab.interpolation.action_graph import ActionGraph
+
+REMOVED = (10, 20, 30)
+
+
+def sets(root: Path, quick: bool) -> dict[str, list[Path]]:
+    walks = sorted((root / "bandai_namco/sessions/walk").glob("*.bvh"))
+    choose = [f for f in walks if "_normal_" in f.name]
+    choose += sorted((root / "bandai_namco/dataset-2/walk-turn-left").glob("*.bvh"))
+    choose += [root / "bandai_namco/dataset-2/run/dataset-2_run_normal_001.bvh"]
+    validate = [f for f in walks if "_normal_" not in f.name][::4]
+    validate += sorted((root / "bandai_namco/dataset-1/run").glob("*.bvh"))
+    validate += [root / f"bandai_namco/dataset-2/run/dataset-2_run_normal_00{i}.bvh" for i in (2, 3)]
+    validate += sorted((root / "bandai_namco/dataset-2/walk-turn-right").glob("*.bvh"))
+    if quick:
+        choose, validate = choose[::6], validate[::6]
+    return {"CHOOSE": choose, "VALIDATE": validate}
+
+
+def false_gaps(root: Path) -> None:
+    files = sorted(root.rglob("*.bvh"))
+    flagged, worst = [], (0.0, "")
+    for f in files:
+        m = bvh.load(f)
+        ratio, _ = detect.consecutive_ratio(m)
+        hits = detect.consecutive_gaps(m)
+        if hits:
+            flagged.append((f, hits))
+        r = float(ratio.max(initial=0.0)) / detect.DELTA
+        if r > worst[0]:
+            worst = (r, str(f.relative_to(root)))
+    print(f"1. false gaps: {len(flagged)} of {len(files)} clean BVH files flagged (Δ = {detect.DELTA});")
+    print(f"   largest D/Δ {worst[0]:.2f} ({worst[1]})")
+    for f, hits in flagged:
+        print(f"   FLAGGED {f}: steps {hits}")
+
+
+def removed_frames(name: str, files: list[Path], rng) -> list:
+    results = []
+    for f in files:
+        m = bvh.load(f)
+        for n in REMOVED:
+            lo, hi = 20, m.num_frames - n - 20
+            if hi <= lo:
+                continue
+            results.append(gap_eval.evaluate_cut(m, int(rng.integers(lo, hi)), n))
+    s = gap_eval.summary(results)
+    print(f"   {name}: {len(files)} clips, {s['cases']} cases (10/20/30 frames removed)")
+    print(f"     detection precision {s['precision']:.3f}, recall {s['recall']:.3f}")
+    ok = sum(r.count_ok for r in results)
+    counted = sum(r.estimate is not None for r in results)
+    print(f"     missing count within 10% (or one frame): {ok} of {counted} ({s['count_ok']:.1%})")
+    bad = [f"{r.name} {r.n}->{r.estimate}" for r in results if r.estimate is not None and not r.count_ok]
+    if bad:
+        print("     outside: " + ", ".join(bad))
+    walks = [r for r in results if "walk" in r.name and "turn" not in r.name]
+    for label, sub in (("straight walks", walks), ("all", results)):
+        w = gap_eval.summary(sub)
+        print(f"     {label}: mean root error over the gap / true displacement: mean {w['root_rel_mean']:.1%}, "
+              f"worst {w['root_rel_max']:.1%}; lowest foot below the clip's floor by at most "
+              f"{1000 * w['below_max']:.1f} mm")  # fmt: skip
+    return results
+
+
+def graph_tracking(root: Path, quick: bool, rng) -> None:
+    walk_dir = root / "bandai_namco/sessions/walk"
+    graph = ActionGraph()
+    graph_takes = [walk_dir / f"dataset-2_walk_normal_{i:03d}.bvh" for i in (1, 2, 3)]
+    for i, f in enumerate(graph_takes):
+        graph.add_node(f"walk{i + 1}", bvh.load(f))
+    streams = [f for f in sorted(walk_dir.glob("*.bvh")) if f not in graph_takes][:: 12 if quick else 3]
+    tp = fp = cases = clean_fp = 0
+    for f in streams:
+        m = bvh.load(f)
+        clean_fp += len(detect.graph_gaps(m, graph))
+        for n in REMOVED:
+            if m.num_frames - n - 40 <= 20:
+                continue
+            s = int(rng.integers(20, m.num_frames - n - 20))
+            found = detect.graph_gaps(m[np.r_[0:s, s + n : m.num_frames]], graph)
+            hit = int((s - 1) in found)
+            tp, fp, cases = tp + hit, fp + len(found) - hit, cases + 1
+    tr = detect.track(m, graph)
+    print(f"3. stream tracked in an action graph of {len(graph_takes)} normal walk takes (Δ = {tr.delta:.2f}):")
+    print(f"   {len(streams)} other walk takes, clean: {clean_fp} false gaps")
+    print(f"   {cases} cases with 10/20/30 frames removed: precision {tp / max(tp + fp, 1):.3f}, recall {tp / max(cases, 1):.3f}")  # fmt: skip
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--quick", action="store_true", help="a sixth of the clips (for CI-sized runs)")
+    args = ap.parse_args(argv)
+    if not os.environ.get("MOTIONLAB_DATA"):
+        sys.exit("set MOTIONLAB_DATA to the shared data folder (e.g. export MOTIONLAB_DATA=/path/to/shared/data)")
+    root = Path(os.environ["MOTIONLAB_DATA"])
+    t0 = time.perf_counter()
+    false_gaps(root)
+    print("2. frames removed from real walks and runs (detector and fill of `motionlab fill-gaps`):")
+    rng = np.random.default_rng(0)
+    for name, files in sets(root, args.quick).items():
+        removed_frames(name, files, rng)
+    graph_tracking(root, args.quick, np.random.default_rng(1))
+    print(f"total time {time.perf_counter() - t0:.1f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,196 @@
+"""Open the built documentation site in headless Chromium: every figure loads, no internal link is broken.
+
+Not a pytest test (it needs Debian's ``chromium``, the ``playwright`` package and a built site);
+``.ci/run`` runs it after ``scripts/build_docs.sh``::
+
+    apt-get install -y chromium
+    pip install playwright          # never `playwright install`: we drive /usr/bin/chromium
+    bash scripts/build_docs.sh && python tests/browser/check_docs_site.py --out /tmp/motionlab_docs
+
+What it does:
+
+1. serves ``docs/_build/html`` on 127.0.0.1 (a random free port) from a thread;
+2. visits every HTML page of the site (starting at ``index.html`` and following internal links);
+   on each, waits for the load event and lists the images that did not load
+   (``complete && naturalWidth > 0``) and every internal link;
+3. checks every internal link: the target file exists and, for ``#fragment`` links, the target
+   page has an element with that id;
+4. for the notebooks stored with outputs, requires at least one figure on the page;
+5. saves screenshots of notebooks 00, 04 and 05 (the first figure in view) and of the home page
+   into ``--out``; prints a JSON summary. Requests to other hosts (the MathJax CDN) are blocked,
+   as on an offline machine; they are counted, not failures.
+
+Exit status 0 when every check passed, 1 otherwise.
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import http.server
+import json
+import shutil
+import sys
+import threading
+import time
+from html.parser import HTMLParser
+from pathlib import Path
+from urllib.parse import unquote, urldefrag, urlparse
+
+REPO = Path(__file__).resolve().parents[2]
+SITE = REPO / "docs" / "_build" / "html"
+SCREENSHOTS = {
+    "00_quaternions_and_fk": "notebooks/00_quaternions_and_fk.html",
+    "04_playback_and_bone_proportions": "notebooks/04_playback_and_bone_proportions.html",
+    "05_motion_graphs": "notebooks/05_motion_graphs.html",
+}
+
+
+def _stored_notebooks() -> list[str]:
+    sys.path.insert(0, str(REPO / "scripts"))
+    try:
+        from store_notebook_outputs import STORED
+    finally:
+        sys.path.pop(0)
+    return list(STORED)
+
+
+class _Ids(HTMLParser):
+    def __init__(self):
+        super().__init__()
+        self.ids: set[str] = set()
+
+    def handle_starttag(self, tag, attrs):
+        for key, value in attrs:
+            if key in ("id", "name") and value:
+                self.ids.add(value)
+
+
+@functools.cache
+def _ids_of(path: Path) -> frozenset:
+    parser = _Ids()
+    parser.feed(path.read_text(encoding="utf-8", errors="replace"))
+    return frozenset(parser.ids)
+
+
+class _QuietHandler(http.server.SimpleHTTPRequestHandler):
+    def log_message(self, *args) -> None:  # no line per request
+        pass
+
+
+def _serve(folder: Path):
+    handler = functools.partial(_QuietHandler, directory=str(folder))
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    return server
+
+
+def _local_file(url: str, base: str) -> Path | None:
+    """The site file a same-origin URL points at (index.html for a folder), or None if outside."""
+    path = unquote(urlparse(url).path)
+    if not url.startswith(base):
+        return None
+    rel = path[len(urlparse(base).path) :]
+    target = SITE / rel
+    if rel == "" or rel.endswith("/"):
+        target = target / "index.html"
+    return target
+
+
+def check(out: Path, timeout_ms: int = 30_000) -> dict:
+    from playwright.sync_api import sync_playwright
+
+    server = _serve(SITE)
+    base = f"http://127.0.0.1:{server.server_address[1]}/"
+    report: dict = {"pages": 0, "images": 0, "broken_images": [], "links_checked": 0, "broken_links": [],
+                    "external_requests_blocked": 0, "figures_per_notebook": {}, "screenshots": []}  # fmt: skip
+    stored = _stored_notebooks()
+    out.mkdir(parents=True, exist_ok=True)
+    start = time.time()
+    try:
+        with sync_playwright() as pw:
+            browser = pw.chromium.launch(
+                executable_path=shutil.which("chromium") or "/usr/bin/chromium",
+                headless=True,
+                args=["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage"],
+            )
+            page = browser.new_page(viewport={"width": 1400, "height": 1000})
+
+            def route(r):
+                if r.request.url.startswith(base):
+                    r.continue_()
+                else:
+                    report["external_requests_blocked"] += 1
+                    r.abort()
+
+            page.route("**/*", route)
+            todo, seen, links = [base + "index.html"], set(), set()
+            while todo:
+                url = todo.pop()
+                if url in seen:
+                    continue
+                seen.add(url)
+                page.goto(url, wait_until="load", timeout=timeout_ms)
+                report["pages"] += 1
+                images = page.eval_on_selector_all(
+                    "img", "els => els.map(e => [e.currentSrc || e.src, e.complete && e.naturalWidth > 0])"
+                )
+                report["images"] += len(images)
+                report["broken_images"] += [{"page": url[len(base) :], "src": src} for src, ok in images if not ok]
+                rel = url[len(base) :]
+                if rel.startswith("notebooks/"):
+                    name = Path(rel).stem
+                    report["figures_per_notebook"][name] = page.locator(".cell_output img").count()
+                for href in page.eval_on_selector_all("a[href]", "els => els.map(e => e.href)"):
+                    if not href.startswith(base):
+                        continue
+                    links.add((rel, href))
+                    target, _ = urldefrag(href)
+                    if target.endswith(".html") and target not in seen:
+                        todo.append(target)
+                if rel in {"index.html", *SCREENSHOTS.values()}:
+                    name = "index" if rel == "index.html" else Path(rel).stem
+                    figure = page.locator(".cell_output img").first
+                    if figure.count():
+                        figure.scroll_into_view_if_needed()
+                        page.evaluate("window.scrollBy(0, -250)")
+                    shot = out / f"docs_{name}.png"
+                    page.screenshot(path=str(shot))
+                    report["screenshots"].append(str(shot))
+            browser.close()
+        for page_rel, href in sorted(links):
+            target_url, fragment = urldefrag(href)
+            report["links_checked"] += 1
+            target = _local_file(target_url, base)
+            if target is None or not target.exists():
+                report["broken_links"].append({"page": page_rel, "href": href[len(base) :], "why": "no such file"})
+            elif fragment and target.suffix == ".html" and unquote(fragment) not in _ids_of(target):
+                report["broken_links"].append({"page": page_rel, "href": href[len(base) :], "why": "no such anchor"})
+    finally:
+        server.shutdown()
+    missing_figures = [n for n in stored if report["figures_per_notebook"].get(n, 0) == 0]
+    report["stored_notebooks_without_figures"] = missing_figures
+    report["seconds"] = round(time.time() - start, 1)
+    report["ok"] = (
+        bool(report["pages"]) and not report["broken_images"] and not report["broken_links"] and not missing_figures
+    )
+    return report
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--out", default="/tmp/motionlab_docs", help="folder for the screenshots")
+    args = parser.parse_args(argv)
+    if not (SITE / "index.html").exists():
+        print(f"{SITE}/index.html not found: build the site first (bash scripts/build_docs.sh)", file=sys.stderr)
+        return 1
+    if not shutil.which("chromium") and not Path("/usr/bin/chromium").exists():
+        print("chromium not found: apt-get install -y chromium", file=sys.stderr)
+        return 1
+    report = check(Path(args.out))
+    print(json.dumps(report, indent=2))
+    return 0 if report["ok"] else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,86 @@
+"""Dropped-frame detection (stream against itself and against the graph) and missing counts."""
+
+import numpy as np
+import pytest
+
+from motionlab.core import bvh
+from motionlab.interpolation import detect, gaps
+from motionlab.interpolation.action_graph import ActionGraph
+from motionlab.interpolation.alignment import reference_joint, reference_transform
+from tests.conftest import require_data
+
+from .conftest import toy_motion
+
+
+def test_clean_motion_has_no_gaps_and_a_cut_is_found():
+    m = toy_motion(150)
+    assert detect.consecutive_gaps(m) == []
+    cut = m[np.r_[0:60, 72:150]]
+    assert detect.consecutive_gaps(cut) == [59]
+    (count,) = detect.estimate_missing(cut, [59])
+    assert abs(count - 12) <= 1
+    assert detect.detect(cut) == [(59, count)]
+
+
+@pytest.mark.parametrize("bad", [-1, 0, 1.0, float("nan"), float("inf"), "abc"])
+def test_nonsense_delta_is_refused(bad):
+    with pytest.raises(ValueError, match="above 1"):
+        detect.check_delta(bad)
+    with pytest.raises(ValueError, match="above 1"):
+        detect.consecutive_gaps(toy_motion(30), bad)
+
+
+def test_graph_tracking_finds_the_cut():
+    g = ActionGraph()
+    g.add_node("walk", toy_motion(90, phase=0.3))
+    stream = toy_motion(150, speed=1.0)
+    assert detect.graph_gaps(stream, g) == []
+    cut = stream[np.r_[0:70, 80:150]]
+    tr = detect.track(cut, g)
+    assert tr.gaps() == [69]
+    assert tr.distance[70] > tr.delta > np.max(np.delete(tr.distance, 70))
+
+
+@pytest.mark.realdata
+@pytest.mark.parametrize(
+    "rel",
+    ["mixamo/Aj/Running.bvh", "mixamo/Aj/Laying_Idle.bvh", "mixamo/Aj/Getting_Thrown.bvh", "cmu/131/131_02.bvh"],
+)
+def test_no_false_gaps_on_clean_real_clips(rel):
+    root = require_data()
+    assert detect.consecutive_gaps(bvh.load(root / rel)) == []
+
+
+@pytest.mark.realdata
+@pytest.mark.parametrize("n", [10, 30])
+def test_real_walk_count_root_and_floor(n):
+    walk = require_data("bandai_namco", "sessions", "walk")
+    m = bvh.load(walk / "dataset-2_walk_youthful_011.bvh")  # not in the choose set
+    s = 90
+    cut = m[np.r_[0:s, s + n : m.num_frames]]
+    found = detect.detect(cut)
+    assert [t for t, _ in found] == [s - 1]
+    est = found[0][1]
+    assert abs(est - n) <= max(1, 0.1 * n)
+    filled, _ = gaps.fill(gaps.insert_missing(cut, found)[0], method="slerp", root="hermite")
+    ref = reference_joint(m)
+    _, true_path = reference_transform(m, joint=ref)
+    _, path = reference_transform(filled, joint=ref)
+    seg = path[s - 1 : s + est + 1]
+    u = np.arange(1, n + 1) / (n + 1)
+    at = np.stack([np.interp(u, np.linspace(0, 1, est + 2), seg[:, k]) for k in range(3)], axis=1)
+    err = np.linalg.norm(at - true_path[s : s + n], axis=1).mean()
+    assert err <= 0.1 * np.linalg.norm(true_path[s + n] - true_path[s - 1])
+    floor = m.global_positions()[:, 1:, 1].min()
+    assert filled[s : s + est].global_positions()[:, 1:, 1].min() >= floor - 1e-9
+
+
+@pytest.mark.realdata
+def test_real_stream_tracked_in_a_graph_of_other_takes():
+    walk = require_data("bandai_namco", "sessions", "walk")
+    g = ActionGraph()
+    g.add_node("walk", bvh.load(walk / "dataset-2_walk_normal_001.bvh"))
+    m = bvh.load(walk / "dataset-2_walk_feminine_004.bvh")
+    assert detect.graph_gaps(m, g) == []
+    cut = m[np.r_[0:50, 65:120, 140 : m.num_frames]]
+    assert detect.graph_gaps(cut, g) == [49, 104]
