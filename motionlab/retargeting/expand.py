@@ -393,7 +393,8 @@ def expand(
         to interrupt a run)
     threads : torch CPU threads during the job (restored afterwards). Default: 1 on the CPU — a
         step's tensors are small, and on the shared 2-core CPU one thread ran the same batches
-        4-9x faster than two (``benchmarks/bench_expand.py`` prints both); unchanged on a GPU.
+        many times faster than two (17x in the README's run of ``benchmarks/bench_expand.py``,
+        which prints both); unchanged on a GPU.
 
     Returns
     -------
