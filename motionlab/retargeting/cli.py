@@ -60,16 +60,36 @@ def _load_checkpoint(path: str | None, device: str | None):
 def _solver_config(args):
     from motionlab.retargeting.solver import SolverConfig
 
-    return SolverConfig(max_steps=args.steps, lr=args.lr, threshold=args.threshold)
+    return SolverConfig(
+        max_steps=args.steps,
+        lr=args.lr,
+        threshold=args.threshold,
+        lambda_contact=args.contact_weight,
+        init=args.init,
+    )
 
 
 def _add_solver_args(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("latent iteration")
     g.add_argument("--steps", type=int, default=100, help="step limit of the latent iteration (default 100)")
     g.add_argument(
-        "--lr", type=float, default=0.1, help="Adam step on the latent, relative to its spread std(φ₀) (default 0.1)"
+        "--lr", type=float, default=0.02, help="Adam step on the latent, relative to its spread std(φ₀) (default 0.02)"
     )
     g.add_argument("--threshold", type=float, default=2e-3, help="stop when L_iter drops below this (default 2e-3)")
+    g.add_argument(
+        "--contact-weight",
+        type=float,
+        default=0.5,
+        metavar="W",
+        help="weight of the foot-contact term (motionlab's addition; 0 = the paper's two losses; default 0.5)",
+    )
+    g.add_argument(
+        "--init",
+        choices=("project", "encoder"),
+        default="project",
+        help="start of the iteration: least-squares projection onto the source's rotations (default) or the "
+        "encoder's latent (the paper)",
+    )
 
 
 # ---------------------------------------------------------------------------- retarget
@@ -195,11 +215,15 @@ def _cmd_evaluate(args) -> int:
         source=args.source,
         targets=args.targets,
         animations=animations or (DEFAULT_ANIMATIONS if not args.all_animations else None),
-        rows=rows_with_root(args.root),
+        rows=rows_with_root(args.root, ablations=not args.no_ablations),
         solver=_solver_config(args),
         progress=not args.quiet,
     )
     print(result.table())
+    print()
+    print(result.breakdown("mse_h2"))
+    print()
+    print(result.breakdown("pose_mse_h2"))
     if args.csv:
         import csv
 
@@ -288,6 +312,9 @@ def register(subparsers) -> None:
     p.add_argument("--train-steps", type=int, default=1500)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--csv", help="write the per-clip records to this CSV")
+    p.add_argument(
+        "--no-ablations", action="store_true", help="skip the ablation rows (full method without one of its parts)"
+    )
     p.add_argument(
         "--root",
         choices=ROOT_MODES,

@@ -223,6 +223,8 @@ class RetargetNet(nn.Module):
         super().__init__()
         cfg = config or ModelConfig()
         self.config = cfg
+        self.use_correction = True
+        """False replaces q_Δ by the identity (the ablation "without q_Δ"); not saved in checkpoints."""
         J = NUM_JOINTS
         self.f_enc = _Encoder(cfg)
         self.f_qlinear = nn.Linear(cfg.latent, 4 * J)
@@ -259,7 +261,12 @@ class RetargetNet(nn.Module):
         return unit(e)
 
     def correction(self, phi: torch.Tensor, embedding: torch.Tensor) -> torch.Tensor:
-        """q_Δ = F_Δ(concat(φ, S̄')) / ‖·‖: (B, T, D) and (B or 1, E) → unit quaternions (B, T, J, 4)."""
+        """q_Δ = F_Δ(concat(φ, S̄')) / ‖·‖: (B, T, D) and (B or 1, E) → unit quaternions (B, T, J, 4).
+
+        With ``use_correction = False`` (an ablation) q_Δ is the identity rotation.
+        """
+        if not self.use_correction:
+            return tq.IDENTITY.to(phi).expand(phi.shape[:2] + (NUM_JOINTS, 4))
         emb = embedding[:, None, :].expand(phi.shape[0], phi.shape[1], -1)
         raw = self.f_delta(torch.cat([phi, emb], dim=-1))
         return unit(raw.reshape(raw.shape[:2] + (NUM_JOINTS, 4)))
@@ -280,6 +287,50 @@ class RetargetNet(nn.Module):
         if s.ndim == 3:
             s = s[:, None]
         return fk_by_level(local_rot, s, humanoid.PARENTS)
+
+    def rotation_jacobian(self, phi: torch.Tensor, embedding: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """Per-frame decoded rotations ``q ⊗ q_Δ`` and their Jacobian with respect to the latent.
+
+        Eqs. 10–13 act on each frame alone, so frame ``t``'s rotations depend on ``φ_t`` only and
+        the Jacobian is a (88 × D) matrix per frame, written out by the chain rule (no autograd):
+        ``d unit(r) = (I − q qᵀ)/‖r‖ dr`` for both normalisations, ``dr = W dφ`` for F_qlinear,
+        ``ds = V diag(σ'(h)) U_φ dφ`` for F_Δ (``h`` its hidden layer), and
+        ``d(q ⊗ p) = L(q) dp + R(p) dq`` for the Hamilton product (L, R: its 4×4 matrices).
+
+        Parameters
+        ----------
+        phi : Tensor (M, D)         latents of M frames
+        embedding : Tensor (M, E) or (1, E)   the skeleton embedding S̄' for each frame
+
+        Returns
+        -------
+        rotations : Tensor (M, 22, 4)
+        jacobian : Tensor (M, 88, D)
+        """
+        M, D = phi.shape
+        eye = torch.eye(4, dtype=phi.dtype, device=phi.device)
+        r = self.f_qlinear(phi).reshape(M, NUM_JOINTS, 4)
+        length = torch.sqrt((r * r).sum(-1, keepdim=True))[..., None]  # (M, J, 1, 1)
+        q = r / length[..., 0]
+        jq = ((eye - q[..., :, None] * q[..., None, :]) / length) @ self.f_qlinear.weight.reshape(NUM_JOINTS, 4, D)
+        if self.use_correction:
+            first, act, last = self.f_delta
+            h = first(torch.cat([phi, embedding.expand(M, -1)], dim=-1))  # (M, H)
+            s = last(act(h)).reshape(M, NUM_JOINTS, 4)
+            slen = torch.sqrt((s * s).sum(-1, keepdim=True))[..., None]
+            p = s / slen[..., 0]
+            slope = torch.where(h > 0, torch.ones_like(h), torch.full_like(h, act.negative_slope))
+            ds = (last.weight[None] * slope[:, None, :]) @ first.weight[:, :D]  # (M, 88, D)
+            jp = ((eye - p[..., :, None] * p[..., None, :]) / slen) @ ds.reshape(M, NUM_JOINTS, 4, D)
+        else:
+            p = tq.IDENTITY.to(phi).expand(M, NUM_JOINTS, 4)
+            jp = torch.zeros_like(jq)
+        w, x, y, z = q.unbind(-1)
+        left = torch.stack([w, -x, -y, -z, x, w, -z, y, y, z, w, -x, z, -y, x, w], -1).reshape(M, NUM_JOINTS, 4, 4)
+        w, x, y, z = p.unbind(-1)
+        right = torch.stack([w, -x, -y, -z, x, w, z, -y, y, -z, w, x, z, y, -x, w], -1).reshape(M, NUM_JOINTS, 4, 4)
+        jac = left @ jp + right @ jq
+        return tq.mul(q, p), jac.reshape(M, 4 * NUM_JOINTS, D)
 
     def decode(self, phi: torch.Tensor, offsets: torch.Tensor) -> Decoded:
         """The whole decoder on skeleton ``offsets`` (J, 3) or (B, J, 3) from the latent φ (B, T, D)."""

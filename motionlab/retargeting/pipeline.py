@@ -48,6 +48,7 @@ import torch
 from motionlab.core import humanoid, preprocess, quat
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
+from motionlab.retargeting import contacts
 from motionlab.retargeting.checkpoint import Checkpoint
 from motionlab.retargeting.features import ClipFeatures, check_motion, clip_features
 from motionlab.retargeting.solver import SolverConfig, solve
@@ -60,6 +61,7 @@ __all__ = [
     "leg_chain",
     "root_scale",
     "target_skeleton",
+    "source_contacts",
     "retarget",
 ]
 
@@ -130,6 +132,12 @@ def root_scale(source: Skeleton, target: Skeleton, mode: str = "stride") -> tupl
             raise ValueError(f"cannot scale the root: {measure.__name__} {a:.4g} m (source) / {b:.4g} m (target)")
         ratios.append(b / a)
     return ratios[0], ratios[1]
+
+
+def source_contacts(source: Motion) -> np.ndarray:
+    """A's planted feet (T, 4) for the contact term, from a canonical motion (:mod:`.contacts`)."""
+    sk = source.skeleton
+    return contacts.detect_contacts(source.global_positions(), contacts.rest_heights(sk), sk.height(), source.fps)
 
 
 def target_skeleton(target: Skeleton | Motion) -> Skeleton:
@@ -221,7 +229,20 @@ def retarget(
                 heading_rot = checkpoint.model(x, offsets).local_rot[0].cpu().numpy()
         else:
             height = torch.as_tensor(root_pos[:, 1], dtype=torch.float32)[None]
-            res = solve(checkpoint.model, x, theta_a, offsets, height, solver, callback=callback, progress=progress)
+            planted = source_contacts(src)
+            res = solve(
+                checkpoint.model,
+                x,
+                theta_a,
+                offsets,
+                height,
+                solver,
+                callback=callback,
+                progress=progress,
+                root_xz=torch.as_tensor(root_pos[:, [0, 2]], dtype=torch.float32)[None],
+                yaw=torch.as_tensor(feats.yaw, dtype=torch.float32)[None],
+                planted=torch.as_tensor(planted)[None],
+            )
             heading_rot, history, reason, steps = res.local_rot[0], res.history, res.stop_reason, res.steps
         local_rot = _to_world(heading_rot, feats.yaw)
     seconds = time.perf_counter() - start
