@@ -85,10 +85,10 @@ def _add_solver_args(p: argparse.ArgumentParser) -> None:
     )
     g.add_argument(
         "--init",
-        choices=("project", "encoder"),
-        default="project",
-        help="start of the iteration: least-squares projection onto the source's rotations (default) or the "
-        "encoder's latent (the paper)",
+        choices=("auto", "project", "encoder"),
+        default="auto",
+        help="start of the iteration: least-squares projection onto the source's rotations, the encoder's "
+        "latent (the paper), or auto (default: projection)",
     )
 
 

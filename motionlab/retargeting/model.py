@@ -308,28 +308,34 @@ class RetargetNet(nn.Module):
         jacobian : Tensor (M, 88, D)
         """
         M, D = phi.shape
-        eye = torch.eye(4, dtype=phi.dtype, device=phi.device)
+
+        def tangent(u: torch.Tensor, length: torch.Tensor, du: torch.Tensor) -> torch.Tensor:
+            # d unit(r) = (du − u ⟨u, du⟩) / ‖r‖ for du (M, J, 4, D); elementwise (tiny batched matmuls are slow)
+            return (du - u[..., :, None] * (u[..., :, None] * du).sum(-2, keepdim=True)) / length[..., None]
+
         r = self.f_qlinear(phi).reshape(M, NUM_JOINTS, 4)
-        length = torch.sqrt((r * r).sum(-1, keepdim=True))[..., None]  # (M, J, 1, 1)
-        q = r / length[..., 0]
-        jq = ((eye - q[..., :, None] * q[..., None, :]) / length) @ self.f_qlinear.weight.reshape(NUM_JOINTS, 4, D)
+        rlen = torch.sqrt((r * r).sum(-1, keepdim=True))
+        q = r / rlen
+        jq = tangent(q, rlen, self.f_qlinear.weight.reshape(1, NUM_JOINTS, 4, D))
         if self.use_correction:
             first, act, last = self.f_delta
             h = first(torch.cat([phi, embedding.expand(M, -1)], dim=-1))  # (M, H)
             s = last(act(h)).reshape(M, NUM_JOINTS, 4)
-            slen = torch.sqrt((s * s).sum(-1, keepdim=True))[..., None]
-            p = s / slen[..., 0]
+            slen = torch.sqrt((s * s).sum(-1, keepdim=True))
+            p = s / slen
             slope = torch.where(h > 0, torch.ones_like(h), torch.full_like(h, act.negative_slope))
-            ds = (last.weight[None] * slope[:, None, :]) @ first.weight[:, :D]  # (M, 88, D)
-            jp = ((eye - p[..., :, None] * p[..., None, :]) / slen) @ ds.reshape(M, NUM_JOINTS, 4, D)
+            ds = (slope[:, None, :] * last.weight[None]) @ first.weight[:, :D]  # (M, 88, D)
+            jp = tangent(p, slen, ds.reshape(M, NUM_JOINTS, 4, D))
         else:
             p = tq.IDENTITY.to(phi).expand(M, NUM_JOINTS, 4)
-            jp = torch.zeros_like(jq)
+            jp = None
         w, x, y, z = q.unbind(-1)
         left = torch.stack([w, -x, -y, -z, x, w, -z, y, y, z, w, -x, z, -y, x, w], -1).reshape(M, NUM_JOINTS, 4, 4)
         w, x, y, z = p.unbind(-1)
         right = torch.stack([w, -x, -y, -z, x, w, z, -y, y, -z, w, x, z, y, -x, w], -1).reshape(M, NUM_JOINTS, 4, 4)
-        jac = left @ jp + right @ jq
+        jac = (right[..., None] * jq[..., None, :, :]).sum(-2)
+        if jp is not None:
+            jac = jac + (left[..., None] * jp[..., None, :, :]).sum(-2)
         return tq.mul(q, p), jac.reshape(M, 4 * NUM_JOINTS, D)
 
     def decode(self, phi: torch.Tensor, offsets: torch.Tensor) -> Decoded:

@@ -61,8 +61,9 @@ from motionlab.retargeting.model import NUM_JOINTS, Decoded, RetargetNet
 
 __all__ = ["SolverConfig", "SolverResult", "iteration_loss", "project_latent", "world_feet", "solve"]
 
-INITS = ("project", "encoder")
-"""How the iteration starts: least-squares projection onto A's rotations, or ``F_enc(X_A)``."""
+INITS = ("auto", "project", "encoder")
+"""How the iteration starts: least-squares projection onto A's rotations, or ``F_enc(X_A)``;
+``auto`` projects when θ is the rotations and starts from the encoder otherwise."""
 
 
 @dataclass
@@ -84,8 +85,9 @@ class SolverConfig:
     lambda_angle, lambda_foot : float   loss weights (paper: 0.3 and 0.5)
     lambda_contact : float weight of the contact term (ours; 0: the paper's two losses); used
                            when :func:`solve` is given contact labels
-    init : str             ``"project"`` (least-squares first step onto A's rotations, default) or
-                           ``"encoder"`` (φ₀ = F_enc(X_A), the paper)
+    init : str             ``"project"`` (least-squares first step onto A's rotations) or
+                           ``"encoder"`` (φ₀ = F_enc(X_A), the paper); ``"auto"`` (default): project
+                           for ``theta="rotations"``, the encoder for ``"directions"``
     project_iters : int    fixed-point rounds of the projection (q_Δ depends on φ)
     theta : str            ``"rotations"`` (joint rotations, default) or ``"directions"``
                            (unit bone directions from positions)
@@ -100,7 +102,7 @@ class SolverConfig:
     lambda_angle: float = losses.LAMBDA_ANGLE
     lambda_foot: float = losses.LAMBDA_FOOT
     lambda_contact: float = losses.LAMBDA_CONTACT
-    init: str = "project"
+    init: str = "auto"
     project_iters: int = 4
     theta: str = "rotations"
     smooth_sigma: float = 3.0
@@ -259,7 +261,8 @@ def project_latent(
             # (JᵀJ + μI)⁻¹ Jᵀ r = Jᵀ (J Jᵀ + μI)⁻¹ r: an 88 × 88 system per frame instead of D × D
             jjt = jac @ jac.transpose(1, 2)
             mu = damping * jjt.diagonal(dim1=1, dim2=2).mean(-1).clamp_min(1e-12)
-            flat = flat + (jac.transpose(1, 2) @ torch.linalg.solve(jjt + mu[:, None, None] * eye, resid))[..., 0]
+            chol = torch.linalg.cholesky(jjt + mu[:, None, None] * eye)  # symmetric positive definite
+            flat = flat + (jac.transpose(1, 2) @ torch.cholesky_solve(resid, chol))[..., 0]
     return flat.reshape(N, T, D)
 
 
@@ -334,7 +337,7 @@ def solve(
     try:
         with torch.no_grad():
             phi0 = model.encode(x)
-        if cfg.init == "project":
+        if cfg.init == "project" or (cfg.init == "auto" and cfg.theta == "rotations"):
             phi0 = project_latent(model, phi0, src, offsets, cfg.project_iters)
         delta = torch.zeros_like(phi0, requires_grad=True)
         smooth = _smoother(cfg.smooth_sigma, phi0.shape[-1], x.dtype, device)

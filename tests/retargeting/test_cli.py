@@ -8,6 +8,7 @@ import pytest
 from motionlab import cli
 from motionlab.core import bvh, humanoid
 from motionlab.retargeting import checkpoint
+from motionlab.retargeting.evaluate import ABLATIONS, ROWS
 
 
 @pytest.fixture(scope="module")
@@ -121,7 +122,8 @@ def test_train_and_evaluate_on_a_small_folder(tmp_path, clips, capsys):
     assert code == 0, err
     for row in ("copy rotations, our root", "no iteration", "full method", "ground truth", "MSE/h²"):
         assert row in stdout
-    assert (tmp_path / "rec.csv").read_text().count("\n") == 1 + 4
+    assert (tmp_path / "rec.csv").read_text().count("\n") == 1 + len(ROWS) + len(ABLATIONS)
+    assert "full, paper's two losses" in stdout and "mse_h2 by target" in stdout
     code, stdout, err = _run(
         capsys, "evaluate", "--data", root, "--source", "A", "--targets", "B", "--animations", "anim1",
         "--checkpoint", ck, "--steps", "2", "-q", "--root", "hips",
