@@ -13,8 +13,9 @@ loss                   formula                                                  
 
 **Our choice of θ (the paper leaves it open): the joint angles themselves**, i.e. each joint's
 local rotation as a unit quaternion (the root's in the heading frame), compared up to sign:
-``‖θ(A) − θ(B')‖ = min(‖q_A − q_B'‖, ‖q_A + q_B'‖)`` (≈ the rotation angle between them for
-small differences). We tried the other natural choice first — the unit direction of every bone
+``‖θ(A) − θ(B')‖ = min(‖q_A − q_B'‖, ‖q_A + q_B'‖) = 2 sin(α/4)``, where α is the angle of the
+rotation that takes one to the other: about α/2 for small differences (not α, and not exactly
+a half-angle either; 0.0175 ≈ 2°). We tried the other natural choice first — the unit direction of every bone
 in the root-centred heading frame, computed from positions (:func:`direction_loss`) — and
 measured why it is worse: real rigs have *different rest poses* (a bone of B points elsewhere
 than A's in the T-pose), so matching A's bone directions bends B away from what its animators
@@ -33,7 +34,7 @@ even when every joint position is right.
 ``contact_loss`` is *our addition* to the iteration: on the frames where A's foot is planted
 (:mod:`motionlab.retargeting.contacts`), B's foot joint should not move in the world.
 
-Paper: ``seeds/000_*.txt``, eq. (8) (L_recon) and eqs. (15)–(18) (the iteration's losses). Taught in ``notebooks/03_latent_iteration.ipynb``.
+Paper: ``seeds/000_*.txt``, eq. (8) (L_recon) and eqs. (15)–(17) (the iteration's losses, §2.2). Taught in ``notebooks/03_latent_iteration.ipynb``.
 """
 
 from __future__ import annotations
@@ -90,7 +91,10 @@ def bone_directions(positions: torch.Tensor) -> torch.Tensor:
 
 
 def angle_loss(source_rot: torch.Tensor, generated_rot: torch.Tensor) -> torch.Tensor:
-    """L_angle with θ = joint rotations: mean over frames and joints of ``min(‖q_A − q_B'‖, ‖q_A + q_B'‖)``.
+    """L_angle with θ = joint rotations (eq. 16): mean over frames and joints of ``min(‖q_A − q_B'‖, ‖q_A + q_B'‖)``.
+
+    For unit quaternions that distance is ``2 sin(α/4)`` with α the angle between the two
+    rotations (so ≈ α/2 for small α, in radians).
 
     Both inputs are local rotations (..., T, 22, 4) (unit quaternions; the root's in the heading frame).
     """
@@ -118,7 +122,7 @@ def direction_loss(source_positions: torch.Tensor, generated_positions: torch.Te
 
 
 def foot_loss(world_y: torch.Tensor) -> torch.Tensor:
-    """L_foot: mean of ``|min(y, 0)|`` over frames and the four foot joints.
+    """L_foot (eq. 17): mean of ``|min(y, 0)|`` over frames and the four foot joints.
 
     Parameters
     ----------

@@ -4,12 +4,12 @@ Given a window ``X_A`` of source features (T frames × 70 numbers, see
 :mod:`motionlab.core.preprocess`) and a target skeleton ``S̄`` (the T-pose bone offsets), the
 network produces local joint rotations for that skeleton and puts them on it by FK::
 
-    φ      = F_enc(X_A)                          (B, T, D)     encoder: temporal 1-D convolutions
-    q      = F_qlinear(φ) / ‖·‖                  (B, T, J, 4)  per-joint, per-frame rotations
-    S̄'     = F_skel(S̄) / ‖·‖                    (B, E)        skeleton embedding (unit vector)
-    q_Δ    = F_Δ(concat(φ, S̄')) / ‖·‖           (B, T, J, 4)  skeleton-conditioned correction
-    q      ← q ⊗ q_Δ                                           Hamilton product
-    P'     = FK(q, S̄)                           (B, T, J, 3)  root at the origin
+    φ      = F_enc(X_A)                          (B, T, D)     eq. 1, encoder: temporal 1-D convolutions
+    q      = F_qlinear(φ) / ‖·‖                  (B, T, J, 4)  eq. 2, per-joint, per-frame rotations
+    S̄'     = F_skel(S̄) / ‖·‖                    (B, E)        eqs. 3–4, skeleton embedding (unit vector)
+    q_Δ    = F_Δ(concat(φ, S̄')) / ‖·‖           (B, T, J, 4)  eq. 5, skeleton-conditioned correction
+    q      ← q ⊗ q_Δ                                           eq. 6, Hamilton product
+    P'     = FK(q, S̄)                           (B, T, J, 3)  eq. 7, root at the origin
 
 Design choices the paper leaves open (documented here, shown in notebook 02):
 
@@ -26,7 +26,8 @@ Design choices the paper leaves open (documented here, shown in notebook 02):
   input features; positions are root-relative. World placement is the job of
   :mod:`motionlab.retargeting.pipeline`.
 
-Paper: "Skeletal motion generation by latent-space iteration" (``seeds/000_*.txt``), §3.
+Paper: "Skeletal motion generation by latent-space iteration" (``seeds/000_*.txt``), §2.2:
+eqs. (1)–(7) for A's own skeleton (training), eqs. (10)–(14) for a target skeleton.
 Taught in ``notebooks/02_training_autoencoder.ipynb``.
 """
 
@@ -105,7 +106,7 @@ def unit(v: torch.Tensor, eps: float = 1e-12) -> torch.Tensor:
 def skeleton_tensor(offsets, dtype=torch.float32, device=None) -> torch.Tensor:
     """Bone offsets (J, 3) of a canonical skeleton as a tensor with the root offset zeroed.
 
-    ``s̄_j = p̄_j − p̄_parent(j)`` in the T-pose, root at the origin (paper A, §3.1).
+    ``s̄_j = p̄_j − p̄_parent(j)`` in the T-pose, root at the origin (paper A, §2.2, eq. 3).
     Accepts a :class:`~motionlab.core.skeleton.Skeleton`, an array or a tensor (…, 22, 3).
     """
     if hasattr(offsets, "offsets") and hasattr(offsets, "parents"):
@@ -212,7 +213,7 @@ class _Encoder(nn.Module):
 
 
 class RetargetNet(nn.Module):
-    """F_enc, F_qlinear, F_skel and F_Δ, with the decoder that combines them (paper A, Fig. 2).
+    """F_enc, F_qlinear, F_skel and F_Δ, with the decoder that combines them (paper A, §2.2 and Fig. 3).
 
     Every step is its own method so notebooks can call and plot it alone:
     :meth:`encode`, :meth:`rotations`, :meth:`skeleton_embedding`, :meth:`correction`,
