@@ -61,6 +61,7 @@ __all__ = [
     "rows_with_root",
     "Evaluation",
     "training_clips",
+    "shared_animations",
     "evaluate",
 ]
 
@@ -143,6 +144,20 @@ def training_clips(
     if not paths:
         raise FileNotFoundError(f"no training clips for {source!r} in {src} (all excluded or none present)")
     return paths
+
+
+def shared_animations(folder: str | Path, source: str, targets: Sequence[str]) -> list[str]:
+    """The animation stems that ``source`` and every target have in ``folder``, sorted."""
+    folder = Path(folder)
+    for name in (source, *targets):
+        if not (folder / name).is_dir():
+            raise FileNotFoundError(f"character folder {folder / name} not found")
+    common = {p.stem for p in (folder / source).glob("*.bvh")}
+    for t in targets:
+        common &= {p.stem for p in (folder / t).glob("*.bvh")}
+    if not common:
+        raise ValueError(f"no animation shared by {source} and {list(targets)} in {folder}")
+    return sorted(common)
 
 
 @dataclass
@@ -253,10 +268,7 @@ def evaluate(
         if not (folder / t).is_dir():
             raise FileNotFoundError(f"target character folder {folder / t} not found")
     if animations is None:
-        common = {p.stem for p in (folder / source).glob("*.bvh")}
-        for t in targets:
-            common &= {p.stem for p in (folder / t).glob("*.bvh")}
-        animations = sorted(common)
+        animations = shared_animations(folder, source, targets)
     if not animations:
         raise ValueError(f"no animation shared by {source} and {list(targets)} in {folder}")
     if checkpoint is None and any(r[1] != "copy" for r in rows):

@@ -27,6 +27,8 @@ about the world origin, with one ratio for the ground plane and one for the heig
 * the heading (facing direction) of every frame is A's: the network's root rotation, expressed
   in A's heading frame, is turned back by A's heading.
 
+``root_mode="contacts"`` replaces the ground-plane ratio by the one that keeps A's planted feet
+still on B's legs (:func:`contact_stride`; the leg chain when the clip has no steps).
 ``root_mode="hips"`` scales all three axes by the hip height and ``"legs"`` by thigh + shin
 (:func:`humanoid.leg_length`, the plain baseline of the data notes). On the shared Mixamo data
 the stride ratio matches Mixamo's own horizontal root scaling best of five leg measures, in
@@ -62,12 +64,13 @@ __all__ = [
     "root_scale",
     "target_skeleton",
     "source_contacts",
+    "contact_stride",
     "retarget",
 ]
 
 METHODS = ("full", "network", "copy")
 """``full``: network + latent iteration; ``network``: no iteration; ``copy``: copy local rotations."""
-ROOT_MODES = ("stride", "hips", "legs")
+ROOT_MODES = ("stride", "hips", "legs", "contacts")
 """How the root trajectory is scaled: see the module docstring."""
 
 
@@ -121,8 +124,42 @@ _MEASURES = {  # root mode -> (ground-plane measure, height measure)
 }
 
 
+def contact_stride(source: Motion, target: Skeleton, min_planted: float = 0.05) -> float | None:
+    """The ground-plane root ratio that keeps A's planted feet still on B's legs, or None.
+
+    While a foot is planted, the root moves by minus the foot's motion relative to the root.
+    With A's joint rotations on B's skeleton, B's planted foot sweeps ``u_B`` where A's sweeps
+    ``u_A`` (horizontal velocities relative to the root, on A's contact frames); the ratio is
+    the least-squares ``r = Σ⟨u_A, u_B⟩ / Σ‖u_A‖²``. It uses A's motion and B's skeleton only.
+    None when fewer than ``min_planted`` of the frames have a planted foot that moves
+    relative to the root (a clip standing still says nothing about strides).
+
+    Parameters
+    ----------
+    source : canonical 22-joint Motion of A
+    target : B's canonical skeleton
+    """
+    planted = source_contacts(source)[:-1] & source_contacts(source)[1:]  # (T-1, 4) both frames planted
+    zero = np.zeros_like(source.root_pos)
+    rel = {}
+    for key, sk in (("a", source.skeleton), ("b", target)):
+        pos = Motion(sk, source.local_rot, zero, source.fps).global_positions()[:, list(contacts.CONTACT_JOINTS)]
+        rel[key] = np.diff(pos[..., [0, 2]], axis=0)  # (T-1, 4, 2)
+    moving = planted & (np.linalg.norm(rel["a"], axis=-1) * source.fps > 0.05 * source.skeleton.height())
+    if moving.any(axis=1).mean() < min_planted:
+        return None
+    ua, ub = rel["a"][moving], rel["b"][moving]
+    return float((ua * ub).sum() / (ua * ua).sum())
+
+
 def root_scale(source: Skeleton, target: Skeleton, mode: str = "stride") -> tuple[float, float]:
-    """``(r_xz, r_y)``: how much B's root moves per unit of A's, on the ground and up (module doc)."""
+    """``(r_xz, r_y)``: how much B's root moves per unit of A's, on the ground and up (module doc).
+
+    ``mode="contacts"`` depends on the motion (:func:`contact_stride`); here it gives the
+    skeleton-only fallback, the ``"stride"`` ratios.
+    """
+    if mode == "contacts":
+        mode = "stride"
     if mode not in _MEASURES:
         raise ValueError(f"root_mode must be one of {ROOT_MODES}, got {mode!r}")
     ratios = []
@@ -213,6 +250,9 @@ def retarget(
     src = preprocess.prepare(source, fps)
     check_motion(src, "source motion")
     r = root_scale(src.skeleton, tgt, root_mode)
+    if root_mode == "contacts":
+        stride = contact_stride(src, tgt)
+        r = (stride, r[1]) if stride is not None else r
     root_pos = src.root_pos * np.array([r[0], r[1], r[0]])
     history: dict = {}
     reason, steps = "", 0
