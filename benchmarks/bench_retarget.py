@@ -1,7 +1,13 @@
-"""Benchmark of the retargeting system (paper A): training time and latent-solver speed.
+"""Benchmark of the retargeting system (paper A): training, decoder fidelity, q_Δ, solver speed.
 
 Goals (2-core CPU): training on Aj's clips to a stable loss in <= 10 minutes; the latent solver
-<= 1 s median per 120-frame window.
+<= 1 s median per 120-frame window; on Aj's 10 held-back ``retarget_gt`` clips (never trained
+on) a reconstruction error <= 1 cm and the iteration within 1° of A's upper-body rotations.
+
+Printed, in order: training; decoder fidelity (reconstruction by the network alone, and the
+upper-body rotation error of the encoder's latent, of the Gauss–Newton start and after the
+iteration, on every target); how far q_Δ departs from the identity on the shared characters and
+on synthetic bone-length sweeps, and how much it changes with the skeleton; solver time.
 
 Usage::
 
@@ -56,10 +62,109 @@ def _train(args):
     return ckpt
 
 
+UPPER = [
+    j for j, n in enumerate(__import__("motionlab.core.humanoid", fromlist=["JOINTS"]).JOINTS)
+    if j > 0 and not any(k in n for k in ("UpLeg", "Leg", "Foot", "Toe"))
+]  # fmt: skip
+"""Spine, neck, head, shoulders, arms and hands: the joints Mixamo copies exactly."""
+
+
+def _degrees(a, b):
+    """Angle (degrees) between unit quaternions, elementwise over (..., 4)."""
+    return np.degrees(2 * np.arccos(np.clip(np.abs((np.asarray(a) * np.asarray(b)).sum(-1)), 0, 1)))
+
+
+def _fidelity(ckpt, args):
+    from motionlab import data, synthetic
+    from motionlab.core import bvh, humanoid, preprocess
+    from motionlab.retargeting.evaluate import DEFAULT_ANIMATIONS, DEFAULT_TARGETS
+    from motionlab.retargeting.pipeline import retarget, target_skeleton
+    from motionlab.retargeting.solver import SolverConfig, project_latent
+
+    if args.synthetic:
+        sources = synthetic.dataset(4, seed=321, num_frames=240)
+        targets = {f"synthetic {i}": synthetic.random_character(i) for i in range(3)}
+    else:
+        root = data.data_root() / "mixamo"
+        sources = [bvh.load(root / "Aj" / f"{a}.bvh") for a in DEFAULT_ANIMATIONS]
+        targets = {t: target_skeleton(bvh.load(root / t / "Running.bvh").skeleton) for t in DEFAULT_TARGETS}
+    model = ckpt.model
+    err, enc_deg, gn_deg = [], [], []
+    for src in sources:
+        c = preprocess.prepare(src, ckpt.fps)
+        f = clip_features_of(c)
+        x = torch.tensor(ckpt.stats.normalize(f.x), dtype=torch.float32)[None]
+        own = torch.tensor(c.skeleton.offsets, dtype=torch.float32)
+        target = torch.tensor(f.local_rot, dtype=torch.float32)[None]
+        with torch.no_grad():
+            phi = model.encode(x)
+            out = model.decode(phi, own)
+            gn = model.decode(project_latent(model, phi, target, own), own)
+        err.append(np.linalg.norm(out.positions[0].numpy() - f.positions, axis=-1))
+        enc_deg.append(_degrees(out.local_rot[0].numpy(), f.local_rot)[:, UPPER])
+        gn_deg.append(_degrees(gn.local_rot[0].numpy(), f.local_rot)[:, UPPER])
+    err = np.concatenate(err)
+    what = "synthetic clips" if args.synthetic else "Aj's 10 held-back retarget_gt clips"
+    print(f"decoder fidelity on {what} (never trained on):")
+    print(
+        f"  reconstruction by the network alone (encoder -> decoder -> FK on A): mean joint error {100 * err.mean():.2f} cm "
+        f"(upper body {100 * err[:, UPPER].mean():.2f}, legs {100 * np.delete(err, [0] + UPPER, axis=1).mean():.2f}); "
+        f"goal <= 1 cm: {'met' if 100 * err.mean() <= 1 else 'MISSED'}"
+    )
+    print(
+        f"  upper-body local rotations vs A, median: encoder's latent {np.median(np.concatenate(enc_deg)):.2f} deg, "
+        f"after the Gauss-Newton start {np.median(np.concatenate(gn_deg)):.3f} deg"
+    )
+    after = {}
+    for name, sk in targets.items():
+        degs = []
+        for src in sources[: 3 if args.quick else None]:
+            res = retarget(src, sk, ckpt, "full", SolverConfig())
+            c = preprocess.prepare(src, ckpt.fps)
+            yaw = clip_features_of(c).yaw
+            rot = res.motion.local_rot.copy()
+            from motionlab.core import quat
+
+            rot[:, 0] = quat.mul(quat.from_yaw(-yaw), rot[:, 0])
+            degs.append(_degrees(rot, clip_features_of(c).local_rot)[:, UPPER])
+        after[name] = float(np.median(np.concatenate(degs)))
+    worst = max(after.values())
+    print(
+        "  after the full iteration on each target, median upper-body angle to A: "
+        + ", ".join(f"{k} {v:.3f}" for k, v in after.items())
+        + f" deg; goal <= 1 deg: {'met' if worst <= 1 else 'MISSED'}"
+    )
+    # q_delta: departure from the identity, and dependence on the skeleton
+    c = preprocess.prepare(sources[0], ckpt.fps)
+    x = torch.tensor(ckpt.stats.normalize(clip_features_of(c).x), dtype=torch.float32)[None]
+    base = humanoid.to_canonical_skeleton(ckpt.skeleton)
+    sweeps = {f"legs x{s}": humanoid.scale_bones(base, legs=s) for s in (0.6, 1.0, 1.6)}
+    sweeps.update({f"arms x{s}": humanoid.scale_bones(base, arms=s) for s in (0.6, 1.6)})
+    sweeps.update({"overall x0.5": humanoid.scale_bones(base, overall=0.5)})
+    with torch.no_grad():
+        phi = model.encode(x)
+        ref = model.decode(phi, torch.tensor(base.offsets, dtype=torch.float32)).q_delta[0].numpy()
+        print(
+            "q_delta on one clip's latent: median angle from the identity / median change from the training skeleton's q_delta"
+        )
+        for name, sk in {**targets, **sweeps}.items():
+            qd = model.decode(phi, torch.tensor(sk.offsets, dtype=torch.float32)).q_delta[0].numpy()
+            print(
+                f"  {name:<14} {np.median(_degrees(qd, np.array([1.0, 0, 0, 0]))):6.2f} deg  "
+                f"{np.median(_degrees(qd, ref)):6.3f} deg (max {_degrees(qd, ref).max():.2f})"
+            )
+
+
+def clip_features_of(motion):
+    from motionlab.retargeting.features import clip_features
+
+    return clip_features(motion)
+
+
 def _solve(ckpt, args):
     from motionlab.core import bvh, humanoid, preprocess
     from motionlab.retargeting.features import clip_features
-    from motionlab.retargeting.pipeline import root_scale
+    from motionlab.retargeting.pipeline import root_scale, source_contacts
     from motionlab.retargeting.solver import SolverConfig, solve
 
     if args.synthetic:
@@ -83,16 +188,21 @@ def _solve(ckpt, args):
         f = clip_features(c)
         x = ckpt.stats.normalize(preprocess.pad_to(f.x, 120)[:120])
         rot = preprocess.pad_to(f.local_rot, 120)[:120]
+        planted = preprocess.pad_to(source_contacts(c), 120)[:120]
+        yaw = preprocess.pad_to(f.yaw, 120)[:120]
         for tgt in targets:
             r = root_scale(c.skeleton, tgt)
-            height = preprocess.pad_to(c.root_pos[:, 1] * r[1], 120)[:120]
+            root = preprocess.pad_to(c.root_pos * np.array([r[0], r[1], r[0]]), 120)[:120]
             res = solve(
                 ckpt.model,
                 torch.tensor(x, dtype=torch.float32)[None],
                 torch.tensor(rot, dtype=torch.float32)[None],
                 torch.tensor(tgt.offsets, dtype=torch.float32),
-                torch.tensor(height, dtype=torch.float32)[None],
+                torch.tensor(root[:, 1], dtype=torch.float32)[None],
                 cfg,
+                root_xz=torch.tensor(root[:, [0, 2]], dtype=torch.float32)[None],
+                yaw=torch.tensor(yaw, dtype=torch.float32)[None],
+                planted=torch.tensor(planted)[None],
             )
             times.append(res.seconds)
             steps.append(res.steps)
@@ -112,6 +222,7 @@ def main() -> None:
     p.add_argument("--synthetic", action="store_true", help="use motionlab.synthetic data instead of MOTIONLAB_DATA")
     p.add_argument("--synthetic-clips", type=int, default=300)
     p.add_argument("--threads", type=int, default=0, help="torch threads (0: torch's default)")
+    p.add_argument("--quick", action="store_true", help="fewer clips per target in the fidelity part")
     args = p.parse_args()
     if args.threads:
         torch.set_num_threads(args.threads)
@@ -124,6 +235,7 @@ def main() -> None:
         ckpt = checkpoint.load(args.checkpoint)
     else:
         ckpt = _train(args)
+    _fidelity(ckpt, args)
     _solve(ckpt, args)
 
 

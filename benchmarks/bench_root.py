@@ -27,7 +27,7 @@ import numpy as np
 from motionlab import data
 from motionlab.core import bvh, humanoid, preprocess
 from motionlab.retargeting.evaluate import DEFAULT_ANIMATIONS, DEFAULT_SOURCE, DEFAULT_TARGETS
-from motionlab.retargeting.pipeline import hip_height, leg_chain
+from motionlab.retargeting.pipeline import contact_stride, hip_height, leg_chain
 
 MEASURES = {
     "hip height": hip_height,
@@ -37,6 +37,9 @@ MEASURES = {
     "leg chain (hip..toe)": leg_chain,
 }
 """Candidate leg measures (metres) of a canonical skeleton; ``leg chain`` is :func:`pipeline.leg_chain`."""
+CONTACTS = "contacts (per clip)"
+"""The ground-plane ratio that keeps A's planted feet still on B's legs (:func:`pipeline.contact_stride`),
+per clip; the leg chain where a clip has no steps. Scored on the ground plane only."""
 
 
 def main(argv=None) -> int:
@@ -55,7 +58,7 @@ def main(argv=None) -> int:
 
     src = {a: preprocess.prepare(bvh.load(folder / args.source / f"{a}.bvh"), 60) for a in args.animations}
     sk_a = next(iter(src.values())).skeleton
-    names = list(MEASURES)
+    names = list(MEASURES) + [CONTACTS]
     err = {ax: {t: {} for t in args.targets} for ax in ("xz", "y")}  # axis -> target -> measure -> mean error
     print(f"Root trajectory of {args.source} scaled onto each target vs the target's real Mixamo root ({folder})")
     print(f"{len(args.animations)} animations; error = mean over frames of |root - real root|^2 / 3 / h^2\n")
@@ -73,35 +76,45 @@ def main(argv=None) -> int:
         b_y = np.concatenate([c.root_pos[:, 1] for c in clips])
         fit_xz = float((a_xz * b_xz).sum() / (a_xz * a_xz).sum())
         fit_y = float((a_y * b_y).sum() / (a_y * a_y).sum())
-        ratios = {n: MEASURES[n](sk_b) / MEASURES[n](sk_a) for n in names}
+        ratios = {n: MEASURES[n](sk_b) / MEASURES[n](sk_a) for n in MEASURES}
+        per_clip = [contact_stride(src[a], sk_b) for a in args.animations]
+        fallback = ratios["leg chain (hip..toe)"]
+        ratios[CONTACTS] = float(np.mean([r if r is not None else fallback for r in per_clip]))
         print(f"{t:<14} {fit_xz:9.3f} {fit_y:8.3f}  " + "  ".join(f"{ratios[n]:20.3f}" for n in names))
         for n in names:
-            r = ratios[n]
-            per_xz, per_y = [], []
-            for a, c, h in zip(args.animations, clips, heights, strict=True):
+            per_xz, per_y = {}, {}
+            for i, (a, c, h) in enumerate(zip(args.animations, clips, heights, strict=True)):
+                r = ratios[n] if n != CONTACTS else (per_clip[i] if per_clip[i] is not None else fallback)
                 ra = src[a].root_pos
-                per_xz.append(((ra[:, [0, 2]] * r - c.root_pos[:, [0, 2]]) ** 2).sum(1).mean() / 3 / h**2)
-                per_y.append(((ra[:, 1] * r - c.root_pos[:, 1]) ** 2).mean() / 3 / h**2)
-            err["xz"][t][n], err["y"][t][n] = float(np.mean(per_xz)), float(np.mean(per_y))
+                per_xz[a] = ((ra[:, [0, 2]] * r - c.root_pos[:, [0, 2]]) ** 2).sum(1).mean() / 3 / h**2
+                per_y[a] = ((ra[:, 1] * r - c.root_pos[:, 1]) ** 2).mean() / 3 / h**2
+            err["xz"][t][n], err["y"][t][n] = per_xz, per_y
+
+    first, second = args.animations[::2], args.animations[1::2]
+
+    def mean_err(ax, targets, anims, n):
+        return float(np.mean([err[ax][t][n][a] for t in targets for a in anims]))
 
     for ax, what in (("xz", "ground plane (x, z)"), ("y", "height (y)")):
+        cands = names if ax == "xz" else list(MEASURES)
         print(f"\nroot error of the {what}, MSE/h^2")
-        print(f"{'target':<14} " + "  ".join(f"{n:>20}" for n in names))
+        print(f"{'target':<14} " + "  ".join(f"{n:>20}" for n in cands))
         for t in args.targets:
-            print(f"{t:<14} " + "  ".join(f"{err[ax][t][n]:20.2e}" for n in names))
-        means = {n: float(np.mean([err[ax][t][n] for t in args.targets])) for n in names}
-        print(f"{'mean':<14} " + "  ".join(f"{means[n]:20.2e}" for n in names))
+            print(f"{t:<14} " + "  ".join(f"{mean_err(ax, [t], args.animations, n):20.2e}" for n in cands))
+        means = {n: mean_err(ax, args.targets, args.animations, n) for n in cands}
+        print(f"{'mean':<14} " + "  ".join(f"{means[n]:20.2e}" for n in cands))
         if len(args.targets) > 1:
-            held = []
-            picks = []
-            for t in args.targets:
+            held, picks = [], []
+            for t in args.targets:  # leave one character AND half the animations out
                 others = [u for u in args.targets if u != t]
-                best = min(names, key=lambda n, o=others: np.mean([err[ax][u][n] for u in o]))
-                picks.append(best)
-                held.append(err[ax][t][best])
+                for chosen_on, tested_on in ((first, second), (second, first)):
+                    best = min(cands, key=lambda n, o=others, c=chosen_on: mean_err(ax, o, c, n))
+                    picks.append(best)
+                    held.append(mean_err(ax, [t], tested_on, best))
             print(
-                f"leave-one-character-out: picks {', '.join(sorted(set(picks)))}; "
-                f"held-out error {np.mean(held):.2e} (best single measure on all: {min(means, key=means.get)})"
+                f"leave one character and half the animations out ({len(held)} splits): picks "
+                + ", ".join(f"{n} x{picks.count(n)}" for n in sorted(set(picks)))
+                + f"; held-out error {np.mean(held):.2e} (best measure on all: {min(means, key=means.get)})"
             )
     return 0
 

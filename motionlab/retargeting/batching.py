@@ -170,7 +170,17 @@ def solve_pairs(
     theta = torch.cat([j.source.theta for j in jobs])
     offsets = torch.stack([j.offsets for j in jobs])
     height = torch.cat([j.root_height for j in jobs])
-    solved = solve_many(checkpoint.model, x, theta, offsets, height, solver)
+    solved = solve_many(
+        checkpoint.model,
+        x,
+        theta,
+        offsets,
+        height,
+        solver,
+        root_xz=torch.cat([j.root_xz for j in jobs]),
+        yaw=torch.cat([j.source.yaw for j in jobs]),
+        planted=torch.cat([j.source.planted for j in jobs]),
+    )
     out = []
     for p, job, res in zip(pairs, jobs, solved):
         r = finish(job, res.local_rot[0], "full", res.history, res.stop_reason, res.steps, res.seconds)

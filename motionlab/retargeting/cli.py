@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT_MODES = ("stride", "hips", "legs")
+ROOT_MODES = ("stride", "hips", "legs", "contacts")
 """``pipeline.ROOT_MODES``, repeated so that ``--help`` does not import torch (a test keeps them equal)."""
 
 __all__ = ["register"]
@@ -57,16 +57,36 @@ def _load_checkpoint(path: str | None, device: str | None):
 def _solver_config(args):
     from motionlab.retargeting.solver import SolverConfig
 
-    return SolverConfig(max_steps=args.steps, lr=args.lr, threshold=args.threshold)
+    return SolverConfig(
+        max_steps=args.steps,
+        lr=args.lr,
+        threshold=args.threshold,
+        lambda_contact=args.contact_weight,
+        init=args.init,
+    )
 
 
 def _add_solver_args(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("latent iteration")
     g.add_argument("--steps", type=int, default=100, help="step limit of the latent iteration (default 100)")
     g.add_argument(
-        "--lr", type=float, default=0.1, help="Adam step on the latent, relative to its spread std(φ₀) (default 0.1)"
+        "--lr", type=float, default=0.02, help="Adam step on the latent, relative to its spread std(φ₀) (default 0.02)"
     )
     g.add_argument("--threshold", type=float, default=2e-3, help="stop when L_iter drops below this (default 2e-3)")
+    g.add_argument(
+        "--contact-weight",
+        type=float,
+        default=0.5,
+        metavar="W",
+        help="weight of the foot-contact term (motionlab's addition; 0 = the paper's two losses; default 0.5)",
+    )
+    g.add_argument(
+        "--init",
+        choices=("auto", "project", "encoder"),
+        default="auto",
+        help="start of the iteration: least-squares projection onto the source's rotations, the encoder's "
+        "latent (the paper), or auto (default: projection)",
+    )
 
 
 # ---------------------------------------------------------------------------- retarget
@@ -167,8 +187,16 @@ def _cmd_train(args) -> int:
 # ---------------------------------------------------------------------------- evaluate
 def _cmd_evaluate(args) -> int:
     from motionlab import data as mdata
+    from motionlab.core import bvh
     from motionlab.retargeting import checkpoint as ck
-    from motionlab.retargeting.evaluate import evaluate, rows_with_root, training_clips
+    from motionlab.retargeting.evaluate import (
+        DEFAULT_ANIMATIONS,
+        Evaluation,
+        evaluate,
+        rows_with_root,
+        shared_animations,
+        training_clips,
+    )
     from motionlab.retargeting.train import TrainConfig, train
 
     folder = Path(args.data) if args.data else mdata.data_root() / "mixamo"
@@ -178,38 +206,62 @@ def _cmd_evaluate(args) -> int:
         files.check_output(args.csv, args.force, "--csv file")
     if not folder.is_dir():
         raise _error(f"data folder {folder} not found")
+    if args.folds < 1:
+        raise _error(f"--folds must be >= 1, got {args.folds}")
     path = Path(args.checkpoint) if args.checkpoint else Path(tempfile.gettempdir()) / f"motionlab_{args.source}.pt"
-    animations = args.animations or None
-    if path.is_file() and not args.retrain:
-        ckpt = _load_checkpoint(str(path), args.device)
-        if not args.quiet:
-            print(f"using checkpoint {path}")
+    if args.animations:
+        animations = list(args.animations)
+    elif args.all_animations:
+        try:
+            animations = shared_animations(folder, args.source, args.targets)
+        except (FileNotFoundError, ValueError) as e:
+            raise _error(str(e)) from None
     else:
-        from motionlab.core import bvh
-        from motionlab.retargeting.evaluate import DEFAULT_ANIMATIONS
-
-        clips = training_clips(folder, args.source, animations or DEFAULT_ANIMATIONS)
-        if not args.quiet:
-            print(f"training on {len(clips)} clips of {args.source} -> {path}")
-        ckpt, _ = train(
-            [bvh.load(p) for p in clips],
-            TrainConfig(steps=args.train_steps, seed=args.seed, device=args.device),
+        animations = list(DEFAULT_ANIMATIONS)
+    if args.folds > len(animations):
+        raise _error(f"--folds {args.folds} is more than the {len(animations)} animations evaluated")
+    # leave animations out: fold k is evaluated by a network trained without the fold's animations
+    folds = [animations[k :: args.folds] for k in range(args.folds)]
+    result = Evaluation(rows=[])
+    for k, fold in enumerate(folds):
+        fpath = path if args.folds == 1 else path.with_name(f"{path.stem}_fold{k + 1}of{args.folds}{path.suffix}")
+        if fpath.is_file() and not args.retrain:
+            ckpt = _load_checkpoint(str(fpath), args.device)
+            if not args.quiet:
+                print(f"using checkpoint {fpath}")
+        else:
+            try:
+                clips = training_clips(folder, args.source, fold if args.folds > 1 else animations)
+            except FileNotFoundError as e:
+                raise _error(str(e)) from None
+            if not args.quiet:
+                print(f"training on {len(clips)} clips of {args.source} (none of the {len(fold)} evaluated) -> {fpath}")
+            ckpt, _ = train(
+                [bvh.load(p) for p in clips],
+                TrainConfig(steps=args.train_steps, seed=args.seed, device=args.device),
+                progress=not args.quiet,
+            )
+            ck.save(fpath, ckpt)
+        part = evaluate(
+            folder,
+            ckpt,
+            source=args.source,
+            targets=args.targets,
+            animations=fold,
+            rows=rows_with_root(args.root, ablations=not args.no_ablations),
+            solver=_solver_config(args),
             progress=not args.quiet,
         )
-        ck.save(path, ckpt)
-    from motionlab.retargeting.evaluate import DEFAULT_ANIMATIONS
-
-    result = evaluate(
-        folder,
-        ckpt,
-        source=args.source,
-        targets=args.targets,
-        animations=animations or (DEFAULT_ANIMATIONS if not args.all_animations else None),
-        rows=rows_with_root(args.root),
-        solver=_solver_config(args),
-        progress=not args.quiet,
-    )
+        result.rows = part.rows
+        result.records += part.records
+        result.ground_truth += part.ground_truth
+    if args.folds > 1:
+        print(f"leave-animations-out: {args.folds} folds, each evaluated by a network trained without its animations")
     print(result.table())
+    print()
+    print(result.breakdown("mse_h2"))
+    print()
+    print(result.breakdown("pose_mse_h2"))
     if args.csv:
         import csv
 
@@ -253,7 +305,8 @@ def register(subparsers) -> None:
         "--root",
         choices=ROOT_MODES,
         default="stride",
-        help="how A's root path is scaled: stride = leg chain on the ground, hip height up (default); "
+        help="how A's root path is scaled: stride = leg chain on the ground, hip height up (default); contacts = "
+        "the ratio that keeps A's planted feet still on B's legs; "
         "hips / legs = one ratio for all axes",
     )
     for name in ("legs", "arms", "spine", "neck"):
@@ -304,10 +357,21 @@ def register(subparsers) -> None:
         "--checkpoint", help="checkpoint to use, trained there if missing (default: <tmp>/motionlab_<source>.pt)"
     )
     p.add_argument("--retrain", action="store_true", help="train even if the checkpoint exists")
+    p.add_argument(
+        "--folds",
+        type=int,
+        default=1,
+        metavar="K",
+        help="leave animations out: split the evaluated animations into K folds and evaluate each with a network "
+        "trained on the source's other clips (checkpoints <checkpoint>_fold<k>of<K>.pt); default 1",
+    )
     p.add_argument("--train-steps", type=int, default=1500)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--csv", help="write the per-clip records to this CSV")
     p.add_argument("--force", action="store_true", help="overwrite an existing --csv file")
+    p.add_argument(
+        "--no-ablations", action="store_true", help="skip the ablation rows (full method without one of its parts)"
+    )
     p.add_argument(
         "--root",
         choices=ROOT_MODES,

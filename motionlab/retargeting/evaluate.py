@@ -7,14 +7,25 @@ of B's motion) and compared with B's real clip reduced to the same 22 joints.
 Metrics (all from :mod:`motionlab.core.metrics`, positions in world space):
 
 * ``mse`` (cm²) and ``mse/h²`` — squared joint-position error over frames, joints and axes; the
-  second divides by B's height² (``h`` = B's full rig rest height, highest minus lowest
-  joint, as in the data notes), the de facto metric; ``pose mse/h²`` does the same after
-  subtracting each frame's root position (pose only, root trajectory removed);
+  second divides by B's height² (``h`` = the rest height of B's **22-joint** skeleton, highest
+  minus lowest joint, as the literature and motionlab's conventions define it; Aj: 141.97 cm
+  as in the paper), the de facto metric; ``pose mse/h²`` does the same after subtracting each
+  frame's root position (pose only, root trajectory removed);
 * ``mpjpe`` (cm) — mean per-joint Euclidean error;
 * ``smooth`` (cm/frame²) — mean acceleration magnitude (the real clips' value is printed too);
 * ``pen`` (% of h) — mean depth of the four foot joints below the ground;
 * ``skate`` (cm/s) — mean horizontal foot speed while touching the ground;
 * ``time`` (s) — wall time of the method per clip (network + latent iteration).
+
+**The protocol differs from the paper's** (§3): the paper trains on Malcolm and retargets Aj
+onto BigVegas, Claire and Mutant (200 clips); those targets are not in the shared data, so
+motionlab trains on Aj's own other clips and retargets Aj's 10 ``retarget_gt`` animations onto
+six other Mixamo characters. The network never sees the evaluated animations (they are left
+out of training); ``folds=K`` also handles folders where every clip of the source is evaluated,
+by training K networks, each without one K-th of the animations.
+
+Rows: :data:`ROWS` (kept with the same labels and order across versions) and
+:data:`ABLATIONS` (the full method with one of motionlab's additions switched off).
 
 Alignment with the ground truth: every method uses the root trajectory of
 :mod:`motionlab.retargeting.pipeline`: A's trajectory scaled about the world origin by B/A
@@ -27,6 +38,7 @@ Taught in ``notebooks/03_latent_iteration.ipynb``.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -45,9 +57,11 @@ __all__ = [
     "DEFAULT_TARGETS",
     "DEFAULT_ANIMATIONS",
     "ROWS",
+    "ABLATIONS",
     "rows_with_root",
     "Evaluation",
     "training_clips",
+    "shared_animations",
     "evaluate",
 ]
 
@@ -69,12 +83,21 @@ ROWS: tuple[tuple[str, str, str], ...] = (
 """Table rows as ``(label, method, root_mode)``: the first is the data notes' plain baseline
 (everything scaled by thigh + shin); the others share the pipeline's default root trajectory."""
 
+ABLATIONS: tuple[tuple, ...] = (
+    ("full, paper's two losses", "full", "stride", {"lambda_contact": 0.0}),
+    ("full, encoder start", "full", "stride", {"init": "encoder", "lr": 0.1}),
+    ("full, without q_delta", "full", "stride", {"correction": False}),
+)
+"""The full method with one addition switched off: ``(label, method, root_mode, options)``, where
+``options`` are :class:`SolverConfig` fields, or ``correction=False`` (q_Δ replaced by the identity)."""
 
-def rows_with_root(root_mode: str) -> tuple[tuple[str, str, str], ...]:
-    """:data:`ROWS` with the root trajectory of every row but the plain baseline set to ``root_mode``."""
+
+def rows_with_root(root_mode: str, ablations: bool = False) -> tuple[tuple, ...]:
+    """:data:`ROWS` (and :data:`ABLATIONS`) with the root of every row but the plain baseline set to ``root_mode``."""
+    rows = ROWS + (ABLATIONS if ablations else ())
     if root_mode == ROWS[-1][2]:
-        return ROWS
-    return ROWS[:1] + tuple((label.replace("our root", f"root {root_mode}"), m, root_mode) for label, m, _ in ROWS[1:])
+        return rows
+    return rows[:1] + tuple((r[0].replace("our root", f"root {root_mode}"), r[1], root_mode, *r[3:]) for r in rows[1:])
 
 
 _CM = 100.0  # metres → file units (centimetres)
@@ -121,6 +144,20 @@ def training_clips(
     if not paths:
         raise FileNotFoundError(f"no training clips for {source!r} in {src} (all excluded or none present)")
     return paths
+
+
+def shared_animations(folder: str | Path, source: str, targets: Sequence[str]) -> list[str]:
+    """The animation stems that ``source`` and every target have in ``folder``, sorted."""
+    folder = Path(folder)
+    for name in (source, *targets):
+        if not (folder / name).is_dir():
+            raise FileNotFoundError(f"character folder {folder / name} not found")
+    common = {p.stem for p in (folder / source).glob("*.bvh")}
+    for t in targets:
+        common &= {p.stem for p in (folder / t).glob("*.bvh")}
+    if not common:
+        raise ValueError(f"no animation shared by {source} and {list(targets)} in {folder}")
+    return sorted(common)
 
 
 @dataclass
@@ -179,6 +216,20 @@ class Evaluation:
             lines.append(f"{label:<{width}} " + " ".join(cells))
         return "\n".join(lines)
 
+    def breakdown(self, key: str = "mse_h2") -> str:
+        """Per target character: the mean of ``key`` for every row (a text table)."""
+        targets = list(dict.fromkeys(r["target"] for r in self.records))
+        width = max([len(r) for r in self.rows] + [12])
+        head = f"{key + ' by target':<{width}} " + " ".join(f"{t[:12]:>12}" for t in targets)
+        lines = [head, "-" * len(head)]
+        for label in self.rows:
+            cells = []
+            for t in targets:
+                vals = [r[key] for r in self.records if r["row"] == label and r["target"] == t]
+                cells.append(f"{np.mean(vals):12.2e}" if vals else f"{'-':>12}")
+            lines.append(f"{label:<{width}} " + " ".join(cells))
+        return "\n".join(lines)
+
 
 def _gt_metrics(pos: np.ndarray, fps: float, height: float) -> dict:
     feet = [humanoid.JOINTS.index(f) for f in humanoid.FEET]
@@ -207,7 +258,7 @@ def evaluate(
     checkpoint : the network trained on ``source`` (None is allowed when only "copy" rows run)
     source, targets : character folder names
     animations : clip stems; ``None``: every stem that the source and all targets share
-    rows : ``(label, method, root_mode)`` triples, see :data:`ROWS`
+    rows : ``(label, method, root_mode[, options])``, see :data:`ROWS` and :data:`ABLATIONS`
     solver : latent iteration settings for the "full" rows
     """
     folder = Path(folder)
@@ -217,13 +268,10 @@ def evaluate(
         if not (folder / t).is_dir():
             raise FileNotFoundError(f"target character folder {folder / t} not found")
     if animations is None:
-        common = {p.stem for p in (folder / source).glob("*.bvh")}
-        for t in targets:
-            common &= {p.stem for p in (folder / t).glob("*.bvh")}
-        animations = sorted(common)
+        animations = shared_animations(folder, source, targets)
     if not animations:
         raise ValueError(f"no animation shared by {source} and {list(targets)} in {folder}")
-    if checkpoint is None and any(m != "copy" for _, m, _ in rows):
+    if checkpoint is None and any(r[1] != "copy" for r in rows):
         raise ValueError("a checkpoint is needed for the network rows")
     result = Evaluation(rows=[r[0] for r in rows])
     sources = {}
@@ -241,10 +289,21 @@ def evaluate(
         fps = checkpoint.fps if checkpoint is not None else gt_rig.fps
         gt = preprocess.prepare(gt_rig, fps)
         gt_pos = gt.global_positions()
-        height = gt_rig.skeleton.height()
+        height = gt.skeleton.height()  # the 22-joint rest height
         result.ground_truth.append({"target": target, "animation": anim, **_gt_metrics(gt_pos, fps, height)})
-        for label, method, root_mode in rows:
-            out = retarget(sources[anim], gt_rig.skeleton, checkpoint, method, solver, root_mode)
+        for row in rows:
+            label, method, root_mode = row[:3]
+            options = dict(row[3]) if len(row) > 3 else {}
+            correction = options.pop("correction", True)
+            cfg = dataclasses.replace(solver or SolverConfig(), **options)
+            model = checkpoint.model if checkpoint is not None else None
+            if model is not None:
+                model.use_correction = correction
+            try:
+                out = retarget(sources[anim], gt_rig.skeleton, checkpoint, method, cfg, root_mode)
+            finally:
+                if model is not None:
+                    model.use_correction = True
             pos = out.positions
             n = min(len(pos), len(gt_pos))
             if len(pos) != len(gt_pos):

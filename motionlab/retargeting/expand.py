@@ -78,11 +78,11 @@ PRESETS: dict[str, dict[str, float]] = {
 MANIFEST = "manifest.csv"
 COLUMNS = (
     "clip", "character", "status", "output", "source", "character_file", "frames", "steps", "stop_reason",
-    "loss", "angle", "foot", "penetration_cm", "skating_cm_s", "source_skating_cm_s", "seconds", "batch_size",
+    "loss", "angle", "foot", "contact", "penetration_cm", "skating_cm_s", "source_skating_cm_s", "seconds", "batch_size",
     "flag", "error",
 )  # fmt: skip
-"""Manifest columns: ``status`` is ``ok`` or ``error``; ``loss``/``angle``/``foot`` the final
-(best) L_iter, L_angle, L_foot (metres); ``seconds`` the pair's share of its batch's wall time;
+"""Manifest columns: ``status`` is ``ok`` or ``error``; ``loss``/``angle``/``foot``/``contact`` the
+final (best) L_iter, L_angle, L_foot (metres), L_contact (metres per frame); ``seconds`` the pair's share of its batch's wall time;
 ``flag`` lists the quality thresholds exceeded (``penetration``, ``skating``), empty if none."""
 
 _ERRORS = (
@@ -327,6 +327,7 @@ def _row(pr: PairResult, source: str, char: Character, source_skate: float, limi
         "loss": _fmt(h["loss"][best]),
         "angle": _fmt(h["angle"][best]),
         "foot": _fmt(h["foot"][best]),
+        "contact": _fmt(h["contact"][best]) if h.get("contact") else "",
         "penetration_cm": _fmt(q["penetration_cm"]),
         "skating_cm_s": _fmt(q["skating_cm_s"]),
         "source_skating_cm_s": _fmt(source_skate),

@@ -8,12 +8,14 @@ loss                   formula                                                  
 ``direction_loss``     the same with θ = unit bone directions (from positions)      unitless
 ``foot_loss``          1/(4T) Σ_t Σ_{i ∈ feet} max(−y_i,t, 0)                       metres
 ``rotation_loss``      mean over frames and joints of 1 − ⟨q, q̂⟩²                   unitless
+``contact_loss``       mean over planted frame pairs of ‖x_t+1 − x_t‖₂ (feet)       m/frame
 =====================  ===========================================================  ==========
 
 **Our choice of θ (the paper leaves it open): the joint angles themselves**, i.e. each joint's
 local rotation as a unit quaternion (the root's in the heading frame), compared up to sign:
-``‖θ(A) − θ(B')‖ = min(‖q_A − q_B'‖, ‖q_A + q_B'‖)`` (≈ the rotation angle between them for
-small differences). We tried the other natural choice first — the unit direction of every bone
+``‖θ(A) − θ(B')‖ = min(‖q_A − q_B'‖, ‖q_A + q_B'‖) = 2 sin(α/4)``, where α is the angle of the
+rotation that takes one to the other: about α/2 for small differences (not α, and not exactly
+a half-angle either; 0.0175 ≈ 2°). We tried the other natural choice first — the unit direction of every bone
 in the root-centred heading frame, computed from positions (:func:`direction_loss`) — and
 measured why it is worse: real rigs have *different rest poses* (a bone of B points elsewhere
 than A's in the T-pose), so matching A's bone directions bends B away from what its animators
@@ -29,7 +31,10 @@ copy-rotation has zero angle loss, and the foot term decides how far the pose mo
 nor a bone's twist, so without it those rotations drift freely and the BVH output looks wrong
 even when every joint position is right.
 
-Paper: ``seeds/000_*.txt``, eqs. (8)–(10). Taught in ``notebooks/03_latent_iteration.ipynb``.
+``contact_loss`` is *our addition* to the iteration: on the frames where A's foot is planted
+(:mod:`motionlab.retargeting.contacts`), B's foot joint should not move in the world.
+
+Paper: ``seeds/000_*.txt``, eq. (8) (L_recon) and eqs. (15)–(17) (the iteration's losses, §2.2). Taught in ``notebooks/03_latent_iteration.ipynb``.
 """
 
 from __future__ import annotations
@@ -49,6 +54,8 @@ __all__ = [
     "direction_loss",
     "foot_loss",
     "rotation_loss",
+    "contact_loss",
+    "LAMBDA_CONTACT",
 ]
 
 LAMBDA_RECON = 0.5
@@ -57,6 +64,8 @@ LAMBDA_ANGLE = 0.3
 """λ_angle of the iteration loss."""
 LAMBDA_FOOT = 0.5
 """λ_foot of the iteration loss."""
+LAMBDA_CONTACT = 0.5
+"""Weight of the contact term (our addition), the same as λ_foot: both are in metres."""
 FOOT_JOINTS: tuple[int, ...] = tuple(humanoid.JOINTS.index(n) for n in humanoid.FEET)
 """Indices of LeftFoot, RightFoot, LeftToeBase, RightToeBase in the canonical skeleton."""
 
@@ -82,7 +91,10 @@ def bone_directions(positions: torch.Tensor) -> torch.Tensor:
 
 
 def angle_loss(source_rot: torch.Tensor, generated_rot: torch.Tensor) -> torch.Tensor:
-    """L_angle with θ = joint rotations: mean over frames and joints of ``min(‖q_A − q_B'‖, ‖q_A + q_B'‖)``.
+    """L_angle with θ = joint rotations (eq. 16): mean over frames and joints of ``min(‖q_A − q_B'‖, ‖q_A + q_B'‖)``.
+
+    For unit quaternions that distance is ``2 sin(α/4)`` with α the angle between the two
+    rotations (so ≈ α/2 for small α, in radians).
 
     Both inputs are local rotations (..., T, 22, 4) (unit quaternions; the root's in the heading frame).
     """
@@ -110,7 +122,7 @@ def direction_loss(source_positions: torch.Tensor, generated_positions: torch.Te
 
 
 def foot_loss(world_y: torch.Tensor) -> torch.Tensor:
-    """L_foot: mean of ``|min(y, 0)|`` over frames and the four foot joints.
+    """L_foot (eq. 17): mean of ``|min(y, 0)|`` over frames and the four foot joints.
 
     Parameters
     ----------
@@ -131,3 +143,23 @@ def rotation_loss(local_rot: torch.Tensor, target_rot: torch.Tensor) -> torch.Te
             f"rotation_loss: expected two (..., 4) tensors of equal shape, got {tuple(local_rot.shape)} and {tuple(target_rot.shape)}"
         )
     return (1.0 - (local_rot * target_rot).sum(-1) ** 2).mean()
+
+
+def contact_loss(feet: torch.Tensor, planted: torch.Tensor) -> torch.Tensor:
+    """Mean distance (metres per frame) that planted feet move between consecutive frames.
+
+    Parameters
+    ----------
+    feet : Tensor (..., T, F, 3)     world positions of F foot joints, metres
+    planted : Tensor (..., T, F) of bool   contact labels; a frame pair counts when the joint
+        is planted in both frames
+
+    Returns 0 (with a gradient path) when no foot is ever planted.
+    """
+    if feet.shape[-1] != 3 or planted.shape != feet.shape[:-1]:
+        raise ValueError(
+            f"contact_loss: expected feet (..., T, F, 3) and planted (..., T, F), got {tuple(feet.shape)} and {tuple(planted.shape)}"
+        )
+    both = (planted[..., 1:, :] & planted[..., :-1, :]).to(feet.dtype)
+    step = _length(feet[..., 1:, :, :] - feet[..., :-1, :, :])
+    return (step * both).sum() / both.sum().clamp_min(1.0)

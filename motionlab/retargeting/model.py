@@ -4,12 +4,12 @@ Given a window ``X_A`` of source features (T frames × 70 numbers, see
 :mod:`motionlab.core.preprocess`) and a target skeleton ``S̄`` (the T-pose bone offsets), the
 network produces local joint rotations for that skeleton and puts them on it by FK::
 
-    φ      = F_enc(X_A)                          (B, T, D)     encoder: temporal 1-D convolutions
-    q      = F_qlinear(φ) / ‖·‖                  (B, T, J, 4)  per-joint, per-frame rotations
-    S̄'     = F_skel(S̄) / ‖·‖                    (B, E)        skeleton embedding (unit vector)
-    q_Δ    = F_Δ(concat(φ, S̄')) / ‖·‖           (B, T, J, 4)  skeleton-conditioned correction
-    q      ← q ⊗ q_Δ                                           Hamilton product
-    P'     = FK(q, S̄)                           (B, T, J, 3)  root at the origin
+    φ      = F_enc(X_A)                          (B, T, D)     eq. 1, encoder: temporal 1-D convolutions
+    q      = F_qlinear(φ) / ‖·‖                  (B, T, J, 4)  eq. 2, per-joint, per-frame rotations
+    S̄'     = F_skel(S̄) / ‖·‖                    (B, E)        eqs. 3–4, skeleton embedding (unit vector)
+    q_Δ    = F_Δ(concat(φ, S̄')) / ‖·‖           (B, T, J, 4)  eq. 5, skeleton-conditioned correction
+    q      ← q ⊗ q_Δ                                           eq. 6, Hamilton product
+    P'     = FK(q, S̄)                           (B, T, J, 3)  eq. 7, root at the origin
 
 Design choices the paper leaves open (documented here, shown in notebook 02):
 
@@ -26,7 +26,8 @@ Design choices the paper leaves open (documented here, shown in notebook 02):
   input features; positions are root-relative. World placement is the job of
   :mod:`motionlab.retargeting.pipeline`.
 
-Paper: "Skeletal motion generation by latent-space iteration" (``seeds/000_*.txt``), §3.
+Paper: "Skeletal motion generation by latent-space iteration" (``seeds/000_*.txt``), §2.2:
+eqs. (1)–(7) for A's own skeleton (training), eqs. (10)–(14) for a target skeleton.
 Taught in ``notebooks/02_training_autoencoder.ipynb``.
 """
 
@@ -105,7 +106,7 @@ def unit(v: torch.Tensor, eps: float = 1e-12) -> torch.Tensor:
 def skeleton_tensor(offsets, dtype=torch.float32, device=None) -> torch.Tensor:
     """Bone offsets (J, 3) of a canonical skeleton as a tensor with the root offset zeroed.
 
-    ``s̄_j = p̄_j − p̄_parent(j)`` in the T-pose, root at the origin (paper A, §3.1).
+    ``s̄_j = p̄_j − p̄_parent(j)`` in the T-pose, root at the origin (paper A, §2.2, eq. 3).
     Accepts a :class:`~motionlab.core.skeleton.Skeleton`, an array or a tensor (…, 22, 3).
     """
     if hasattr(offsets, "offsets") and hasattr(offsets, "parents"):
@@ -212,7 +213,7 @@ class _Encoder(nn.Module):
 
 
 class RetargetNet(nn.Module):
-    """F_enc, F_qlinear, F_skel and F_Δ, with the decoder that combines them (paper A, Fig. 2).
+    """F_enc, F_qlinear, F_skel and F_Δ, with the decoder that combines them (paper A, §2.2 and Fig. 3).
 
     Every step is its own method so notebooks can call and plot it alone:
     :meth:`encode`, :meth:`rotations`, :meth:`skeleton_embedding`, :meth:`correction`,
@@ -223,6 +224,8 @@ class RetargetNet(nn.Module):
         super().__init__()
         cfg = config or ModelConfig()
         self.config = cfg
+        self.use_correction = True
+        """False replaces q_Δ by the identity (the ablation "without q_Δ"); not saved in checkpoints."""
         J = NUM_JOINTS
         self.f_enc = _Encoder(cfg)
         self.f_qlinear = nn.Linear(cfg.latent, 4 * J)
@@ -259,7 +262,12 @@ class RetargetNet(nn.Module):
         return unit(e)
 
     def correction(self, phi: torch.Tensor, embedding: torch.Tensor) -> torch.Tensor:
-        """q_Δ = F_Δ(concat(φ, S̄')) / ‖·‖: (B, T, D) and (B or 1, E) → unit quaternions (B, T, J, 4)."""
+        """q_Δ = F_Δ(concat(φ, S̄')) / ‖·‖: (B, T, D) and (B or 1, E) → unit quaternions (B, T, J, 4).
+
+        With ``use_correction = False`` (an ablation) q_Δ is the identity rotation.
+        """
+        if not self.use_correction:
+            return tq.IDENTITY.to(phi).expand(phi.shape[:2] + (NUM_JOINTS, 4))
         emb = embedding[:, None, :].expand(phi.shape[0], phi.shape[1], -1)
         raw = self.f_delta(torch.cat([phi, emb], dim=-1))
         return unit(raw.reshape(raw.shape[:2] + (NUM_JOINTS, 4)))
@@ -280,6 +288,56 @@ class RetargetNet(nn.Module):
         if s.ndim == 3:
             s = s[:, None]
         return fk_by_level(local_rot, s, humanoid.PARENTS)
+
+    def rotation_jacobian(self, phi: torch.Tensor, embedding: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """Per-frame decoded rotations ``q ⊗ q_Δ`` and their Jacobian with respect to the latent.
+
+        Eqs. 10–13 act on each frame alone, so frame ``t``'s rotations depend on ``φ_t`` only and
+        the Jacobian is a (88 × D) matrix per frame, written out by the chain rule (no autograd):
+        ``d unit(r) = (I − q qᵀ)/‖r‖ dr`` for both normalisations, ``dr = W dφ`` for F_qlinear,
+        ``ds = V diag(σ'(h)) U_φ dφ`` for F_Δ (``h`` its hidden layer), and
+        ``d(q ⊗ p) = L(q) dp + R(p) dq`` for the Hamilton product (L, R: its 4×4 matrices).
+
+        Parameters
+        ----------
+        phi : Tensor (M, D)         latents of M frames
+        embedding : Tensor (M, E) or (1, E)   the skeleton embedding S̄' for each frame
+
+        Returns
+        -------
+        rotations : Tensor (M, 22, 4)
+        jacobian : Tensor (M, 88, D)
+        """
+        M, D = phi.shape
+
+        def tangent(u: torch.Tensor, length: torch.Tensor, du: torch.Tensor) -> torch.Tensor:
+            # d unit(r) = (du − u ⟨u, du⟩) / ‖r‖ for du (M, J, 4, D); elementwise (tiny batched matmuls are slow)
+            return (du - u[..., :, None] * (u[..., :, None] * du).sum(-2, keepdim=True)) / length[..., None]
+
+        r = self.f_qlinear(phi).reshape(M, NUM_JOINTS, 4)
+        rlen = torch.sqrt((r * r).sum(-1, keepdim=True))
+        q = r / rlen
+        jq = tangent(q, rlen, self.f_qlinear.weight.reshape(1, NUM_JOINTS, 4, D))
+        if self.use_correction:
+            first, act, last = self.f_delta
+            h = first(torch.cat([phi, embedding.expand(M, -1)], dim=-1))  # (M, H)
+            s = last(act(h)).reshape(M, NUM_JOINTS, 4)
+            slen = torch.sqrt((s * s).sum(-1, keepdim=True))
+            p = s / slen
+            slope = torch.where(h > 0, torch.ones_like(h), torch.full_like(h, act.negative_slope))
+            ds = (slope[:, None, :] * last.weight[None]) @ first.weight[:, :D]  # (M, 88, D)
+            jp = tangent(p, slen, ds.reshape(M, NUM_JOINTS, 4, D))
+        else:
+            p = tq.IDENTITY.to(phi).expand(M, NUM_JOINTS, 4)
+            jp = None
+        w, x, y, z = q.unbind(-1)
+        left = torch.stack([w, -x, -y, -z, x, w, -z, y, y, z, w, -x, z, -y, x, w], -1).reshape(M, NUM_JOINTS, 4, 4)
+        w, x, y, z = p.unbind(-1)
+        right = torch.stack([w, -x, -y, -z, x, w, z, -y, y, -z, w, x, z, y, -x, w], -1).reshape(M, NUM_JOINTS, 4, 4)
+        jac = (right[..., None] * jq[..., None, :, :]).sum(-2)
+        if jp is not None:
+            jac = jac + (left[..., None] * jp[..., None, :, :]).sum(-2)
+        return tq.mul(q, p), jac.reshape(M, 4 * NUM_JOINTS, D)
 
     def decode(self, phi: torch.Tensor, offsets: torch.Tensor, embedding: torch.Tensor | None = None) -> Decoded:
         """The whole decoder on skeleton ``offsets`` (J, 3) or (B, J, 3) from the latent φ (B, T, D).

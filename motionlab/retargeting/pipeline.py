@@ -27,6 +27,8 @@ about the world origin, with one ratio for the ground plane and one for the heig
 * the heading (facing direction) of every frame is A's: the network's root rotation, expressed
   in A's heading frame, is turned back by A's heading.
 
+``root_mode="contacts"`` replaces the ground-plane ratio by the one that keeps A's planted feet
+still on B's legs (:func:`contact_stride`; the leg chain when the clip has no steps).
 ``root_mode="hips"`` scales all three axes by the hip height and ``"legs"`` by thigh + shin
 (:func:`humanoid.leg_length`, the plain baseline of the data notes). On the shared Mixamo data
 the stride ratio matches Mixamo's own horizontal root scaling best of five leg measures, in
@@ -48,6 +50,7 @@ import torch
 from motionlab.core import humanoid, preprocess, quat
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
+from motionlab.retargeting import contacts
 from motionlab.retargeting.checkpoint import Checkpoint
 from motionlab.retargeting.features import ClipFeatures, check_motion, clip_features
 from motionlab.retargeting.solver import SolverConfig, solve
@@ -65,12 +68,14 @@ __all__ = [
     "prepare_source",
     "prepare_pair",
     "finish",
+    "source_contacts",
+    "contact_stride",
     "retarget",
 ]
 
 METHODS = ("full", "network", "copy")
 """``full``: network + latent iteration; ``network``: no iteration; ``copy``: copy local rotations."""
-ROOT_MODES = ("stride", "hips", "legs")
+ROOT_MODES = ("stride", "hips", "legs", "contacts")
 """How the root trajectory is scaled: see the module docstring."""
 
 
@@ -124,8 +129,42 @@ _MEASURES = {  # root mode -> (ground-plane measure, height measure)
 }
 
 
+def contact_stride(source: Motion, target: Skeleton, min_planted: float = 0.05) -> float | None:
+    """The ground-plane root ratio that keeps A's planted feet still on B's legs, or None.
+
+    While a foot is planted, the root moves by minus the foot's motion relative to the root.
+    With A's joint rotations on B's skeleton, B's planted foot sweeps ``u_B`` where A's sweeps
+    ``u_A`` (horizontal velocities relative to the root, on A's contact frames); the ratio is
+    the least-squares ``r = Σ⟨u_A, u_B⟩ / Σ‖u_A‖²``. It uses A's motion and B's skeleton only.
+    None when fewer than ``min_planted`` of the frames have a planted foot that moves
+    relative to the root (a clip standing still says nothing about strides).
+
+    Parameters
+    ----------
+    source : canonical 22-joint Motion of A
+    target : B's canonical skeleton
+    """
+    planted = source_contacts(source)[:-1] & source_contacts(source)[1:]  # (T-1, 4) both frames planted
+    zero = np.zeros_like(source.root_pos)
+    rel = {}
+    for key, sk in (("a", source.skeleton), ("b", target)):
+        pos = Motion(sk, source.local_rot, zero, source.fps).global_positions()[:, list(contacts.CONTACT_JOINTS)]
+        rel[key] = np.diff(pos[..., [0, 2]], axis=0)  # (T-1, 4, 2)
+    moving = planted & (np.linalg.norm(rel["a"], axis=-1) * source.fps > 0.05 * source.skeleton.height())
+    if moving.any(axis=1).mean() < min_planted:
+        return None
+    ua, ub = rel["a"][moving], rel["b"][moving]
+    return float((ua * ub).sum() / (ua * ua).sum())
+
+
 def root_scale(source: Skeleton, target: Skeleton, mode: str = "stride") -> tuple[float, float]:
-    """``(r_xz, r_y)``: how much B's root moves per unit of A's, on the ground and up (module doc)."""
+    """``(r_xz, r_y)``: how much B's root moves per unit of A's, on the ground and up (module doc).
+
+    ``mode="contacts"`` depends on the motion (:func:`contact_stride`); here it gives the
+    skeleton-only fallback, the ``"stride"`` ratios.
+    """
+    if mode == "contacts":
+        mode = "stride"
     if mode not in _MEASURES:
         raise ValueError(f"root_mode must be one of {ROOT_MODES}, got {mode!r}")
     ratios = []
@@ -135,6 +174,12 @@ def root_scale(source: Skeleton, target: Skeleton, mode: str = "stride") -> tupl
             raise ValueError(f"cannot scale the root: {measure.__name__} {a:.4g} m (source) / {b:.4g} m (target)")
         ratios.append(b / a)
     return ratios[0], ratios[1]
+
+
+def source_contacts(source: Motion) -> np.ndarray:
+    """A's planted feet (T, 4) for the contact term, from a canonical motion (:mod:`.contacts`)."""
+    sk = source.skeleton
+    return contacts.detect_contacts(source.global_positions(), contacts.rest_heights(sk), sk.height(), source.fps)
 
 
 def target_skeleton(target: Skeleton | Motion) -> Skeleton:
@@ -180,6 +225,8 @@ class PreparedSource:
     features : ClipFeatures or None   network-side features (None for ``method="copy"``)
     x : Tensor (1, T, 70) or None      A's normalised features on the checkpoint's device
     theta : Tensor (1, T, 22, 4) or (1, T, 22, 3) or None   θ(A) for the solver's ``theta``
+    yaw : Tensor (1, T) or None        A's heading, radians (the contact term's world frame)
+    planted : Tensor (1, T, 4) of bool or None   A's foot contacts (:func:`source_contacts`)
     """
 
     name: str
@@ -187,6 +234,8 @@ class PreparedSource:
     features: ClipFeatures | None = None
     x: torch.Tensor | None = None
     theta: torch.Tensor | None = None
+    yaw: torch.Tensor | None = None
+    planted: torch.Tensor | None = None
 
 
 @dataclass
@@ -202,6 +251,7 @@ class PreparedPair:
     root_pos : ndarray (T, 3)   B's root trajectory, metres
     offsets : Tensor (22, 3) or None   B's bone offsets on the checkpoint's device
     root_height : Tensor (1, T) or None   B's root height, metres
+    root_xz : Tensor (1, T, 2) or None    B's root on the ground plane, metres (contact term)
     """
 
     source: PreparedSource
@@ -210,6 +260,7 @@ class PreparedPair:
     root_pos: np.ndarray
     offsets: torch.Tensor | None = None
     root_height: torch.Tensor | None = None
+    root_xz: torch.Tensor | None = None
 
 
 def prepare_source(
@@ -226,7 +277,9 @@ def prepare_source(
         return PreparedSource(source.name, src)
     feats = clip_features(src)
     x, theta = _network_inputs(checkpoint, feats, (solver or SolverConfig()).theta)
-    return PreparedSource(source.name, src, feats, x, theta)
+    yaw = torch.as_tensor(feats.yaw, dtype=torch.float32, device=x.device)[None]
+    planted = torch.as_tensor(source_contacts(src), device=x.device)[None]
+    return PreparedSource(source.name, src, feats, x, theta, yaw, planted)
 
 
 def prepare_pair(source: PreparedSource, target: Skeleton | Motion, root_mode: str = "stride") -> PreparedPair:
@@ -234,13 +287,17 @@ def prepare_pair(source: PreparedSource, target: Skeleton | Motion, root_mode: s
     tgt = target_skeleton(target)
     src = source.motion
     r = root_scale(src.skeleton, tgt, root_mode)
+    if root_mode == "contacts":
+        stride = contact_stride(src, tgt)
+        r = (stride, r[1]) if stride is not None else r
     root_pos = src.root_pos * np.array([r[0], r[1], r[0]])
     if source.x is None:
         return PreparedPair(source, tgt, r, root_pos)
     device = source.x.device
     offsets = torch.tensor(tgt.offsets, dtype=torch.float32, device=device)
     height = torch.as_tensor(root_pos[:, 1], dtype=torch.float32)[None]
-    return PreparedPair(source, tgt, r, root_pos, offsets, height)
+    root_xz = torch.as_tensor(root_pos[:, [0, 2]], dtype=torch.float32, device=device)[None]
+    return PreparedPair(source, tgt, r, root_pos, offsets, height, root_xz)
 
 
 def finish(
@@ -327,6 +384,9 @@ def retarget(
             solver,
             callback=callback,
             progress=progress,
+            root_xz=pair.root_xz,
+            yaw=src.yaw,
+            planted=src.planted,
         )
         heading_rot, history, reason, steps = res.local_rot[0], res.history, res.stop_reason, res.steps
     return finish(pair, heading_rot, method, history, reason, steps, time.perf_counter() - start)

@@ -8,6 +8,7 @@ import pytest
 from motionlab import cli
 from motionlab.core import bvh, humanoid
 from motionlab.retargeting import checkpoint
+from motionlab.retargeting.evaluate import ABLATIONS, ROWS
 
 
 @pytest.fixture(scope="module")
@@ -121,7 +122,8 @@ def test_train_and_evaluate_on_a_small_folder(tmp_path, clips, capsys):
     assert code == 0, err
     for row in ("copy rotations, our root", "no iteration", "full method", "ground truth", "MSE/h²"):
         assert row in stdout
-    assert (tmp_path / "rec.csv").read_text().count("\n") == 1 + 4
+    assert (tmp_path / "rec.csv").read_text().count("\n") == 1 + len(ROWS) + len(ABLATIONS)
+    assert "full, paper's two losses" in stdout and "mse_h2 by target" in stdout
     code, stdout, err = _run(
         capsys, "evaluate", "--data", root, "--source", "A", "--targets", "B", "--animations", "anim1",
         "--checkpoint", ck, "--steps", "2", "-q", "--root", "hips",
@@ -130,3 +132,26 @@ def test_train_and_evaluate_on_a_small_folder(tmp_path, clips, capsys):
     assert "copy rotations, root hips" in stdout and "root x leg length" in stdout
     code, _, err = _run(capsys, "evaluate", "--data", root, "--source", "Nobody", "--checkpoint", ck)
     assert code == 2 and "Nobody" in err
+
+
+def test_evaluate_leaves_animations_out_by_folds(tmp_path, clips, capsys):
+    """--folds 2: each animation is evaluated by a network trained without it (one checkpoint per fold)."""
+    root = tmp_path / "chars"
+    big = humanoid.scale_bones(clips[0].skeleton, legs=1.2)
+    for name, sk in (("A", clips[0].skeleton), ("B", big)):
+        (root / name).mkdir(parents=True)
+        for i, c in enumerate(clips):
+            bvh.save(root / name / f"anim{i}.bvh", c.copy(skeleton=sk))
+    ck = tmp_path / "a.pt"
+    code, stdout, err = _run(
+        capsys, "evaluate", "--data", root, "--source", "A", "--targets", "B", "--all-animations", "--folds", "2",
+        "--checkpoint", ck, "--train-steps", "2", "--steps", "1", "--no-ablations",
+    )  # fmt: skip
+    assert code == 0, err
+    assert "leave-animations-out: 2 folds" in stdout and "over 2 clips" in stdout
+    for k in (1, 2):
+        info = checkpoint.load(tmp_path / f"a_fold{k}of2.pt").info
+        assert info["clips"] == 1  # trained on the other animation only
+    assert not ck.exists()
+    code, _, err = _run(capsys, "evaluate", "--data", root, "--source", "A", "--targets", "B", "--folds", "0")
+    assert code == 2 and "--folds" in err

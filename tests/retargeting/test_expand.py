@@ -86,7 +86,8 @@ def test_outputs_equal_single_pair_path(ckpt, library, tmp_path):
             assert (tmp_path / c.name / f"{clip}.bvh").read_text() == bvh.dumps(single.motion), (clip, c.name)
     row = next(r for r in job.rows if r["clip"] == "walk" and r["character"] == "rig0")
     assert int(row["frames"]) == 40 and int(row["steps"]) <= FAST.max_steps and row["stop_reason"]
-    assert float(row["loss"]) == pytest.approx(0.3 * float(row["angle"]) + 0.5 * float(row["foot"]), rel=1e-4)
+    expected = 0.3 * float(row["angle"]) + 0.5 * float(row["foot"]) + 0.5 * float(row["contact"])
+    assert float(row["loss"]) == pytest.approx(expected, rel=1e-4)
     assert "rig0" in job.summary() and "9 solved" in job.summary()
 
 

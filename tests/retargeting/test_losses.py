@@ -84,3 +84,15 @@ def test_bad_shapes_refused():
         losses.recon_loss(torch.zeros(2, 22, 3), torch.zeros(3, 22, 3))
     with pytest.raises(ValueError, match="22"):
         losses.foot_loss(torch.zeros(5, 7))
+
+
+def test_angle_loss_is_two_sines_of_a_quarter_angle():
+    """‖q_A − q_B‖ for unit quaternions 2 sin(α/4) apart by a rotation of α (≈ α/2, not α)."""
+    from motionlab.core import quat_torch as tq
+    from motionlab.retargeting.losses import angle_loss
+
+    alpha = torch.tensor(0.7)
+    a = tq.IDENTITY.expand(1, 22, 4)
+    b = tq.from_axis_angle(torch.tensor([0.0, 1.0, 0.0]), alpha).expand(1, 22, 4)
+    assert float(angle_loss(a, b)) == pytest.approx(float(2 * torch.sin(alpha / 4)), rel=1e-5)
+    assert float(angle_loss(a, -b)) == pytest.approx(float(2 * torch.sin(alpha / 4)), rel=1e-5)  # sign-blind

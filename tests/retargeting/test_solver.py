@@ -56,7 +56,7 @@ def test_smoothed_updates_are_smooth_in_time(tiny_checkpoint, data):
             src,
             off,
             h,
-            SolverConfig(max_steps=20, lr=0.05, threshold=0.0, patience=0, smooth_sigma=sigma),
+            SolverConfig(max_steps=20, lr=0.05, threshold=0.0, patience=0, smooth_sigma=sigma, init="encoder"),
         )
         d = res.phi - phi0
         jitter[sigma] = float((d[:, 2:] - 2 * d[:, 1:-1] + d[:, :-2]).abs().mean() / d.abs().mean())
