@@ -103,6 +103,9 @@ class SolverConfig:
     project_iters : int    Gauss–Newton rounds of the projection
     smooth_projection : bool  smooth each Gauss–Newton step over time with G_σ (below), so the
                            start latent is as smooth in time as the encoder's
+    project_exact : int    of the ``project_iters`` rounds, how many last ones are not smoothed
+                           (they remove what the smoothed rounds leave of A's fastest details;
+                           2, chosen on 5 of the 10 Mixamo animations and the synthetic demo)
     theta : str            ``"rotations"`` (joint rotations, default) or ``"directions"``
                            (unit bone directions from positions)
     smooth_sigma : float   σ (frames) of the Gaussian that smooths latent updates over time; 0: off
@@ -121,6 +124,7 @@ class SolverConfig:
     theta: str = "rotations"
     smooth_sigma: float = 3.0
     smooth_projection: bool = True
+    project_exact: int = 2
 
     def __post_init__(self) -> None:
         if self.init not in INITS:
@@ -234,6 +238,7 @@ def project_latent(
     iters: int = 4,
     damping: float = 1e-3,
     smooth=None,
+    exact_rounds: int = 0,
 ) -> torch.Tensor:
     """The latent whose decoded rotations ``q ⊗ q_Δ`` match ``target_rot``: Gauss–Newton per frame.
 
@@ -273,7 +278,7 @@ def project_latent(
         flat = phi.reshape(N * T, D)
 
         eye = torch.eye(4 * NUM_JOINTS, dtype=phi.dtype, device=phi.device)
-        for _ in range(iters):
+        for k in range(iters):
             out, jac = model.rotation_jacobian(flat, emb_frames)
             goal = torch.where((out * target).sum(-1, keepdim=True) < 0, -target, target)
             resid = (goal - out).reshape(N * T, -1, 1)
@@ -284,7 +289,7 @@ def project_latent(
             mu = damping * jjt.diagonal(dim1=1, dim2=2).mean(-1).clamp_min(1e-12)
             chol = torch.linalg.cholesky(jjt + mu[:, None, None] * eye)  # symmetric positive definite
             step = (jac.transpose(1, 2) @ torch.cholesky_solve(resid, chol))[..., 0]
-            if smooth is not None:
+            if smooth is not None and k < iters - exact_rounds:
                 step = smooth(step.reshape(N, T, D)).reshape(N * T, D)
             flat = flat + step
     return flat.reshape(N, T, D)
@@ -487,6 +492,7 @@ def _iterate(
                             offsets[i] if per_row_offsets else offsets,
                             cfg.project_iters,
                             smooth=steps_filter,
+                            exact_rounds=cfg.project_exact,
                         )
                         for i in range(x.shape[0])
                     ]
