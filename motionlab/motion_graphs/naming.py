@@ -128,9 +128,9 @@ def parse_name(name: str, name_map: NameMap | None = None) -> ClipLabel:
     Parameters
     ----------
     name : clip name or file stem (a ``.bvh`` suffix and folders are ignored)
-    name_map : optional ``{stem: label text}`` (exact stem) or a callable ``stem -> label
-        text | ClipLabel | None``; consulted first, ``None`` / a missing stem falls back to the
-        built-in forms
+    name_map : optional ``{stem: label text}`` (exact stem) or a callable that takes the stem
+        and returns label text, a ``ClipLabel`` or ``None``; consulted first, ``None`` / a missing
+        stem falls back to the built-in forms
 
     Raises
     ------

@@ -43,9 +43,9 @@ def build_report(graph: MotionGraph) -> dict:
 
     Returns
     -------
-    dict with ``rows`` (one per behaviour/style: ``behaviour, style, takes, frames, cycles,
-    transitions, in_largest`` (frames), ``in_largest_percent``, ``pruned``), ``behaviours``
-    (per behaviour: ``frames, largest_scc, percent``), ``largest_scc`` and ``recorded_frames``
+    dict with ``rows`` (one per behaviour/style: ``behaviour``, ``style``, ``takes``, ``frames``,
+    ``cycles``, ``transitions``, ``in_largest`` (frames), ``in_largest_percent``, ``pruned``),
+    ``behaviours`` (per behaviour: ``frames``, ``largest_scc``, ``percent``), ``largest_scc`` and ``recorded_frames``
     (whole graph), ``percent``, ``conditions`` (kind → ``count``, ``example``) and ``info``
     (build times and counts).
     """
