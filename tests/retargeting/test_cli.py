@@ -88,14 +88,20 @@ def test_retarget_user_errors(files, capsys, clips):
     assert code == 2 and ".bvh" in err
 
 
-def test_train_and_evaluate_on_a_small_folder(tmp_path, clips, capsys):
-    """Train on one synthetic character, evaluate against a re-proportioned copy of it."""
+def _two_characters(tmp_path, clips):
+    """``<tmp>/chars/{A,B}/anim<i>.bvh``: the clips on their own skeleton (A) and with 1.2x legs (B)."""
     root = tmp_path / "chars"
     big = humanoid.scale_bones(clips[0].skeleton, legs=1.2)
     for name, sk in (("A", clips[0].skeleton), ("B", big)):
         (root / name).mkdir(parents=True)
         for i, c in enumerate(clips):
             bvh.save(root / name / f"anim{i}.bvh", c.copy(skeleton=sk))
+    return root
+
+
+def test_train_and_evaluate_on_a_small_folder(tmp_path, clips, capsys):
+    """Train on one synthetic character, evaluate against a re-proportioned copy of it."""
+    root = _two_characters(tmp_path, clips)
     ck = tmp_path / "a.pt"
     code, stdout, err = _run(
         capsys,
@@ -136,12 +142,7 @@ def test_train_and_evaluate_on_a_small_folder(tmp_path, clips, capsys):
 
 def test_evaluate_leaves_animations_out_by_folds(tmp_path, clips, capsys):
     """--folds 2: each animation is evaluated by a network trained without it (one checkpoint per fold)."""
-    root = tmp_path / "chars"
-    big = humanoid.scale_bones(clips[0].skeleton, legs=1.2)
-    for name, sk in (("A", clips[0].skeleton), ("B", big)):
-        (root / name).mkdir(parents=True)
-        for i, c in enumerate(clips):
-            bvh.save(root / name / f"anim{i}.bvh", c.copy(skeleton=sk))
+    root = _two_characters(tmp_path, clips)
     ck = tmp_path / "a.pt"
     code, stdout, err = _run(
         capsys, "evaluate", "--data", root, "--source", "A", "--targets", "B", "--all-animations", "--folds", "2",
