@@ -28,6 +28,9 @@ import time
 import numpy as np
 import torch
 
+from motionlab.core import humanoid, quat
+from motionlab.retargeting.features import clip_features
+
 
 def _train(args):
     from motionlab.core import bvh
@@ -62,10 +65,7 @@ def _train(args):
     return ckpt
 
 
-UPPER = [
-    j for j, n in enumerate(__import__("motionlab.core.humanoid", fromlist=["JOINTS"]).JOINTS)
-    if j > 0 and not any(k in n for k in ("UpLeg", "Leg", "Foot", "Toe"))
-]  # fmt: skip
+UPPER = [j for j, n in enumerate(humanoid.JOINTS) if j > 0 and not any(k in n for k in ("UpLeg", "Leg", "Foot", "Toe"))]
 """Spine, neck, head, shoulders, arms and hands: the joints Mixamo copies exactly."""
 
 
@@ -76,7 +76,7 @@ def _degrees(a, b):
 
 def _fidelity(ckpt, args):
     from motionlab import data, synthetic
-    from motionlab.core import bvh, humanoid, preprocess
+    from motionlab.core import bvh, preprocess
     from motionlab.retargeting.evaluate import DEFAULT_ANIMATIONS, DEFAULT_TARGETS
     from motionlab.retargeting.pipeline import retarget, target_skeleton
     from motionlab.retargeting.solver import SolverConfig, project_latent
@@ -92,7 +92,7 @@ def _fidelity(ckpt, args):
     err, enc_deg, gn_deg = [], [], []
     for src in sources:
         c = preprocess.prepare(src, ckpt.fps)
-        f = clip_features_of(c)
+        f = clip_features(c)
         x = torch.tensor(ckpt.stats.normalize(f.x), dtype=torch.float32)[None]
         own = torch.tensor(c.skeleton.offsets, dtype=torch.float32)
         target = torch.tensor(f.local_rot, dtype=torch.float32)[None]
@@ -120,13 +120,10 @@ def _fidelity(ckpt, args):
         degs = []
         for src in sources[: 3 if args.quick else None]:
             res = retarget(src, sk, ckpt, "full", SolverConfig())
-            c = preprocess.prepare(src, ckpt.fps)
-            yaw = clip_features_of(c).yaw
+            f = clip_features(preprocess.prepare(src, ckpt.fps))
             rot = res.motion.local_rot.copy()
-            from motionlab.core import quat
-
-            rot[:, 0] = quat.mul(quat.from_yaw(-yaw), rot[:, 0])
-            degs.append(_degrees(rot, clip_features_of(c).local_rot)[:, UPPER])
+            rot[:, 0] = quat.mul(quat.from_yaw(-f.yaw), rot[:, 0])  # root back into A's heading frame
+            degs.append(_degrees(rot, f.local_rot)[:, UPPER])
         after[name] = float(np.median(np.concatenate(degs)))
     worst = max(after.values())
     print(
@@ -136,7 +133,7 @@ def _fidelity(ckpt, args):
     )
     # q_delta: departure from the identity, and dependence on the skeleton
     c = preprocess.prepare(sources[0], ckpt.fps)
-    x = torch.tensor(ckpt.stats.normalize(clip_features_of(c).x), dtype=torch.float32)[None]
+    x = torch.tensor(ckpt.stats.normalize(clip_features(c).x), dtype=torch.float32)[None]
     base = humanoid.to_canonical_skeleton(ckpt.skeleton)
     sweeps = {f"legs x{s}": humanoid.scale_bones(base, legs=s) for s in (0.6, 1.0, 1.6)}
     sweeps.update({f"arms x{s}": humanoid.scale_bones(base, arms=s) for s in (0.6, 1.6)})
@@ -155,15 +152,8 @@ def _fidelity(ckpt, args):
             )
 
 
-def clip_features_of(motion):
-    from motionlab.retargeting.features import clip_features
-
-    return clip_features(motion)
-
-
 def _solve(ckpt, args):
-    from motionlab.core import bvh, humanoid, preprocess
-    from motionlab.retargeting.features import clip_features
+    from motionlab.core import bvh, preprocess
     from motionlab.retargeting.pipeline import root_scale, source_contacts
     from motionlab.retargeting.solver import SolverConfig, solve
 

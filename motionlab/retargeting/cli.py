@@ -57,6 +57,14 @@ def _load_checkpoint(path: str | None, device: str | None):
 def _solver_config(args):
     from motionlab.retargeting.solver import SolverConfig
 
+    for option, value, ok, expected in (
+        ("--steps", args.steps, args.steps >= 0, ">= 0"),
+        ("--lr", args.lr, args.lr > 0, "> 0"),
+        ("--threshold", args.threshold, args.threshold >= 0, ">= 0"),
+        ("--contact-weight", args.contact_weight, args.contact_weight >= 0, ">= 0"),
+    ):
+        if not ok:  # also refuses nan
+            raise _error(f"{option} must be {expected}, got {value}")
     return SolverConfig(
         max_steps=args.steps,
         lr=args.lr,

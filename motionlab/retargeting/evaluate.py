@@ -8,8 +8,8 @@ Metrics (all from :mod:`motionlab.core.metrics`, positions in world space):
 
 * ``mse`` (cm²) and ``mse/h²`` — squared joint-position error over frames, joints and axes; the
   second divides by B's height² (``h`` = the rest height of B's **22-joint** skeleton, highest
-  minus lowest joint, as the literature and motionlab's conventions define it; Aj: 141.97 cm
-  as in the paper), the de facto metric; ``pose mse/h²`` does the same after subtracting each
+  minus lowest joint, as the literature and motionlab's conventions define it; Aj: 141.95 cm,
+  the paper gives 141.97), the de facto metric; ``pose mse/h²`` does the same after subtracting each
   frame's root position (pose only, root trajectory removed);
 * ``mpjpe`` (cm) — mean per-joint Euclidean error;
 * ``smooth`` (cm/frame²) — mean acceleration magnitude (the real clips' value is printed too);

@@ -144,7 +144,8 @@ def contact_stride(source: Motion, target: Skeleton, min_planted: float = 0.05) 
     source : canonical 22-joint Motion of A
     target : B's canonical skeleton
     """
-    planted = source_contacts(source)[:-1] & source_contacts(source)[1:]  # (T-1, 4) both frames planted
+    labels = source_contacts(source)
+    planted = labels[:-1] & labels[1:]  # (T-1, 4): planted in both frames
     zero = np.zeros_like(source.root_pos)
     rel = {}
     for key, sk in (("a", source.skeleton), ("b", target)):

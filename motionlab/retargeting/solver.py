@@ -17,9 +17,9 @@ numbers do not depend on the rest of the batch, so its result equals :func:`solv
 
 Three additions of motionlab, each measured in the README's Table 1 (ablation rows):
 
-**A least-squares first step (``init="project"``, default).** The encoder reproduces A's joint
-rotations only approximately on clips it was not trained on (13° median on Aj's held-back
-clips), and Adam on the angle loss closes that gap slowly. ``F_qlinear`` is linear (eq. 10):
+**A Gauss–Newton start (``init="project"``; the default ``"auto"`` uses it).** The encoder
+reproduces A's joint rotations only approximately on clips it was not trained on (12° median,
+upper body, on Aj's held-back clips: ``benchmarks/bench_retarget.py``), and Adam on the angle loss closes that gap slowly. ``F_qlinear`` is linear (eq. 10):
 ``q = unit(W φ + b)`` with ``W`` of shape (88, D), D ≥ 88, so the latent that makes ``q ⊗ q_Δ``
 equal A's rotations can be found by least squares, one frame at a time.
 This is a Gauss–Newton step on the angle term (:func:`project_latent`; ``q_Δ`` depends on φ,
@@ -133,6 +133,10 @@ class SolverConfig:
             raise ValueError("init='project' matches A's rotations, so it needs theta='rotations'; use init='encoder'")
         if self.project_iters < 1:
             raise ValueError(f"project_iters must be >= 1, got {self.project_iters}")
+        if not 0 <= self.project_exact <= self.project_iters:
+            raise ValueError(
+                f"project_exact must be between 0 and project_iters ({self.project_iters}), got {self.project_exact}"
+            )
         if not self.lambda_contact >= 0:
             raise ValueError(f"lambda_contact must be >= 0, got {self.lambda_contact}")
         if self.theta not in ("rotations", "directions"):
@@ -245,9 +249,9 @@ def project_latent(
     The decoder's rotations of frame ``t`` depend on that frame's latent ``φ_t`` alone (eqs. 10–13
     are per-frame layers), so the angle term can be solved frame by frame: with ``g(φ_t)`` the 88
     numbers of the 22 decoded quaternions and ``J_t`` its Jacobian (88 × D,
-    :meth:`RetargetNet.rotation_jacobian`), each round takes the damped Gauss–Newton (Levenberg–Marquardt) step (solved in its
-    88 × 88 dual form)
-    ``φ_t ← φ_t + (J_tᵀ J_t + μ I)⁻¹ J_tᵀ (q*_t − g(φ_t))``, where ``q*_t`` is the target with
+    :meth:`RetargetNet.rotation_jacobian`), each round takes the damped Gauss–Newton
+    (Levenberg–Marquardt) step ``φ_t ← φ_t + (J_tᵀ J_t + μ I)⁻¹ J_tᵀ (q*_t − g(φ_t))``, solved in
+    its 88 × 88 dual form, where ``q*_t`` is the target with
     each quaternion's sign matched to the current output. ``μ = damping × mean diag(JᵀJ)`` keeps
     the step small where the decoder is insensitive.
 
@@ -264,6 +268,8 @@ def project_latent(
         frame to frame (q_Δ reacts to it), so that later Adam steps add jitter (measured: mean
         acceleration 0.41 vs 0.28 cm/frame² on the Mixamo data); smoothed steps converge more
         slowly on the fastest details but keep the latent as smooth as the encoder's
+    exact_rounds : int                 the last ``exact_rounds`` rounds are not smoothed, so the
+        start still reaches the target's fastest details
 
     Returns
     -------

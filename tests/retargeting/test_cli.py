@@ -156,3 +156,14 @@ def test_evaluate_leaves_animations_out_by_folds(tmp_path, clips, capsys):
     assert not ck.exists()
     code, _, err = _run(capsys, "evaluate", "--data", root, "--source", "A", "--targets", "B", "--folds", "0")
     assert code == 2 and "--folds" in err
+
+
+@pytest.mark.parametrize(
+    "option, value",
+    [("--contact-weight", "-1"), ("--lr", "nan"), ("--lr", "0"), ("--steps", "-3"), ("--threshold", "-1")],
+)
+def test_solver_options_refuse_nonsense_by_name(tmp_path, clips, capsys, option, value):
+    src = bvh.save(tmp_path / "a.bvh", clips[0])
+    code, _, err = _run(capsys, "retarget", src, "--target", src, "-o", tmp_path / "out.bvh", option, value)
+    assert code == 2 and option in err and value in err
+    assert not (tmp_path / "out.bvh").exists()
