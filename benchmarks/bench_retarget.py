@@ -193,6 +193,7 @@ def _solve(ckpt, args):
                 root_xz=torch.tensor(root[:, [0, 2]], dtype=torch.float32)[None],
                 yaw=torch.tensor(yaw, dtype=torch.float32)[None],
                 planted=torch.tensor(planted)[None],
+                fps=ckpt.fps,
             )
             times.append(res.seconds)
             steps.append(res.steps)

@@ -12,6 +12,7 @@ metric                    formula                                               
 ``smoothness``            mean over frames, joints of ‖p[t+1] - 2 p[t] + p[t-1]‖      m/frame²
 ``foot_penetration``      mean over frames and foot joints of max(0, -y)              m
 ``foot_skating``          mean horizontal foot speed over frames in ground contact    m/s
+``planted_slide``         mean horizontal speed of feet where given labels say planted m/s
 ``bone_length_error``     mean over bones of std_t(length) / mean_t(length)           unitless
 ========================  ==========================================================  ==========
 
@@ -28,6 +29,7 @@ __all__ = [
     "smoothness",
     "foot_penetration",
     "foot_contacts",
+    "planted_slide",
     "foot_skating",
     "bone_length_error",
 ]
@@ -112,6 +114,28 @@ def foot_skating(pos, feet, fps: float, height_threshold: float = 0.05) -> float
     if not np.any(contact):
         return 0.0
     return float(np.mean(speed[contact]))
+
+
+def planted_slide(pos, feet, planted, fps: float) -> float:
+    """Mean horizontal speed (units/s) of the ``feet`` joints over the frame pairs where ``planted``
+    (T, F) marks them planted in both frames; 0 when none is.
+
+    Unlike :func:`foot_skating`, which decides contact by a height threshold on the motion itself,
+    the labels come from elsewhere (e.g. the source's contacts in retargeting), so a foot that
+    floats while it should stand still counts too, and a low swinging foot does not.
+    """
+    pos = _pos(pos)
+    planted = np.asarray(planted, dtype=bool)
+    p = pos[..., list(feet), :]
+    if planted.shape != p.shape[-3:-1]:
+        raise ValueError(f"planted_slide: expected planted of shape {p.shape[-3:-1]} (T, feet), got {planted.shape}")
+    if p.shape[-3] < 2:
+        return 0.0
+    speed = np.linalg.norm(np.diff(p[..., [0, 2]], axis=-3), axis=-1) * fps  # (..., T-1, F)
+    both = planted[1:] & planted[:-1]
+    if not np.any(both):
+        return 0.0
+    return float(np.mean(speed[..., both]))
 
 
 def bone_length_error(pos, parents) -> float:

@@ -14,7 +14,10 @@ Metrics (all from :mod:`motionlab.core.metrics`, positions in world space):
 * ``mpjpe`` (cm) — mean per-joint Euclidean error;
 * ``smooth`` (cm/frame²) — mean acceleration magnitude (the real clips' value is printed too);
 * ``pen`` (% of h) — mean depth of the four foot joints below the ground;
-* ``skate`` (cm/s) — mean horizontal foot speed while touching the ground;
+* ``skate`` (cm/s) — mean horizontal foot speed while touching the ground (a foot joint below
+  5 cm): it counts low swinging feet and misses floating ones, so it depends on the root height too;
+* ``slide`` (cm/s) — mean horizontal speed of the feet on the frames where A's foot is planted
+  (:func:`motionlab.retargeting.pipeline.source_contacts`): how still a planted foot stays;
 * ``time`` (s) — wall time of the method per clip (network + latent iteration).
 
 **The protocol differs from the paper's** (§3): the paper trains on Malcolm and retargets Aj
@@ -49,7 +52,7 @@ from tqdm.auto import tqdm
 
 from motionlab.core import humanoid, metrics, preprocess
 from motionlab.retargeting.checkpoint import Checkpoint
-from motionlab.retargeting.pipeline import retarget
+from motionlab.retargeting.pipeline import retarget, source_contacts
 from motionlab.retargeting.solver import SolverConfig
 
 __all__ = [
@@ -199,6 +202,7 @@ class Evaluation:
             ("pen", "pen %h", "{:7.3f}"),
             ("skate", "skate cm/s", "{:10.2f}"),
             ("time", "time s/clip", "{:11.3f}"),
+            ("slide", "slide cm/s", "{:10.2f}"),
         ]
         n = len(self.records) // max(len(self.rows), 1)
         width = max([len(r) for r in s] + [12])
@@ -231,12 +235,14 @@ class Evaluation:
         return "\n".join(lines)
 
 
-def _gt_metrics(pos: np.ndarray, fps: float, height: float) -> dict:
+def _gt_metrics(pos: np.ndarray, fps: float, height: float, planted: np.ndarray) -> dict:
     feet = [humanoid.JOINTS.index(f) for f in humanoid.FEET]
+    n = min(len(pos), len(planted))
     return {
         "smooth": metrics.smoothness(pos) * _CM,
         "pen": 100 * metrics.foot_penetration(pos, feet) / height,
         "skate": metrics.foot_skating(pos, feet, fps) * _CM,
+        "slide": metrics.planted_slide(pos[:n], feet, planted[:n], fps) * _CM,
     }
 
 
@@ -274,7 +280,7 @@ def evaluate(
     if checkpoint is None and any(r[1] != "copy" for r in rows):
         raise ValueError("a checkpoint is needed for the network rows")
     result = Evaluation(rows=[r[0] for r in rows])
-    sources = {}
+    sources, planted = {}, {}
     pairs = [(t, a) for t in targets for a in animations]
     for target, anim in tqdm(pairs, desc="evaluating", disable=not progress):
         src_path, gt_path = folder / source / f"{anim}.bvh", folder / target / f"{anim}.bvh"
@@ -283,14 +289,17 @@ def evaluate(
                 f"skipping {target}/{anim}: {src_path if not src_path.is_file() else gt_path} missing", stacklevel=2
             )
             continue
-        if anim not in sources:
-            sources[anim] = _load(src_path)
         gt_rig = _load(gt_path)
         fps = checkpoint.fps if checkpoint is not None else gt_rig.fps
+        if anim not in sources:
+            sources[anim] = _load(src_path)
+            planted[anim] = source_contacts(preprocess.prepare(sources[anim], fps))
         gt = preprocess.prepare(gt_rig, fps)
         gt_pos = gt.global_positions()
         height = gt.skeleton.height()  # the 22-joint rest height
-        result.ground_truth.append({"target": target, "animation": anim, **_gt_metrics(gt_pos, fps, height)})
+        result.ground_truth.append(
+            {"target": target, "animation": anim, **_gt_metrics(gt_pos, fps, height, planted[anim])}
+        )
         for row in rows:
             label, method, root_mode = row[:3]
             options = dict(row[3]) if len(row) > 3 else {}
@@ -320,7 +329,7 @@ def evaluate(
                 "mse_h2": metrics.mse(p, g, height=height),
                 "pose_mse_h2": metrics.mse(rel_p, rel_g, height=height),
                 "mpjpe": metrics.mpjpe(p, g) * _CM,
-                **_gt_metrics(p, fps, height),
+                **_gt_metrics(p, fps, height, planted[anim]),
                 "time": out.seconds,
                 "steps": out.steps,
                 "stop_reason": out.stop_reason,

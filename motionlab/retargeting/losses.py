@@ -8,7 +8,7 @@ loss                   formula                                                  
 ``direction_loss``     the same with θ = unit bone directions (from positions)      unitless
 ``foot_loss``          1/(4T) Σ_t Σ_{i ∈ feet} max(−y_i,t, 0)                       metres
 ``rotation_loss``      mean over frames and joints of 1 − ⟨q, q̂⟩²                   unitless
-``contact_loss``       mean over planted frame pairs of ‖x_t+1 − x_t‖₂ (feet)       m/frame
+``contact_loss``       mean over planted frame pairs of fps · ‖x_t+1 − x_t‖₂ (feet)  m/s
 =====================  ===========================================================  ==========
 
 **Our choice of θ (the paper leaves it open): the joint angles themselves**, i.e. each joint's
@@ -65,7 +65,8 @@ LAMBDA_ANGLE = 0.3
 LAMBDA_FOOT = 0.5
 """λ_foot of the iteration loss."""
 LAMBDA_CONTACT = 0.5
-"""Weight of the contact term (our addition), the same as λ_foot: both are in metres."""
+"""Weight of the contact term (our addition), the same number as λ_foot; the term is a speed
+(m/s), so a planted foot sliding at 2 cm/s costs as much as a foot 2 cm below the ground."""
 FOOT_JOINTS: tuple[int, ...] = tuple(humanoid.JOINTS.index(n) for n in humanoid.FEET)
 """Indices of LeftFoot, RightFoot, LeftToeBase, RightToeBase in the canonical skeleton."""
 
@@ -145,14 +146,17 @@ def rotation_loss(local_rot: torch.Tensor, target_rot: torch.Tensor) -> torch.Te
     return (1.0 - (local_rot * target_rot).sum(-1) ** 2).mean()
 
 
-def contact_loss(feet: torch.Tensor, planted: torch.Tensor) -> torch.Tensor:
-    """Mean distance (metres per frame) that planted feet move between consecutive frames.
+def contact_loss(feet: torch.Tensor, planted: torch.Tensor, fps: float | torch.Tensor) -> torch.Tensor:
+    """Mean speed (metres per second) of planted feet: ``fps`` × their motion between consecutive frames.
+
+    A speed, not a distance per frame, so its weight means the same at every frame rate.
 
     Parameters
     ----------
     feet : Tensor (..., T, F, 3)     world positions of F foot joints, metres
     planted : Tensor (..., T, F) of bool   contact labels; a frame pair counts when the joint
         is planted in both frames
+    fps : frames per second of ``feet`` (a number or a 0-d tensor)
 
     Returns 0 (with a gradient path) when no foot is ever planted.
     """
@@ -162,4 +166,4 @@ def contact_loss(feet: torch.Tensor, planted: torch.Tensor) -> torch.Tensor:
         )
     both = (planted[..., 1:, :] & planted[..., :-1, :]).to(feet.dtype)
     step = _length(feet[..., 1:, :, :] - feet[..., :-1, :, :])
-    return (step * both).sum() / both.sum().clamp_min(1.0)
+    return fps * (step * both).sum() / both.sum().clamp_min(1.0)

@@ -388,6 +388,7 @@ def retarget(
             root_xz=pair.root_xz,
             yaw=src.yaw,
             planted=src.planted,
+            fps=src.motion.fps,
         )
         heading_rot, history, reason, steps = res.local_rot[0], res.history, res.stop_reason, res.steps
     return finish(pair, heading_rot, method, history, reason, steps, time.perf_counter() - start)

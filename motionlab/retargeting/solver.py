@@ -29,8 +29,12 @@ Adam only has to trade that against the foot terms. ``init="encoder"`` starts fr
 
 **Foot contacts (``lambda_contact``).** Where A's foot is planted
 (:mod:`motionlab.retargeting.contacts`), B's foot should stay still in the world;
-:func:`losses.contact_loss` measures how far it moves per frame. This needs B's world
-positions, so :func:`solve` takes B's root trajectory and heading.
+:func:`losses.contact_loss` measures how fast it moves (m/s). This needs B's world
+positions, so :func:`solve` takes B's root trajectory, heading and the frame rate. The term is
+a speed so that its weight does not depend on the frame rate; a first version measured metres
+per *frame*, which at 60 fps weighed it 60× less: L_iter then fell below the paper's threshold
+after about 5 Adam steps, and planted feet kept sliding (the ``slide`` column of
+``motionlab evaluate``; ``--contact-weight 0.0083`` = 0.5 / 60 reproduces that first version).
 
 **Smooth latent updates (``smooth_sigma``).** The decoder works frame by frame, so per-frame
 Adam steps on φ add frame-to-frame jitter (on the Mixamo data the mean acceleration tripled,
@@ -104,8 +108,12 @@ class SolverConfig:
     smooth_projection : bool  smooth each Gauss–Newton step over time with G_σ (below), so the
                            start latent is as smooth in time as the encoder's
     project_exact : int    of the ``project_iters`` rounds, how many last ones are not smoothed
-                           (they remove what the smoothed rounds leave of A's fastest details;
-                           2, chosen on 5 of the 10 Mixamo animations and the synthetic demo)
+                           (they remove what the smoothed rounds leave of A's fastest details).
+                           4: with 2, the start left a residual that, where the iteration stops
+                           at once (the synthetic demo), gave more skating than copying A's
+                           rotations (0.225 vs 0.223 m/s); 4 reproduces them. On 5 of the 10
+                           Mixamo animations 2, 3 and 4 score the same (pose MSE/h² 1.49e-4);
+                           the other 5 confirm it (README, Table 1)
     theta : str            ``"rotations"`` (joint rotations, default) or ``"directions"``
                            (unit bone directions from positions)
     smooth_sigma : float   σ (frames) of the Gaussian that smooths latent updates over time; 0: off
@@ -124,7 +132,7 @@ class SolverConfig:
     theta: str = "rotations"
     smooth_sigma: float = 3.0
     smooth_projection: bool = True
-    project_exact: int = 2
+    project_exact: int = 4
 
     def __post_init__(self) -> None:
         if self.init not in INITS:
@@ -309,12 +317,13 @@ def sequence_losses(
     root_world: torch.Tensor | None = None,
     yaw: torch.Tensor | None = None,
     planted: torch.Tensor | None = None,
+    fps: torch.Tensor | None = None,
 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
     """:func:`iteration_loss` of every sequence on its own: ``(L_iter, L_angle, L_foot, L_contact)``, each (N,).
 
     The same function, mapped over the batch axis with ``torch.func.vmap``, so entry ``i`` is
     what :func:`iteration_loss` gives for sequence ``i`` alone (inputs as there, (N, T, ...)).
-    With ``root_world`` (N, T, 3), ``yaw`` (N, T) and ``planted`` (N, T, 4) the contact term is
+    With ``root_world`` (N, T, 3), ``yaw`` (N, T), ``planted`` (N, T, 4) and ``fps`` (N,) the contact term is
     included (:func:`losses.contact_loss` on :func:`world_feet`); otherwise L_contact is 0.
     """
     cfg = config or SolverConfig()
@@ -329,9 +338,9 @@ def sequence_losses(
             source, generated.local_rot, generated.positions, generated.q, generated.q_delta, root_height
         )
 
-    def one_contact(src, rot, pos, q, q_delta, height, root, heading, feet_planted):
+    def one_contact(src, rot, pos, q, q_delta, height, root, heading, feet_planted, rate):
         out = Decoded(rot[None], pos[None], q[None], q_delta[None])
-        contact = losses.contact_loss(world_feet(pos[None], root[None], heading[None]), feet_planted[None])
+        contact = losses.contact_loss(world_feet(pos[None], root[None], heading[None]), feet_planted[None], rate)
         total, angle, foot = iteration_loss(src[None], out, height[None], cfg, contact)
         return total, angle, foot, contact
 
@@ -345,6 +354,7 @@ def sequence_losses(
         root_world,
         yaw,
         planted,
+        fps,
     )
 
 
@@ -360,12 +370,17 @@ def _check_inputs(x, source, offsets, root_height, cfg) -> None:
         raise ValueError(f"expected offsets (22, 3) or ({x.shape[0]}, 22, 3), got {shape}")
 
 
-def _contact_inputs(x, root_height, cfg, root_xz, yaw, planted):
-    """``(root_world (N, T, 3), yaw (N, T), planted (N, T, 4))`` for the contact term, or None when it is off."""
+def _contact_inputs(x, root_height, cfg, root_xz, yaw, planted, fps):
+    """``(root_world (N, T, 3), yaw (N, T), planted (N, T, 4), fps (N,))`` for the contact term, or None when it is off."""
     if planted is None or cfg.lambda_contact <= 0:
         return None
-    if root_xz is None or yaw is None:
-        raise ValueError("the contact term needs B's root path: pass root_xz (N, T, 2) and yaw (N, T) with planted")
+    if root_xz is None or yaw is None or fps is None:
+        raise ValueError(
+            "the contact term needs B's root path and the frame rate: pass root_xz (N, T, 2), yaw (N, T) and fps with planted"
+        )
+    rate = torch.as_tensor(fps, dtype=x.dtype).reshape(-1).expand(x.shape[0]).clone()
+    if not bool(torch.all(rate > 0)):
+        raise ValueError(f"fps must be positive, got {fps}")
     if tuple(planted.shape) != x.shape[:2] + (len(CONTACT_JOINTS),) or tuple(root_xz.shape) != x.shape[:2] + (2,):
         raise ValueError(
             f"expected planted (N, T, 4) and root_xz (N, T, 2) for x {tuple(x.shape)}, got "
@@ -373,7 +388,7 @@ def _contact_inputs(x, root_height, cfg, root_xz, yaw, planted):
         )
     root_xz = torch.as_tensor(root_xz, dtype=x.dtype)
     root_world = torch.stack([root_xz[..., 0], torch.as_tensor(root_height, dtype=x.dtype), root_xz[..., 1]], dim=-1)
-    return root_world, torch.as_tensor(yaw, dtype=x.dtype), torch.as_tensor(planted, dtype=torch.bool)
+    return root_world, torch.as_tensor(yaw, dtype=x.dtype), torch.as_tensor(planted, dtype=torch.bool), rate
 
 
 def solve(
@@ -388,6 +403,7 @@ def solve(
     root_xz: torch.Tensor | None = None,
     yaw: torch.Tensor | None = None,
     planted: torch.Tensor | None = None,
+    fps: float | torch.Tensor | None = None,
 ) -> SolverResult:
     """Optimise the latent of a frozen network for skeleton ``offsets``.
 
@@ -412,6 +428,7 @@ def solve(
     planted : Tensor (N, T, 4) of bool, optional   A's foot contacts
         (:func:`motionlab.retargeting.contacts.detect_contacts`); with ``root_xz`` and ``yaw``
         they switch on the contact term (weight ``config.lambda_contact``)
+    fps : float or Tensor (N,), optional  frame rate of the sequences (needed by the contact term)
 
     Returns
     -------
@@ -419,7 +436,7 @@ def solve(
     """
     cfg = config or SolverConfig()
     _check_inputs(x, source, offsets, root_height, cfg)
-    contact = _contact_inputs(x, root_height, cfg, root_xz, yaw, planted)
+    contact = _contact_inputs(x, root_height, cfg, root_xz, yaw, planted, fps)
     return _iterate(model, x, source, offsets, root_height, cfg, [x.shape[0]], callback, progress, contact)[0]
 
 
@@ -434,6 +451,7 @@ def solve_many(
     root_xz: torch.Tensor | None = None,
     yaw: torch.Tensor | None = None,
     planted: torch.Tensor | None = None,
+    fps: float | torch.Tensor | None = None,
 ) -> list[SolverResult]:
     """Solve N independent problems (one per sequence) in one batched latent iteration.
 
@@ -450,7 +468,7 @@ def solve_many(
     """
     cfg = config or SolverConfig()
     _check_inputs(x, source, offsets, root_height, cfg)
-    contact = _contact_inputs(x, root_height, cfg, root_xz, yaw, planted)
+    contact = _contact_inputs(x, root_height, cfg, root_xz, yaw, planted, fps)
     return _iterate(model, x, source, offsets, root_height, cfg, [1] * x.shape[0], None, progress, contact)
 
 
@@ -530,7 +548,9 @@ def _iterate(
             s, h = (src, root_height) if everyone else (src[rows], root_height[rows])
             extra = {}
             if contact is not None:
-                extra = dict(zip(("root_world", "yaw", "planted"), contact if everyone else [c[rows] for c in contact]))
+                extra = dict(
+                    zip(("root_world", "yaw", "planted", "fps"), contact if everyone else [c[rows] for c in contact])
+                )
             loss, angle, foot, touch = sequence_losses(s, out, h, cfg, **extra)  # (rows,): each sequence on its own
             owner = group_of_row if everyone else group_of_row[rows]
             which = owner if everyone else torch.searchsorted(torch.as_tensor(active, device=device), owner)

@@ -53,6 +53,23 @@ def test_foot_skating_measures_sliding_only_in_contact():
     assert metrics.foot_skating(pos, [0], fps=100) == 0.0
 
 
+def test_planted_slide_uses_the_given_labels_not_the_height():
+    pos = np.zeros((5, 2, 3))
+    pos[:, 0, 0] = np.arange(5) * 0.01  # joint 0 slides 1 cm per frame
+    pos[:, :, 1] = 1.0  # both float 1 m up: foot_skating sees no contact at all
+    planted = np.zeros((5, 2), dtype=bool)
+    planted[:, 0] = True
+    assert metrics.foot_skating(pos, [0, 1], fps=100) == 0.0
+    assert metrics.planted_slide(pos, [0, 1], planted, fps=100) == pytest.approx(1.0)
+    planted[:, 1] = True  # a still planted joint halves the mean
+    assert metrics.planted_slide(pos, [0, 1], planted, fps=100) == pytest.approx(0.5)
+    # a pair counts only when planted in both frames: alternate labels give no pair
+    planted[:] = np.arange(5)[:, None] % 2 == 0
+    assert metrics.planted_slide(pos, [0, 1], planted, fps=100) == 0.0
+    with pytest.raises(ValueError, match="planted"):
+        metrics.planted_slide(pos, [0, 1], planted[:, :1], fps=100)
+
+
 def test_foot_contacts():
     pos = np.zeros((5, 1, 3))
     pos[3:, 0, 1] = 1.0

@@ -81,16 +81,23 @@ def test_contact_loss_zero_when_still_positive_when_sliding():
     T = 10
     feet = torch.zeros(1, T, 4, 3)
     planted = torch.ones(1, T, 4, dtype=torch.bool)
-    assert float(losses.contact_loss(feet, planted)) == pytest.approx(0.0, abs=1e-5)
+    assert float(losses.contact_loss(feet, planted, 60)) == pytest.approx(
+        0.0, abs=1e-3
+    )  # (_length keeps a tiny epsilon)
     sliding = feet.clone()
     sliding[..., 0, 0] = torch.arange(T, dtype=torch.float32) * 0.01  # 1 cm per frame
-    assert float(losses.contact_loss(sliding, planted)) == pytest.approx(0.01 / 4, rel=1e-3)
+    # one of four feet slides at 0.6 m/s at 60 fps: the mean speed is 0.15 m/s
+    assert float(losses.contact_loss(sliding, planted, 60)) == pytest.approx(0.6 / 4, rel=1e-3)
+    # a speed: the same slide recorded at 30 fps (2 cm per frame) costs the same
+    assert float(losses.contact_loss(sliding[:, ::2] * 1.0, planted[:, ::2], 30)) == pytest.approx(0.6 / 4, rel=1e-3)
     # a sliding foot that is not planted costs nothing; no contacts at all gives 0
     planted[..., 0] = False
-    assert float(losses.contact_loss(sliding, planted)) == pytest.approx(0.0, abs=1e-5)
-    assert float(losses.contact_loss(sliding, torch.zeros_like(planted))) == 0.0
+    assert float(losses.contact_loss(sliding, planted, 60)) == pytest.approx(
+        0.0, abs=1e-3
+    )  # (_length keeps a tiny epsilon)
+    assert float(losses.contact_loss(sliding, torch.zeros_like(planted), 60)) == 0.0
     with pytest.raises(ValueError, match="planted"):
-        losses.contact_loss(feet, planted[..., :2])
+        losses.contact_loss(feet, planted[..., :2], 60)
 
 
 def test_world_feet_turns_and_moves_the_heading_frame():
