@@ -98,6 +98,26 @@ def removed_frames(name: str, files: list[Path], rng) -> list:
     return results
 
 
+def dense_counts(root: Path, every: int) -> None:
+    """Missing counts on every walk take, a cut every ``every`` frames (normal style: CHOOSE)."""
+    walks = sorted((root / "bandai_namco/sessions/walk").glob("*.bvh"))
+    groups = {"CHOOSE (normal)": [f for f in walks if "_normal_" in f.name],
+              "VALIDATE (6 other styles)": [f for f in walks if "_normal_" not in f.name]}  # fmt: skip
+    print(f"4. missing counts on every walk take of sessions/walk, a cut every {every} frames:")
+    for name, files in groups.items():
+        errors = []
+        for f in files:
+            m = bvh.load(f)
+            for n in REMOVED:
+                for s in range(20, m.num_frames - n - 20, every):
+                    stream = gap_eval.cut(m, s, n)
+                    est = detect.estimate_missing(stream, [s - 1])[0]
+                    errors.append((abs(est - n) <= max(1.0, 0.1 * n), abs(est - n) / n, f"{f.stem}@{s} {n}->{est}"))
+        ok = sum(e[0] for e in errors)
+        print(f"   {name}: {ok} of {len(errors)} cases within 10% (or one frame) ({ok / len(errors):.2%})")
+        print("     worst: " + ", ".join(e[2] for e in sorted(errors, key=lambda e: -e[1])[:5]))
+
+
 def graph_tracking(root: Path, quick: bool, rng) -> None:
     walk_dir = root / "bandai_namco/sessions/walk"
     graph = ActionGraph()
@@ -125,6 +145,8 @@ def graph_tracking(root: Path, quick: bool, rng) -> None:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="a sixth of the clips (for CI-sized runs)")
+    ap.add_argument("--dense", type=int, metavar="EVERY", default=0,
+                    help="also count on every walk take, a cut every EVERY frames (e.g. 15; slow)")  # fmt: skip
     args = ap.parse_args(argv)
     if not os.environ.get("MOTIONLAB_DATA"):
         sys.exit("set MOTIONLAB_DATA to the shared data folder (e.g. export MOTIONLAB_DATA=/path/to/shared/data)")
@@ -136,6 +158,8 @@ def main(argv=None) -> int:
     for name, files in sets(root, args.quick).items():
         removed_frames(name, files, rng)
     graph_tracking(root, args.quick, np.random.default_rng(1))
+    if args.dense:
+        dense_counts(root, args.dense)
     print(f"total time {time.perf_counter() - t0:.1f} s")
     return 0
 
