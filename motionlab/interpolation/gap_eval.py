@@ -2,7 +2,7 @@
 
 A clean clip has its frames ``start … start+n-1`` cut out; the shortened stream goes through what
 ``motionlab fill-gaps`` does (:func:`.detect.detect`, :func:`.gaps.insert_missing`,
-:func:`.gaps.fill` with SLERP rotations and the Hermite root) and is compared with the clip:
+:func:`.gaps.fill` with SLERP rotations and, by default, the stride-continued root) and is compared with the clip:
 
 * **detection**: was the step ``start-1 → start`` flagged, and was anything else flagged;
 * **count**: the estimated missing count against ``n`` (within 10% or one frame is the goal);
@@ -63,8 +63,11 @@ def cut(motion: Motion, start: int, n: int) -> Motion:
     return motion[np.r_[0:start, start + n : motion.num_frames]]
 
 
-def evaluate_cut(motion: Motion, start: int, n: int, graph=None) -> CutResult:
-    """Cut, detect (against ``graph`` if given, else the stream itself), fill, compare."""
+def evaluate_cut(
+    motion: Motion, start: int, n: int, graph=None, method: str = "stride", root: str = "stride"
+) -> CutResult:
+    """Cut, detect (against ``graph`` if given, else the stream itself), fill (``method`` and
+    ``root`` of :func:`.gaps.fill`; by default what ``motionlab fill-gaps`` does), compare."""
     stream = cut(motion, start, n)
     found = detect.detect(stream, graph=graph)
     steps = [t for t, _ in found]
@@ -73,7 +76,7 @@ def evaluate_cut(motion: Motion, start: int, n: int, graph=None) -> CutResult:
     if not hit:
         return res
     est = dict(found)[start - 1]
-    filled, _ = gaps.fill(gaps.insert_missing(stream, found)[0], method="slerp", root="hermite")
+    filled, _ = gaps.fill(gaps.insert_missing(stream, found)[0], method=method, root=root)
     shift = sum(c for t, c in found if t < start - 1)  # frames inserted before this gap
     a = start - 1 + shift
     ref = reference_joint(motion)
