@@ -357,7 +357,8 @@ def _stride(sides: list, fps: float) -> float | None:
         return None
     lags, d = lags[ok], sums[ok] / counts[ok]
     pooled = np.concatenate(sides)
-    if d.min() > np.mean(np.sum((pooled - pooled.mean(0)) ** 2, axis=1)):
+    variance = np.mean(np.sum((pooled - pooled.mean(0)) ** 2, axis=1))
+    if variance < 1e-8 * pooled.shape[1] or d.min() > variance:  # a pose held still has no stride either
         return None
     inner = (d[1:-1] <= d[:-2]) & (d[1:-1] <= d[2:]) & (d[1:-1] <= 1.5 * d.min())
     if not inner.any():
