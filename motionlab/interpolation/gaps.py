@@ -13,8 +13,10 @@
 and ``b = stop``:
 
 * *inside one action node* (or without a graph): interpolate between ``a`` and ``b`` — SLERP with
-  linear root, or Hermite variants, or, when an :class:`~.action_graph.ActionGraph` is given, the
-  key-pose-guided filling of :mod:`.library` with the node's recordings;
+  linear root, or Hermite variants; or, in a gait, continue the recorded strides on both sides
+  across the gap (``method="stride"``, :mod:`.stride`; what ``motionlab fill-gaps`` does by
+  default); or, when an :class:`~.action_graph.ActionGraph` is given, the key-pose-guided
+  filling of :mod:`.library` with the node's recordings;
 * *across nodes*: find the path ``a's action → … → b's action`` in the graph, place one key pose of
   every intermediate action (its best transition frame from the previous action — a PPCA key frame,
   :meth:`~.action_graph.ActionGraph.best_transition` — root-aligned onto the straight line from
