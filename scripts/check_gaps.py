@@ -96,7 +96,7 @@ def removed_frames(name: str, files: list[Path], rng) -> list:
         w = gap_eval.summary(sub)
         print(f"     {label}: mean root error over the gap / true displacement: mean {w['root_rel_mean']:.1%}, "
               f"worst {w['root_rel_max']:.1%}; lowest foot below the clip's floor by at most "
-              f"{1000 * w['below_max']:.1f} mm")  # fmt: skip
+              f"{1000 * w['below_max']:.1f} mm; joints about the root {w['pose_cm_mean']:.1f} cm off")  # fmt: skip
     worst = max((r for r in walks if r.root_rel is not None), key=lambda r: r.root_rel, default=None)
     if worst is not None:
         print(f"     worst straight walk: {worst.name} {worst.n} frames at {worst.start}")
@@ -105,7 +105,8 @@ def removed_frames(name: str, files: list[Path], rng) -> list:
                        ("all", hermite)):  # fmt: skip
         w = gap_eval.summary(sub)
         print(
-            f"     (before: --method slerp --root hermite, same cases) {label}: mean {w['root_rel_mean']:.1%}, worst {w['root_rel_max']:.1%}"
+            f"     (before: --method slerp --root hermite, same cases) {label}: mean {w['root_rel_mean']:.1%}, worst {w['root_rel_max']:.1%}, "
+            f"joints about the root {w['pose_cm_mean']:.1f} cm off"
         )
     return results
 
