@@ -16,9 +16,9 @@ apart from the scored windows (LaFAN1 uses its training subjects):
 Rows: zero-velocity, interpolation (SLERP + linear root, LaFAN1's baseline), Hermite root + SLERP,
 and motionlab's key-pose-guided filling (MotionLibrary over the scored and the apart clips,
 leave-one-clip-out: a window is never filled from its own clip; Bandai: only recordings of the
-window's own action), without and with a matching-cost limit above which a gap is interpolated
-instead; the limit is chosen on the apart clips' own windows (:func:`choose_max_cost`), never on
-the scored ones. Columns: transition lengths 5, 15, 30, 45. Outputs are made sign-continuous
+window's own action), without and with a matching-cost limit above which a gap is filled by a
+simple method instead; the limit and that fallback (interpolation or Hermite root + SLERP) are
+chosen together on the apart clips' own windows (:func:`choose_fill`), never on the scored ones. Columns: transition lengths 5, 15, 30, 45. Outputs are made sign-continuous
 with the last context frame before FK; nothing is flipped at scoring. NOT LaFAN1 numbers.
 """
 
@@ -76,13 +76,13 @@ def run_group(name, scored, apart, same_action, k, fps):
     lib = MotionLibrary(everything, labels=[bm.action_label(c.name) for c in everything])
     key = f"motionlab key-pose (k={k})"
     apart_windows = bm.make_windows(held)
-    max_cost = bm.choose_max_cost(apart_windows, lib, stats, k=k, same_action=same_action)
+    simple = {"interpolation (SLERP+lin)": bm.method_interpolation, "Hermite root + SLERP": bm.method_hermite}
+    fallback, max_cost, totals = bm.choose_fill(apart_windows, lib, stats, simple, k=k, same_action=same_action)
     methods = {
         "zero-velocity": bm.method_zero_velocity,
-        "interpolation (SLERP+lin)": bm.method_interpolation,
-        "Hermite root + SLERP": bm.method_hermite,
+        **simple,
         f"key-pose, no cost limit (k={k})": bm.method_library(lib, k=k, same_action=same_action),
-        key: bm.method_library(lib, k=k, same_action=same_action, max_cost=max_cost),
+        key: bm.method_library(lib, k=k, same_action=same_action, max_cost=max_cost, fallback=simple[fallback]),
     }
     res = bm.evaluate(windows, methods, stats)
     frames = sum(c.num_frames for c in clips)
@@ -90,8 +90,10 @@ def run_group(name, scored, apart, same_action, k, fps):
     print(f"    L2P statistics from {len(held)} clips kept apart ({sum(c.num_frames for c in held)} frames); "
           f"library: both sets ({lib.num_frames} frames), leave-one-clip-out"
           + (", same action only" if same_action else ""))  # fmt: skip
-    print(f"    cost limit {max_cost:.3g} chosen on the {len(apart_windows)} windows of the apart clips (gaps 15, 30;")
-    print("    above it a gap is interpolated: no recording matches its ends)")
+    print(f"    fallback and cost limit chosen on the {len(apart_windows)} windows of the apart clips (gaps 15, 30;")
+    print("    summed L2P with each fallback at its best limit: "
+          + ", ".join(f"{n} {t:.2f}" for n, t in totals.items()) + ")")  # fmt: skip
+    print(f"    -> above cost {max_cost:.3g} (no recording matches the gap's ends) a gap is filled by {fallback}")
     print("    scored: " + ", ".join(c.name for c in clips))
     print("    apart:  " + ", ".join(c.name for c in held))
     print()

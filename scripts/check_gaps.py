@@ -8,9 +8,10 @@
 2. **Removed frames**: real walks and runs with 10, 20 or 30 frames cut out at a random place
    (seeded; at least 20 frames left on each side). For each case: was the gap found, and only it
    (precision, recall), the estimated missing count against the truth (within 10% or one frame?),
-   and after filling (SLERP + Hermite root, what ``fill-gaps`` does) the mean root position error
-   over the gap relative to the true root displacement across it, and the lowest foot against
-   the clip's own floor.
+   and after filling (the body continued from the strides on both sides, what ``fill-gaps`` does) the mean root
+   position error over the gap relative to the true root displacement across it, and the lowest
+   foot against the clip's own floor; the root error also with ``--method slerp --root hermite`` (SLERP and a Hermite root) for
+   comparison.
 3. **Stream against the graph** (§3.3): walk takes of one style tracked in an action graph built
    from *other* takes (normal style, takes 1–3), precision and recall.
 
@@ -72,7 +73,7 @@ def false_gaps(root: Path) -> None:
 
 
 def removed_frames(name: str, files: list[Path], rng) -> list:
-    results = []
+    results, cases = [], []
     for f in files:
         m = bvh.load(f)
         for n in REMOVED:
@@ -80,6 +81,7 @@ def removed_frames(name: str, files: list[Path], rng) -> list:
             if hi <= lo:
                 continue
             results.append(gap_eval.evaluate_cut(m, int(rng.integers(lo, hi)), n))
+            cases.append((f, results[-1]))
     s = gap_eval.summary(results)
     print(f"   {name}: {len(files)} clips, {s['cases']} cases (10/20/30 frames removed)")
     print(f"     detection precision {s['precision']:.3f}, recall {s['recall']:.3f}")
@@ -94,8 +96,43 @@ def removed_frames(name: str, files: list[Path], rng) -> list:
         w = gap_eval.summary(sub)
         print(f"     {label}: mean root error over the gap / true displacement: mean {w['root_rel_mean']:.1%}, "
               f"worst {w['root_rel_max']:.1%}; lowest foot below the clip's floor by at most "
-              f"{1000 * w['below_max']:.1f} mm")  # fmt: skip
+              f"{1000 * w['below_max']:.1f} mm; joints about the root {w['pose_cm_mean']:.1f} cm off")  # fmt: skip
+    worst = max((r for r in walks if r.root_rel is not None), key=lambda r: r.root_rel, default=None)
+    if worst is not None:
+        print(f"     worst straight walk: {worst.name} {worst.n} frames at {worst.start}")
+    hermite = [gap_eval.evaluate_cut(bvh.load(f), r.start, r.n, method="slerp", root="hermite") for f, r in cases]
+    for label, sub in (("straight walks", [h for h in hermite if "walk" in h.name and "turn" not in h.name]),
+                       ("all", hermite)):  # fmt: skip
+        w = gap_eval.summary(sub)
+        print(
+            f"     (before: --method slerp --root hermite, same cases) {label}: mean {w['root_rel_mean']:.1%}, worst {w['root_rel_max']:.1%}, "
+            f"joints about the root {w['pose_cm_mean']:.1f} cm off"
+        )
     return results
+
+
+def dense(root: Path, every: int) -> None:
+    """Every walk take, a cut every ``every`` frames (normal style: CHOOSE, the rest: VALIDATE):
+    detection, missing count, root error and floor, as in part 2."""
+    walks = sorted((root / "bandai_namco/sessions/walk").glob("*.bvh"))
+    groups = {"CHOOSE (normal)": [f for f in walks if "_normal_" in f.name],
+              "VALIDATE (6 other styles)": [f for f in walks if "_normal_" not in f.name]}  # fmt: skip
+    print(f"4. every walk take of sessions/walk, 10/20/30 frames cut every {every} frames (from frame 20):")
+    for name, files in groups.items():
+        results = []
+        for f in files:
+            m = bvh.load(f)
+            for n in REMOVED:
+                results.extend(gap_eval.evaluate_cut(m, s, n) for s in range(20, m.num_frames - n - 20, every))
+        s = gap_eval.summary(results)
+        ok = sum(r.count_ok for r in results)
+        print(f"   {name}: {len(results)} cases; recall {s['recall']:.4f}, precision {s['precision']:.4f}")
+        print(f"     missing count within 10% (or one frame): {ok} of {len(results)} ({ok / len(results):.2%})")
+        off = sorted((r for r in results if r.estimate is not None), key=lambda r: -abs(r.estimate - r.n) / r.n)
+        print("     farthest off: " + ", ".join(f"{r.name}@{r.start} {r.n}->{r.estimate}" for r in off[:5]))
+        print(f"     root error / displacement: mean {s['root_rel_mean']:.1%}, worst {s['root_rel_max']:.1%}, "
+              f"share above 10%: {np.mean([r.root_rel > 0.1 for r in results if r.root_rel is not None]):.2%}; "
+              f"lowest foot below the floor by at most {1000 * s['below_max']:.1f} mm")  # fmt: skip
 
 
 def graph_tracking(root: Path, quick: bool, rng) -> None:
@@ -125,6 +162,8 @@ def graph_tracking(root: Path, quick: bool, rng) -> None:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="a sixth of the clips (for CI-sized runs)")
+    ap.add_argument("--dense", type=int, metavar="EVERY", default=0,
+                    help="also every walk take, a cut every EVERY frames (e.g. 30; minutes)")  # fmt: skip
     args = ap.parse_args(argv)
     if not os.environ.get("MOTIONLAB_DATA"):
         sys.exit("set MOTIONLAB_DATA to the shared data folder (e.g. export MOTIONLAB_DATA=/path/to/shared/data)")
@@ -136,6 +175,8 @@ def main(argv=None) -> int:
     for name, files in sets(root, args.quick).items():
         removed_frames(name, files, rng)
     graph_tracking(root, args.quick, np.random.default_rng(1))
+    if args.dense:
+        dense(root, args.dense)
     print(f"total time {time.perf_counter() - t0:.1f} s")
     return 0
 

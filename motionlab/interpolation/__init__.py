@@ -13,6 +13,7 @@ Modules, one concept each:
 * :mod:`.labels`       does a clip show what its action label says (hip height, speed, flight)
 * :mod:`.detect`       dropped-frame detection (stream vs graph, stream vs itself) and counts
 * :mod:`.gaps`         inserting and filling missing frames
+* :mod:`.stride`       gaps in a gait filled from the recorded strides on both sides
 * :mod:`.gap_eval`     measuring detection and filling on clips with frames removed
 * :mod:`.paper`        the paper's experiments (§4: Fig. 6/7 walk, Fig. 8 run → squat)
 * :mod:`.benchmark`    LaFAN1-style benchmark (L2Q, L2P, NPSS)
@@ -33,6 +34,7 @@ from motionlab.interpolation import (
     paper,
     ppca,
     slerp,
+    stride,
 )
 from motionlab.interpolation.action_graph import ActionGraph
 from motionlab.interpolation.library import MotionLibrary
@@ -46,6 +48,7 @@ __all__ = [
     "features",
     "keyposes",
     "gaps",
+    "stride",
     "detect",
     "labels",
     "gap_eval",

@@ -61,6 +61,7 @@ __all__ = [
     "method_hermite",
     "method_library",
     "choose_max_cost",
+    "choose_fill",
     "action_label",
     "evaluate",
     "format_table",
@@ -270,7 +271,12 @@ def action_label(name: str) -> str:
 
 
 def method_library(
-    library, k: int = 1, leave_one_out: bool = True, same_action: bool = True, max_cost: float | None = None
+    library,
+    k: int = 1,
+    leave_one_out: bool = True,
+    same_action: bool = True,
+    max_cost: float | None = None,
+    fallback: Method | None = None,
 ) -> Method:
     """motionlab's key-pose-guided filling (:class:`~.library.MotionLibrary`) as a benchmark method.
 
@@ -278,15 +284,16 @@ def method_library(
     ``same_action`` a gap is filled only from recordings of its own action node (the library's
     labels against :func:`action_label` of the window's clip). A gap whose best stretch costs more
     than ``max_cost`` (no recording matches its ends well; see :func:`choose_max_cost`), or whose
-    node holds no other recording, falls back to plain interpolation, which is what the paper does
-    inside a node.
+    node holds no other recording, falls back to ``fallback`` — plain interpolation by default,
+    which is what the paper does inside a node (:func:`choose_fill` picks it on apart windows).
     """
+    fallback = method_interpolation if fallback is None else fallback
 
     def run(w: Windows, n_past: int, gap: int):
         rot, trans, cost = _library_fill(library, w, n_past, gap, k, leave_one_out, same_action)
         none = ~np.isfinite(cost) if max_cost is None else ~(cost <= max_cost)
         if np.any(none):
-            i_rot, i_trans = method_interpolation(w, n_past, gap)
+            i_rot, i_trans = fallback(w, n_past, gap)
             rot[none], trans[none] = i_rot[none], i_trans[none]
         return rot, trans
 
@@ -316,6 +323,25 @@ def _window_l2p(w: Windows, rot, trans, n_past: int, gap: int, stats) -> np.ndar
     return np.sqrt(np.sum(d * d, axis=-1)).mean(axis=1)
 
 
+def _limit_and_total(windows: Windows, library, stats, gaps, k, same_action, n_past, fallback: Method):
+    """The cost limit minimising the summed L2P of ``windows`` when gaps above it use ``fallback``,
+    and that sum."""
+    costs, lib_err, fb_err = [], [], []
+    for gap in gaps:
+        rot, trans, cost = _library_fill(library, windows, n_past, gap, k, True, same_action)
+        f_rot, f_trans = fallback(windows, n_past, gap)
+        ok = np.isfinite(cost)
+        rot[~ok], trans[~ok] = f_rot[~ok], f_trans[~ok]
+        costs.append(np.where(ok, cost, np.inf))
+        lib_err.append(_window_l2p(windows, rot, trans, n_past, gap, stats))
+        fb_err.append(_window_l2p(windows, f_rot, f_trans, n_past, gap, stats))
+    c, lib, fb = np.concatenate(costs), np.concatenate(lib_err), np.concatenate(fb_err)
+    candidates = np.concatenate([[-np.inf], np.unique(c[np.isfinite(c)]), [np.inf]])
+    total = np.array([np.sum(np.where(c <= t, lib, fb)) for t in candidates])
+    i = int(np.argmin(total))
+    return max(float(candidates[i]), 0.0), float(total[i])
+
+
 def choose_max_cost(
     windows: Windows,
     library,
@@ -324,28 +350,39 @@ def choose_max_cost(
     k: int = 1,
     same_action: bool = True,
     n_past: int = N_PAST,
+    fallback: Method | None = None,
 ) -> float:
     """The matching cost above which the library fill is not trusted, chosen on ``windows`` that
     must be kept apart from any scored window (leave-one-clip-out fills).
 
-    Every window's best-stretch cost and its L2P with the library fill and with plain
-    interpolation are computed at each gap; the threshold is the one (among the observed costs,
-    and ``inf``) that minimises the summed L2P when windows above it are interpolated instead.
+    Every window's best-stretch cost and its L2P with the library fill and with ``fallback``
+    (plain interpolation by default) are computed at each gap; the threshold is the one (among
+    the observed costs, and ``inf``) that minimises the summed L2P when windows above it use the
+    fallback instead.
     """
-    costs, lib_err, int_err = [], [], []
-    for gap in gaps:
-        rot, trans, cost = _library_fill(library, windows, n_past, gap, k, True, same_action)
-        i_rot, i_trans = method_interpolation(windows, n_past, gap)
-        ok = np.isfinite(cost)
-        rot[~ok], trans[~ok] = i_rot[~ok], i_trans[~ok]
-        costs.append(np.where(ok, cost, np.inf))
-        lib_err.append(_window_l2p(windows, rot, trans, n_past, gap, stats))
-        int_err.append(_window_l2p(windows, i_rot, i_trans, n_past, gap, stats))
-    c, lib, itp = np.concatenate(costs), np.concatenate(lib_err), np.concatenate(int_err)
-    candidates = np.concatenate([[-np.inf], np.unique(c[np.isfinite(c)]), [np.inf]])
-    total = [np.sum(np.where(c <= t, lib, itp)) for t in candidates]
-    best = float(candidates[int(np.argmin(total))])
-    return max(best, 0.0)
+    fallback = method_interpolation if fallback is None else fallback
+    return _limit_and_total(windows, library, stats, gaps, k, same_action, n_past, fallback)[0]
+
+
+def choose_fill(
+    windows: Windows,
+    library,
+    stats,
+    fallbacks: dict[str, Method],
+    gaps: Sequence[int] = (15, 30),
+    k: int = 1,
+    same_action: bool = True,
+    n_past: int = N_PAST,
+) -> tuple[str, float, dict[str, float]]:
+    """The fallback (a name of ``fallbacks``) and cost limit of :func:`method_library` that together
+    give the lowest summed L2P on ``windows`` (kept apart from any scored window), and each
+    fallback's summed L2P there (with its own best limit)."""
+    if not fallbacks:
+        raise ValueError("choose_fill needs at least one fallback method")
+    scores = {name: _limit_and_total(windows, library, stats, gaps, k, same_action, n_past, f)
+              for name, f in fallbacks.items()}  # fmt: skip
+    best = min(scores, key=lambda name: scores[name][1])
+    return best, scores[best][0], {name: total for name, (_, total) in scores.items()}
 
 
 def evaluate(

@@ -11,8 +11,11 @@ Examples::
 Dropped frames are found with the ``D > Δ`` rule of :mod:`motionlab.interpolation.detect`: against
 the action graph when ``--action`` clips are given (the stream tracked in the graph, §3.3), else
 against the stream's own neighbouring steps. The missing count is estimated from the motion on
-both sides (ground speed, travel direction), the frames are inserted and filled; the root follows
-a Hermite curve with the velocities on both sides (``--root linear`` for the LaFAN1 baseline).
+both sides (ground speed, travel direction, step phase), the frames are inserted and filled: by
+default the whole body continues the recorded strides on both sides across the gap
+(:mod:`motionlab.interpolation.stride`); where the motion does not repeat, SLERP with the root
+given by ``--root`` (``stride``: the strides' root path where one side repeats, else ``hermite``,
+a Hermite curve with the velocities on both sides; ``linear``: the LaFAN1 baseline).
 A clean clip (nothing found) is copied byte for byte. A report lists every gap and how it was
 filled.
 """
@@ -34,11 +37,13 @@ def register(subparsers) -> None:
     )
     p.add_argument("input", help="BVH file with dropped frames")
     p.add_argument("-o", "--output", required=True, help="where to write the filled BVH file")
-    p.add_argument("--method", choices=("slerp", "hermite", "graph"), default="slerp",
-                   help="slerp: SLERP + linear root; hermite: velocity-matched; graph: key-pose guided (needs --action)")  # fmt: skip
+    p.add_argument("--method", choices=("stride", "slerp", "hermite", "graph"), default="stride",
+                   help="stride: the strides on both sides continued (default; slerp where the motion does not "
+                   "repeat); slerp: SLERP; hermite: velocity-matched; graph: key-pose guided (needs --action)")  # fmt: skip
     p.add_argument("--curve", choices=("linear", "ease", "smoothstep"), default="linear", help="α(k) curve")
-    p.add_argument("--root", choices=("hermite", "linear"), default="hermite",
-                   help="root path across a gap: Hermite with the velocities on both sides (default) or linear")  # fmt: skip
+    p.add_argument("--root", choices=("stride", "hermite", "linear"), default="stride",
+                   help="root path across a gap: the strides on both sides continued (default; Hermite where "
+                   "the motion does not repeat), Hermite with the velocities on both sides, or linear")  # fmt: skip
     p.add_argument("--delta", "--threshold", "--factor", dest="delta", type=str, default=None, metavar="Δ",
                    help="Δ: a step this many times the typical step means dropped frames (a number above 1; "
                    "default 2.5, or derived from the graph's speed spread with --action)")  # fmt: skip

@@ -2,14 +2,16 @@
 
 A clean clip has its frames ``start … start+n-1`` cut out; the shortened stream goes through what
 ``motionlab fill-gaps`` does (:func:`.detect.detect`, :func:`.gaps.insert_missing`,
-:func:`.gaps.fill` with SLERP rotations and the Hermite root) and is compared with the clip:
+:func:`.gaps.fill` with SLERP rotations and, by default, the stride-continued root) and is compared with the clip:
 
 * **detection**: was the step ``start-1 → start`` flagged, and was anything else flagged;
 * **count**: the estimated missing count against ``n`` (within 10% or one frame is the goal);
 * **root**: the reference joint's path over the gap, the filled one resampled at the true frames'
   fractions of the gap (the counts may differ), mean distance to the true path, relative to the
   true displacement across the gap;
-* **floor**: how far the lowest non-root joint of the filled frames goes below the clip's floor.
+* **floor**: how far the lowest non-root joint of the filled frames goes below the clip's floor;
+* **pose**: the mean distance of every joint, taken about the reference joint, from the truth
+  (resampled the same way), centimetres.
 
 Used by ``scripts/check_gaps.py`` and notebook 06.
 """
@@ -40,6 +42,8 @@ class CutResult:
     estimate : int or None      missing count (None when the gap was not found)
     root_rel : float or None    mean root error over the gap / true displacement
     below : float or None       lowest filled foot below the clip's floor, metres (>= 0)
+    pose_cm : float or None     mean joint position error about the reference joint, centimetres
+                                (the body's shape, the root error left out)
     """
 
     name: str
@@ -50,6 +54,7 @@ class CutResult:
     estimate: int | None = None
     root_rel: float | None = None
     below: float | None = None
+    pose_cm: float | None = None
 
     @property
     def count_ok(self) -> bool:
@@ -63,8 +68,11 @@ def cut(motion: Motion, start: int, n: int) -> Motion:
     return motion[np.r_[0:start, start + n : motion.num_frames]]
 
 
-def evaluate_cut(motion: Motion, start: int, n: int, graph=None) -> CutResult:
-    """Cut, detect (against ``graph`` if given, else the stream itself), fill, compare."""
+def evaluate_cut(
+    motion: Motion, start: int, n: int, graph=None, method: str = "stride", root: str = "stride"
+) -> CutResult:
+    """Cut, detect (against ``graph`` if given, else the stream itself), fill (``method`` and
+    ``root`` of :func:`.gaps.fill`; by default what ``motionlab fill-gaps`` does), compare."""
     stream = cut(motion, start, n)
     found = detect.detect(stream, graph=graph)
     steps = [t for t, _ in found]
@@ -73,7 +81,7 @@ def evaluate_cut(motion: Motion, start: int, n: int, graph=None) -> CutResult:
     if not hit:
         return res
     est = dict(found)[start - 1]
-    filled, _ = gaps.fill(gaps.insert_missing(stream, found)[0], method="slerp", root="hermite")
+    filled, _ = gaps.fill(gaps.insert_missing(stream, found)[0], method=method, root=root)
     shift = sum(c for t, c in found if t < start - 1)  # frames inserted before this gap
     a = start - 1 + shift
     ref = reference_joint(motion)
@@ -83,9 +91,17 @@ def evaluate_cut(motion: Motion, start: int, n: int, graph=None) -> CutResult:
     at = np.stack([np.interp(u, np.linspace(0.0, 1.0, est + 2), path[:, k]) for k in range(3)], axis=1)
     err = float(np.linalg.norm(at - truth[start : start + n], axis=1).mean())
     disp = float(np.linalg.norm(truth[start + n] - truth[start - 1]))
-    floor = float(motion.global_positions()[:, 1:, 1].min())
-    low = float(filled[a + 1 : a + est + 1].global_positions()[:, 1:, 1].min())
+    true_pos = motion.global_positions()
+    floor = float(true_pos[:, 1:, 1].min())
+    filled_pos = filled[a : a + est + 2].global_positions()  # (est+2, J, 3), frame a first
+    low = float(filled_pos[1:-1, 1:, 1].min())
     below = floor - low  # rounding below a nanometre is not a foot in the floor
+    x = u * (est + 1)  # the true frames' places among the filled ones
+    lo = np.minimum(np.floor(x).astype(np.int64), est)
+    f = (x - lo)[:, None, None]
+    body = (1.0 - f) * filled_pos[lo] + f * filled_pos[lo + 1] - at[:, None, :]  # joints about the root
+    true_body = true_pos[start : start + n] - truth[start : start + n, None, :]
+    res.pose_cm = float(100.0 * np.linalg.norm(body - true_body, axis=-1).mean())
     res.estimate, res.root_rel, res.below = int(est), err / max(disp, 1e-9), below if below > 1e-9 else 0.0
     return res
 
@@ -105,4 +121,5 @@ def summary(results: list[CutResult]) -> dict:
         "root_rel_mean": float(rel.mean()) if rel.size else float("nan"),
         "root_rel_max": float(rel.max()) if rel.size else float("nan"),
         "below_max": float(below.max()) if below.size else float("nan"),
+        "pose_cm_mean": float(np.mean([r.pose_cm for r in counted])) if counted else float("nan"),
     }

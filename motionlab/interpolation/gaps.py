@@ -13,8 +13,10 @@
 and ``b = stop``:
 
 * *inside one action node* (or without a graph): interpolate between ``a`` and ``b`` — SLERP with
-  linear root, or Hermite variants, or, when an :class:`~.action_graph.ActionGraph` is given, the
-  key-pose-guided filling of :mod:`.library` with the node's recordings;
+  linear root, or Hermite variants; or, in a gait, continue the recorded strides on both sides
+  across the gap (``method="stride"``, :mod:`.stride`; what ``motionlab fill-gaps`` does by
+  default); or, when an :class:`~.action_graph.ActionGraph` is given, the key-pose-guided
+  filling of :mod:`.library` with the node's recordings;
 * *across nodes*: find the path ``a's action → … → b's action`` in the graph, place one key pose of
   every intermediate action (its best transition frame from the previous action — a PPCA key frame,
   :meth:`~.action_graph.ActionGraph.best_transition` — root-aligned onto the straight line from
@@ -47,9 +49,11 @@ from motionlab.interpolation.alignment import reference_joint, reference_transfo
 from motionlab.interpolation.features import pose_features
 from motionlab.interpolation.library import MotionLibrary
 from motionlab.interpolation.slerp import alphas
+from motionlab.interpolation.stride import stride_fill, stride_path
 
 __all__ = [
     "METHODS",
+    "ROOTS",
     "FilledGap",
     "nan_gaps",
     "timestamp_gaps",
@@ -61,7 +65,8 @@ __all__ = [
     "moving_slerp",
 ]
 
-METHODS = ("slerp", "hermite", "graph")
+METHODS = ("slerp", "hermite", "stride", "graph")
+ROOTS = ("stride", "hermite", "linear")
 
 
 @dataclass
@@ -71,7 +76,7 @@ class FilledGap:
     Attributes
     ----------
     start, stop : int     the filled frames are ``start … stop-1`` of the returned motion
-    method : str          ``"slerp"``, ``"hermite"``, ``"library"`` or ``"graph"``
+    method : str          ``"slerp"``, ``"hermite"``, ``"stride"``, ``"library"`` or ``"graph"``
     path : list of str    actions from frame ``start-1`` to frame ``stop`` (graph methods)
     anchors : list of int frames where intermediate key poses were placed
     """
@@ -476,6 +481,27 @@ def smooth_root(motion: Motion, anchors, joint: int | None = None) -> Motion:
     return out
 
 
+def _follow(motion: Motion, a: int, b: int, joint: int, target: np.ndarray) -> Motion:
+    """A copy of ``motion`` whose reference joint follows ``target`` (b−a−1, 3) over frames
+    ``a+1 … b-1``, moved by the root translation and held back from the floor as in
+    :func:`smooth_root`."""
+    _, path = reference_transform(motion, np.arange(a + 1, b), joint=joint)
+    delta = target - path
+    delta[:, 1] = _floor_guard(motion, a, b, delta[:, 1])
+    out = motion.copy()
+    out.root_pos[a + 1 : b] += delta
+    if out.local_pos is not None:
+        out.local_pos[a + 1 : b, 0] = out.root_pos[a + 1 : b]
+    return out
+
+
+def _stride_root(motion: Motion, a: int, b: int, joint: int) -> Motion:
+    """:func:`.stride.stride_path` for the reference joint over frames ``a+1 … b-1`` (or
+    :func:`smooth_root` through ``[a, b]`` where no stride is found)."""
+    target = stride_path(motion, a, b, joint) if b - a >= 2 else None
+    return smooth_root(motion, [a, b], joint=joint) if target is None else _follow(motion, a, b, joint, target)
+
+
 def fill(
     motion: Motion,
     method: str = "slerp",
@@ -489,22 +515,27 @@ def fill(
     ----------
     motion : Motion with NaN rows where frames are missing (see :func:`insert_missing`)
     method : ``"slerp"`` (SLERP + linear root), ``"hermite"`` (Hermite root and rotations from the
-        velocities around the gap) or ``"graph"`` (needs ``graph``: key-pose-guided filling within
+        velocities around the gap), ``"stride"`` (the whole body continued from the recorded
+        strides on both sides, :mod:`.stride`; SLERP with ``root`` where no stride is found) or
+        ``"graph"`` (needs ``graph``: key-pose-guided filling within
         an action, key poses of intermediate actions across actions; the root through the gap's
         ends and key poses is then made C1 by :func:`smooth_root`)
     graph : ActionGraph whose node clips use ``motion``'s skeleton
     curve : α(k) curve for the interpolated parts
-    root : ``"linear"`` (the LaFAN1 baseline) or ``"hermite"``: for ``"slerp"``/``"hermite"``, the
-        reference joint's path across each gap is then the cubic Hermite curve whose end tangents
-        are the velocities measured just outside the gap (:func:`smooth_root` with the gap's two
-        ends as anchors), so a walking character keeps walking through it at the speed it had on
-        both sides; the foot-through-floor guard of :func:`smooth_root` applies. (The ``"graph"``
-        method always does this.)
+    root : for ``"slerp"``/``"hermite"``, the reference joint's path across each gap:
+        ``"linear"`` (the LaFAN1 baseline); ``"hermite"``, the cubic Hermite curve whose end
+        tangents are the velocities measured just outside the gap (:func:`smooth_root` with the
+        gap's two ends as anchors), so a walking character keeps walking through it at the speed
+        it had on both sides; or ``"stride"``, the recorded strides on both sides continued across
+        the gap (turned with the walker's heading) and blended (:mod:`.stride_root`; the Hermite
+        curve where no stride can be read), which keeps the hips' bob and sway. The
+        foot-through-floor guard of :func:`smooth_root` applies to both. (The ``"graph"`` method
+        always uses the Hermite curve through its key poses.)
     """
     if method not in METHODS:
         raise ValueError(f"unknown filling method {method!r}; expected one of {METHODS}")
-    if root not in ("linear", "hermite"):
-        raise ValueError(f"unknown root mode {root!r}; expected 'linear' or 'hermite'")
+    if root not in ROOTS:
+        raise ValueError(f"unknown root mode {root!r}; expected one of {ROOTS}")
     if method == "graph":
         if graph is None or not graph.nodes:
             raise ValueError("method='graph' needs an ActionGraph with at least one action")
@@ -523,14 +554,22 @@ def fill(
             report.append(FilledGap(start, stop, "hold"))
             continue
         a, b = start - 1, stop
-        if method in ("slerp", "hermite"):
+        if method == "stride":
+            strided = stride_fill(out, a, b, ref)
+            if strided is not None:
+                out = lift_above_floor(_follow(strided[0], a, b, ref, strided[1]), a, b)
+                report.append(FilledGap(start, stop, "stride"))
+                continue
+        if method in ("slerp", "hermite", "stride"):  # stride: SLERP where no stride is found
             mode = "hermite" if method == "hermite" else "linear"
             out = inbetween.fill_between(out, start, stop, curve=curve, root=mode,
                                          rotation="hermite" if method == "hermite" else "slerp")  # fmt: skip
-            if root == "hermite":
+            if root == "stride":
+                out = _stride_root(out, a, b, ref)
+            elif root == "hermite":
                 out = smooth_root(out, [a, b], joint=ref)
             out = lift_above_floor(out, a, b)
-            report.append(FilledGap(start, stop, method))
+            report.append(FilledGap(start, stop, "slerp" if method == "stride" else method))
             continue
         node_a = graph.classify(_frame_features(out, a, before=True)[None])[0]
         node_b = graph.classify(_frame_features(out, b, before=False)[None])[0]

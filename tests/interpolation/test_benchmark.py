@@ -142,3 +142,17 @@ def test_cost_limit_chosen_on_apart_windows(clips, windows):
     i_rot, i_trans = bm.method_interpolation(windows, bm.N_PAST, 15)
     np.testing.assert_allclose(rot, i_rot)
     np.testing.assert_allclose(trans, i_trans)
+
+
+def test_fallback_and_limit_chosen_together_on_apart_windows(clips, windows):
+    lib = MotionLibrary(clips, labels=[bm.action_label(c.name) for c in clips])
+    stats = bm.position_stats(clips)
+    simple = {"interp": bm.method_interpolation, "zero": bm.method_zero_velocity}
+    name, limit, totals = bm.choose_fill(windows, lib, stats, simple, gaps=(15,), k=1)
+    assert name == min(totals, key=totals.get) == "interp"  # standing still loses to interpolating
+    assert limit == bm.choose_max_cost(windows, lib, stats, gaps=(15,), k=1)
+    capped = bm.method_library(lib, k=1, max_cost=-1.0, fallback=bm.method_zero_velocity)
+    rot, _ = capped(windows, bm.N_PAST, 15)
+    np.testing.assert_allclose(rot, bm.method_zero_velocity(windows, bm.N_PAST, 15)[0])
+    with pytest.raises(ValueError, match="at least one"):
+        bm.choose_fill(windows, lib, stats, {}, gaps=(15,))

@@ -67,3 +67,14 @@ def test_fill_gaps_on_a_clean_clip_writes_an_unchanged_copy(tmp_path, capsys):
     assert main(["fill-gaps", str(clean), "-o", str(out)]) == 0
     assert "unchanged copy" in capsys.readouterr().out
     assert out.read_bytes() == clean.read_bytes()
+
+
+def test_fill_gaps_continues_the_strides_by_default(tmp_path, capsys):
+    m = toy_motion(240)  # one stride a second, 1.5 strides known on both sides of the cut
+    path = tmp_path / "walk.bvh"
+    bvh.save(path, m[np.r_[0:100, 112:240]])
+    out = tmp_path / "out.bvh"
+    assert main(["fill-gaps", str(path), "-o", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "(method: stride)" in text and ": stride" in text
+    assert abs(bvh.load(out).num_frames - m.num_frames) <= 1  # 12 frames missing, counted to one

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from motionlab.core import bvh
+from motionlab.core.motion import Motion
 from motionlab.interpolation import detect, gaps
 from motionlab.interpolation.action_graph import ActionGraph
 from motionlab.interpolation.alignment import reference_joint, reference_transform
@@ -84,3 +85,34 @@ def test_real_stream_tracked_in_a_graph_of_other_takes():
     assert detect.graph_gaps(m, g) == []
     cut = m[np.r_[0:50, 65:120, 140 : m.num_frames]]
     assert detect.graph_gaps(cut, g) == [49, 104]
+
+
+def _speeding_up(num_frames: int = 240):
+    """The toy walk (one stride a second) whose root speeds up from 0.5 to 2 m/s over 3 s."""
+    m = toy_motion(num_frames)
+    t = np.arange(num_frames) / m.fps
+    root = m.root_pos.copy()
+    root[:, 0] = 0.0
+    root[:, 2] = np.concatenate([[0.0], np.cumsum(np.clip(0.5 + 0.5 * t, 0.0, 2.0)[1:] / m.fps)])
+    return Motion(m.skeleton, m.local_rot, root, m.fps, name="speeding up")
+
+
+def test_stride_of_the_toy_walk_is_one_second():
+    m = toy_motion(240)
+    pose = detect._body_pose(m)
+    assert detect._stride([pose], m.fps) == pytest.approx(30.0, abs=0.2)
+    assert detect._stride([pose[:50], pose[80:]], m.fps) == pytest.approx(30.0, abs=0.2)  # pooled over two sides
+    assert detect._stride([pose[:12]], m.fps) is None  # under one stride: no period
+
+
+@pytest.mark.parametrize("n", [20, 30])
+def test_count_of_a_body_speeding_up_comes_from_the_step_phase(n, monkeypatch):
+    m = _speeding_up()
+    s = 60
+    cut = m[np.r_[0:s, s + n : m.num_frames]]
+    assert detect.consecutive_gaps(cut) == [s - 1]
+    (count,) = detect.estimate_missing(cut, [s - 1])
+    assert abs(count - n) <= 1
+    monkeypatch.setattr(detect, "TRANSIENT", np.inf)  # distance and speeds only: off by 4 or more
+    (distance_only,) = detect.estimate_missing(cut, [s - 1])
+    assert abs(distance_only - n) >= 4

@@ -1,0 +1,57 @@
+"""Gaps in a gait filled from the recorded strides (interpolation.stride, fill(method="stride"))."""
+
+import numpy as np
+import pytest
+
+from motionlab.core import bvh
+from motionlab.interpolation import gap_eval, gaps, stride
+from tests.conftest import require_data
+
+from .conftest import toy_motion
+
+
+@pytest.mark.parametrize("n", [10, 25, 40])
+def test_a_periodic_turning_walk_is_filled_exactly(n):
+    # the toy walk repeats its pose every second and turns at a constant rate: the stride
+    # continued and turned by its heading change is the truth, whatever the gap's length
+    m = toy_motion(240)
+    s = 100
+    holed, _ = gaps.insert_missing(gap_eval.cut(m, s, n), [(s - 1, n)])
+    out, path = stride.stride_fill(holed, s - 1, s + n, joint=0)
+    assert np.abs(path - m.root_pos[s : s + n]).max() < 1e-3  # metres; the period is read to 0.01 frame
+    assert np.abs(np.abs(np.sum(out.local_rot[s : s + n] * m.local_rot[s : s + n], axis=-1)) - 1).max() < 1e-6
+    _, report = gaps.fill(holed, method="stride")
+    assert [r.method for r in report] == ["stride"]
+    slerp, _ = gaps.fill(holed, method="slerp")
+    assert np.abs(slerp.root_pos[s : s + n] - m.root_pos[s : s + n]).max() > 0.01
+
+
+def test_a_motion_that_does_not_repeat_falls_back_to_slerp():
+    m = toy_motion(240)
+    m.local_rot[:] = m.local_rot[:1]  # a frozen pose gliding along: no stride to read
+    m.root_pos[:, 1] = 0.9
+    holed, _ = gaps.insert_missing(gap_eval.cut(m, 100, 10), [(99, 10)])
+    assert stride.stride_fill(holed, 99, 110, joint=0) is None
+    _, report = gaps.fill(holed, method="stride")
+    assert [r.method for r in report] == ["slerp"]
+
+
+def test_a_side_shorter_than_one_and_a_half_strides_lends_nothing():
+    m = toy_motion(240)
+    holed, _ = gaps.insert_missing(gap_eval.cut(m, 40, 10), [(39, 10)])
+    period, before, after = stride.stride_period(holed, 39, 50)
+    assert period == pytest.approx(30.0, abs=0.1)
+    assert len(before) == 40 < stride.MIN_STRIDES * period + 1 <= len(after)
+    path = stride.stride_path(holed, 39, 50, joint=0)  # from the side after the gap alone
+    assert np.abs(path - m.root_pos[40:50]).max() < 1e-3
+
+
+@pytest.mark.realdata
+def test_real_walk_root_error_below_the_hermite_one():
+    walk = require_data("bandai_namco", "sessions", "walk")
+    m = bvh.load(walk / "dataset-2_walk_feminine_010.bvh")  # a validate style
+    for n in (10, 30):
+        strided = gap_eval.evaluate_cut(m, 70, n)
+        hermite = gap_eval.evaluate_cut(m, 70, n, method="slerp", root="hermite")
+        assert strided.count_ok and strided.below == 0.0
+        assert strided.root_rel < 0.1 and strided.root_rel < hermite.root_rel
