@@ -8,6 +8,7 @@ the static Jupyter view, inline matplotlib figures, ``PYTHONHASHSEED=0``), with 
 (``MOTIONLAB_DATA``, required unless ``--no-data``). Then the outputs are made small and stable:
 
 * PNG figures are re-encoded with a 256-colour palette (typically a third of the size);
+* consecutive pieces of one stream are merged (how print output is split depends on timing);
 * execution timings and the widget state (the players' pictures again, several 100 kB) are dropped;
 * the notebook's metadata records ``motionlab.outputs = "stored"`` (strict nbval, see
   ``tests/nbval_modes.py``), whether the course data was used, and a hash of its code cells
@@ -35,9 +36,14 @@ STORED = [
     "00_quaternions_and_fk",
     "00b_bvh_file_format",
     "01_preprocessing",
+    "02_training_autoencoder",
+    "03_latent_iteration",
     "04_playback_and_bone_proportions",
+    "05_motion_graphs",
+    "06_keypose_interpolation",
+    "07_expanding_a_database",
 ]
-"""Notebooks committed with outputs (strict nbval). 02, 03, 05 and 06 are still stored without."""
+"""Notebooks committed with outputs (strict nbval): all of them."""
 
 ENV = {
     "MOTIONLAB_QUICK": "1",
@@ -69,10 +75,24 @@ def compress_png(b64: str) -> str:
     return base64.b64encode(out.getvalue()).decode("ascii") if out.tell() < len(raw) else b64
 
 
+def coalesce_streams(outputs: list) -> list:
+    """Consecutive stream outputs of one name merged into one (the split depends on flush timing)."""
+    merged = []
+    for output in outputs:
+        prev = merged[-1] if merged else None
+        if prev is not None and output.output_type == prev.output_type == "stream" and output.name == prev.name:
+            prev.text += output.text
+        else:
+            merged.append(output)
+    return merged
+
+
 def tidy(nb, used_data: bool) -> None:
-    """Compress figures, drop run-specific metadata, mark the notebook as stored."""
+    """Compress figures, merge split streams, drop run-specific metadata, mark the notebook as stored."""
     for cell in nb.cells:
         cell.metadata.pop("execution", None)
+        if cell.cell_type == "code":
+            cell.outputs = coalesce_streams(cell.outputs)
         for output in cell.get("outputs", []):
             data = output.get("data", {})
             if "image/png" in data:

@@ -1,4 +1,4 @@
-"""Every exercise check of notebooks 00, 01 and 04 against the instructor's key (must pass),
+"""Every exercise check of notebooks 00, 01, 02, 03, 04, 05 and 06 against the instructor's key (must pass),
 typical wrong answers written as a student would (must fail, with the matching hint), an
 alternative correct answer where one exists (must pass), and an unattempted stub (must not raise).
 """
@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import torch
 
 from motionlab import exercises
 from motionlab.core import fk, humanoid, quat
@@ -28,8 +29,12 @@ def _key(name: str):
 K00 = _key("key_00_quaternions_and_fk")
 K01 = _key("key_01_preprocessing")
 K04 = _key("key_04_playback_and_bone_proportions")
+K02 = _key("key_02_training_autoencoder")
+K03 = _key("key_03_latent_iteration")
+K05 = _key("key_05_motion_graphs")
+K06 = _key("key_06_keypose_interpolation")
 
-# (exercise, the key's solution) for every exercise of the three notebooks
+# (exercise, the key's solution) for every exercise of the notebooks
 SOLUTIONS = {
     "conj": K00.my_conj,
     "slerp": K00.my_slerp,
@@ -38,6 +43,17 @@ SOLUTIONS = {
     "window_count": K01.my_window_count,
     "pose_error": K04.my_pose_error,
     "joint_speed": K04.my_joint_speed,
+    "recon_loss": K02.my_recon_loss,
+    "combine": K02.my_combine,
+    "rotations": K02.my_rotations,
+    "foot_loss": K03.my_foot_loss,
+    "root_scale": K03.my_root_scale,
+    "angle_loss": K03.my_angle_loss,
+    "local_minima": K05.my_local_minima,
+    "distance_matrix": K05.my_distance_matrix,
+    "ease": K06.my_ease,
+    "sigma2": K06.my_sigma2,
+    "jumps": K06.my_jumps,
 }
 
 
@@ -129,6 +145,126 @@ def _pose_error_squared(motion, reference):
     return (((a - a[:, :1]) - (b - b[:, :1])) ** 2).sum(-1).mean(1)
 
 
+# notebooks 02, 03, 05, 06
+def _recon_squared(pred, target):
+    return 0.5 * ((pred - target) ** 2).sum(-1).mean() / 3
+
+
+def _recon_summed_batch(pred, target):
+    T, J = pred.shape[-3], pred.shape[-2]
+    return 0.5 / (3 * T * J) * torch.sqrt(((pred - target) ** 2).sum(-1)).sum()
+
+
+def _combine_reversed(q, d):
+    return K02.my_combine(d, q)
+
+
+def _combine_plus_dot(q, d):
+    w = q[..., :1] * d[..., :1] + (q[..., 1:] * d[..., 1:]).sum(-1, keepdim=True)
+    v = q[..., :1] * d[..., 1:] + d[..., :1] * q[..., 1:] + torch.cross(q[..., 1:], d[..., 1:], dim=-1)
+    return torch.cat([w, v], -1)
+
+
+def _rotations_unnormalised(net, phi):
+    return net.f_qlinear(phi).reshape(phi.shape[0], phi.shape[1], 22, 4)
+
+
+def _rotations_whole_frame(net, phi):
+    raw = net.f_qlinear(phi)
+    raw = raw / torch.linalg.norm(raw, dim=-1, keepdim=True)
+    return raw.reshape(phi.shape[0], phi.shape[1], 22, 4)
+
+
+def _foot_all_joints(world_y):
+    return torch.relu(-world_y).mean()
+
+
+def _foot_signed(world_y):
+    return torch.minimum(world_y[..., K03.FEET], torch.zeros(())).mean()
+
+
+def _foot_abs(world_y):
+    return world_y[..., K03.FEET].abs().mean()
+
+
+def _root_hip_ratio(a, b):
+    return (b.rest_positions()[0, 1] - b.rest_positions()[:, 1].min()) / (
+        a.rest_positions()[0, 1] - a.rest_positions()[:, 1].min()
+    )
+
+
+def _root_thigh_shin(a, b):
+    def legs(s):
+        return sum(np.linalg.norm(s.offsets[s.index(n)]) for n in ("LeftLeg", "LeftFoot"))
+
+    return legs(b) / legs(a)
+
+
+def _angle_no_sign(a, b):
+    return torch.linalg.norm(a - b, dim=-1).mean()
+
+
+def _angle_radians(a, b):
+    return (2 * torch.acos(torch.clamp(torch.abs((a * b).sum(-1)), max=1.0))).mean()
+
+
+def _minima_strict(m):
+    p = np.pad(m, 1, constant_values=np.inf)
+    r, c = m.shape
+    return np.all(
+        [m < p[1 + i : 1 + i + r, 1 + j : 1 + j + c] for i in (-1, 0, 1) for j in (-1, 0, 1) if i or j], axis=0
+    )
+
+
+def _minima_four(m):
+    p = np.pad(m, 1, constant_values=np.inf)
+    return (m <= p[:-2, 1:-1]) & (m <= p[2:, 1:-1]) & (m <= p[1:-1, :-2]) & (m <= p[1:-1, 2:])
+
+
+def _minima_roll(m):
+    out = np.ones(m.shape, bool)
+    for i in (-1, 0, 1):
+        for j in (-1, 0, 1):
+            if i or j:
+                out &= m <= np.roll(np.roll(m, i, 0), j, 1)
+    return out
+
+
+def _distance_without_turn(pos_a, pos_b):
+    from motionlab.motion_graphs import distance
+
+    fa, fb = distance.cloud_features(pos_a), distance.cloud_features(pos_b)
+    w2 = np.concatenate([fa.weights, fa.weights])
+    a = (fa.centred * w2) @ fb.centred.T
+    y = (fa.height * fa.weights) @ fb.height.T
+    return np.maximum(fa.self_term[:, None] + fb.self_term[None, :] - 2 * y - 2 * a, 0)
+
+
+def _sigma2_np_cov(X, q):
+    lam = np.sort(np.linalg.eigvalsh(np.cov(X.T)))[::-1]
+    return lam[q:].mean()
+
+
+def _sigma2_unsorted(X, q):
+    xc = X - X.mean(0)
+    lam, _ = np.linalg.eigh(xc.T @ xc / len(X))
+    return lam[q:].mean()
+
+
+def _sigma2_over_d(X, q):
+    xc = X - X.mean(0)
+    lam = np.sort(np.linalg.eigvalsh(xc.T @ xc / len(X)))[::-1]
+    return lam[q:].sum() / X.shape[1]
+
+
+def _jumps_unshifted(s):
+    return np.flatnonzero(s[1:-1] > 2.5 * np.maximum(s[:-2], s[2:]))
+
+
+def _jumps_min(s):
+    return np.array([t for t in range(1, len(s) - 1) if s[t] > 2.5 * min(s[t - 1], s[t + 1])])
+
+
 WRONG = [
     ("conj", lambda q: -q, "all four components"),
     ("conj", lambda q: quat.inv(q), "inverse"),
@@ -149,6 +285,31 @@ WRONG = [
     ("joint_speed", _speed_per_frame, "metres per second"),
     ("joint_speed", _speed_short, "one frame fewer"),
     ("joint_speed", lambda m: np.gradient(m.global_positions(), axis=0) * m.fps, "velocity"),
+    ("recon_loss", _recon_squared, "not squared distances"),
+    ("recon_loss", _recon_summed_batch, "average over the batch"),
+    ("combine", _combine_reversed, "not commutative"),
+    ("combine", _combine_plus_dot, "scalar part"),
+    ("rotations", _rotations_unnormalised, "divide each by its norm"),
+    ("rotations", _rotations_whole_frame, "each joint's 4 numbers"),
+    ("foot_loss", _foot_all_joints, "four foot joints"),
+    ("foot_loss", _foot_signed, "negative"),
+    ("foot_loss", _foot_abs, "costs nothing"),
+    ("root_scale", _root_hip_ratio, "r_y"),
+    ("root_scale", _root_thigh_shin, "thigh + shin"),
+    ("root_scale", lambda a, b: K03.my_root_scale(b, a), "upside down"),
+    ("angle_loss", _angle_no_sign, "smaller of"),
+    ("angle_loss", _angle_radians, "rotation angle"),
+    ("local_minima", _minima_strict, "<="),
+    ("local_minima", _minima_four, "diagonal"),
+    ("local_minima", _minima_roll, "np.roll"),
+    ("distance_matrix", _distance_without_turn, "square-root term"),
+    ("ease", lambda n: np.arange(1, n + 1) / (n + 1), "linear weights"),
+    ("ease", lambda n: 0.5 * (1 - np.cos(np.pi * np.arange(1, n + 1) / n)), "N + 1"),
+    ("sigma2", _sigma2_np_cov, "N − 1"),
+    ("sigma2", _sigma2_unsorted, "increasing"),
+    ("sigma2", _sigma2_over_d, "not over all D"),
+    ("jumps", _jumps_unshifted, "one too small"),
+    ("jumps", _jumps_min, "larger"),
 ]
 
 
@@ -228,6 +389,89 @@ def _speed_backward(motion):
     return np.linalg.norm(v, axis=-1) * motion.fps
 
 
+def _recon_numpy_style(pred, target):
+    return 0.5 * torch.sqrt(((pred - target) ** 2).sum(-1)).mean() / 3
+
+
+def _combine_by_matrix(q, d):
+    """q ⊗ p as the 4x4 left-multiplication matrix of q applied to p."""
+    w, x, y, z = q.unbind(-1)
+    rows = [
+        torch.stack([w, -x, -y, -z], -1),
+        torch.stack([x, w, -z, y], -1),
+        torch.stack([y, z, w, -x], -1),
+        torch.stack([z, -y, x, w], -1),
+    ]
+    return (torch.stack(rows, -2) @ d[..., None])[..., 0]
+
+
+def _rotations_functional(net, phi):
+    raw = torch.nn.functional.linear(phi, net.f_qlinear.weight, net.f_qlinear.bias)
+    return torch.nn.functional.normalize(raw.view(*phi.shape[:-1], 22, 4), dim=-1)
+
+
+def _foot_relu(world_y):
+    return torch.relu(-world_y[..., K03.FEET]).mean()
+
+
+def _root_from_rest_positions(a, b):
+    def chain(s):
+        p = s.rest_positions()
+        total = 0.0
+        for side in ("Left", "Right"):
+            names = ["Hips"] + [side + j for j in ("UpLeg", "Leg", "Foot", "ToeBase")]
+            total += sum(np.linalg.norm(p[s.index(n)] - p[s.index(m)]) for m, n in zip(names[:-1], names[1:]))
+        return total / 2
+
+    return chain(b) / chain(a)
+
+
+def _angle_by_stack(a, b):
+    return torch.stack([(a - b).norm(dim=-1), (a + b).norm(dim=-1)]).min(dim=0).values.mean()
+
+
+def _minima_loop(m):
+    r, c = m.shape
+    out = np.zeros((r, c), bool)
+    for i in range(r):
+        for j in range(c):
+            block = m[max(i - 1, 0) : i + 2, max(j - 1, 0) : j + 2]
+            out[i, j] = m[i, j] <= block.min()
+    return out
+
+
+def _distance_by_alignment(pos_a, pos_b):
+    """Another way: the optimal turn and shift of every pair, then the weighted squared distance."""
+    from motionlab.core import quat
+    from motionlab.motion_graphs import distance
+
+    fa, fb = distance.cloud_features(pos_a), distance.cloud_features(pos_b)
+    h = distance.DEFAULT_WINDOW // 2
+    clouds = [
+        p[np.clip(np.arange(len(p))[:, None] + np.arange(-h, h + 1), 0, len(p) - 1)].reshape(len(p), -1, 3)
+        for p in (pos_a, pos_b)
+    ]
+    i, j = np.meshgrid(np.arange(len(pos_a)), np.arange(len(pos_b)), indexing="ij")
+    theta, shift = distance.alignment(fa, fb, i, j)
+    moved = quat.rotate(quat.from_yaw(theta)[..., None, :], clouds[1][j]) + shift[..., None, :]
+    return np.sum(fa.weights * np.sum((clouds[0][i] - moved) ** 2, axis=-1), axis=-1)
+
+
+def _ease_sin(num):
+    return np.sin(np.pi * np.arange(1, num + 1) / (2 * (num + 1))) ** 2  # ½(1 − cos 2x) = sin² x
+
+
+def _sigma2_svd(X, q):
+    s = np.linalg.svd(X - X.mean(0), compute_uv=False)
+    lam = np.zeros(X.shape[1])
+    lam[: len(s)] = s**2 / len(X)
+    return lam[q:].mean()
+
+
+def _jumps_loop(s):
+    return np.array([t for t in range(1, len(s) - 1) if s[t] > 2.5 * max(s[t - 1], s[t + 1])], dtype=int)
+
+
 ALTERNATIVES = [
     ("conj", _conj_concat),
     ("slerp", _slerp_by_power),
@@ -237,6 +481,17 @@ ALTERNATIVES = [
     ("pose_error", _pose_error_loop),
     ("joint_speed", _speed_forward),
     ("joint_speed", _speed_backward),
+    ("recon_loss", _recon_numpy_style),
+    ("combine", _combine_by_matrix),
+    ("rotations", _rotations_functional),
+    ("foot_loss", _foot_relu),
+    ("root_scale", _root_from_rest_positions),
+    ("angle_loss", _angle_by_stack),
+    ("local_minima", _minima_loop),
+    ("distance_matrix", _distance_by_alignment),
+    ("ease", _ease_sin),
+    ("sigma2", _sigma2_svd),
+    ("jumps", _jumps_loop),
 ]
 
 
@@ -275,3 +530,14 @@ def test_generic_check_compares_quaternions_up_to_sign_and_angles_up_to_turns():
     assert not exercises.check(lambda q: -q, lambda q: q, [(q,)]).passed
     a = np.linspace(-3, 3, 7)
     assert exercises.check(lambda a: a + 2 * np.pi, lambda a: a, [(a,)], period=2 * np.pi).passed
+
+
+# ----------------------------------------------------------------------------- the notebooks use them
+def test_every_named_exercise_is_checked_in_a_notebook_and_no_cell_expects_an_error():
+    """The notebooks check each exercise by name and run top to bottom: no cell is allowed to raise."""
+    notebooks = {p.stem: p.read_text(encoding="utf-8") for p in (KEYS.parent).glob("*.ipynb")}
+    for name in exercises.EXERCISES:
+        assert any(f"exercises.{name}.check(" in text for text in notebooks.values()), f"{name} is checked nowhere"
+    for stem, text in notebooks.items():
+        assert "NBVAL_RAISES_EXCEPTION" not in text, f"{stem}: a cell is expected to raise"
+        assert "exercises.check(" not in text, f"{stem}: an ad-hoc check; use a named exercise with a key"

@@ -14,7 +14,7 @@ import numpy as np
 from motionlab.motion_graphs.graph import EDGE_KINDS, MotionGraph
 from motionlab.motion_graphs.structured import structure_rows
 
-__all__ = ["structure_table_text", "plot_structure_table", "plot_graph", "plot_distance"]
+__all__ = ["structure_table_text", "plot_structure_table", "plot_graph", "plot_distance", "plot_transition_counts"]
 
 _COLUMNS = ("behaviour", "style", "takes", "start", "frames", "alive", "links")
 
@@ -90,7 +90,9 @@ def plot_distance(matrix: np.ndarray, i=None, j=None, ax=None, title: str = "fra
 
     if ax is None:
         _, ax = plt.subplots(figsize=(6, 5))
-    im = ax.imshow(np.sqrt(np.maximum(matrix, 0.0)), origin="lower", cmap="viridis", aspect="auto")
+    # nearest: one flat block per frame pair (no smoothing between cells; also a far smaller PNG)
+    rms = np.sqrt(np.maximum(matrix, 0.0))
+    im = ax.imshow(rms, origin="lower", cmap="viridis", aspect="auto", interpolation="nearest")
     plt.colorbar(im, ax=ax)
     if i is not None and len(i):
         ax.scatter(np.asarray(j), np.asarray(i), s=12, facecolors="none", edgecolors="red", label="transitions")
@@ -98,4 +100,36 @@ def plot_distance(matrix: np.ndarray, i=None, j=None, ax=None, title: str = "fra
     ax.set_xlabel("frame of B")
     ax.set_ylabel("frame of A")
     ax.set_title(title)
+    return ax
+
+
+def plot_transition_counts(graph: MotionGraph, ax=None, title: str | None = None):
+    """Transitions between clips as a matrix: row = clip left, column = clip entered.
+
+    Counts the graph's live jump edges (frame-level, both ends alive) by the clips they join;
+    the diagonal holds the jumps back into the same clip. A readable alternative to drawing
+    every edge: which takes, styles and blends are joined, and how densely.
+    """
+    import matplotlib.pyplot as plt
+
+    live = graph.alive[graph.src] & graph.alive[graph.dst]
+    a, b = graph.clip_of(graph.src[live]), graph.clip_of(graph.dst[live])
+    n = len(graph.clips)
+    counts = np.zeros((n, n), dtype=int)
+    np.add.at(counts, (a, b), 1)
+    names = [c.name for c in graph.clips]
+    if ax is None:
+        _, ax = plt.subplots(figsize=(1.2 + 0.42 * n, 0.8 + 0.36 * n))
+    shown = np.ma.masked_equal(counts, 0)
+    im = ax.imshow(np.ma.log10(shown), cmap="Blues", vmin=-0.3, vmax=np.log10(max(counts.max(), 10)))
+    for (r, c), v in np.ndenumerate(counts):
+        if v:
+            dark = np.log10(v) > 0.6 * np.log10(max(counts.max(), 10))
+            ax.text(c, r, str(v), ha="center", va="center", fontsize=6.5, color="white" if dark else "black")
+    ax.set_xticks(range(n), names, rotation=60, ha="right", fontsize=7)
+    ax.set_yticks(range(n), names, fontsize=7)
+    ax.set_xlabel("clip entered")
+    ax.set_ylabel("clip left")
+    ax.set_title(title or f"transitions between the {n} clips (empty: none)", fontsize=10)
+    plt.colorbar(im, ax=ax, fraction=0.04, pad=0.02, label="log₁₀ transitions")
     return ax
