@@ -12,7 +12,7 @@ metric                    formula                                               
 ``smoothness``            mean over frames, joints of ‖p[t+1] - 2 p[t] + p[t-1]‖      m/frame²
 ``foot_penetration``      mean over frames and foot joints of max(0, -y)              m
 ``foot_skating``          mean horizontal foot speed over frames in ground contact    m/s
-``planted_slide``         mean horizontal speed of feet where given labels say planted m/s
+``planted_slide``         mean horizontal foot speed where given labels say planted   m/s
 ``bone_length_error``     mean over bones of std_t(length) / mean_t(length)           unitless
 ========================  ==========================================================  ==========
 

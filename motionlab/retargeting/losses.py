@@ -8,7 +8,7 @@ loss                   formula                                                  
 ``direction_loss``     the same with θ = unit bone directions (from positions)      unitless
 ``foot_loss``          1/(4T) Σ_t Σ_{i ∈ feet} max(−y_i,t, 0)                       metres
 ``rotation_loss``      mean over frames and joints of 1 − ⟨q, q̂⟩²                   unitless
-``contact_loss``       mean over planted frame pairs of fps · ‖x_t+1 − x_t‖₂ (feet)  m/s
+``contact_loss``       mean over planted frame pairs of fps·‖x_t+1 − x_t‖₂ (feet)   m/s
 =====================  ===========================================================  ==========
 
 **Our choice of θ (the paper leaves it open): the joint angles themselves**, i.e. each joint's
