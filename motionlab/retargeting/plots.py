@@ -419,4 +419,7 @@ def plot_summary(
         ax.grid(axis="x", alpha=0.3)
         for i, v in enumerate(values):
             ax.text(v, i, f" {v:.3g}", va="center", fontsize=8)
+        top = max([v for v in values if np.isfinite(v)] + [0.0])
+        if top > 0:
+            ax.set_xlim(0, 1.3 * top)  # room for the value written after the longest bar
     return axes
