@@ -57,11 +57,13 @@ def _load_checkpoint(path: str | None, device: str | None):
 def _solver_config(args):
     from motionlab.retargeting.solver import SolverConfig
 
+    rounds = SolverConfig().project_iters
     for option, value, ok, expected in (
         ("--steps", args.steps, args.steps >= 0, ">= 0"),
         ("--lr", args.lr, args.lr > 0, "> 0"),
         ("--threshold", args.threshold, args.threshold >= 0, ">= 0"),
         ("--contact-weight", args.contact_weight, args.contact_weight >= 0, ">= 0"),
+        ("--exact-rounds", args.exact_rounds, 0 <= args.exact_rounds <= rounds, f"between 0 and {rounds}"),
     ):
         if not ok:  # also refuses nan
             raise _error(f"{option} must be {expected}, got {value}")
@@ -71,6 +73,7 @@ def _solver_config(args):
         threshold=args.threshold,
         lambda_contact=args.contact_weight,
         init=args.init,
+        project_exact=args.exact_rounds,
     )
 
 
@@ -94,6 +97,13 @@ def _add_solver_args(p: argparse.ArgumentParser) -> None:
         default="auto",
         help="start of the iteration: least-squares projection onto the source's rotations, the encoder's "
         "latent (the paper), or auto (default: projection)",
+    )
+    g.add_argument(
+        "--exact-rounds",
+        type=int,
+        default=4,
+        metavar="K",
+        help="of the projection's 8 Gauss-Newton rounds, how many last ones are not smoothed over time (default 4)",
     )
 
 

@@ -112,8 +112,9 @@ class SolverConfig:
                            4: with 2, the start left a residual that, where the iteration stops
                            at once (the synthetic demo), gave more skating than copying A's
                            rotations (0.225 vs 0.223 m/s); 4 reproduces them. On 5 of the 10
-                           Mixamo animations 2, 3 and 4 score the same (pose MSE/h² 1.49e-4);
-                           the other 5 confirm it (README, Table 1)
+                           Mixamo animations 2, 3 and 4 score the same to 0.5 % in pose MSE/h²
+                           (``motionlab evaluate --exact-rounds K``); the other 5 confirm it
+                           (README, Table 1)
     theta : str            ``"rotations"`` (joint rotations, default) or ``"directions"``
                            (unit bone directions from positions)
     smooth_sigma : float   σ (frames) of the Gaussian that smooths latent updates over time; 0: off

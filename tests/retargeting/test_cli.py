@@ -160,7 +160,14 @@ def test_evaluate_leaves_animations_out_by_folds(tmp_path, clips, capsys):
 
 @pytest.mark.parametrize(
     "option, value",
-    [("--contact-weight", "-1"), ("--lr", "nan"), ("--lr", "0"), ("--steps", "-3"), ("--threshold", "-1")],
+    [
+        ("--contact-weight", "-1"),
+        ("--lr", "nan"),
+        ("--lr", "0"),
+        ("--steps", "-3"),
+        ("--threshold", "-1"),
+        ("--exact-rounds", "9"),
+    ],
 )
 def test_solver_options_refuse_nonsense_by_name(tmp_path, clips, capsys, option, value):
     src = bvh.save(tmp_path / "a.bvh", clips[0])
