@@ -82,7 +82,7 @@ COLUMNS = (
     "flag", "error",
 )  # fmt: skip
 """Manifest columns: ``status`` is ``ok`` or ``error``; ``loss``/``angle``/``foot``/``contact`` the
-final (best) L_iter, L_angle, L_foot (metres), L_contact (metres per frame); ``seconds`` the pair's share of its batch's wall time;
+final (best) L_iter, L_angle, L_foot (metres), L_contact (m/s); ``seconds`` the pair's share of its batch's wall time;
 ``flag`` lists the quality thresholds exceeded (``penetration``, ``skating``), empty if none."""
 
 _ERRORS = (

@@ -168,8 +168,8 @@ class SolverResult:
     positions : ndarray (N, T, 22, 3)   FK on the target skeleton, root at the origin, metres
     phi : Tensor (N, T, D)              the optimised latent
     history : dict of lists             per evaluated step: ``loss`` (L_iter), ``angle`` (L_angle),
-                                        ``foot`` (L_foot, metres), ``contact`` (L_contact, metres
-                                        per frame; 0 without contact labels); entry 0 is the
+                                        ``foot`` (L_foot, metres), ``contact`` (L_contact, m/s;
+                                        0 without contact labels); entry 0 is the
                                         starting point (after the projection, if any)
     stop_reason : str                   ``"threshold"``, ``"plateau"`` or ``"max_steps"``
     best_step : int                     the step whose latent is returned: the lowest ``L_iter``
