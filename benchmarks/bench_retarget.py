@@ -49,7 +49,9 @@ def _train(args):
         motions = [bvh.load(p) for p in clips]
     ds = training_set(motions, progress=False)
     prep = time.perf_counter() - t0
-    ckpt, history = train(ds, TrainConfig(steps=args.steps, log_every=10), progress=True)
+    ckpt, history = train(
+        ds, TrainConfig(steps=args.steps, log_every=10, pose_augment=args.pose_augment), progress=True
+    )
     losses = np.array([h["loss"] for h in history])
     k = max(len(losses) // 10, 1)
     last, before = losses[-k:].mean(), losses[-2 * k : -k].mean()
@@ -210,6 +212,9 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--checkpoint", help="skip training and use this checkpoint")
     p.add_argument("--steps", type=int, default=1500, help="training steps (default 1500)")
+    p.add_argument(
+        "--pose-augment", type=float, default=0.0, help="TrainConfig.pose_augment: batch fraction with joints turned"
+    )
     p.add_argument("--synthetic", action="store_true", help="use motionlab.synthetic data instead of MOTIONLAB_DATA")
     p.add_argument("--synthetic-clips", type=int, default=300)
     p.add_argument("--threads", type=int, default=0, help="torch threads (0: torch's default)")

@@ -188,8 +188,15 @@ def _cmd_train(args) -> int:
         data = training_set(motions, progress=not args.quiet)
     except ValueError as e:
         raise _error(str(e)) from None
+    if not 0.0 <= args.pose_augment <= 0.5:  # also refuses nan; skeleton augmentation takes the other half
+        raise _error(f"--pose-augment must be between 0 and 0.5, got {args.pose_augment}")
     cfg = TrainConfig(
-        steps=args.train_steps, batch_size=args.batch_size, lr=args.train_lr, seed=args.seed, device=args.device
+        steps=args.train_steps,
+        batch_size=args.batch_size,
+        lr=args.train_lr,
+        seed=args.seed,
+        device=args.device,
+        pose_augment=args.pose_augment,
     )
     mcfg = ModelConfig(latent=args.latent, hidden=args.hidden)
     ckpt, history = train(data, cfg, mcfg, progress=not args.quiet)
@@ -348,6 +355,13 @@ def register(subparsers) -> None:
     p.add_argument("-o", "--output", required=True, help="checkpoint file to write (.pt)")
     p.add_argument("--train-steps", type=int, default=1500, help="Adam steps (default 1500)")
     p.add_argument("--batch-size", type=int, default=32)
+    p.add_argument(
+        "--pose-augment",
+        type=float,
+        default=0.0,
+        metavar="F",
+        help="fraction of each batch with joints turned at random (up to 0.3 rad; 0..0.5, default 0 = off)",
+    )
     p.add_argument("--train-lr", type=float, default=2e-3)
     p.add_argument("--latent", type=int, default=128, help="latent channels D per frame")
     p.add_argument("--hidden", type=int, default=96, help="hidden channels")

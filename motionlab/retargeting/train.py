@@ -36,15 +36,25 @@ import torch
 from tqdm.auto import tqdm
 
 from motionlab.core import humanoid, preprocess
+from motionlab.core import quat_torch as tq
 from motionlab.core.motion import Motion
 from motionlab.core.preprocess import NormStats
 from motionlab.core.skeleton import Skeleton
 from motionlab.retargeting import losses
 from motionlab.retargeting.checkpoint import Checkpoint
 from motionlab.retargeting.features import clip_features
-from motionlab.retargeting.model import ModelConfig, RetargetNet
+from motionlab.retargeting.model import NUM_JOINTS, ModelConfig, RetargetNet
 
-__all__ = ["TrainingSet", "training_set", "mirrored", "TrainConfig", "train", "pick_device"]
+__all__ = [
+    "TrainingSet",
+    "training_set",
+    "mirrored",
+    "TrainConfig",
+    "random_turns",
+    "turned_window",
+    "train",
+    "pick_device",
+]
 
 _SWAP = [
     humanoid.JOINTS.index(n.replace("Left", "#").replace("Right", "Left").replace("#", "Right"))
@@ -169,6 +179,9 @@ class TrainConfig:
     augment : float         fraction of each batch decoded on a re-proportioned skeleton (0 = off)
     scale_range : float     bone-group scales drawn log-uniformly in [1/scale_range, scale_range]
     overall_range : float   overall size drawn log-uniformly in [1/overall_range, overall_range]
+    pose_augment : float    fraction of each batch whose joint rotations are perturbed (0 = off):
+                            every non-root joint turned by a random rotation, fixed over the window
+    pose_noise : float      largest angle (radians) of those rotations
     log_every : int         steps between history entries / callback calls
     device : str or None    None: CUDA when available, else CPU
     """
@@ -182,6 +195,8 @@ class TrainConfig:
     augment: float = 0.5
     scale_range: float = 1.5
     overall_range: float = 2.0
+    pose_augment: float = 0.0
+    pose_noise: float = 0.3
     log_every: int = 10
     device: str | None = None
 
@@ -194,6 +209,12 @@ class TrainConfig:
             raise ValueError(f"lr must be positive, got {self.lr}")
         if not 0.0 <= self.augment <= 1.0:
             raise ValueError(f"augment is a fraction in [0, 1], got {self.augment}")
+        if not (0.0 <= self.pose_augment <= 1.0 and self.augment + self.pose_augment <= 1.0):
+            raise ValueError(
+                f"pose_augment is a fraction in [0, 1 - augment], got {self.pose_augment} (augment {self.augment})"
+            )
+        if not self.pose_noise >= 0:
+            raise ValueError(f"pose_noise must be >= 0 radians, got {self.pose_noise}")
         if self.scale_range < 1.0 or self.overall_range < 1.0:
             raise ValueError("scale_range and overall_range must be >= 1")
 
@@ -220,6 +241,39 @@ def random_offsets(base: torch.Tensor, batch: int, cfg: TrainConfig, generator: 
     per_joint[:, mask] = g[:, torch.as_tensor(idx[idx >= 0])]
     factor = torch.exp(per_joint + overall)
     return base[None] * factor[..., None].to(base)
+
+
+def random_turns(batch: int, cfg: TrainConfig, generator: torch.Generator) -> torch.Tensor:
+    """``batch`` sets (batch, 22, 4) of random rotations, uniform axis, angle uniform in
+    [0, ``cfg.pose_noise``]; the root's is the identity."""
+    axis = torch.randn(batch, len(humanoid.JOINTS), 3, generator=generator)
+    axis = axis / axis.norm(dim=-1, keepdim=True).clamp_min(1e-9)
+    angle = torch.rand(batch, len(humanoid.JOINTS), generator=generator) * cfg.pose_noise
+    angle[:, 0] = 0.0
+    return torch.cat([torch.cos(angle / 2)[..., None], torch.sin(angle / 2)[..., None] * axis], dim=-1)
+
+
+@torch.no_grad()
+def turned_window(
+    x: torch.Tensor, local_rot: torch.Tensor, offsets: torch.Tensor, turns: torch.Tensor, mean, std
+) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """Windows with every joint turned by ``turns``: new features, rotations and positions.
+
+    ``x`` (n, W, 70) normalised features, ``local_rot`` (n, W, 22, 4), ``offsets`` (n, 22, 3),
+    ``turns`` (n, 22, 4) (applied on the right, ``q ⊗ turn``, the same in every frame), ``mean`` and
+    ``std`` (70,) the normalisation. The features' joint positions (the first 66 numbers: FK in the
+    heading frame, lifted by the root height) are recomputed; the root's motion (v_x, v_z, ω, h)
+    is unchanged. Returns ``(x', local_rot', positions')``, positions root-relative (n, W, 22, 3).
+    """
+    mean, std = torch.as_tensor(mean).to(x), torch.as_tensor(std).to(x)
+    cols = slice(0, 3 * NUM_JOINTS)
+    turned = tq.normalize(tq.mul(local_rot, turns[:, None]))
+    pos = RetargetNet.forward_kinematics(turned, offsets)
+    height = x[..., -1] * std[-1] + mean[-1]  # the root height, metres
+    lifted = pos + torch.stack([torch.zeros_like(height), height, torch.zeros_like(height)], -1)[..., None, :]
+    out = x.clone()
+    out[..., cols] = (lifted.flatten(-2) - mean[cols]) / std[cols]
+    return out, turned, pos
 
 
 def train(
@@ -262,6 +316,7 @@ def train(
     opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, cfg.steps, eta_min=cfg.lr / 10)
     n_aug = int(round(cfg.augment * cfg.batch_size))
+    n_pose = min(int(round(cfg.pose_augment * cfg.batch_size)), cfg.batch_size - n_aug)
     history: list[dict] = []
     start = time.perf_counter()
     bar = tqdm(range(1, cfg.steps + 1), desc="training", disable=not progress)
@@ -278,6 +333,11 @@ def train(
             with torch.no_grad():
                 target = target.clone()
                 target[:n_aug] = RetargetNet.forward_kinematics(rot[:n_aug], offsets[:n_aug])
+        if n_pose:  # the last n_pose rows: A's skeleton, joints turned, features recomputed
+            rows = slice(cfg.batch_size - n_pose, None)
+            x, rot, target = x.clone(), rot.clone(), target.clone()
+            turns = random_turns(n_pose, cfg, gen).to(device)
+            x[rows], rot[rows], target[rows] = turned_window(x[rows], rot[rows], offsets[rows], turns, mean, std)
         out = model(x, offsets)
         recon = losses.recon_loss(out.positions, target, cfg.recon_weight)
         rot_l = losses.rotation_loss(out.local_rot, rot) if cfg.rot_weight > 0 else torch.zeros((), device=device)

@@ -9,7 +9,15 @@ import torch
 from motionlab import synthetic
 from motionlab.core import humanoid
 from motionlab.retargeting.model import ModelConfig, RetargetNet
-from motionlab.retargeting.train import TrainConfig, TrainingSet, random_offsets, train, training_set
+from motionlab.retargeting.train import (
+    TrainConfig,
+    TrainingSet,
+    random_offsets,
+    random_turns,
+    train,
+    training_set,
+    turned_window,
+)
 
 TINY = ModelConfig(latent=8, hidden=16, skel_embed=4, kernel=3, layers=2)
 
@@ -75,6 +83,37 @@ def test_random_offsets_keep_directions_and_stay_in_range():
     np.testing.assert_allclose(cos.numpy(), 1.0, atol=1e-5)
 
 
+def test_turned_windows_are_the_features_of_the_turned_motion(data):
+    """Pose augmentation: identity turns give back the stored features; real turns give the
+    features that preprocessing computes from the turned motion (positions by FK, root unchanged)."""
+    x = torch.from_numpy((data.x[:3] - data.stats.mean) / data.stats.std).float()
+    rot = torch.from_numpy(data.local_rot[:3])
+    offsets = torch.tensor(np.array(data.skeleton.offsets), dtype=torch.float32).expand(3, -1, -1)
+    ident = torch.zeros(3, 22, 4)
+    ident[..., 0] = 1.0
+    same, rot0, pos0 = turned_window(x, rot, offsets, ident, data.stats.mean, data.stats.std)
+    torch.testing.assert_close(same, x, atol=1e-4, rtol=0)
+    np.testing.assert_allclose(pos0.numpy(), data.positions[:3], atol=1e-5)
+    turns = random_turns(3, TrainConfig(pose_noise=0.4), torch.Generator().manual_seed(0))
+    angle = 2 * torch.arccos(turns[..., 0].clamp(-1, 1))
+    assert torch.all(angle[:, 0] == 0) and angle.max() <= 0.4 + 1e-6 and angle.max() > 0.1
+    x2, rot2, pos2 = turned_window(x, rot, offsets, turns, data.stats.mean, data.stats.std)
+    np.testing.assert_allclose(pos2.numpy(), RetargetNet.forward_kinematics(rot2, offsets).numpy(), atol=1e-6)
+    raw = x2.numpy() * data.stats.std + data.stats.mean
+    np.testing.assert_allclose(raw[..., 66:], data.x[:3, :, 66:], atol=1e-4)  # the root's motion is kept
+    lifted = pos2.numpy() + np.stack([0 * raw[..., -1], raw[..., -1], 0 * raw[..., -1]], -1)[..., None, :]
+    np.testing.assert_allclose(raw[..., :66], lifted.reshape(3, -1, 66), atol=1e-4)
+    assert np.abs(raw[..., :66] - data.x[:3, :, :66]).max() > 0.01  # and the pose did change
+
+
+def test_training_with_pose_augmentation_runs_and_is_seeded(data):
+    cfg = TrainConfig(steps=3, batch_size=4, augment=0.25, pose_augment=0.5, log_every=1, device="cpu")
+    _, h1 = train(data, cfg, TINY, progress=False)
+    _, h2 = train(data, cfg, TINY, progress=False)
+    assert all(np.isfinite(r["loss"]) for r in h1)
+    assert [r["loss"] for r in h1] == [r["loss"] for r in h2]
+
+
 def test_mixed_characters_and_bad_config_are_refused(clips):
     other = synthetic.dataset(
         1, seed=1, num_frames=120, skeleton=humanoid.scale_bones(humanoid.canonical_skeleton(), legs=1.4)
@@ -85,3 +124,5 @@ def test_mixed_characters_and_bad_config_are_refused(clips):
         training_set([], progress=False)
     with pytest.raises(ValueError, match="augment"):
         TrainConfig(augment=2.0)
+    with pytest.raises(ValueError, match="pose_augment"):
+        TrainConfig(augment=0.5, pose_augment=0.75)
