@@ -71,21 +71,19 @@ def action_groups(root: Path) -> dict[str, list[Path]]:
 
 
 class OtherTakes:
-    """``RecordedTakes`` of every other take of a file's action, loaded once per file."""
+    """Every other take of a file's action as ``RecordedTakes`` (features computed once per action)."""
 
     def __init__(self, root: Path) -> None:
         self.groups = action_groups(root)
-        self._clips: dict[Path, object] = {}
+        self._all: dict[str, RecordedTakes] = {}
 
     def __call__(self, f: Path) -> RecordedTakes | None:
-        group = next((g for g in self.groups.values() if f in g), None)
-        if group is None:
+        action = next((a for a, g in self.groups.items() if f in g), None)
+        if action is None:
             return None
-        others = [x for x in group if x.name != f.name]  # leave the scored take out, also by name
-        for x in others:
-            if x not in self._clips:
-                self._clips[x] = bvh.load(x)
-        return RecordedTakes([self._clips[x] for x in others]) if others else None
+        if action not in self._all:
+            self._all[action] = RecordedTakes([bvh.load(x) for x in self.groups[action]])
+        return self._all[action].without(bvh.load(f).name)  # leave the scored take out
 
 
 def count_with_takes(motion, start: int, n: int, takes) -> int | None:

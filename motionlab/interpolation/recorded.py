@@ -66,8 +66,8 @@ MAX_SECONDS = 3.0
 
 
 def mirror_index(names: Sequence[str]) -> np.ndarray | None:
-    """For each joint, its mirror joint (left ↔ right by name), or ``None`` where a left or right
-    joint has no partner. Recognises ``Left``/``Right``, ``left``/``right`` and ``_L``/``_R``,
+    """For each joint, its mirror joint (left ↔ right by name; a middle joint is its own), or
+    ``None`` where a left or right joint has no partner or no joint is named left or right. Recognises ``Left``/``Right``, ``left``/``right`` and ``_L``/``_R``,
     ``.L``/``.R``, ``L_``/``R_`` affixes."""
     pairs = [("Left", "Right"), ("left", "right")]
 
@@ -86,8 +86,8 @@ def mirror_index(names: Sequence[str]) -> np.ndarray | None:
         return name
 
     index = {n: k for k, n in enumerate(names)}
-    out = [index.get(swap(n), -1) for n in names]
-    return None if min(out) < 0 else np.asarray(out)
+    out = np.asarray([index.get(swap(n), -1) for n in names])
+    return None if out.min() < 0 or np.array_equal(out, np.arange(len(out))) else out
 
 
 def _body(motion: Motion, ref: int | None = None) -> tuple[int, np.ndarray]:
@@ -159,7 +159,7 @@ class RecordedTakes:
         mirror = bool(mirror) and mirror_index(first.skeleton.names) is not None
         refs = [reference_joint(m) for m in motions]  # one body for all: the takes' usual reference joint
         self.ref = int(np.bincount(refs).argmax())
-        feats, paces, clip = [], [], []
+        feats, paces, clip, owner = [], [], [], []
         for c, m in enumerate(motions):
             if m.num_frames < 2:
                 continue
@@ -168,8 +168,11 @@ class RecordedTakes:
                 feats.append(f)
                 paces.append(p)
                 clip.append(np.full(len(f), 2 * c + int(flip)))
+                owner.append(np.full(len(f), c))
         if not feats:
             raise ValueError("recorded takes: every clip is shorter than two frames")
+        self.takes = [m.name for m in motions]
+        self.owner = np.concatenate(owner)  # (N,) index into ``takes`` (a take and its mirror image)
         self.names = list(first.skeleton.names)
         self.fps = float(first.fps)
         self.feat = np.concatenate(feats)  # (N, D)
@@ -178,6 +181,17 @@ class RecordedTakes:
         self.frame = np.concatenate([np.arange(len(f)) for f in feats])
         self.length = np.concatenate([np.full(len(f), len(f)) for f in feats])
         self._sq = np.sum(self.feat**2, axis=1)  # (N,) |F[i]|²
+
+    def without(self, name: str) -> RecordedTakes:
+        """These takes less every take named ``name`` (and its mirror image): leave one take out."""
+        keep = np.array([n != name for n in self.takes])[self.owner]
+        if not keep.any():
+            raise ValueError(f"recorded takes: nothing left without {name!r}")
+        out = object.__new__(RecordedTakes)
+        out.__dict__.update(self.__dict__)
+        for attr in ("feat", "pace", "clip", "frame", "length", "owner", "_sq"):
+            setattr(out, attr, getattr(self, attr)[keep])
+        return out
 
     def _window_costs(self, q: np.ndarray, ending: bool, rates: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Best time-scaled match of the ``k`` stream frames ``q`` (k, D) at every take frame.
