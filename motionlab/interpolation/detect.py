@@ -210,9 +210,9 @@ def _pose(motion: Motion, ref: int | None = None) -> np.ndarray:
     the walk. Left out (the body alone), 58 clean walk takes of other styles tracked in three
     normal takes get 29 false gaps, all elderly takes, about once per stride: matched by pose
     alone, a slow gait's frame lands on graph frames that move slower than the ones it passes
-    through. Adding the joints' velocities to the match leaves 5, and the median graph speed over the
-    15 nearest frames 1 (measured with ``/tmp`` scripts, not kept); not 0, so the marker stays
-    until the match itself is made robust (windows of frames, or a time-warped track).
+    through. Adding the joints' velocities to the match leaves 5 (``scripts/check_tracking_pose.py``
+    prints these); not 0, so the marker stays until the match itself is made robust (windows of
+    frames, or a time-warped track).
     """
     g_rot, g_pos = motion.fk()
     j = reference_joint(motion) if ref is None else ref
