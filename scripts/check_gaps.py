@@ -12,6 +12,10 @@
    position error over the gap relative to the true root displacement across it, and the lowest
    foot against the clip's own floor; the root error also with ``--method slerp --root hermite`` (SLERP and a Hermite root) for
    comparison.
+   The missing count also **with the other recordings of the action** (``motionlab fill-gaps
+   --takes``, :mod:`motionlab.interpolation.recorded`): every other take of the same action
+   (``sessions/walk``; the two ``walk-turn`` takes, each the other's mirror image; the 18 runs of
+   ``dataset-1/run`` and ``dataset-2/run``), never the take being scored (leave one take out).
 3. **Stream against the graph** (§3.3): walk takes of one style tracked in an action graph built
    from *other* takes (normal style, takes 1–3), precision and recall.
 
@@ -36,6 +40,7 @@ import numpy as np
 from motionlab.core import bvh
 from motionlab.interpolation import detect, gap_eval
 from motionlab.interpolation.action_graph import ActionGraph
+from motionlab.interpolation.recorded import RecordedTakes
 
 REMOVED = (10, 20, 30)
 
@@ -52,6 +57,43 @@ def sets(root: Path, quick: bool) -> dict[str, list[Path]]:
     if quick:
         choose, validate = choose[::6], validate[::6]
     return {"CHOOSE": choose, "VALIDATE": validate}
+
+
+def action_groups(root: Path) -> dict[str, list[Path]]:
+    """The takes of each action (a take's recordings are the others of its group)."""
+    b = root / "bandai_namco"
+    return {
+        "walk": sorted((b / "sessions/walk").glob("*.bvh")),
+        "walk-turn": sorted((b / "dataset-2/walk-turn-left").glob("*.bvh"))
+        + sorted((b / "dataset-2/walk-turn-right").glob("*.bvh")),
+        "run": sorted((b / "dataset-1/run").glob("*.bvh")) + sorted((b / "dataset-2/run").glob("*.bvh")),
+    }
+
+
+class OtherTakes:
+    """Every other take of a file's action as ``RecordedTakes`` (features computed once per action)."""
+
+    def __init__(self, root: Path) -> None:
+        self.groups = action_groups(root)
+        self._all: dict[str, RecordedTakes] = {}
+
+    def __call__(self, f: Path) -> RecordedTakes | None:
+        action = next((a for a, g in self.groups.items() if f in g), None)
+        if action is None:
+            return None
+        if action not in self._all:
+            self._all[action] = RecordedTakes([bvh.load(x) for x in self.groups[action]])
+        return self._all[action].without(bvh.load(f).name)  # leave the scored take out
+
+
+def count_with_takes(motion, start: int, n: int, takes) -> int | None:
+    """The missing count ``motionlab fill-gaps --takes`` gives a cut of ``n`` frames at ``start``."""
+    found = dict(detect.detect(gap_eval.cut(motion, start, n), takes=takes))
+    return found.get(start - 1)
+
+
+def within(estimate, n: int) -> bool:
+    return estimate is not None and abs(estimate - n) <= max(1.0, 0.1 * n)
 
 
 def false_gaps(root: Path) -> None:
@@ -72,7 +114,7 @@ def false_gaps(root: Path) -> None:
         print(f"   FLAGGED {f}: steps {hits}")
 
 
-def removed_frames(name: str, files: list[Path], rng) -> list:
+def removed_frames(name: str, files: list[Path], rng, other_takes: OtherTakes) -> list:
     results, cases = [], []
     for f in files:
         m = bvh.load(f)
@@ -91,6 +133,19 @@ def removed_frames(name: str, files: list[Path], rng) -> list:
     bad = [f"{r.name} {r.n}->{r.estimate}" for r in results if r.estimate is not None and not r.count_ok]
     if bad:
         print("     outside: " + ", ".join(bad))
+    with_takes = []
+    for f in files:
+        takes = other_takes(f)
+        m = bvh.load(f)
+        for g, r in cases:
+            if g == f and r.hit:
+                with_takes.append((r, count_with_takes(m, r.start, r.n, takes)))
+    ok_t = sum(within(e, r.n) for r, e in with_takes)
+    print(f"     with the other takes of the action (--takes, leave one take out): {ok_t} of {len(with_takes)} "
+          f"({ok_t / max(len(with_takes), 1):.1%})")  # fmt: skip
+    bad = [f"{r.name} {r.n}->{e}" for r, e in with_takes if not within(e, r.n)]
+    if bad:
+        print("       outside: " + ", ".join(bad))
     walks = [r for r in results if "walk" in r.name and "turn" not in r.name]
     for label, sub in (("straight walks", walks), ("all", results)):
         w = gap_eval.summary(sub)
@@ -111,25 +166,38 @@ def removed_frames(name: str, files: list[Path], rng) -> list:
     return results
 
 
-def dense(root: Path, every: int) -> None:
+def dense(root: Path, every: int, other_takes: OtherTakes | None = None) -> None:
     """Every walk take, a cut every ``every`` frames (normal style: CHOOSE, the rest: VALIDATE):
-    detection, missing count, root error and floor, as in part 2."""
+    detection, missing count, root error and floor, as in part 2; with ``other_takes`` also the
+    count with the other takes of the action (leave one take out)."""
     walks = sorted((root / "bandai_namco/sessions/walk").glob("*.bvh"))
     groups = {"CHOOSE (normal)": [f for f in walks if "_normal_" in f.name],
               "VALIDATE (6 other styles)": [f for f in walks if "_normal_" not in f.name]}  # fmt: skip
     print(f"4. every walk take of sessions/walk, 10/20/30 frames cut every {every} frames (from frame 20):")
     for name, files in groups.items():
-        results = []
+        results, with_takes = [], []
         for f in files:
             m = bvh.load(f)
+            takes = other_takes(f) if other_takes is not None else None
             for n in REMOVED:
                 results.extend(gap_eval.evaluate_cut(m, s, n) for s in range(20, m.num_frames - n - 20, every))
+                if takes is not None:
+                    with_takes.extend(
+                        (f.stem, s, n, count_with_takes(m, s, n, takes))
+                        for s in range(20, m.num_frames - n - 20, every)
+                    )
         s = gap_eval.summary(results)
         ok = sum(r.count_ok for r in results)
         print(f"   {name}: {len(results)} cases; recall {s['recall']:.4f}, precision {s['precision']:.4f}")
         print(f"     missing count within 10% (or one frame): {ok} of {len(results)} ({ok / len(results):.2%})")
         off = sorted((r for r in results if r.estimate is not None), key=lambda r: -abs(r.estimate - r.n) / r.n)
         print("     farthest off: " + ", ".join(f"{r.name}@{r.start} {r.n}->{r.estimate}" for r in off[:5]))
+        if with_takes:
+            ok_t = sum(within(e, n) for *_, n, e in with_takes)
+            print(f"     with the other takes of the action (--takes): {ok_t} of {len(with_takes)} "
+                  f"({ok_t / len(with_takes):.2%})")  # fmt: skip
+            off = sorted((w for w in with_takes if w[3] is not None), key=lambda w: -abs(w[3] - w[2]) / w[2])
+            print("       farthest off: " + ", ".join(f"{a}@{s} {n}->{e}" for a, s, n, e in off[:5]))
         print(f"     root error / displacement: mean {s['root_rel_mean']:.1%}, worst {s['root_rel_max']:.1%}, "
               f"share above 10%: {np.mean([r.root_rel > 0.1 for r in results if r.root_rel is not None]):.2%}; "
               f"lowest foot below the floor by at most {1000 * s['below_max']:.1f} mm")  # fmt: skip
@@ -164,6 +232,8 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="a sixth of the clips (for CI-sized runs)")
     ap.add_argument("--dense", type=int, metavar="EVERY", default=0,
                     help="also every walk take, a cut every EVERY frames (e.g. 30; minutes)")  # fmt: skip
+    ap.add_argument("--dense-takes", action="store_true",
+                    help="in --dense, also the count with the other takes of the action (several more minutes)")  # fmt: skip
     args = ap.parse_args(argv)
     if not os.environ.get("MOTIONLAB_DATA"):
         sys.exit("set MOTIONLAB_DATA to the shared data folder (e.g. export MOTIONLAB_DATA=/path/to/shared/data)")
@@ -172,11 +242,12 @@ def main(argv=None) -> int:
     false_gaps(root)
     print("2. frames removed from real walks and runs (detector and fill of `motionlab fill-gaps`):")
     rng = np.random.default_rng(0)
+    other_takes = OtherTakes(root)
     for name, files in sets(root, args.quick).items():
-        removed_frames(name, files, rng)
+        removed_frames(name, files, rng, other_takes)
     graph_tracking(root, args.quick, np.random.default_rng(1))
     if args.dense:
-        dense(root, args.dense)
+        dense(root, args.dense, other_takes if args.dense_takes else None)
     print(f"total time {time.perf_counter() - t0:.1f} s")
     return 0
 

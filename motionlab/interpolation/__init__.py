@@ -12,6 +12,7 @@ Modules, one concept each:
 * :mod:`.library`      key-pose-guided in-betweening from recorded clips
 * :mod:`.labels`       does a clip show what its action label says (hip height, speed, flight)
 * :mod:`.detect`       dropped-frame detection (stream vs graph, stream vs itself) and counts
+* :mod:`.recorded`     missing counts read off other recordings of the action
 * :mod:`.gaps`         inserting and filling missing frames
 * :mod:`.stride`       gaps in a gait filled from the recorded strides on both sides
 * :mod:`.gap_eval`     measuring detection and filling on clips with frames removed
@@ -33,6 +34,7 @@ from motionlab.interpolation import (
     labels,
     paper,
     ppca,
+    recorded,
     slerp,
     stride,
 )
@@ -50,6 +52,7 @@ __all__ = [
     "gaps",
     "stride",
     "detect",
+    "recorded",
     "labels",
     "gap_eval",
     "paper",

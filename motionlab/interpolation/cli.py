@@ -4,6 +4,7 @@ Examples::
 
     motionlab fill-gaps take.bvh -o take_filled.bvh
     motionlab fill-gaps take.bvh -o out.bvh --method hermite --delta 3
+    motionlab fill-gaps take_007.bvh -o out.bvh --takes take_001.bvh --takes take_002.bvh
     motionlab fill-gaps take.bvh -o out.bvh --method graph \\
         --action run=Running.bvh --action walk=Walk.bvh --action stand=Idle.bvh \\
         --allow "run -> walk" --allow "walk -> stand"
@@ -11,7 +12,9 @@ Examples::
 Dropped frames are found with the ``D > Δ`` rule of :mod:`motionlab.interpolation.detect`: against
 the action graph when ``--action`` clips are given (the stream tracked in the graph, §3.3), else
 against the stream's own neighbouring steps. The missing count is estimated from the motion on
-both sides (ground speed, travel direction, step phase), the frames are inserted and filled: by
+both sides (ground speed, travel direction, step phase) and, with ``--takes``, also from how long
+other recordings of the action need between the poses at the gap's ends (the two averaged,
+:mod:`motionlab.interpolation.recorded`); the frames are inserted and filled: by
 default the whole body continues the recorded strides on both sides across the gap
 (:mod:`motionlab.interpolation.stride`); where the motion does not repeat, SLERP with the root
 given by ``--root`` (``stride``: the strides' root path where one side repeats, else ``hermite``,
@@ -51,6 +54,9 @@ def register(subparsers) -> None:
                    help="an action node of the graph and a clip of it (repeat)")  # fmt: skip
     p.add_argument("--allow", action="append", default=[], metavar="'A -> B'",
                    help="an allowed transition (repeat; default: every pair of actions, both ways)")  # fmt: skip
+    p.add_argument("--takes", action="append", default=[], metavar="FILE.bvh",
+                   help="another recording of the stream's action (repeat; never the input itself): the missing "
+                   "count also reads how long these take from the pose before a gap to the pose after it")  # fmt: skip
     p.add_argument("--force", action="store_true", help="overwrite the output file if it exists")
     p.set_defaults(func=run_fill_gaps)
 
@@ -79,6 +85,29 @@ def _graph(actions: list[str], allow: list[str]):
     except GraphError as e:
         raise CLIError(str(e)) from None
     return g
+
+
+def _takes(paths: list[str], src: Path):
+    """:class:`~.recorded.RecordedTakes` of the ``--takes`` files (none of them the input)."""
+    from motionlab.cli import CLIError
+    from motionlab.core import bvh
+    from motionlab.interpolation.recorded import RecordedTakes
+
+    clips = []
+    for path in paths:
+        p = Path(path)
+        if not p.is_file():
+            raise CLIError(f"--takes: no such file {path!r}")
+        if p.resolve() == src.resolve():
+            raise CLIError(f"--takes {path}: the input itself cannot be one of the other recordings")
+        try:
+            clips.append(bvh.load(p))
+        except bvh.BVHError as e:
+            raise CLIError(f"--takes {path}: {e}") from None
+    try:
+        return RecordedTakes(clips)
+    except ValueError as e:
+        raise CLIError(f"--takes: {e}") from None
 
 
 def _copy(src: Path, dst: Path) -> None:
@@ -120,8 +149,9 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
     except bvh.BVHError as e:
         raise CLIError(str(e)) from None
     graph = _graph(args.action, args.allow) if args.method == "graph" else None
+    takes = _takes(args.takes, src) if args.takes else None
     try:
-        missing = detect.detect(motion, graph=graph, delta=delta)
+        missing = detect.detect(motion, graph=graph, delta=delta, takes=takes)
     except ValueError as e:
         raise CLIError(str(e)) from None
     print(f"{src}: {motion.num_frames} frames at {motion.fps:g} fps")

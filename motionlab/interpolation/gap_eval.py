@@ -69,12 +69,14 @@ def cut(motion: Motion, start: int, n: int) -> Motion:
 
 
 def evaluate_cut(
-    motion: Motion, start: int, n: int, graph=None, method: str = "stride", root: str = "stride"
+    motion: Motion, start: int, n: int, graph=None, method: str = "stride", root: str = "stride", takes=None
 ) -> CutResult:
-    """Cut, detect (against ``graph`` if given, else the stream itself), fill (``method`` and
-    ``root`` of :func:`.gaps.fill`; by default what ``motionlab fill-gaps`` does), compare."""
+    """Cut, detect (against ``graph`` if given, else the stream itself; counts also from the other
+    recordings ``takes`` if given, :class:`.recorded.RecordedTakes`, never holding ``motion``), fill
+    (``method`` and ``root`` of :func:`.gaps.fill`; by default what ``motionlab fill-gaps`` does),
+    compare."""
     stream = cut(motion, start, n)
-    found = detect.detect(stream, graph=graph)
+    found = detect.detect(stream, graph=graph, takes=takes)
     steps = [t for t, _ in found]
     hit = (start - 1) in steps
     res = CutResult(motion.name, n, start, hit, len(steps) - int(hit))

@@ -78,3 +78,16 @@ def test_fill_gaps_continues_the_strides_by_default(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "(method: stride)" in text and ": stride" in text
     assert abs(bvh.load(out).num_frames - m.num_frames) <= 1  # 12 frames missing, counted to one
+
+
+def test_fill_gaps_with_other_takes(dropped, tmp_path, capsys):
+    other = tmp_path / "other.bvh"
+    bvh.save(other, toy_motion(150, phase=0.7, speed=1.1))
+    out = tmp_path / "out.bvh"
+    assert main(["fill-gaps", str(dropped), "-o", str(out), "--takes", str(other)]) == 0
+    assert "filled 1 gap(s)" in capsys.readouterr().out
+    assert abs(bvh.load(out).num_frames - 120) <= 1
+    assert main(["fill-gaps", str(dropped), "-o", str(out), "--force", "--takes", str(dropped)]) == 2
+    assert "the input itself" in capsys.readouterr().err
+    assert main(["fill-gaps", str(dropped), "-o", str(out), "--force", "--takes", str(tmp_path / "no.bvh")]) == 2
+    assert "no such file" in capsys.readouterr().err
