@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from motionlab.core import bvh
-from motionlab.interpolation import detect, recorded
+from motionlab.interpolation import detect, gap_eval, recorded
 from motionlab.interpolation.action_graph import ActionGraph
 
 
@@ -53,13 +53,10 @@ def main() -> int:
                 clean += len(found)
                 if found:
                     flagged.append(f.stem)
-                for n in (10, 20, 30):
-                    if m.num_frames - n - 40 <= 20:
-                        continue
-                    s = int(rng.integers(20, m.num_frames - n - 20))
-                    found = detect.graph_gaps(m[np.r_[0:s, s + n : m.num_frames]], graph)
-                    hit = int((s - 1) in found)
-                    tp, fp, cases = tp + hit, fp + len(found) - hit, cases + 1
+                hit, false, made = gap_eval.detection_counts(
+                    m, lambda c: detect.graph_gaps(c, graph), (10, 20, 30), rng
+                )
+                tp, fp, cases = tp + hit, fp + false, cases + made
             print(f"{name}: {clean} false gaps on {len(streams)} clean takes ({len(flagged)} takes: "
                   f"{', '.join(sorted(set(x.split('_')[2] for x in flagged))) or '-'}); "
                   f"{cases} cut: precision {tp / max(tp + fp, 1):.3f}, recall {tp / max(cases, 1):.3f}")  # fmt: skip

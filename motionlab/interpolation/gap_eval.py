@@ -26,7 +26,7 @@ from motionlab.core.motion import Motion
 from motionlab.interpolation import detect, gaps
 from motionlab.interpolation.alignment import reference_joint, reference_transform
 
-__all__ = ["CutResult", "cut", "evaluate_cut", "summary"]
+__all__ = ["CutResult", "cut", "evaluate_cut", "summary", "detection_counts"]
 
 
 @dataclass
@@ -66,6 +66,25 @@ def cut(motion: Motion, start: int, n: int) -> Motion:
     if not (start >= 1 and start + n < motion.num_frames and n >= 1):
         raise ValueError(f"cannot cut {n} frames at {start} from a {motion.num_frames}-frame motion")
     return motion[np.r_[0:start, start + n : motion.num_frames]]
+
+
+def detection_counts(motion: Motion, find, removed, rng: np.random.Generator, margin: int = 20) -> tuple[int, int, int]:
+    """Detection on cuts of ``motion``: for each ``n`` in ``removed``, frames ``s … s+n-1`` removed at
+    a random ``s`` (``margin`` frames from either end; skipped when the clip is too short) and
+    ``find(stream)`` asked for the steps that hide missing frames.
+
+    Returns ``(hits, false_flags, cases)``: cuts whose step ``s-1 → s`` was flagged, other steps
+    flagged, and cuts made.
+    """
+    hits = false = cases = 0
+    for n in removed:
+        if motion.num_frames - n - 2 * margin <= margin:
+            continue
+        s = int(rng.integers(margin, motion.num_frames - n - margin))
+        found = find(cut(motion, s, n))
+        hit = int((s - 1) in found)
+        hits, false, cases = hits + hit, false + len(found) - hit, cases + 1
+    return hits, false, cases
 
 
 def evaluate_cut(

@@ -27,3 +27,18 @@ def test_pose_error_is_zero_for_the_truth_and_smaller_with_strides():
     assert gap_eval.summary([strided, slerped])["pose_cm_mean"] == pytest.approx(
         (strided.pose_cm + slerped.pose_cm) / 2
     )
+
+
+def test_detection_counts_scores_hits_and_false_flags():
+    import numpy as np
+
+    from motionlab.interpolation import detect
+
+    m = toy_motion(150)
+    hits, false, cases = gap_eval.detection_counts(m, detect.consecutive_gaps, (10, 20), np.random.default_rng(0))
+    assert (hits, false, cases) == (2, 0, 2)
+    # a finder that flags one wrong step per stream: no hit, one false flag per cut
+    hits, false, cases = gap_eval.detection_counts(m, lambda s: [0], (10, 20, 30), np.random.default_rng(0))
+    assert (hits, false, cases) == (0, 3, 3)
+    # too short for the cut and its margins: no case
+    assert gap_eval.detection_counts(toy_motion(60), lambda s: [], (30,), np.random.default_rng(0)) == (0, 0, 0)
