@@ -116,6 +116,14 @@ class Skeleton:
         """Indices of the direct children of joint ``j``."""
         return [int(c) for c in np.flatnonzero(self.parents == j)]
 
+    def subtree(self, j: int) -> np.ndarray:
+        """Mask (J,) of joint ``j`` and every joint below it (one pass: parents precede children)."""
+        inside = np.zeros(self.num_joints, dtype=bool)
+        inside[j] = True
+        for k in range(j + 1, self.num_joints):
+            inside[k] = inside[self.parents[k]]
+        return inside
+
     def depth(self) -> np.ndarray:
         """Number of ancestors of each joint, shape (J,)."""
         d = np.zeros(self.num_joints, dtype=np.int64)

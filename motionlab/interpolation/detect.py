@@ -331,11 +331,7 @@ def _body_pose(motion: Motion) -> np.ndarray:
     """
     g_rot, g_pos = motion.fk()
     j = reference_joint(motion)
-    parents = motion.skeleton.parents
-    inside = np.zeros(len(parents), dtype=bool)
-    inside[j] = True
-    for k in range(j + 1, len(parents)):  # parents precede children: one pass over the joints
-        inside[k] = parents[k] >= 0 and inside[parents[k]]
+    inside = motion.skeleton.subtree(j)
     local, _, _ = heading_frame(g_rot, g_pos, j)
     return local[:, inside].reshape(len(local), -1)
 

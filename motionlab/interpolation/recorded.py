@@ -94,12 +94,7 @@ def _body(motion: Motion, ref: int | None = None) -> tuple[int, np.ndarray]:
     """Reference joint (``ref``, else :func:`~.alignment.reference_joint`) and a mask (J,) of it and
     the joints below it."""
     j = reference_joint(motion) if ref is None else int(ref)
-    parents = motion.skeleton.parents
-    inside = np.zeros(len(parents), dtype=bool)
-    inside[j] = True
-    for k in range(j + 1, len(parents)):  # parents precede children: one pass over the joints
-        inside[k] = parents[k] >= 0 and inside[parents[k]]
-    return j, inside
+    return j, motion.skeleton.subtree(j)
 
 
 def body_features(

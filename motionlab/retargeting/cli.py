@@ -174,6 +174,8 @@ def _cmd_train(args) -> int:
     out = Path(args.output)
     if out.exists() and not args.force:
         raise _error(f"{out} exists; pass --force to overwrite it")
+    if not 0.0 <= args.pose_augment <= 0.5:  # also refuses nan; skeleton augmentation takes the other half
+        raise _error(f"--pose-augment must be between 0 and 0.5, got {args.pose_augment}")
     if args.synthetic:
         if args.clips:
             raise _error("give BVH clips or --synthetic N, not both")
@@ -188,8 +190,6 @@ def _cmd_train(args) -> int:
         data = training_set(motions, progress=not args.quiet)
     except ValueError as e:
         raise _error(str(e)) from None
-    if not 0.0 <= args.pose_augment <= 0.5:  # also refuses nan; skeleton augmentation takes the other half
-        raise _error(f"--pose-augment must be between 0 and 0.5, got {args.pose_augment}")
     cfg = TrainConfig(
         steps=args.train_steps,
         batch_size=args.batch_size,

@@ -121,6 +121,9 @@ def test_basic_queries():
     assert sk.children(0) == [1, 3]
     assert sk.children(5) == []
     np.testing.assert_array_equal(sk.depth(), [0, 1, 2, 1, 2, 3])
+    np.testing.assert_array_equal(sk.subtree(0), [True] * 6)  # parents (-1, 0, 1, 0, 3, 4)
+    np.testing.assert_array_equal(sk.subtree(3), [False, False, False, True, True, True])
+    np.testing.assert_array_equal(sk.subtree(5), [False] * 5 + [True])
     assert "6 joints" in repr(sk) and "'Hips'" in repr(sk)
 
 

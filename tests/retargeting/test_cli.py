@@ -121,6 +121,10 @@ def test_train_and_evaluate_on_a_small_folder(tmp_path, clips, capsys):
     assert checkpoint.load(ck).info["train_config"]["steps"] == 3
     code, _, err = _run(capsys, "train", root / "A" / "anim0.bvh", "-o", ck)
     assert code == 2 and "--force" in err
+    before = ck.read_bytes()
+    code, _, err = _run(capsys, "train", root / "A" / "anim0.bvh", "-o", ck, "--force", "--pose-augment", "0.9")
+    assert code == 2 and "--pose-augment" in err and "0.9" in err
+    assert ck.read_bytes() == before  # refused before any work: the checkpoint is untouched
     code, stdout, err = _run(
         capsys, "evaluate", "--data", root, "--source", "A", "--targets", "B", "--animations", "anim1",
         "--checkpoint", ck, "--steps", "2", "-q", "--csv", tmp_path / "rec.csv",
