@@ -10,20 +10,23 @@ One measure of "how far the body moved between stream frames ``t`` and ``t+1``" 
   whenever that heading is ill-defined, which is how the old rule found "gaps" in clean rolls.)
 
 **Stream against the graph** (:func:`graph_gaps`, the paper's rule). Each incoming frame ``M_c`` is
-tracked to the graph frame ``M_i`` nearest to it in pose (heading-frame joint positions), and the
-distance compares how the stream moved into ``M_c`` with how the graph moves at ``M_i``:
+tracked to a graph frame ``M_i`` (:func:`track`): the 0.4 s of stream just before the step into
+it, or just after, whichever matches better, is matched against every stretch of every graph
+clip, time-warped to tempi from half to twice the recordings', by the body's heading-frame joint
+positions and velocities. The distance compares how the stream moved into ``M_c`` with how the
+graph moves at ``M_i``, time-scaled by the matched tempo ``ρ``:
 
-.. math::  r(t) = \\frac{s(t)}{\\bar s_{\\text{graph}}(i(t))}, \\qquad
+.. math::  r(t) = \\frac{s(t)}{\\rho(t)\\,\\bar s_{\\text{graph}}(i(t))}, \\qquad
            D(M_c, M_i) = \\frac{r(t)}{\\operatorname{median}_{\\text{around } t}\\, r}
 
-with ``s(t)`` the stream's joint step into frame ``t`` (m/s) and ``s̄_graph(i)`` the graph clip's
-joint speed at the matched frame ``i`` (mean over ``i−2 … i+2``, never below ``STEP_FLOOR``). The
-graph predicts how fast the body moves *at this pose* (slow at a walk's double support, fast in
-swing); the running median of ``r`` (``WINDOW`` frames on each side, the larger side, and the
-two adjacent values, as in :func:`consecutive_gaps`, so only an isolated jump counts) removes
-the one factor by which this take is slower or faster than the graph's recordings (an exhausted
-walk moves far slower than a normal one; a raw ``r > Δ`` rule flagged many false gaps in clean
-takes of the other Bandai walk styles). With nothing missing ``D ≈ 1``;
+with ``s(t)`` the stream's joint step into frame ``t`` and ``ρ s̄_graph(i)`` the graph clip's
+joint step at the matched frame ``i`` (mean over ``i−2 … i+2``) scaled to a stream step (never
+below ``STEP_FLOOR``). The graph predicts how fast the body moves *at this point of the motion*
+(slow at a walk's double support, fast in swing); the running median of ``r`` (``WINDOW`` frames
+on each side, the larger side, and the two adjacent values, as in :func:`consecutive_gaps`, so
+only an isolated jump counts) removes what the tempo leaves: a walker who takes shorter steps
+than the recordings at the same tempo (an elderly or exhausted walk moves far slower than a
+normal one). With nothing missing ``D ≈ 1``;
 with ``n`` frames missing the stream moved ``n+1`` steps at once, ``D ≈ n+1``. ``D > Δ`` flags a
 gap. **Δ is chosen by principle, not fitted**: one missing frame doubles the step (``D = 2``), the
 largest ``D`` over all 418 clean shared files by the stream-only rule is 1.6, so ``Δ = 2.5``
@@ -67,7 +70,7 @@ import numpy as np
 from motionlab.core.motion import Motion
 from motionlab.interpolation.alignment import reference_joint
 from motionlab.interpolation.features import heading_frame
-from motionlab.interpolation.recorded import recorded_missing
+from motionlab.interpolation.recorded import body_features, recorded_missing
 
 __all__ = [
     "DELTA",
@@ -201,44 +204,107 @@ class GraphTrack:
         return [int(t) - 1 for t in np.flatnonzero(self.distance > self.delta)]
 
 
-def _pose(motion: Motion, ref: int | None = None) -> np.ndarray:
-    """Heading-frame joint positions (T, 3J) with the reference joint's height kept.
+TRACK_RATES = np.geomspace(0.5, 2.0, 13)
+"""Tempi ``ρ`` (graph seconds per stream second, 12% apart) at which a stream window is matched in
+the graph (:func:`track`): from a walker twice as slow as the recordings to one twice as fast."""
 
-    In rigs carried by a hips channel (Bandai Namco) joint 0 is a marker at the world origin, so
-    its heading-frame position is where the walker is in the capture volume; takes of one session
-    walk the same path, so it ties each stream frame to the graph frame at the same progress along
-    the walk. Left out (the body alone), 58 clean walk takes of other styles tracked in three
-    normal takes get 29 false gaps, all elderly takes, about once per stride: matched by pose
-    alone, a slow gait's frame lands on graph frames that move slower than the ones it passes
-    through. Adding the joints' velocities to the match leaves 5 (``scripts/check_tracking_pose.py``
-    prints these); not 0, so the marker stays until the match itself is made robust (windows of
-    frames, or a time-warped track).
+TRACK_CONTEXT = 0.4
+"""Seconds of stream frames in one matched window (:func:`track`; 12 frames at 30 fps, the
+context of :data:`.recorded.CONTEXT`)."""
+
+
+def _resampled(x: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
+    """Rows of ``x`` (N, D) linearly interpolated at times ``0, step, 2·step, …`` (in rows), and
+    those times."""
+    times = np.arange(int(np.floor((len(x) - 1) / step + 1e-9)) + 1) * step
+    i0 = np.minimum(np.floor(times).astype(np.int64), len(x) - 1)
+    i1 = np.minimum(i0 + 1, len(x) - 1)
+    w = (times - i0)[:, None]
+    return (1.0 - w) * x[i0] + w * x[i1], times
+
+
+def _window_costs(q: np.ndarray, g: np.ndarray, k: int, block: int = 512) -> tuple[np.ndarray, np.ndarray]:
+    """For every window of ``k`` stream rows ``q[t : t+k]`` (D-dimensional), the lowest mean squared
+    distance to a window of ``k`` consecutive rows of ``g`` and where that window starts.
+
+    Returns
+    -------
+    cost : ndarray (T-k+1,)   mean over the window of the squared distance per row
+    start : ndarray (T-k+1,)  first row of the best window of ``g`` (int)
     """
-    g_rot, g_pos = motion.fk()
-    j = reference_joint(motion) if ref is None else ref
-    local, _, _ = heading_frame(g_rot, g_pos, j)
-    return local.reshape(len(local), -1)
+    nq, ng = len(q) - k + 1, len(g) - k + 1
+    cost, start = np.full(nq, np.inf), np.zeros(nq, dtype=np.int64)
+    if nq < 1 or ng < 1:
+        return cost, start
+    gg = np.sum(g * g, axis=1)
+    for a in range(0, nq, block):  # blocks of stream windows bound the memory, not a loop over frames
+        b = min(nq, a + block)
+        rows = q[a : b + k - 1]
+        d = np.maximum(np.sum(rows * rows, axis=1)[:, None] + gg[None, :] - 2.0 * rows @ g.T, 0.0)
+        w = sum(d[i : i + b - a, i : i + ng] for i in range(k))  # the K diagonals of each window
+        start[a:b] = np.argmin(w, axis=1)
+        cost[a:b] = w[np.arange(b - a), start[a:b]] / k
+    return cost, start
 
 
-def _graph_tables(graph) -> tuple[list[str], np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Per graph frame: node index, frame index, pose (N, 3J) and smoothed joint step (N,) in m/s."""
-    names = list(graph.nodes)
-    node, frame, pose, speed = [], [], [], []
-    for k, n in enumerate(names):
-        m = graph.nodes[n].motion
-        s = joint_steps(m) * m.fps
-        s = np.concatenate([s[:1], 0.5 * (s[1:] + s[:-1]), s[-1:]]) if len(s) > 1 else np.repeat(s, 2)
-        kernel = np.ones(5) / 5.0
-        s = np.convolve(np.pad(s, 2, mode="edge"), kernel, mode="valid")
-        node.append(np.full(m.num_frames, k))
-        frame.append(np.arange(m.num_frames))
-        pose.append(_pose(m))
-        speed.append(s)
-    return names, np.concatenate(node), np.concatenate(frame), np.concatenate(pose), np.concatenate(speed)
+@dataclass
+class _Match:
+    """Best graph match of each stream window (see :func:`_match_windows`)."""
+
+    cost: np.ndarray  # (W,) mean squared distance per frame
+    node: np.ndarray  # (W,) node index
+    time: np.ndarray  # (W,) graph frame (float) matched to the window's first stream frame
+    rate: np.ndarray  # (W,) graph frames per stream frame
+
+
+def _match_windows(q: np.ndarray, clips: list, k: int, fps: float) -> _Match:
+    """Every window of ``k`` stream frames ``q`` (T, J, 6: positions, weighted velocities) matched to
+    the graph clips ``clips`` (pairs of features (N, J, 6) and frame rate) at every tempo ``ρ`` of
+    :data:`TRACK_RATES`, time-warped linearly (the graph's velocities scaled by ``ρ``)."""
+    n = len(q) - k + 1
+    best = _Match(np.full(n, np.inf), np.zeros(n, np.int64), np.zeros(n), np.ones(n))
+    q = q.reshape(len(q), -1)
+    for c, (feat, clip_fps) in enumerate(clips):
+        for rho in TRACK_RATES:
+            step = rho * clip_fps / fps  # graph frames per stream frame
+            g, times = _resampled((feat * np.array([1.0, 1.0, 1.0, rho, rho, rho])).reshape(len(feat), -1), step)
+            cost, start = _window_costs(q, g, k)
+            better = cost < best.cost
+            best.cost[better], best.node[better] = cost[better], c
+            best.time[better], best.rate[better] = times[start[better]], step
+    return best
+
+
+def _track_features(motion: Motion, ref: int) -> np.ndarray:
+    """Per frame and body joint (T, J, 6): heading-frame position and weighted heading-frame
+    velocity (:func:`.recorded.body_features`; the velocity carries the travel speed, so a stream
+    that walks is never matched to a graph clip standing still)."""
+    feat, _ = body_features(motion, ref=ref)
+    return feat.reshape(len(feat), -1, 6)
 
 
 def track(motion: Motion, graph, delta: float | None = None) -> GraphTrack:
     """Track every stream frame in the graph and compute ``D(M_c, M_i)`` (module docstring).
+
+    **The match.** A single frame's pose is a poor clue to where a walker is in the gait cycle
+    when the walker differs from the recordings: matched by pose alone, the shuffling steps of an
+    elderly walker land on graph frames where the recorded walker stands still or moves slower,
+    and the stream's ordinary step then looks like a jump. So *windows* are matched: the ``K``
+    stream frames (:data:`TRACK_CONTEXT` seconds) ending at frame ``t`` and the ``K`` starting at
+    ``t+1`` are each compared with every run of graph frames, time-warped by every tempo ``ρ`` of
+    :data:`TRACK_RATES` (the graph's velocities scaled by ``ρ``). Frames are compared by the body
+    alone, heading-frame positions and weighted velocities of the reference joint and the joints
+    below it (:func:`_track_features`), so where the take was recorded in the capture volume does
+    not matter. Of the two windows beside the step ``t → t+1`` the one matched better is kept:
+    near a gap, the window that spans it matches badly.
+
+    **The distance.** The graph then predicts the stream's step at that point: the graph clip's
+    joint step at the matched frame (mean over five frames), times ``ρ``. ``r(t)`` is the stream's
+    step over that prediction, and ``D = r / (typical r around t)`` as in the module docstring.
+
+    ``scripts/check_tracking_pose.py`` compares this match with single frames, with and without
+    velocities (false gaps on the clean walk takes of ``sessions/walk``, and on the same takes moved
+    3 m in the capture volume).
 
     Parameters
     ----------
@@ -252,21 +318,43 @@ def track(motion: Motion, graph, delta: float | None = None) -> GraphTrack:
     if sk.names != motion.skeleton.names:
         raise ValueError("the stream uses another skeleton than the action graph's clips")
     delta = check_delta(DELTA if delta is None else delta)
-    names, node, frame, pose, speed = _graph_tables(graph)
-    q = _pose(motion)
-    d2 = np.sum(q * q, axis=1)[:, None] + np.sum(pose * pose, axis=1)[None, :] - 2.0 * q @ pose.T
-    best = np.argmin(d2, axis=1)
-    floor = STEP_FLOOR * body_height(motion)
-    s = np.concatenate([[0.0], joint_steps(motion) * motion.fps])  # step INTO each frame, m/s
-    rel = s / np.maximum(speed[best], floor)  # the stream's speed over the graph's at the match
-    r = rel[1:]
+    names = list(graph.nodes)
+    T = motion.num_frames
+    if T < 4:
+        return GraphTrack([names[0]] * T, np.zeros(T, np.int64), np.zeros(T), delta)
+    k = max(1, min(int(round(TRACK_CONTEXT * motion.fps)), T // 2))
+    ref = reference_joint(motion)
+    clips, speeds = [], []
+    for node in graph.nodes.values():
+        m = node.motion
+        s = joint_steps(m)  # metres per graph frame, step into frame i+1
+        s = np.concatenate([s[:1], 0.5 * (s[1:] + s[:-1]), s[-1:]]) if len(s) > 1 else np.repeat(s, 2)
+        speeds.append(np.convolve(np.pad(s, 2, mode="edge"), np.ones(5) / 5.0, mode="valid"))
+        clips.append((_track_features(m, ref), m.fps))
+    match = _match_windows(_track_features(motion, ref), clips, k, motion.fps)
+    # step t -> t+1 (t = 0 … T-2): the window ending at t (index t-k+1) or the one starting at t+1
+    steps_at = np.arange(T - 1)
+    back, ahead = steps_at - k + 1, steps_at + 1
+    back_ok, ahead_ok = back >= 0, ahead <= T - k
+    cb = np.where(back_ok, match.cost[np.clip(back, 0, None)], np.inf)
+    ca = np.where(ahead_ok, match.cost[np.clip(ahead, None, T - k)], np.inf)
+    use_back = cb <= ca
+    w = np.where(use_back, np.clip(back, 0, None), np.clip(ahead, None, T - k))
+    at = match.time[w] + np.where(use_back, (k - 1) * match.rate[w], 0.0)  # graph frame of t (or t+1)
+    node = match.node[w]
+    predicted = np.array([np.interp(a, np.arange(len(speeds[c])), speeds[c]) for a, c in zip(at, node)])
+    predicted *= match.rate[w]  # metres per stream step
+    floor = STEP_FLOOR * body_height(motion) / motion.fps
+    s = joint_steps(motion)
+    r = s / np.maximum(predicted, floor)
     before, after = _side_medians(r, WINDOW)
     near = np.fmax(np.concatenate([[np.nan], r[:-1]]), np.concatenate([r[1:], [np.nan]]))
-    typical = np.concatenate([[np.inf], np.fmax(np.fmax(before, after), near)])
+    typical = np.fmax(np.fmax(before, after), near)
     typical = np.where(np.isfinite(typical) & (typical > 0), typical, np.inf)
-    dist = np.where(s > floor, rel / typical, 0.0)
-    dist[0] = 0.0
-    return GraphTrack([names[k] for k in node[best]], frame[best], dist, delta)
+    dist = np.concatenate([[0.0], np.where(s > floor, r / typical, 0.0)])
+    frame_of = np.concatenate([[match.time[0]], at + np.where(use_back, match.rate[w], 0.0)])
+    node_of = np.concatenate([[match.node[0]], node])
+    return GraphTrack([names[c] for c in node_of], np.rint(frame_of).astype(np.int64), dist, delta)
 
 
 def graph_gaps(motion: Motion, graph, delta: float | None = None) -> list[int]:
@@ -322,15 +410,16 @@ def _phase_count(gstep: np.ndarray, distance: float, before: np.ndarray, after: 
     return float(np.mean(estimates)) if estimates else None
 
 
-def _body_pose(motion: Motion) -> np.ndarray:
-    """Heading-frame positions (T, 3K) of the reference joint and the K-1 joints below it.
+def _body_pose(motion: Motion, ref: int | None = None) -> np.ndarray:
+    """Heading-frame positions (T, 3K) of the reference joint (``ref``, default
+    :func:`~.alignment.reference_joint`) and the K-1 joints below it.
 
     Joints outside the reference joint's subtree are left out: in rigs carried by a hips channel
     (Bandai Namco) joint 0 is a marker at the world origin, whose heading-frame position is the
     walker's distance from the origin, not part of the pose.
     """
     g_rot, g_pos = motion.fk()
-    j = reference_joint(motion)
+    j = reference_joint(motion) if ref is None else ref
     inside = motion.skeleton.subtree(j)
     local, _, _ = heading_frame(g_rot, g_pos, j)
     return local[:, inside].reshape(len(local), -1)
