@@ -49,7 +49,7 @@ def register(subparsers) -> None:
                    "the motion does not repeat), Hermite with the velocities on both sides, or linear")  # fmt: skip
     p.add_argument("--delta", "--threshold", "--factor", dest="delta", type=str, default=None, metavar="Δ",
                    help="Δ: a step this many times the typical step means dropped frames (a number above 1; "
-                   "default 2.5, or derived from the graph's speed spread with --action)")  # fmt: skip
+                   "default 2.5, against the stream itself or, with --action, against the graph)")  # fmt: skip
     p.add_argument("--action", action="append", default=[], metavar="NAME=FILE.bvh",
                    help="an action node of the graph and a clip of it (repeat)")  # fmt: skip
     p.add_argument("--allow", action="append", default=[], metavar="'A -> B'",
