@@ -77,6 +77,8 @@ __all__ = [
     "STEP_FLOOR",
     "WINDOW",
     "TRANSIENT",
+    "TRACK_CONTEXT",
+    "TRACK_RATES",
     "check_delta",
     "body_height",
     "joint_steps",
