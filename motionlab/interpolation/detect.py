@@ -304,6 +304,9 @@ def track(motion: Motion, graph, delta: float | None = None) -> GraphTrack:
     joint step at the matched frame (mean over five frames), times ``ρ``. ``r(t)`` is the stream's
     step over that prediction, and ``D = r / (typical r around t)`` as in the module docstring.
 
+    The work grows as stream frames × graph frames × the 13 tempi (matrix products, in blocks of
+    512 stream windows, so memory stays bounded).
+
     ``scripts/check_tracking_pose.py`` compares this match with single frames, with and without
     velocities (false gaps on the clean walk takes of ``sessions/walk``, and on the same takes moved
     3 m in the capture volume).
