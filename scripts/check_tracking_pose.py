@@ -45,15 +45,18 @@ from motionlab.interpolation.action_graph import ActionGraph
 from motionlab.interpolation.features import heading_frame
 
 
-def every_joint(motion, ref):
+def every_joint(motion, ref, difference="central"):
     """Heading-frame positions of every joint, velocities zero: (T, J, 6)."""
     g_rot, g_pos = motion.fk()
     local, _, _ = heading_frame(g_rot, g_pos, ref)
     return np.concatenate([local, np.zeros_like(local)], axis=-1)
 
 
-def positions_only(motion, ref):
-    feat = VARIANTS["window, body+velocity"][0](motion, ref).copy()
+BODY = detect._track_features  # kept: the variants below replace detect._track_features
+
+
+def positions_only(motion, ref, difference="central"):
+    feat = BODY(motion, ref, difference).copy()
     feat[..., 3:] = 0.0
     return feat
 

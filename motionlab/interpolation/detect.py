@@ -277,11 +277,11 @@ def _match_windows(q: np.ndarray, clips: list, k: int, fps: float) -> _Match:
     return best
 
 
-def _track_features(motion: Motion, ref: int) -> np.ndarray:
+def _track_features(motion: Motion, ref: int, difference: str = "central") -> np.ndarray:
     """Per frame and body joint (T, J, 6): heading-frame position and weighted heading-frame
-    velocity (:func:`.recorded.body_features`; the velocity carries the travel speed, so a stream
-    that walks is never matched to a graph clip standing still)."""
-    feat, _ = body_features(motion, ref=ref)
+    velocity (:func:`.recorded.body_features`, velocities by ``difference``; the velocity carries
+    the travel speed, so a stream that walks is never matched to a graph clip standing still)."""
+    feat, _ = body_features(motion, ref=ref, difference=difference)
     return feat.reshape(len(feat), -1, 6)
 
 
@@ -297,7 +297,8 @@ def track(motion: Motion, graph, delta: float | None = None) -> GraphTrack:
     :data:`TRACK_RATES` (the graph's velocities scaled by ``ρ``). Frames are compared by the body
     alone, heading-frame positions and weighted velocities of the reference joint and the joints
     below it (:func:`_track_features`), so where the take was recorded in the capture volume does
-    not matter. Of the two windows beside the step ``t → t+1`` the one matched better is kept:
+    not matter; the velocities are one-sided (backward in a window ending at ``t``, forward in one
+    starting at ``t+1``), so no window differences across the step it judges. Of the two windows beside the step ``t → t+1`` the one matched better is kept:
     near a gap, the window that spans it matches badly.
 
     **The distance.** The graph then predicts the stream's step at that point: the graph clip's
@@ -336,19 +337,23 @@ def track(motion: Motion, graph, delta: float | None = None) -> GraphTrack:
         s = np.concatenate([s[:1], 0.5 * (s[1:] + s[:-1]), s[-1:]]) if len(s) > 1 else np.repeat(s, 2)
         speeds.append(np.convolve(np.pad(s, 2, mode="edge"), np.ones(5) / 5.0, mode="valid"))
         clips.append((_track_features(m, ref), m.fps))
-    match = _match_windows(_track_features(motion, ref), clips, k, motion.fps)
+    # windows ending at a frame take backward velocities, windows starting at one forward velocities
+    ending = _match_windows(_track_features(motion, ref, "backward"), clips, k, motion.fps)
+    starting = _match_windows(_track_features(motion, ref, "forward"), clips, k, motion.fps)
     # step t -> t+1 (t = 0 … T-2): the window ending at t (index t-k+1) or the one starting at t+1
     steps_at = np.arange(T - 1)
-    back, ahead = steps_at - k + 1, steps_at + 1
-    back_ok, ahead_ok = back >= 0, ahead <= T - k
-    cb = np.where(back_ok, match.cost[np.clip(back, 0, None)], np.inf)
-    ca = np.where(ahead_ok, match.cost[np.clip(ahead, None, T - k)], np.inf)
+    back = np.clip(steps_at - k + 1, 0, None)
+    ahead = np.clip(steps_at + 1, None, T - k)
+    cb = np.where(steps_at - k + 1 >= 0, ending.cost[back], np.inf)
+    ca = np.where(steps_at + 1 <= T - k, starting.cost[ahead], np.inf)
     use_back = cb <= ca
-    w = np.where(use_back, np.clip(back, 0, None), np.clip(ahead, None, T - k))
-    at = match.time[w] + np.where(use_back, (k - 1) * match.rate[w], 0.0)  # graph frame of t (or t+1)
-    node = match.node[w]
-    predicted = np.array([np.interp(a, np.arange(len(speeds[c])), speeds[c]) for a, c in zip(at, node)])
-    predicted *= match.rate[w]  # metres per stream step
+    node = np.where(use_back, ending.node[back], starting.node[ahead])
+    rate = np.where(use_back, ending.rate[back], starting.rate[ahead])
+    # graph frame of t (window ending there) or of t+1 (window starting there)
+    at = np.where(use_back, ending.time[back] + (k - 1) * ending.rate[back], starting.time[ahead])
+    first = np.cumsum([0] + [len(x) for x in speeds])[:-1]  # each node's first row in the joined speeds
+    joined = np.concatenate(speeds)
+    predicted = np.interp(first[node] + at, np.arange(len(joined)), joined) * rate  # metres per stream step
     floor = STEP_FLOOR * body_height(motion) / motion.fps
     s = joint_steps(motion)
     r = s / np.maximum(predicted, floor)
@@ -357,8 +362,8 @@ def track(motion: Motion, graph, delta: float | None = None) -> GraphTrack:
     typical = np.fmax(np.fmax(before, after), near)
     typical = np.where(np.isfinite(typical) & (typical > 0), typical, np.inf)
     dist = np.concatenate([[0.0], np.where(s > floor, r / typical, 0.0)])
-    frame_of = np.concatenate([[match.time[0]], at + np.where(use_back, match.rate[w], 0.0)])
-    node_of = np.concatenate([[match.node[0]], node])
+    frame_of = np.concatenate([[starting.time[0]], at + np.where(use_back, rate, 0.0)])
+    node_of = np.concatenate([[starting.node[0]], node])
     return GraphTrack([names[c] for c in node_of], np.rint(frame_of).astype(np.int64), dist, delta)
 
 

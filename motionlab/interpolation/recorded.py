@@ -98,12 +98,19 @@ def _body(motion: Motion, ref: int | None = None) -> tuple[int, np.ndarray]:
 
 
 def body_features(
-    motion: Motion, mirror: bool = False, ref: int | None = None, velocity_weight: float = VELOCITY_WEIGHT
+    motion: Motion,
+    mirror: bool = False,
+    ref: int | None = None,
+    velocity_weight: float = VELOCITY_WEIGHT,
+    difference: str = "central",
 ):
     """Per-frame features of the body and its pose pace.
 
     ``ref``: the reference joint (default :func:`~.alignment.reference_joint`); the takes of a
-    :class:`RecordedTakes` and the stream use one, so their features line up.
+    :class:`RecordedTakes` and the stream use one, so their features line up. ``difference``: the
+    velocity at frame ``t`` from ``t-1 … t+1`` (``"central"``), ``t-1 … t`` (``"backward"``) or
+    ``t … t+1`` (``"forward"``; one-sided at the clip's ends in every case). A window that ends just
+    before a gap (or starts just after it) takes one-sided velocities, so none differences across it.
 
     Returns
     -------
@@ -115,7 +122,14 @@ def body_features(
     g_rot, g_pos = motion.fk()
     j, inside = _body(motion, ref)
     local, yaw, _ = heading_frame(g_rot, g_pos, j)
-    vel = quat.rotate(quat.from_yaw(-yaw)[:, None], np.gradient(g_pos, axis=0) * motion.fps)
+    if difference not in ("central", "backward", "forward"):
+        raise ValueError(f"difference must be 'central', 'backward' or 'forward', got {difference!r}")
+    if difference == "central" or len(g_pos) < 2:
+        delta = np.gradient(g_pos, axis=0) if len(g_pos) > 1 else np.zeros_like(g_pos)
+    else:
+        step = np.diff(g_pos, axis=0)  # (T-1, J, 3): frame t to t+1
+        delta = np.concatenate([step[:1], step]) if difference == "backward" else np.concatenate([step, step[-1:]])
+    vel = quat.rotate(quat.from_yaw(-yaw)[:, None], delta * motion.fps)
     if mirror:
         swap = mirror_index(motion.skeleton.names)
         if swap is None:

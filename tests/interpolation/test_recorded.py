@@ -88,3 +88,20 @@ def test_takes_on_another_skeleton_or_rate_are_refused():
         recorded.recorded_missing(other, 30, takes, 5.0)
     with pytest.raises(ValueError, match="at least one"):
         recorded.RecordedTakes([])
+
+
+def test_one_sided_velocities_never_difference_across_a_gap():
+    """Cut frames out after t: the backward features up to t, and the forward ones from t+1, stay as
+    they were; the central ones at t change (they see the jump)."""
+    from .conftest import toy_motion
+
+    m = toy_motion(80)
+    back, _ = recorded.body_features(m, difference="backward")
+    fwd, _ = recorded.body_features(m, difference="forward")
+    cut = m[np.r_[0:40, 55:80]]
+    np.testing.assert_allclose(recorded.body_features(cut, difference="backward")[0][:40], back[:40], atol=1e-9)
+    np.testing.assert_allclose(recorded.body_features(cut, difference="forward")[0][40:], fwd[55:], atol=1e-9)
+    central = recorded.body_features(cut)[0]
+    assert not np.allclose(central[39], recorded.body_features(m)[0][39])
+    with pytest.raises(ValueError, match="backward"):
+        recorded.body_features(m, difference="sideways")
