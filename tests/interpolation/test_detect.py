@@ -105,6 +105,24 @@ def test_stride_of_the_toy_walk_is_one_second():
     assert detect._stride([pose[:12]], m.fps) is None  # under one stride: no period
 
 
+def test_step_period_is_claimed_only_where_the_signal_holds_two():
+    t = np.arange(200)
+    x = np.sin(2 * np.pi * t / 40) + 0.3 * np.sin(2 * np.pi * t / 13)
+    assert detect._step_period(x, 10, 150)[0] == 40
+    lag, _ = detect._step_period(x[:70], 10, 150)  # under two periods: 40 is not tried
+    assert lag <= 35
+    assert detect._step_period(x[:15], 10, 150) == (None, -1.0)
+
+
+@pytest.mark.realdata
+def test_real_120fps_walk_count_not_from_a_few_pairs_of_frames():
+    """A Xia walk (120 fps, a source no rule was chosen on), 30 frames cut: the ground speed after
+    the gap once gave a step period of 152 frames from 9 pairs of frames, and a count of 42."""
+    m = bvh.load(require_data("xia", "walk", "sexy_01_000.bvh"))
+    cut = m[np.r_[0:66, 96 : m.num_frames]]
+    assert detect.detect(cut) == [(65, pytest.approx(30, abs=3))]
+
+
 @pytest.mark.parametrize("n", [20, 30])
 def test_count_of_a_body_speeding_up_comes_from_the_step_phase(n, monkeypatch):
     m = _speeding_up()
