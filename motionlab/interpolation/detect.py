@@ -531,7 +531,8 @@ def estimate_missing(motion: Motion, steps_at, seconds: float = 1.0, takes=None)
       joint's ground point, lengthened to the arc of a circle turning by the change ``ψ`` of travel
       direction between the two sides, ``arc = chord · (ψ/2) / sin(ψ/2)``;
     * **step phase**: where the ground speed on a side (up to two seconds, other gaps left out)
-      repeats with a period ``P`` of 0.3–1.3 s (normalised autocorrelation ≥ 0.5), the gap is taken
+      repeats with a period ``P`` of 0.3–1.3 s (normalised autocorrelation ≥ 0.5; the side must hold
+      two periods, see :func:`_step_period`), the gap is taken
       to repeat that side's last cycle (before) or first cycle (after, backwards) and ``n + 1`` is
       where the cycle's cumulative ground distance reaches the arc; both sides are averaged;
     * otherwise ``n + 1 = arc / v`` with ``v`` the mean ground speed (metres per frame) over
