@@ -123,6 +123,17 @@ def test_real_120fps_walk_count_not_from_a_few_pairs_of_frames():
     assert detect.detect(cut) == [(65, pytest.approx(30, abs=3))]
 
 
+def test_real_120fps_short_gap_counted_from_the_speeds_at_its_edges():
+    """A Xia walk (120 fps), 10 frames (83 ms, a sixth of a step) cut: the stride count says 12,
+    the local count 10, and the rehearsal on the clip's own frames picks the local one."""
+    m = bvh.load(require_data("xia", "walk", "strutting_01_000.bvh"))
+    s, n = 212, 10
+    cut = m[np.r_[0:s, s + n : m.num_frames]]
+    c = detect.count_choice(cut, s - 1)
+    assert round(c.stride) == 12 and round(c.local) == n and c.p < detect.SIGNIFICANCE
+    assert detect.detect(cut) == [(s - 1, n)]
+
+
 @pytest.mark.parametrize("n", [20, 30])
 def test_count_of_a_body_speeding_up_comes_from_the_step_phase(n, monkeypatch):
     m = _speeding_up()
@@ -131,9 +142,38 @@ def test_count_of_a_body_speeding_up_comes_from_the_step_phase(n, monkeypatch):
     assert detect.consecutive_gaps(cut) == [s - 1]
     (count,) = detect.estimate_missing(cut, [s - 1])
     assert abs(count - n) <= 1
-    monkeypatch.setattr(detect, "TRANSIENT", np.inf)  # distance and speeds only: off by 4 or more
+    monkeypatch.setattr(detect, "TRANSIENT", np.inf)  # no step phase, and never the local count
+    monkeypatch.setattr(detect, "SIGNIFICANCE", 0.0)  # (test_rehearsal_…): off by 4 or more
     (distance_only,) = detect.estimate_missing(cut, [s - 1])
     assert abs(distance_only - n) >= 4
+
+
+def test_local_count_of_a_quadratic_speed_is_exact():
+    """Ground speed a quadratic in time (60 fps): the local count recovers the cut, whatever the
+    guess it starts from (every n whose quadratic covers the arc is a crossing; the one nearest)."""
+    fps, n, s = 60.0, 14, 80
+    tau = np.arange(200) + 0.5  # step k → k+1 at time k + ½
+    speed = 0.02 + 4e-4 * tau - 1.5e-6 * tau**2  # metres per frame, positive throughout
+    gstep = np.r_[speed[: s - 1], speed[s - 1 : s + n].sum(), speed[s + n :]]  # n frames cut after s-1
+    arc = float(speed[s - 1 : s + n].sum())
+    for guess in (8.0, 14.0, 20.0):
+        assert detect._local_count(gstep, s - 1, 0, len(gstep), arc, guess, fps) == pytest.approx(n, abs=0.05)
+
+
+def test_rehearsal_reads_the_stream_itself(monkeypatch):
+    """The rehearsal cuts known frames beside the gap and scores both counts there. On the toy walk
+    speeding up at constant acceleration, without the step phase, the stride count (mean speeds)
+    is 2 frames long, the local count is exact (known answer: a linear speed is a quadratic); the
+    rehearsal finds that from the stream alone, and the count comes out right."""
+    monkeypatch.setattr(detect, "TRANSIENT", np.inf)
+    s, n = 60, 15
+    cut = _speeding_up()[np.r_[0:s, s + n : 240]]
+    c = detect.count_choice(cut, s - 1)
+    assert abs(c.stride - n) > 1.5 and c.local == pytest.approx(n, abs=0.5)
+    assert c.stride_only == 0 and c.local_only >= 10 and c.p < detect.SIGNIFICANCE
+    assert detect.estimate_missing(cut, [s - 1]) == [n]
+    assert detect._sign_test(3, 3) == pytest.approx(42 / 64)  # 3 or more of 6: (20 + 15 + 6 + 1) / 64
+    assert detect._sign_test(5, 0) == pytest.approx(1 / 32)
 
 
 @pytest.mark.realdata
