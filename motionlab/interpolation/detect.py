@@ -56,8 +56,9 @@ below ``STEP_FLOOR``) falls back to the joint-step ratio.
 A gap short against a step (as 10–30 frames are at 120 fps) is better served by the speeds
 right at its edges: a quadratic in time through the nearest 0.1 s of ground speeds on both sides.
 Which of the two a gap gets is decided by the stream itself: both are *rehearsed* on gaps of the
-same length cut out of the known frames beside the real one, and the one that gets more of
-those within 10% (or one frame) is used (:func:`count_choice`).
+same length cut out of the known frames beside the real one, and the local count is used only
+where it gets clearly more of those within 10% (or one frame): a sign test at ``SIGNIFICANCE``
+(:func:`count_choice`).
 Given other recordings of the action (:mod:`.recorded`), the count also reads how long they need
 from the pose before the gap to the pose after it, and the two counts are averaged.
 Timestamps, where the input has them, give the count exactly (:func:`~.gaps.timestamp_gaps`).
@@ -113,8 +114,8 @@ WINDOW = 8
 
 LOCAL_SECONDS = 0.1
 """Seconds of ground speeds on each side of a gap that the local count fits (:func:`_local_count`;
-0.1 and 0.2 s, degree 1 and 2 tried on the held-out Xia clips of ``scripts/check_gaps.py`` part 5;
-checked on part 6, clips never looked at before)."""
+0.1, 0.2, 0.3 and 0.5 s and degrees 1–3 tried on the Xia clips of ``scripts/check_gaps.py`` part
+5, which are therefore no longer held out; checked on part 6, clips never looked at before)."""
 
 REHEARSAL_SECONDS = 2.0
 """How far from a gap, on each side, the two counts are rehearsed (:func:`count_choice`)."""
@@ -581,7 +582,7 @@ def estimate_missing(motion: Motion, steps_at, seconds: float = 1.0, takes=None)
       count (the rules above) or the local one, is decided by :func:`count_choice`: gaps of the same
       length are cut out of the known frames on both sides (up to ``REHEARSAL_SECONDS``), both
       counts are made for each, and the local count is used only where it gets more of them
-      within 10% (or one frame). At 30 fps a 10–30-frame gap spans one to two steps and the
+      within 10% (or one frame) by a one-sided sign test at ``SIGNIFICANCE``. At 30 fps a 10–30-frame gap spans one to two steps and the
       stride count wins the rehearsal; at 120 fps the same gaps span a fraction of a step and the
       local count does.
 
@@ -611,6 +612,11 @@ def estimate_missing(motion: Motion, steps_at, seconds: float = 1.0, takes=None)
     at = sorted(int(t) for t in steps_at)
     if not at:
         return []
+    if at[0] < 0 or at[-1] > motion.num_frames - 2:
+        raise ValueError(
+            f"clip {motion.name!r}: steps that hide missing frames must lie in 0 … {motion.num_frames - 2} "
+            f"(step t is frame t → t+1), got {at}"
+        )
     arrays = _Arrays.of(motion)
     out = []
     for t in at:
@@ -647,18 +653,27 @@ class CountChoice:
 def count_choice(motion: Motion, t: int, start: int = 0, stop: int | None = None, seconds: float = 1.0) -> CountChoice:
     """Both stream counts of the gap at step ``t → t+1`` of ``motion`` (known steps ``start …
     stop``, default the whole stream) and the rehearsal between them (:func:`estimate_missing`)."""
-    a = _Arrays.of(motion)
-    return _choose(a, int(t), int(start), len(a.gstep) if stop is None else int(stop), seconds)
+    last = motion.num_frames - 2  # the last step
+    stop = last + 1 if stop is None else int(stop)
+    t, start = int(t), int(start)
+    if not 0 <= start <= t < stop <= last + 1:
+        raise ValueError(
+            f"clip {motion.name!r}: the gap's step must lie in start … stop-1 of steps 0 … {last} "
+            f"(0 <= start <= t < stop <= {last + 1}), got t={t}, start={start}, stop={stop}"
+        )
+    return _choose(_Arrays.of(motion), t, start, stop, seconds)
 
 
 def _choose(a: _Arrays, t: int, start: int, stop: int, seconds: float) -> CountChoice:
     n, arc = _stride_count(a, t, start, stop, seconds)
     if arc is None:  # the body does not travel: the joint-step ratio, nothing to rehearse
         return CountChoice(n, None, 0, 0, 1.0, n)
+    local = _local_count(a.gstep, t, start, stop, arc, n, a.fps)
+    if local is None:  # no local count for this gap: nothing to rehearse it against
+        return CountChoice(n, None, 0, 0, 1.0, n)
     stride_only, local_only = _rehearse(a, t, start, stop, max(1, int(round(n))), seconds)
     p = _sign_test(local_only, stride_only)
-    local = _local_count(a.gstep, t, start, stop, arc, n, a.fps)
-    count = local if (local is not None and p < SIGNIFICANCE) else n
+    count = local if p < SIGNIFICANCE else n
     return CountChoice(n, local, stride_only, local_only, p, count)
 
 

@@ -194,3 +194,11 @@ def test_real_elderly_walk_tracked_in_normal_takes_wherever_it_was_recorded():
         cut = take[np.r_[0:100, 110:200, 220:300, 330 : take.num_frames]]
         assert detect.graph_gaps(cut, g) == [99, 189, 269]
     np.testing.assert_allclose(detect.track(far, g).distance, detect.track(m, g).distance, atol=1e-9)
+
+
+def test_a_step_outside_the_stream_is_refused_by_name():
+    m = _speeding_up(60)
+    with pytest.raises(ValueError, match=r"speeding up.*0 … 58"):
+        detect.estimate_missing(m, [59])
+    with pytest.raises(ValueError, match=r"speeding up.*t=70"):
+        detect.count_choice(m, 70)
