@@ -84,6 +84,7 @@ __all__ = [
     "STEP_FLOOR",
     "WINDOW",
     "TRANSIENT",
+    "changes_speed",
     "TRACK_CONTEXT",
     "TRACK_RATES",
     "check_delta",
@@ -128,6 +129,14 @@ TRANSIENT = 0.2
 """Relative difference of the mean ground speeds on the two sides of a gap above which the body is
 taken to be speeding up or slowing down, and the count comes from the step phase
 (:func:`estimate_missing`; chosen on the ``normal`` walk takes of ``sessions/walk``)."""
+
+
+def changes_speed(v_before: float, v_after: float) -> bool:
+    """Whether a body whose mean ground speeds are ``v_before`` and ``v_after`` on the two sides of
+    a gap is speeding up or slowing down across it: they differ by more than ``TRANSIENT`` of their
+    mean. The one rule for both the missing count (:func:`estimate_missing`) and the root across a
+    stride fill (:func:`.gaps.fill`)."""
+    return abs(v_before - v_after) > TRANSIENT * 0.5 * (v_before + v_after)
 
 
 def check_delta(delta, name: str = "delta") -> float:
@@ -734,7 +743,7 @@ def _stride_count(a: _Arrays, t: int, start: int, stop: int, seconds: float) -> 
     long_after = np.arange(t + 1, min(stop, t + 1 + far))
     frames = _phase_count(gstep, arc, long_before, long_after, fps)
     n = (arc / v if frames is None else frames) - 1.0
-    if len(speeds) == 2 and abs(speeds[0] - speeds[1]) > TRANSIENT * v:  # speeding up / slowing down
+    if len(speeds) == 2 and changes_speed(*speeds):
         phased = _phase_missing(a.pose, t, start, stop, n, fps)
         if phased is None:
             near = max(2, int(round(0.35 * fps)))

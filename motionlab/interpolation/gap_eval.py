@@ -88,14 +88,23 @@ def detection_counts(motion: Motion, find, removed, rng: np.random.Generator, ma
 
 
 def evaluate_cut(
-    motion: Motion, start: int, n: int, graph=None, method: str = "stride", root: str = "stride", takes=None
+    motion: Motion,
+    start: int,
+    n: int,
+    graph=None,
+    method: str = "stride",
+    root: str = "stride",
+    takes=None,
+    found: list[tuple[int, int]] | None = None,
 ) -> CutResult:
     """Cut, detect (against ``graph`` if given, else the stream itself; counts also from the other
     recordings ``takes`` if given, :class:`.recorded.RecordedTakes`, never holding ``motion``), fill
     (``method`` and ``root`` of :func:`.gaps.fill`; by default what ``motionlab fill-gaps`` does),
-    compare."""
+    compare. ``found``: the detection's ``(step, count)`` pairs of the cut stream, if already made
+    (to compare fills on the same counts)."""
     stream = cut(motion, start, n)
-    found = detect.detect(stream, graph=graph, takes=takes)
+    if found is None:
+        found = detect.detect(stream, graph=graph, takes=takes)
     steps = [t for t, _ in found]
     hit = (start - 1) in steps
     res = CutResult(motion.name, n, start, hit, len(steps) - int(hit))

@@ -48,7 +48,7 @@ from motionlab.core.motion import Motion
 from motionlab.interpolation import detect
 from motionlab.interpolation.alignment import reference_transform
 
-__all__ = ["SIDE_SECONDS", "MIN_STRIDES", "known_side", "stride_period", "stride_path", "stride_fill"]
+__all__ = ["SIDE_SECONDS", "MIN_STRIDES", "known_side", "side_speeds", "stride_period", "stride_path", "stride_fill"]
 
 SIDE_SECONDS = 3.0
 """How much of each side of a gap (seconds) the stride is read from."""
@@ -69,6 +69,19 @@ def known_side(motion: Motion, t: int, step: int, limit: int) -> np.ndarray:
     finite = np.all(np.isfinite(motion.root_pos[idx]), axis=1) & np.all(np.isfinite(motion.local_rot[idx]), axis=(1, 2))
     bad = np.flatnonzero(~finite)
     return np.sort(idx[: bad[0]] if bad.size else idx)
+
+
+def side_speeds(motion: Motion, a: int, b: int, joint: int, seconds: float = 1.0) -> tuple[float, float]:
+    """Mean ground speeds (metres/frame) of the reference joint ``joint`` over the known frames of
+    the last ``seconds`` before the gap ``a … b`` (ending at ``a``) and the first after it (from
+    ``b``), as :func:`.detect.estimate_missing` measures them; ``nan`` for a side without a step."""
+    limit = max(3, int(round(seconds * motion.fps))) + 1
+    speeds = []
+    for frames in (known_side(motion, a, -1, limit), known_side(motion, b, +1, limit)):
+        _, pos = reference_transform(motion, frames, joint=joint)
+        steps = np.linalg.norm(np.diff(pos[:, [0, 2]], axis=0), axis=1)
+        speeds.append(float(steps.mean()) if steps.size else float("nan"))
+    return speeds[0], speeds[1]
 
 
 def stride_period(motion: Motion, a: int, b: int) -> tuple[float | None, np.ndarray, np.ndarray]:

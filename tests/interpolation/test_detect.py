@@ -202,3 +202,10 @@ def test_a_step_outside_the_stream_is_refused_by_name():
         detect.estimate_missing(m, [59])
     with pytest.raises(ValueError, match=r"speeding up.*t=70"):
         detect.count_choice(m, 70)
+
+
+def test_changes_speed_is_a_relative_difference_of_the_two_sides():
+    # TRANSIENT (20%) of the mean: 1.0 against 1.25 differs by 0.25 > 0.2 · 1.125; 1.0 against 1.2 does not
+    assert detect.changes_speed(1.0, 1.25) and detect.changes_speed(1.25, 1.0)
+    assert not detect.changes_speed(1.0, 1.2) and not detect.changes_speed(0.0, 0.0)
+    assert detect.changes_speed(0.0, 0.5)  # a start from standing

@@ -42,3 +42,12 @@ def test_detection_counts_scores_hits_and_false_flags():
     assert (hits, false, cases) == (0, 3, 3)
     # too short for the cut and its margins: no case
     assert gap_eval.detection_counts(toy_motion(60), lambda s: [], (30,), np.random.default_rng(0)) == (0, 0, 0)
+
+
+def test_counts_given_are_the_counts_filled():
+    # found= skips the detection: the same count gives the same result, another count another fill
+    m = toy_motion(150)
+    detected = gap_eval.evaluate_cut(m, 60, 12)
+    assert gap_eval.evaluate_cut(m, 60, 12, found=[(59, detected.estimate)]) == detected
+    other = gap_eval.evaluate_cut(m, 60, 12, found=[(59, 20)])
+    assert other.estimate == 20 and not other.count_ok and other.root_rel != detected.root_rel
