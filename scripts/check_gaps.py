@@ -25,6 +25,9 @@
    or chosen on them.
 6. **Clips held out from every choice** (``FRESH_SOURCES``): fixed before the local count and its
    rehearsal were written, and run once after they were chosen; nothing was chosen on them.
+7. **Locomotion never scored before session 23** (``UNSCORED_SOURCES``): Bandai Namco
+   ``dataset-1`` walks, dashes and side steps, and Mixamo clips of other locomotion; fixed before
+   the session-23 changes were tried, scored once after they were chosen.
 
 Rules were chosen on the CHOOSE set and are reported separately on the VALIDATE set:
 
@@ -237,6 +240,25 @@ FRESH_SOURCES = {
 written, and scored once after they were chosen (part 6)."""
 
 
+UNSCORED_SOURCES = {
+    "bandai dataset-1 walks (30 fps, 16 styles)": ["bandai_namco/dataset-1/walk/*.bvh"],
+    "bandai dataset-1 dashes (30 fps, 15 styles)": ["bandai_namco/dataset-1/dash/*.bvh"],
+    "bandai side steps, left and right (30 fps)": [
+        "bandai_namco/dataset-1/walk-left/*.bvh",
+        "bandai_namco/dataset-1/walk-right/*.bvh",
+    ],
+    "mixamo catwalk turns, quick steps, wheelbarrow walk (60 fps)": [
+        "mixamo/Aj/Catwalk_Twist_R_To_Walk_180.bvh",
+        "mixamo/Aj/Catwalk_Walk_Start_Turn_180_Right.bvh",
+        "mixamo/Aj/Quick_Steps.bvh",
+        "mixamo/Aj/Wheelbarrow_Walk_Turn.bvh",
+    ],
+}
+"""Locomotion clips whose missing counts and roots were never scored before session 23 (part 7):
+fixed, and committed, before the session-23 changes to the count (held frames, the stride period
+from the poses) were tried, and scored once after they were chosen on parts 2, 5 and 6."""
+
+
 def other_sources(root: Path, rng, cuts: int = 4, sources: dict | None = None, label: str = "") -> None:
     """The walks and runs of ``sources`` (default ``OTHER_SOURCES``), ``cuts`` seeded cuts of 10,
     20 and 30 frames per clip: detection, missing count (stream alone: no other takes of these
@@ -307,6 +329,8 @@ def main(argv=None) -> int:
     cuts = 1 if args.quick else 4
     other_sources(root, np.random.default_rng(7), cuts, FRESH_SOURCES,
                   f"6. clips held out from every choice, {cuts} cuts of 10/20/30 frames per clip:")  # fmt: skip
+    other_sources(root, np.random.default_rng(11), cuts, UNSCORED_SOURCES,
+                  f"7. locomotion never scored before session 23, {cuts} cuts of 10/20/30 frames per clip:")  # fmt: skip
     print(f"total time {time.perf_counter() - t0:.1f} s")
     return 0
 
