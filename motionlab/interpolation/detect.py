@@ -125,6 +125,12 @@ SIGNIFICANCE = 0.05
 """The local count replaces the stride count only where it wins the rehearsal by a one-sided sign
 test at this level (the cuts that one count gets right and the other wrong; the usual 5%)."""
 
+HELD = 1e-6
+"""A step that moves no joint by more than this fraction of the body height (RMS) repeats its
+frame exactly: a held pose, as in Mixamo clips padded to 60 frames with copies of their last
+pose. Held frames carry no speed and no timing, so the counts read nothing from them
+(:func:`count_choice`): 1e-6 of a body height is a micrometre, far below any capture's noise."""
+
 TRANSIENT = 0.2
 """Relative difference of the mean ground speeds on the two sides of a gap above which the body is
 taken to be speeding up or slowing down, and the count comes from the step phase
@@ -424,6 +430,8 @@ def _step_period(speed: np.ndarray, lo: int, hi: int) -> tuple[int | None, float
     holds two of it: at a longer lag the correlation rests on a few pairs of frames and comes out
     near 1 by chance (a 2 s side of a 120 fps walk once gave a "period" of 152 frames from 9 pairs).
     """
+    if len(speed) < 2 * lo:  # not two of even the shortest period (an empty side, say)
+        return None, -1.0
     x = speed - speed.mean()
     best, lag_best = -1.0, None
     for lag in range(lo, min(hi, len(x) // 2) + 1):  # a loop over lags, not frames
@@ -530,7 +538,8 @@ def _phase_missing(pose: np.ndarray, t: int, start: int, stop: int, guess: float
     stride before it (frame ``j``: then ``n ≡ j − t − 1``, mod ``P``) and the last frame before the
     gap to the first stride after it (frame ``j'``: ``n ≡ t − j'``). The two residues, where both
     exist, must agree within a tenth of a stride, else ``None``; ``n`` is the residue plus the whole
-    number of strides that brings it nearest to ``guess``.
+    number of strides that brings it nearest to ``guess``, and ``None`` where that says no frame
+    is missing (below one half), which a detected gap contradicts.
     """
     far = int(round(3.0 * fps))
     before, after = pose[max(start, t - far) : t + 1], pose[t + 1 : min(stop + 1, t + 1 + far)]
@@ -549,7 +558,8 @@ def _phase_missing(pose: np.ndarray, t: int, start: int, stop: int, guess: float
     if len(x) == 2 and abs((x[0] - x[1] + 0.5 * period) % period - 0.5 * period) > 0.1 * period:
         return None
     x = float(np.angle(np.mean(np.exp(2j * np.pi * x / period)))) * period / (2.0 * np.pi)
-    return x + round((guess - x) / period) * period
+    n = x + round((guess - x) / period) * period
+    return n if n >= 0.5 else None  # "nothing missing" contradicts the gap: the phase cannot tell
 
 
 def estimate_missing(motion: Motion, steps_at, seconds: float = 1.0, takes=None) -> list[int]:
@@ -597,6 +607,11 @@ def estimate_missing(motion: Motion, steps_at, seconds: float = 1.0, takes=None)
 
     When the body does not travel (speed below ``STEP_FLOOR``), ``n + 1`` is the joint step across
     the gap over the median joint step around it. Always at least 1.
+
+    **Held frames** (a step that moves no joint by ``HELD`` of the body height: exact copies, as in
+    a clip padded with its last pose) are no motion: the known frames around a gap end at the
+    nearest held step on each side, so a held side adds no zero speed to the count. What such a
+    stream lost of the held pose itself no count can say; the count is of the moving frames.
 
     **Other recordings of the action** (``takes``, a :class:`~.recorded.RecordedTakes` of *other*
     takes, never this one): how long the recorded takes need from the pose before the gap to the
@@ -674,6 +689,7 @@ def count_choice(motion: Motion, t: int, start: int = 0, stop: int | None = None
 
 
 def _choose(a: _Arrays, t: int, start: int, stop: int, seconds: float) -> CountChoice:
+    start, stop = _moving_bounds(a, t, start, stop)
     n, arc = _stride_count(a, t, start, stop, seconds)
     if arc is None:  # the body does not travel: the joint-step ratio, nothing to rehearse
         return CountChoice(n, None, 0, 0, 1.0, n)
@@ -686,13 +702,23 @@ def _choose(a: _Arrays, t: int, start: int, stop: int, seconds: float) -> CountC
     return CountChoice(n, local, stride_only, local_only, p, count)
 
 
+def _moving_bounds(a: _Arrays, t: int, start: int, stop: int) -> tuple[int, int]:
+    """The known steps ``start … stop`` around step ``t`` cut short at the nearest held step on
+    each side (``HELD``): copies of one frame are not motion the counts can read."""
+    held = np.flatnonzero(a.jsteps <= a.held)
+    lower, upper = held[held < t], held[held > t]
+    start = max(start, int(lower[-1]) + 1) if lower.size else start
+    stop = min(stop, int(upper[0])) if upper.size else stop
+    return start, stop
+
+
 @dataclass
 class _Arrays:
     """What the counts read off a stream, per frame: the reference joint's ground point ``ground``
     (T, 3), the ground distance ``gstep`` (T-1,) and RMS joint step ``jsteps`` (T-1,) of each step,
     heading-frame body poses ``pose`` (T, 3K, :func:`_body_pose`), world joint positions
-    ``positions`` (T, J, 3), the frame rate and the slowest travelling speed ``floor`` (metres per
-    frame)."""
+    ``positions`` (T, J, 3), the frame rate, the slowest travelling speed ``floor`` (metres per
+    frame) and the RMS joint step ``held`` at or below which a step repeats its frame (``HELD``)."""
 
     ground: np.ndarray
     gstep: np.ndarray
@@ -701,24 +727,26 @@ class _Arrays:
     positions: np.ndarray
     fps: float
     floor: float
+    held: float
 
     @classmethod
     def of(cls, motion: Motion) -> _Arrays:
         g_rot, g_pos = motion.fk()
         j = reference_joint(motion)
         ground = g_pos[:, j] * np.array([1.0, 0.0, 1.0])
-        floor = STEP_FLOOR * body_height(motion) / motion.fps
-        return cls._from(ground, g_pos, _pose_of(motion, g_rot, g_pos, j), motion.fps, floor)
+        height = body_height(motion)
+        floor = STEP_FLOOR * height / motion.fps
+        return cls._from(ground, g_pos, _pose_of(motion, g_rot, g_pos, j), motion.fps, floor, HELD * height)
 
     @classmethod
-    def _from(cls, ground, positions, pose, fps, floor) -> _Arrays:
+    def _from(cls, ground, positions, pose, fps, floor, held) -> _Arrays:
         gstep = np.linalg.norm(np.diff(ground, axis=0), axis=-1)
         jsteps = np.sqrt(np.mean(np.sum(np.diff(positions, axis=0) ** 2, axis=-1), axis=-1))
-        return cls(ground, gstep, jsteps, pose, positions, float(fps), float(floor))
+        return cls(ground, gstep, jsteps, pose, positions, float(fps), float(floor), float(held))
 
     def without(self, keep: np.ndarray) -> _Arrays:
         """The stream of frames ``keep`` (indices) only."""
-        return _Arrays._from(self.ground[keep], self.positions[keep], self.pose[keep], self.fps, self.floor)
+        return _Arrays._from(self.ground[keep], self.positions[keep], self.pose[keep], self.fps, self.floor, self.held)
 
 
 def _stride_count(a: _Arrays, t: int, start: int, stop: int, seconds: float) -> tuple[float, float | None]:

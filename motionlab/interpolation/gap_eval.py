@@ -5,7 +5,10 @@ A clean clip has its frames ``start … start+n-1`` cut out; the shortened strea
 :func:`.gaps.fill` with SLERP rotations and, by default, the stride-continued root) and is compared with the clip:
 
 * **detection**: was the step ``start-1 → start`` flagged, and was anything else flagged;
-* **count**: the estimated missing count against ``n`` (within 10% or one frame is the goal);
+* **count**: the estimated missing count against ``n`` (within 10% or one frame is the goal), and
+  against the *countable* frames: those of the ``n`` that are not exact copies of a frame kept
+  beside the gap (a clip padded with its last pose, :data:`.detect.HELD`, loses frames there that
+  nothing in the stream can count);
 * **root**: the reference joint's path over the gap, the filled one resampled at the true frames'
   fractions of the gap (the counts may differ), mean distance to the true path, relative to the
   true displacement across the gap;
@@ -26,7 +29,7 @@ from motionlab.core.motion import Motion
 from motionlab.interpolation import detect, gaps
 from motionlab.interpolation.alignment import reference_joint, reference_transform
 
-__all__ = ["CutResult", "cut", "evaluate_cut", "summary", "detection_counts"]
+__all__ = ["CutResult", "cut", "countable", "evaluate_cut", "summary", "detection_counts"]
 
 
 @dataclass
@@ -39,6 +42,8 @@ class CutResult:
     n, start : int
     hit : bool                  the gap's step was flagged
     false : int                 other steps flagged
+    countable : int             the removed frames that are not copies of a kept frame beside
+                                the gap (:func:`countable`; ``n`` but in held poses)
     estimate : int or None      missing count (None when the gap was not found)
     root_rel : float or None    mean root error over the gap / true displacement
     below : float or None       lowest filled foot below the clip's floor, metres (>= 0)
@@ -51,6 +56,7 @@ class CutResult:
     start: int
     hit: bool
     false: int
+    countable: int
     estimate: int | None = None
     root_rel: float | None = None
     below: float | None = None
@@ -58,7 +64,14 @@ class CutResult:
 
     @property
     def count_ok(self) -> bool:
+        """The count is within 10% (or one frame) of the frames removed."""
         return self.estimate is not None and abs(self.estimate - self.n) <= max(1.0, 0.1 * self.n)
+
+    @property
+    def countable_ok(self) -> bool:
+        """The count is within 10% (or one frame) of the countable frames removed."""
+        m = self.countable
+        return self.estimate is not None and abs(self.estimate - m) <= max(1.0, 0.1 * m)
 
 
 def cut(motion: Motion, start: int, n: int) -> Motion:
@@ -66,6 +79,20 @@ def cut(motion: Motion, start: int, n: int) -> Motion:
     if not (start >= 1 and start + n < motion.num_frames and n >= 1):
         raise ValueError(f"cannot cut {n} frames at {start} from a {motion.num_frames}-frame motion")
     return motion[np.r_[0:start, start + n : motion.num_frames]]
+
+
+def countable(motion: Motion, start: int, n: int) -> int:
+    """How many of the frames ``start … start+n-1`` of ``motion`` are not exact copies of frame
+    ``start-1`` or ``start+n`` (the frames kept beside the cut): copies differ by at most
+    :data:`.detect.HELD` of the body height (RMS over the joints), as held poses do. A stream
+    cut there cannot show how many copies it lost."""
+    pos = motion.global_positions()
+    held = detect.HELD * detect.body_height(motion)
+    inside = pos[start : start + n]
+    copy = np.zeros(n, dtype=bool)
+    for kept in (pos[start - 1], pos[start + n]):  # the two frames beside the cut
+        copy |= np.sqrt(np.mean(np.sum((inside - kept) ** 2, axis=-1), axis=-1)) <= held
+    return int(n - copy.sum())
 
 
 def detection_counts(motion: Motion, find, removed, rng: np.random.Generator, margin: int = 20) -> tuple[int, int, int]:
@@ -107,7 +134,7 @@ def evaluate_cut(
         found = detect.detect(stream, graph=graph, takes=takes)
     steps = [t for t, _ in found]
     hit = (start - 1) in steps
-    res = CutResult(motion.name, n, start, hit, len(steps) - int(hit))
+    res = CutResult(motion.name, n, start, hit, len(steps) - int(hit), countable(motion, start, n))
     if not hit:
         return res
     est = dict(found)[start - 1]
@@ -148,6 +175,7 @@ def summary(results: list[CutResult]) -> dict:
         "precision": tp / max(tp + fp, 1),
         "recall": tp / max(len(results), 1),
         "count_ok": float(np.mean([r.count_ok for r in counted])) if counted else 0.0,
+        "countable_ok": float(np.mean([r.countable_ok for r in counted])) if counted else 0.0,
         "root_rel_mean": float(rel.mean()) if rel.size else float("nan"),
         "root_rel_max": float(rel.max()) if rel.size else float("nan"),
         "below_max": float(below.max()) if below.size else float("nan"),

@@ -209,3 +209,48 @@ def test_changes_speed_is_a_relative_difference_of_the_two_sides():
     assert detect.changes_speed(1.0, 1.25) and detect.changes_speed(1.25, 1.0)
     assert not detect.changes_speed(1.0, 1.2) and not detect.changes_speed(0.0, 0.0)
     assert detect.changes_speed(0.0, 0.5)  # a start from standing
+
+
+def _padded_walk(moving: int, held: int) -> Motion:
+    """The toy walk for ``moving`` frames, then ``held`` exact copies of its last frame (as Mixamo
+    pads a clip to 60 frames with its last pose)."""
+    m = toy_motion(moving)
+    return m[np.r_[0:moving, np.full(held, moving - 1)]]
+
+
+def test_held_frames_are_not_read_as_a_stop():
+    """Frames 28 … 37 cut from a walk of 35 frames padded to 65 with copies of frame 34: six frames
+    of motion are missing (28 … 33; 34 … 37 are copies of the kept frame 38). The held side
+    carries no speed, so the count reads the walk before the gap only; averaged with the held
+    side's zero speed, as it was, the count came out about twice as long (the walk is shorter
+    than the two strides a step phase would need)."""
+    m = _padded_walk(35, 30)
+    s, n = 28, 10
+    cut = m[np.r_[0:s, s + n : m.num_frames]]
+    assert detect.consecutive_gaps(cut) == [s - 1]
+    assert abs(detect.estimate_missing(cut, [s - 1])[0] - 6) <= 1
+    c = detect.count_choice(cut, s - 1)
+    assert c.local is None and c.stride_only == c.local_only == 0  # no known frames after the gap
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(detect, "HELD", -1.0)  # no step counts as held
+        assert detect.estimate_missing(cut, [s - 1])[0] >= 10
+
+
+@pytest.mark.realdata
+def test_real_clip_padded_with_its_last_pose_is_counted_by_its_motion():
+    """Mixamo's ``Run_Arc_Left`` (60 fps) runs for 33 frames and holds frame 32 to the end. Cut
+    frames 26 … 35: six frames of running are missing (26 … 31) and four copies of the held pose."""
+    m = bvh.load(require_data("mixamo", "Aj", "Run_Arc_Left.bvh"))
+    s, n = 26, 10
+    cut = m[np.r_[0:s, s + n : m.num_frames]]
+    assert detect.detect(cut) == [(s - 1, pytest.approx(6, abs=1))]
+
+
+def test_a_phase_that_says_nothing_is_missing_is_no_count():
+    """On the uncut toy walk the pose after step t is the next one: the step phase finds no frame
+    missing (modulo a stride), which a detected gap contradicts, so it gives no count."""
+    m = toy_motion(240)
+    pose = detect._body_pose(m)
+    assert detect._phase_missing(pose, 120, 0, 239, 5.0, m.fps) is None
+    cut = pose[np.r_[0:121, 126:240]]  # five frames missing after frame 120
+    assert detect._phase_missing(cut, 120, 0, 234, 5.0, m.fps) == pytest.approx(5.0, abs=0.5)

@@ -1,5 +1,6 @@
 """Cut, detect, fill, compare: the measurement behind scripts/check_gaps.py."""
 
+import numpy as np
 import pytest
 
 from motionlab.interpolation import gap_eval
@@ -51,3 +52,13 @@ def test_counts_given_are_the_counts_filled():
     assert gap_eval.evaluate_cut(m, 60, 12, found=[(59, detected.estimate)]) == detected
     other = gap_eval.evaluate_cut(m, 60, 12, found=[(59, 20)])
     assert other.estimate == 20 and not other.count_ok and other.root_rel != detected.root_rel
+
+
+def test_countable_leaves_out_copies_of_the_kept_frames():
+    """The toy walk moves for 60 frames, then holds frame 59 for 30 (known construction)."""
+    padded = toy_motion(60)[np.r_[0:60, np.full(30, 59)]]
+    assert gap_eval.countable(padded, 20, 10) == 10  # all moving
+    assert gap_eval.countable(padded, 55, 10) == 4  # 55 … 58 move; 59 … 64 are copies of frame 65
+    assert gap_eval.countable(padded, 70, 10) == 0  # inside the hold
+    r = gap_eval.evaluate_cut(padded, 55, 10)
+    assert r.countable == 4 and r.countable_ok and not r.count_ok
