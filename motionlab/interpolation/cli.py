@@ -5,6 +5,7 @@ Examples::
     motionlab fill-gaps take.bvh -o take_filled.bvh
     motionlab fill-gaps take.bvh -o out.bvh --method hermite --delta 3
     motionlab fill-gaps take_007.bvh -o out.bvh --takes take_001.bvh --takes take_002.bvh
+    motionlab fill-gaps take.bvh -o out.bvh --times take_times.txt
     motionlab fill-gaps take.bvh -o out.bvh --method graph \\
         --action run=Running.bvh --action walk=Walk.bvh --action stand=Idle.bvh \\
         --allow "run -> walk" --allow "walk -> stand"
@@ -19,6 +20,9 @@ default the whole body continues the recorded strides on both sides across the g
 (:mod:`motionlab.interpolation.stride`); where the motion does not repeat, SLERP with the root
 given by ``--root`` (``stride``: the strides' root path where one side repeats, else ``hermite``,
 a Hermite curve with the velocities on both sides; ``linear``: the LaFAN1 baseline).
+Where the capture logged each frame's time, ``--times FILE`` (one time in seconds per frame,
+:func:`motionlab.interpolation.gaps.load_times`) gives the gaps and their counts exactly
+(:func:`~motionlab.interpolation.gaps.timestamp_gaps`): no rule, no estimate.
 A clean clip (nothing found) is copied byte for byte. A report lists every gap and how it was
 filled.
 """
@@ -57,6 +61,9 @@ def register(subparsers) -> None:
     p.add_argument("--takes", action="append", default=[], metavar="FILE.bvh",
                    help="another recording of the stream's action (repeat; never the input itself): the missing "
                    "count also reads how long these take from the pose before a gap to the pose after it")  # fmt: skip
+    p.add_argument("--times", metavar="FILE", default=None,
+                   help="the frames' capture times, one per line in seconds: the gaps and their counts are "
+                   "read from them (exact), not detected or estimated")  # fmt: skip
     p.add_argument("--force", action="store_true", help="overwrite the output file if it exists")
     p.set_defaults(func=run_fill_gaps)
 
@@ -148,16 +155,26 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
         motion = bvh.load(src)
     except bvh.BVHError as e:
         raise CLIError(str(e)) from None
+    if args.times is not None and (args.takes or delta is not None):
+        raise CLIError("--times gives the gaps and their counts; --takes and --delta would not be used")
     graph = _graph(args.action, args.allow) if args.method == "graph" else None
     takes = _takes(args.takes, src) if args.takes else None
     try:
-        missing = detect.detect(motion, graph=graph, delta=delta, takes=takes)
+        if args.times is not None:
+            missing = gaps.timestamp_gaps(gaps.load_times(args.times, motion.num_frames), motion.fps)
+        else:
+            missing = detect.detect(motion, graph=graph, delta=delta, takes=takes)
+    except OSError as e:
+        raise CLIError(f"--times: {e}") from None
     except ValueError as e:
         raise CLIError(str(e)) from None
     print(f"{src}: {motion.num_frames} frames at {motion.fps:g} fps")
+    nothing = (
+        f"no dropped frames in the times of {args.times}" if args.times else "no dropped frames found (D > Δ nowhere)"
+    )
     if not missing:
         _copy(src, dst)
-        print("no dropped frames found (D > Δ nowhere); wrote an unchanged copy")
+        print(f"{nothing}; wrote an unchanged copy")
         print(f"wrote {dst} ({motion.num_frames} frames)")
         return 0
     expanded, _ = gaps.insert_missing(motion, missing)
@@ -167,7 +184,7 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
         raise CLIError(str(e)) from None
     bvh.save(dst, filled, overwrite=args.force)
     if not report:
-        print("no dropped frames found (D > Δ nowhere); wrote an unchanged copy")
+        print(f"{nothing}; wrote an unchanged copy")
     else:
         total = sum(r.stop - r.start for r in report)
         print(f"filled {len(report)} gap(s), {total} frame(s) in all (method: {args.method}):")

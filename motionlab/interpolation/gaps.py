@@ -56,6 +56,7 @@ __all__ = [
     "ROOTS",
     "FilledGap",
     "nan_gaps",
+    "load_times",
     "timestamp_gaps",
     "insert_missing",
     "fill",
@@ -112,8 +113,44 @@ def _motion_nan_gaps(motion: Motion) -> list[tuple[int, int]]:
     return nan_gaps(np.concatenate(parts, axis=1))
 
 
+def load_times(path, frames: int | None = None) -> np.ndarray:
+    """The frames' capture times (seconds) from a text file: one number per line, blank lines and
+    lines starting with ``#`` skipped (as a capture system's frame log, or a column cut from one).
+
+    Raises ``ValueError`` naming the file and the line: a line that is not one finite number, a
+    time not after the one before it, or (``frames`` given) a count of times other than ``frames``.
+
+    Returns
+    -------
+    ndarray, shape (T,), seconds, strictly increasing
+    """
+    times, lines = [], []
+    with open(path, encoding="utf-8") as fh:
+        for k, line in enumerate(fh, start=1):
+            text = line.strip()
+            if not text or text.startswith("#"):
+                continue
+            try:
+                value = float(text)
+            except ValueError:
+                value = float("nan")
+            if not np.isfinite(value):
+                raise ValueError(f"{path} line {k}: expected one time in seconds, found {text[:40]!r}")
+            if times and value <= times[-1]:
+                raise ValueError(
+                    f"{path} line {k}: {value:g} s is not after {times[-1]:g} s (line {lines[-1]}); "
+                    "frame times must increase"
+                )
+            times.append(value)
+            lines.append(k)
+    if frames is not None and len(times) != frames:
+        raise ValueError(f"{path}: {len(times)} frame times for {frames} frames; expected one time per frame")
+    return np.asarray(times, dtype=np.float64)
+
+
 def timestamp_gaps(times, fps: float) -> list[tuple[int, int]]:
-    """Where frames are missing from timestamps (seconds): ``(after frame i, missing count)``."""
+    """Where frames are missing from timestamps (seconds): ``(after frame i, missing count)``, the
+    count being the frame periods ``1/fps`` between two times, rounded, less one."""
     t = np.asarray(times, dtype=np.float64)
     if t.ndim != 1 or not np.all(np.diff(t) > 0):
         raise ValueError("expected strictly increasing timestamps (T,) in seconds")

@@ -1,5 +1,7 @@
 """``motionlab fill-gaps``: fills dropped frames, reports them, never overwrites without --force."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -91,3 +93,46 @@ def test_fill_gaps_with_other_takes(dropped, tmp_path, capsys):
     assert "the input itself" in capsys.readouterr().err
     assert main(["fill-gaps", str(dropped), "-o", str(out), "--force", "--takes", str(tmp_path / "no.bvh")]) == 2
     assert "no such file" in capsys.readouterr().err
+
+
+def _times_file(path, times, header="# frame times (s)"):
+    path.write_text(header + "\n" + "\n".join(f"{t:.6f}" for t in times) + "\n")
+    return path
+
+
+def test_fill_gaps_reads_the_counts_from_frame_times(dropped, tmp_path, capsys):
+    """``dropped`` is the toy walk (30 fps) without frames 50 … 57: its capture times say so exactly."""
+    keep = np.r_[0:50, 58:120]
+    times = _times_file(tmp_path / "times.txt", 0.25 + keep / 30.0)  # a clock that does not start at 0
+    out = tmp_path / "out.bvh"
+    assert main(["fill-gaps", str(dropped), "-o", str(out), "--times", str(times)]) == 0
+    assert "filled 1 gap(s), 8 frame(s)" in capsys.readouterr().out
+    assert bvh.load(out).num_frames == 120
+    clean = tmp_path / "clean.bvh"
+    bvh.save(clean, toy_motion(40))
+    regular = _times_file(tmp_path / "regular.txt", np.arange(40) / 30.0)
+    copy = tmp_path / "copy.bvh"
+    assert main(["fill-gaps", str(clean), "-o", str(copy), "--times", str(regular)]) == 0
+    assert "no dropped frames in the times of" in capsys.readouterr().out
+    assert copy.read_bytes() == clean.read_bytes()
+
+
+def test_fill_gaps_refuses_frame_times_that_do_not_fit(dropped, tmp_path, capsys):
+    out = tmp_path / "out.bvh"
+    keep = np.r_[0:50, 58:120]
+    cases = {
+        "short.txt": (keep[:-1] / 30.0, r"short.txt: 111 frame times for 112 frames"),
+        "word.txt": (list(keep[:2] / 30.0) + ["abc"], r"word.txt line 4: expected one time in seconds, found 'abc'"),
+        "back.txt": ([0.0, 0.1, 0.05], r"back.txt line 4: 0.05 s is not after 0.1 s \(line 3\)"),
+    }
+    for name, (times, message) in cases.items():
+        path = tmp_path / name
+        path.write_text("# times\n" + "\n".join(str(t) for t in times) + "\n")
+        assert main(["fill-gaps", str(dropped), "-o", str(out), "--times", str(path)]) == 2
+        assert re.search(message, capsys.readouterr().err), name
+        assert not out.exists()
+    assert main(["fill-gaps", str(dropped), "-o", str(out), "--times", str(tmp_path / "none.txt")]) == 2
+    assert "--times" in capsys.readouterr().err
+    times = _times_file(tmp_path / "t.txt", keep / 30.0)
+    assert main(["fill-gaps", str(dropped), "-o", str(out), "--times", str(times), "--takes", str(dropped)]) == 2
+    assert "--times gives the gaps" in capsys.readouterr().err

@@ -29,6 +29,14 @@ def test_nan_and_timestamp_gaps():
     assert gaps.timestamp_gaps(times, 30) == [(2, 2), (4, 1)]
 
 
+def test_frame_times_file_skips_blank_lines_and_comments(tmp_path):
+    path = tmp_path / "times.txt"
+    path.write_text("# capture log\n0.000\n\n0.0333\n  0.1000  \n# dropped two\n0.1333\n")
+    t = gaps.load_times(path, frames=4)
+    np.testing.assert_allclose(t, [0.0, 0.0333, 0.1, 0.1333])
+    assert gaps.timestamp_gaps(t, 30) == [(1, 1)]  # 0.0333 -> 0.1000: two periods, one frame missing
+
+
 def test_fill_rows_linear_and_edges():
     x = np.arange(10.0)[:, None] * np.array([[1.0, -2.0]])
     broken = x.copy()
