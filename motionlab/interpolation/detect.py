@@ -129,7 +129,7 @@ HELD = 1e-6
 """A step that moves no joint by more than this fraction of the body height (RMS) repeats its
 frame exactly: a held pose, as in Mixamo clips padded to 60 frames with copies of their last
 pose. Held frames carry no speed and no timing, so the counts read nothing from them
-(:func:`count_choice`): 1e-6 of a body height is a micrometre, far below any capture's noise."""
+(:func:`count_choice`): 1e-6 of a body height is one or two micrometres, far below any capture's noise."""
 
 TRANSIENT = 0.2
 """Relative difference of the mean ground speeds on the two sides of a gap above which the body is
