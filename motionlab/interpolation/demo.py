@@ -12,6 +12,7 @@ import numpy as np
 
 from motionlab import data
 from motionlab.core.motion import Motion
+from motionlab.interpolation import detect
 
 __all__ = [
     "BEHAVIOUR_CLIPS",
@@ -39,12 +40,10 @@ _SYNTHETIC = {"run": "run", "walk": "walk", "stand": "idle", "squat": "squat"}
 
 
 def trim_frozen(motion: Motion) -> Motion:
-    """``motion`` without the trailing frames that repeat the frame before them exactly (some Mixamo
-    exports pad a clip with a frozen pose: ``Run_Arc_Left`` stops moving after 33 of its 60 frames)."""
-    same = (motion.local_rot[1:] == motion.local_rot[:-1]).all(axis=(1, 2)) & (
-        motion.root_pos[1:] == motion.root_pos[:-1]
-    ).all(axis=1)
-    moving = np.flatnonzero(~same)
+    """``motion`` without the trailing frames that repeat the frame before them
+    (:func:`.detect.held_steps`: some Mixamo exports pad a clip with its last pose; ``Run_Arc_Left``
+    stops moving after 33 of its 60 frames)."""
+    moving = np.flatnonzero(~detect.held_steps(motion))
     last = int(moving[-1]) + 2 if moving.size else 1
     return motion[: max(last, 2)] if last < motion.num_frames else motion
 

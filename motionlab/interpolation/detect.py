@@ -85,6 +85,8 @@ __all__ = [
     "WINDOW",
     "TRANSIENT",
     "changes_speed",
+    "HELD",
+    "held_steps",
     "TRACK_CONTEXT",
     "TRACK_RATES",
     "check_delta",
@@ -128,7 +130,8 @@ test at this level (the cuts that one count gets right and the other wrong; the 
 HELD = 1e-6
 """A step that moves no joint by more than this fraction of the body height (RMS) repeats its
 frame exactly: a held pose, as in Mixamo clips padded to 60 frames with copies of their last
-pose. Held frames carry no speed and no timing, so the counts read nothing from them
+pose (:func:`held_steps`; :func:`.demo.trim_frozen` trims such a tail off the action clips).
+Held frames carry no speed and no timing, so the counts read nothing from them
 (:func:`count_choice`): 1e-6 of a body height is one or two micrometres, far below any capture's noise."""
 
 TRANSIENT = 0.2
@@ -169,6 +172,11 @@ def _positions(motion: Motion) -> np.ndarray:
     return motion.global_positions()  # (T, J, 3)
 
 
+def _rms_steps(positions: np.ndarray) -> np.ndarray:
+    """RMS over joints of each step's displacement, (T, J, 3) → (T-1,)."""
+    return np.sqrt(np.mean(np.sum(np.diff(positions, axis=0) ** 2, axis=-1), axis=-1))
+
+
 def joint_steps(motion: Motion) -> np.ndarray:
     """RMS over joints of each joint's world displacement from frame ``t`` to ``t+1``.
 
@@ -176,8 +184,12 @@ def joint_steps(motion: Motion) -> np.ndarray:
     -------
     ndarray, shape (T-1,), metres per stream step
     """
-    pos = _positions(motion)
-    return np.sqrt(np.mean(np.sum(np.diff(pos, axis=0) ** 2, axis=-1), axis=-1))
+    return _rms_steps(_positions(motion))
+
+
+def held_steps(motion: Motion) -> np.ndarray:
+    """Which steps ``t → t+1`` repeat their frame (``HELD``): (T-1,) bool."""
+    return joint_steps(motion) <= HELD * body_height(motion)
 
 
 def _side_medians(steps: np.ndarray, window: int) -> tuple[np.ndarray, np.ndarray]:
@@ -741,8 +753,7 @@ class _Arrays:
     @classmethod
     def _from(cls, ground, positions, pose, fps, floor, held) -> _Arrays:
         gstep = np.linalg.norm(np.diff(ground, axis=0), axis=-1)
-        jsteps = np.sqrt(np.mean(np.sum(np.diff(positions, axis=0) ** 2, axis=-1), axis=-1))
-        return cls(ground, gstep, jsteps, pose, positions, float(fps), float(floor), float(held))
+        return cls(ground, gstep, _rms_steps(positions), pose, positions, float(fps), float(floor), float(held))
 
     def without(self, keep: np.ndarray) -> _Arrays:
         """The stream of frames ``keep`` (indices) only."""

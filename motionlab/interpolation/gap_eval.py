@@ -76,9 +76,16 @@ class CutResult:
 
 def cut(motion: Motion, start: int, n: int) -> Motion:
     """``motion`` without frames ``start … start+n-1`` (at least one frame kept on each side)."""
-    if not (start >= 1 and start + n < motion.num_frames and n >= 1):
-        raise ValueError(f"cannot cut {n} frames at {start} from a {motion.num_frames}-frame motion")
+    _check_cut(motion, start, n)
     return motion[np.r_[0:start, start + n : motion.num_frames]]
+
+
+def _check_cut(motion: Motion, start: int, n: int) -> None:
+    if not (start >= 1 and start + n < motion.num_frames and n >= 1):
+        raise ValueError(
+            f"cannot cut {n} frames at {start} from {motion.name!r}, a {motion.num_frames}-frame motion "
+            "(at least one frame must be kept on each side)"
+        )
 
 
 def countable(motion: Motion, start: int, n: int) -> int:
@@ -86,6 +93,7 @@ def countable(motion: Motion, start: int, n: int) -> int:
     ``start-1`` or ``start+n`` (the frames kept beside the cut): copies differ by at most
     :data:`.detect.HELD` of the body height (RMS over the joints), as held poses do. A stream
     cut there cannot show how many copies it lost."""
+    _check_cut(motion, start, n)
     pos = motion.global_positions()
     held = detect.HELD * detect.body_height(motion)
     inside = pos[start : start + n]

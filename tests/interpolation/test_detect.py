@@ -5,7 +5,7 @@ import pytest
 
 from motionlab.core import bvh
 from motionlab.core.motion import Motion
-from motionlab.interpolation import detect, gaps
+from motionlab.interpolation import demo, detect, gaps
 from motionlab.interpolation.action_graph import ActionGraph
 from motionlab.interpolation.alignment import reference_joint, reference_transform
 from tests.conftest import require_data
@@ -254,3 +254,11 @@ def test_a_phase_that_says_nothing_is_missing_is_no_count():
     assert detect._phase_missing(pose, 120, 0, 239, 5.0, m.fps) is None
     cut = pose[np.r_[0:121, 126:240]]  # five frames missing after frame 120
     assert detect._phase_missing(cut, 120, 0, 234, 5.0, m.fps) == pytest.approx(5.0, abs=0.5)
+
+
+def test_held_steps_mark_the_copies_and_trim_frozen_cuts_them_off():
+    m = _padded_walk(35, 30)  # frames 35 … 64 repeat frame 34
+    held = detect.held_steps(m)
+    assert not held[:34].any() and held[34:].all()
+    assert demo.trim_frozen(m).num_frames == 35
+    assert demo.trim_frozen(toy_motion(40)).num_frames == 40  # nothing held: unchanged

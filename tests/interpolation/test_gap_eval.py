@@ -62,3 +62,7 @@ def test_countable_leaves_out_copies_of_the_kept_frames():
     assert gap_eval.countable(padded, 70, 10) == 0  # inside the hold
     r = gap_eval.evaluate_cut(padded, 55, 10)
     assert r.countable == 4 and r.countable_ok and not r.count_ok
+
+    for start, n in ((0, 10), (85, 10), (20, 0)):  # no kept frame before / after, nothing cut
+        with pytest.raises(ValueError, match=r"cannot cut .* from 'toy', a 90-frame motion"):
+            gap_eval.countable(padded, start, n)
