@@ -262,6 +262,18 @@ fixed, and committed, before the session-23 changes to the count (held frames, t
 from the poses) were tried, and scored once after they were chosen on parts 2, 5 and 6."""
 
 
+def source_cuts(root: Path, rng, cuts: int, patterns: list[str]):
+    """``(motion, first removed frame, frames removed)`` for the clips matching ``patterns``:
+    ``cuts`` seeded places per clip and count of ``REMOVED`` (parts 5–7; the places drawn from
+    ``rng`` in this order)."""
+    for f in sorted({f for p in patterns for f in root.glob(p)}):
+        m = bvh.load(f)
+        for n in REMOVED:
+            if m.num_frames - n - 20 <= 20:
+                continue
+            yield from ((m, int(s), n) for s in rng.integers(20, m.num_frames - n - 20, cuts))
+
+
 def other_sources(root: Path, rng, cuts: int = 4, sources: dict | None = None, label: str = "") -> None:
     """The walks and runs of ``sources`` (default ``OTHER_SOURCES``), ``cuts`` seeded cuts of 10,
     20 and 30 frames per clip: detection, missing count (stream alone: no other takes of these
@@ -269,15 +281,7 @@ def other_sources(root: Path, rng, cuts: int = 4, sources: dict | None = None, l
     print(label or f"5. held-out sources (seen since session 20), {cuts} cuts of 10/20/30 frames per clip:")
     for name, patterns in (OTHER_SOURCES if sources is None else sources).items():
         files = sorted({f for p in patterns for f in root.glob(p)})
-        results = []
-        for f in files:
-            m = bvh.load(f)
-            for n in REMOVED:
-                if m.num_frames - n - 20 <= 20:
-                    continue
-                results.extend(
-                    gap_eval.evaluate_cut(m, int(s), n) for s in rng.integers(20, m.num_frames - n - 20, cuts)
-                )
+        results = [gap_eval.evaluate_cut(m, s, n) for m, s, n in source_cuts(root, rng, cuts, patterns)]
         if not results:
             continue
         s = gap_eval.summary(results)

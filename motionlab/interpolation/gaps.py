@@ -47,6 +47,7 @@ from motionlab.interpolation.alignment import apply as apply_rigid
 from motionlab.interpolation.alignment import estimate as estimate_rigid
 from motionlab.interpolation.alignment import reference_joint, reference_transform
 from motionlab.interpolation.features import pose_features
+from motionlab.interpolation.footing import plant_feet
 from motionlab.interpolation.library import MotionLibrary
 from motionlab.interpolation.slerp import alphas
 from motionlab.interpolation.stride import side_speeds, stride_fill, stride_path
@@ -452,6 +453,13 @@ def lift_above_floor(motion: Motion, a: int, b: int) -> Motion:
     return out
 
 
+def _feet_on_floor(motion: Motion, a: int, b: int) -> Motion:
+    """Frames ``a+1 … b-1`` with every foot that went below the floor raised onto it by bending its
+    leg (:func:`.footing.plant_feet`), and the body lifted by whatever the legs could not reach
+    (:func:`lift_above_floor`)."""
+    return lift_above_floor(plant_feet(motion, a, b), a, b)
+
+
 def smooth_root(motion: Motion, anchors, joint: int | None = None) -> Motion:
     """A copy of ``motion`` whose root path through ``anchors`` is C1 (no corners).
 
@@ -615,7 +623,7 @@ def fill(
         if method == "stride":
             strided = stride_fill(out, a, b, ref)
             if strided is not None:
-                out = lift_above_floor(_follow_strides(strided[0], a, b, ref, strided[1]), a, b)
+                out = _feet_on_floor(_follow_strides(strided[0], a, b, ref, strided[1]), a, b)
                 report.append(FilledGap(start, stop, "stride"))
                 continue
         if method in ("slerp", "hermite", "stride"):  # stride: SLERP where no stride is found
@@ -626,7 +634,7 @@ def fill(
                 out = _stride_root(out, a, b, ref)
             elif root == "hermite":
                 out = smooth_root(out, [a, b], joint=ref)
-            out = lift_above_floor(out, a, b)
+            out = _feet_on_floor(out, a, b)
             report.append(FilledGap(start, stop, "slerp" if method == "stride" else method))
             continue
         node_a = graph.classify(_frame_features(out, a, before=True)[None])[0]
@@ -662,6 +670,6 @@ def fill(
             if not ok:
                 out = inbetween.fill_between(out, lo + 1, hi, curve=curve)
                 used = "graph+slerp"
-        out = lift_above_floor(smooth_root(out, anchors, joint=ref), a, b)
+        out = _feet_on_floor(smooth_root(out, anchors, joint=ref), a, b)
         report.append(FilledGap(start, stop, "graph" if inner else used, path, slots))
     return out, report

@@ -1,0 +1,102 @@
+"""Feet kept out of the floor across a filled gap by bending the legs, not by lifting the body.
+
+SLERP between the two poses bounding a gap turns each leg joint at a constant rate, and half-way
+the leg is longer, top to bottom, than either end pose holds it: the stance foot sinks into the
+floor (measured on the Bandai Namco walks: up to 7 cm). :func:`.gaps.lift_above_floor` lifts the
+whole body out by that depth, which keeps the feet dry but makes the hips hop: on the slow
+``dataset-1`` ``proud`` walk cut by 10 frames at 211 the hips rose 4.5 cm where the walker's rose
+0.5 cm, 11.6% of the root's displacement across the gap.
+
+:func:`plant_feet` instead moves each foot that went below the floor straight up by its depth,
+rigidly (the ankle's world rotation kept, so the toes follow), and bends that leg to reach it:
+the hip → knee → ankle chain is solved in closed form (:func:`motionlab.synthetic.ik.two_bone`,
+the knee bending the way it already bends), the hip and knee joints turned by the shortest
+rotations that carry the old bones onto the new ones, and the ankle's local rotation set so that
+its world rotation is what it was. Where a leg cannot reach (folded as far as it goes), what is
+left is lifted by :func:`.gaps.lift_above_floor` as before.
+
+The floor is the one :func:`.gaps.lift_above_floor` uses: the lower of the lowest joints (the root
+left out) of the two known frames ``a`` and ``b``. The legs are found by the humanoid rig mapping
+(:func:`motionlab.core.humanoid.find_mapping`); a rig it does not map has its body lifted only.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from motionlab.core import humanoid, quat
+from motionlab.core.motion import Motion
+from motionlab.core.skeleton import Skeleton
+from motionlab.synthetic.ik import two_bone
+
+__all__ = ["legs", "plant_feet"]
+
+_SIDES = (("LeftUpLeg", "LeftLeg", "LeftFoot"), ("RightUpLeg", "RightLeg", "RightFoot"))
+
+
+def legs(skeleton: Skeleton) -> list[tuple[int, int, int]]:
+    """The ``(hip, knee, ankle)`` joint indices of each leg of a humanoid rig (left, right), or
+    ``[]`` where :func:`~motionlab.core.humanoid.find_mapping` does not map the rig."""
+    try:
+        mapping = humanoid.find_mapping(skeleton)
+    except humanoid.RigMappingError:
+        return []
+    out = []
+    for names in _SIDES:
+        hip, knee, ankle = (mapping.source[humanoid.JOINTS.index(n)] for n in names)
+        if min(hip, knee, ankle) >= 0:
+            out.append((int(hip), int(knee), int(ankle)))
+    return out
+
+
+def _floor(motion: Motion, a: int, b: int) -> float:
+    """The lower of the lowest joints (the root left out) of frames ``a`` and ``b``."""
+    height = motion[np.array([a, b])].global_positions()[..., 1]  # (2, J)
+    return float((height[:, 1:] if height.shape[1] > 1 else height).min())
+
+
+def plant_feet(motion: Motion, a: int, b: int) -> Motion:
+    """A copy of ``motion`` whose frames ``a+1 … b-1`` have every foot that went below the floor
+    raised onto it by bending its leg (module docstring); other frames untouched.
+
+    Parameters
+    ----------
+    motion : Motion whose frames ``a`` and ``b`` are known and ``a+1 … b-1`` filled (no NaN)
+    a, b : int, the known frames bounding the gap
+
+    Returns
+    -------
+    Motion, a copy; the same values where no foot is below the floor
+    """
+    out = motion.copy()
+    chains = legs(motion.skeleton)
+    if b - a < 2 or not chains:
+        return out
+    floor = _floor(motion, a, b)
+    frames = np.arange(a + 1, b)
+    parents = motion.skeleton.parents
+    for hip, knee, ankle in chains:  # two legs: a loop over legs, each vectorised over frames
+        g_rot, g_pos = out[frames].fk()  # (F, J, 4), (F, J, 3)
+        foot = motion.skeleton.subtree(ankle)
+        depth = np.maximum(0.0, floor - g_pos[:, foot, 1].min(axis=1))  # (F,)
+        sink = np.flatnonzero(depth > 0.0)
+        if not sink.size:
+            continue
+        g_rot, g_pos = g_rot[sink], g_pos[sink]
+        h, k, f = g_pos[:, hip], g_pos[:, knee], g_pos[:, ankle]  # (S, 3)
+        target = f + depth[sink, None] * np.array([0.0, 1.0, 0.0])
+        pole = k - 0.5 * (h + f)  # the way the knee bends now
+        new_k, new_f = two_bone(h, target, np.linalg.norm(k - h, axis=1), np.linalg.norm(f - k, axis=1), pole)
+        turn_hip = quat.between(k - h, new_k - h)  # (S, 4), world frame
+        turn_knee = quat.between(quat.rotate(turn_hip, f - k), new_f - new_k)
+        new_hip = quat.mul(turn_hip, g_rot[:, hip])
+        # every joint from the hip down to the knee's parent turns with the hip, and from the knee
+        # down to the ankle's parent with both
+        knee_parent = quat.mul(turn_hip, g_rot[:, parents[knee]])
+        new_knee = quat.mul(turn_knee, quat.mul(turn_hip, g_rot[:, knee]))
+        ankle_parent = quat.mul(turn_knee, quat.mul(turn_hip, g_rot[:, parents[ankle]]))
+        rows = frames[sink]
+        out.local_rot[rows, hip] = quat.normalize(quat.mul(quat.inv(g_rot[:, parents[hip]]), new_hip))
+        out.local_rot[rows, knee] = quat.normalize(quat.mul(quat.inv(knee_parent), new_knee))
+        out.local_rot[rows, ankle] = quat.normalize(quat.mul(quat.inv(ankle_parent), g_rot[:, ankle]))
+    return out

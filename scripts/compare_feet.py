@@ -1,0 +1,107 @@
+"""A foot that a fill swings into the floor: the body lifted out, or the leg bent (README,
+*Key-pose interpolation and gap filling*).
+
+    MOTIONLAB_DATA=/path/to/shared/data python scripts/compare_feet.py [--every 90] [--quick]
+
+Two ways to keep filled frames out of the floor, each on the *same* counts (the detection runs once
+per cut) and the same fill otherwise:
+
+* **body lifted** (the fill until session 24): every filled frame raised by how far its lowest
+  joint went below the floor (``gaps.lift_above_floor``);
+* **leg bent** (what ``gaps.fill`` does): each sunk foot moved up onto the floor by bending its
+  leg (:func:`motionlab.interpolation.footing.plant_feet`), the body lifted only by what the legs
+  cannot reach.
+
+Cuts of 10, 20 and 30 frames: the CHOOSE and VALIDATE cases of ``scripts/check_gaps.py`` part 2
+(same seed) with every walk take of ``bandai_namco/sessions/walk`` cut every ``EVERY`` frames
+(as ``scripts/compare_stride_root.py`` makes them), and the cuts of parts 5, 6 and 7 (same seeds).
+Prints, per set and rule, the mean and worst root error over the gap relative to the true
+displacement, the cuts above 10%, the lowest filled foot below the clip's floor and the mean joint
+error about the root.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from contextlib import contextmanager
+from pathlib import Path
+
+import check_gaps
+import numpy as np
+from compare_stride_root import cases
+from tqdm.auto import tqdm
+
+from motionlab.core import bvh
+from motionlab.interpolation import detect, gap_eval, gaps
+
+RULES = ("body lifted", "leg bent")
+
+
+@contextmanager
+def body_lifted():
+    """``gaps.fill`` keeping feet out of the floor by lifting the body only."""
+    keep = gaps._feet_on_floor
+    gaps._feet_on_floor = gaps.lift_above_floor
+    try:
+        yield
+    finally:
+        gaps._feet_on_floor = keep
+
+
+def score(motion, s: int, n: int) -> list[gap_eval.CutResult] | None:
+    """Each rule's result on one cut (``RULES`` order), or ``None`` when the gap is not found."""
+    found = detect.detect(gap_eval.cut(motion, s, n))
+    if (s - 1) not in dict(found):
+        return None
+    with body_lifted():
+        lifted = gap_eval.evaluate_cut(motion, s, n, found=found)
+    return [lifted, gap_eval.evaluate_cut(motion, s, n, found=found)]
+
+
+def all_cuts(root: Path, every: int, quick: bool) -> dict[str, list]:
+    """(motion loader, first removed frame, frames removed) per set."""
+    out = {name: [(f, s, n) for f, s, n in cuts] for name, cuts in cases(root, every, quick).items()}
+    parts = (("part 5", 5, check_gaps.OTHER_SOURCES), ("part 6", 7, check_gaps.FRESH_SOURCES),
+             ("part 7", 11, check_gaps.UNSCORED_SOURCES))  # fmt: skip
+    for name, seed, sources in parts:  # check_gaps.py main(): one generator per part
+        rng = np.random.default_rng(seed)
+        out[name] = [cut for patterns in sources.values()
+                     for cut in check_gaps.source_cuts(root, rng, 1 if quick else 4, patterns)]  # fmt: skip
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--every", type=int, default=90, help="a cut every EVERY frames of every walk take (default 90)")
+    ap.add_argument("--quick", action="store_true", help="a sixth of the Bandai Namco clips, one cut per held-out clip")
+    args = ap.parse_args(argv)
+    if not os.environ.get("MOTIONLAB_DATA"):
+        sys.exit("set MOTIONLAB_DATA to the shared data folder (e.g. export MOTIONLAB_DATA=/path/to/shared/data)")
+    root = Path(os.environ["MOTIONLAB_DATA"])
+    t0 = time.perf_counter()
+    for name, cuts in all_cuts(root, args.every, args.quick).items():
+        rows, loaded = [], {}
+        for clip, s, n in tqdm(cuts, desc=name, mininterval=5):
+            if isinstance(clip, Path):  # parts 2 and 4 name files; parts 5-7 give loaded motions
+                if clip not in loaded:
+                    loaded = {clip: bvh.load(clip)}
+                clip = loaded[clip]
+            row = score(clip, s, n)
+            if row is not None:
+                rows.append(row)
+        print(f"{name}: {len(rows)} cuts found of {len(cuts)}; root error over the gap / true displacement")
+        for k, rule in enumerate(RULES):
+            rel = np.array([r[k].root_rel for r in rows])
+            below = 1000 * max(r[k].below for r in rows)
+            pose = np.mean([r[k].pose_cm for r in rows])
+            print(f"   {rule:12s} mean {rel.mean():6.2%}, worst {rel.max():6.2%}, above 10%: {int((rel > 0.1).sum()):3d}; "
+                  f"lowest foot below the floor {below:.1f} mm; joints about the root {pose:.2f} cm off")  # fmt: skip
+    print(f"total time {time.perf_counter() - t0:.1f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

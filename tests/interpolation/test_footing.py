@@ -1,0 +1,91 @@
+"""Feet kept out of the floor by bending the legs (motionlab.interpolation.footing)."""
+
+import numpy as np
+import pytest
+
+from motionlab.core import bvh, quat
+from motionlab.interpolation import footing, gap_eval, gaps, inbetween
+from tests.conftest import require_data
+from tests.interpolation.conftest import toy_motion
+
+
+def _slerp_gap(m, a, b):
+    """``m`` with frames ``a+1 … b-1`` replaced by SLERP and a linear root (no floor handling)."""
+    broken = m.copy()
+    broken.local_rot[a + 1 : b] = np.nan
+    broken.root_pos[a + 1 : b] = np.nan
+    if broken.local_pos is not None:
+        broken.local_pos[a + 1 : b] = np.nan
+    return inbetween.fill_between(broken, a + 1, b, root="linear")
+
+
+def _lowest_foot(m, legs):
+    """The lowest joint of either foot (the ankles and everything below them), per frame."""
+    feet = np.zeros(m.skeleton.num_joints, dtype=bool)
+    for _, _, ankle in legs:
+        feet |= m.skeleton.subtree(ankle)
+    return m.global_positions()[:, feet, 1].min(axis=1)
+
+
+def test_a_rig_without_legs_is_left_alone():
+    m = toy_motion(40)  # joints named LUp, LLow, ...: no humanoid mapping
+    assert footing.legs(m.skeleton) == []
+    out = footing.plant_feet(m, 10, 20)
+    np.testing.assert_array_equal(out.local_rot, m.local_rot)
+    np.testing.assert_array_equal(out.root_pos, m.root_pos)
+
+
+@pytest.mark.realdata
+def test_sunk_feet_are_raised_onto_the_floor_by_the_legs_alone(real_walk):
+    m = real_walk
+    legs = footing.legs(m.skeleton)
+    assert len(legs) == 2 and all(m.skeleton.names[h].endswith("_L") for h, _, _ in legs[:1])
+    # a gap where SLERP sinks a foot into the floor
+    for a in range(60, m.num_frames - 40, 7):
+        b = a + 16
+        filled = _slerp_gap(m, a, b)
+        floor = footing._floor(filled, a, b)
+        if _lowest_foot(filled[a + 1 : b], legs).min() < floor - 0.01:
+            break
+    else:
+        pytest.fail("no 15-frame SLERP gap of the walk sank a foot by a centimetre")
+    out = footing.plant_feet(filled, a, b)
+    inside = slice(a + 1, b)
+    assert _lowest_foot(out[inside], legs).min() >= floor - 1e-9  # on the floor, not in it
+    np.testing.assert_array_equal(out.root_pos, filled.root_pos)  # the hips are not lifted
+    leg_joints = {j for leg in legs for j in leg}
+    others = [j for j in range(m.skeleton.num_joints) if j not in leg_joints]
+    np.testing.assert_array_equal(out.local_rot[:, others], filled.local_rot[:, others])
+    np.testing.assert_array_equal(out.local_rot[: a + 1], filled.local_rot[: a + 1])
+    np.testing.assert_array_equal(out.local_rot[b:], filled.local_rot[b:])
+    g_new, p_new = out[inside].fk()
+    g_old, p_old = filled[inside].fk()
+    ankles = [ankle for _, _, ankle in legs]
+    # each foot moved rigidly: its world rotation kept, its joints all moved straight up by one amount
+    np.testing.assert_allclose(np.abs(np.sum(g_new[:, ankles] * g_old[:, ankles], axis=-1)), 1.0, atol=1e-9)
+    for ankle in ankles:
+        foot = m.skeleton.subtree(ankle)
+        shift = p_new[:, foot] - p_old[:, foot]
+        np.testing.assert_allclose(shift[..., [0, 2]], 0.0, atol=1e-9)
+        np.testing.assert_allclose(shift[..., 1], shift[:, :1, 1].repeat(foot.sum(), axis=1), atol=1e-9)
+        assert np.all(shift[..., 1] >= -1e-12)
+    par = m.skeleton.parents
+    bones = np.arange(1, m.skeleton.num_joints)
+    np.testing.assert_allclose(np.linalg.norm(p_new[:, bones] - p_new[:, par[bones]], axis=-1),
+                               np.linalg.norm(p_old[:, bones] - p_old[:, par[bones]], axis=-1), atol=1e-9)  # fmt: skip
+    assert np.all(np.isclose(np.linalg.norm(out.local_rot, axis=-1), 1.0))
+    assert not np.allclose(quat.canonical(out.local_rot[inside]), quat.canonical(filled.local_rot[inside]))
+
+
+@pytest.mark.realdata
+def test_a_slow_walk_gap_keeps_the_hips_level_instead_of_hopping(monkeypatch):
+    """Bandai Namco's ``dataset-1`` ``proud`` walk is too slow for a stride to be read on 3 s sides,
+    so a 10-frame gap at 211 is filled by SLERP; the stance foot sank 4 cm there, and lifting the
+    body out made the hips rise 4.5 cm where the walker's rose 0.5 cm (11.6% of the root's
+    displacement across the gap). Bending the leg keeps the hips on their path."""
+    m = bvh.load(require_data("bandai_namco", "dataset-1", "walk", "dataset-1_walk_proud_001.bvh"))
+    bent = gap_eval.evaluate_cut(m, 211, 10, found=[(210, 10)])
+    assert bent.below == 0.0 and bent.root_rel < 0.05
+    monkeypatch.setattr(gaps, "_feet_on_floor", gaps.lift_above_floor)  # the body lifted instead
+    lifted = gap_eval.evaluate_cut(m, 211, 10, found=[(210, 10)])
+    assert lifted.below == 0.0 and lifted.root_rel > 0.10
