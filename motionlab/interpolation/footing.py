@@ -8,12 +8,12 @@ whole body out by that depth, which keeps the feet dry but makes the hips hop: o
 0.5 cm, 11.6% of the root's displacement across the gap.
 
 :func:`plant_feet` instead moves each foot that went below the floor straight up by its depth,
-rigidly (the ankle's world rotation kept, so the toes follow), and bends that leg to reach it:
-the hip → knee → ankle chain is solved in closed form (:func:`motionlab.synthetic.ik.two_bone`,
-the knee bending the way it already bends), the hip and knee joints turned by the shortest
-rotations that carry the old bones onto the new ones, and the ankle's local rotation set so that
-its world rotation is what it was. Where a leg cannot reach (folded as far as it goes), what is
-left is lifted by :func:`.gaps.lift_above_floor` as before.
+rigidly (the ankle's world rotation kept, so the toes follow), and bends that leg to reach it: the
+hip → knee → ankle chain is solved in closed form (:func:`motionlab.synthetic.ik.two_bone`), the
+knee bending the way it already bends (towards the toes where the leg is held straight), the hip
+and knee joints turned by the shortest rotations that carry the old bones onto the new ones, and
+the ankle's local rotation set so that its world rotation is what it was. Where a leg cannot reach
+(folded as far as it goes), what is left is lifted by :func:`.gaps.lift_above_floor` as before.
 
 The floor is the one :func:`.gaps.lift_above_floor` uses: the lower of the lowest joints (the root
 left out) of the two known frames ``a`` and ``b``. The legs are found by the humanoid rig mapping
@@ -85,7 +85,13 @@ def plant_feet(motion: Motion, a: int, b: int) -> Motion:
         g_rot, g_pos = g_rot[sink], g_pos[sink]
         h, k, f = g_pos[:, hip], g_pos[:, knee], g_pos[:, ankle]  # (S, 3)
         target = f + depth[sink, None] * np.array([0.0, 1.0, 0.0])
-        pole = k - 0.5 * (h + f)  # the way the knee bends now
+        along = (f - h) / np.linalg.norm(f - h, axis=1, keepdims=True)
+        pole = (k - h) - np.sum((k - h) * along, axis=1, keepdims=True) * along  # the knee's bend now,
+        # off the hip-ankle line; a leg held straight bends towards the toes
+        toes = g_pos[:, foot] - f[:, None]  # (S, n, 3): the foot's joints from the ankle
+        toe = toes[np.arange(len(sink)), np.argmax(np.linalg.norm(toes, axis=-1), axis=1)]
+        straight = np.linalg.norm(pole, axis=1) < 0.01 * np.linalg.norm(k - h, axis=1)
+        pole[straight] = toe[straight]
         new_k, new_f = two_bone(h, target, np.linalg.norm(k - h, axis=1), np.linalg.norm(f - k, axis=1), pole)
         turn_hip = quat.between(k - h, new_k - h)  # (S, 4), world frame
         turn_knee = quat.between(quat.rotate(turn_hip, f - k), new_f - new_k)

@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from motionlab.core import bvh, quat
+from motionlab.core import bvh, humanoid, quat
+from motionlab.core.motion import Motion
 from motionlab.interpolation import footing, gap_eval, gaps, inbetween
 from tests.conftest import require_data
 from tests.interpolation.conftest import toy_motion
@@ -89,3 +90,26 @@ def test_a_slow_walk_gap_keeps_the_hips_level_instead_of_hopping(monkeypatch):
     monkeypatch.setattr(gaps, "_feet_on_floor", gaps.lift_above_floor)  # the body lifted instead
     lifted = gap_eval.evaluate_cut(m, 211, 10, found=[(210, 10)])
     assert lifted.below == 0.0 and lifted.root_rel > 0.10
+
+
+def test_a_straight_leg_bends_its_knee_towards_the_toes():
+    """Straight legs (the canonical rest pose) give the knee no bend to keep: turned to face +X and
+    lowered 5 cm into the floor, the body's legs fold forward, where the toes point, not sideways,
+    and the feet end on the floor."""
+    sk = humanoid.canonical_skeleton()
+    root = np.tile([0.0, 0.9, 0.0], (7, 1))
+    root[1:6, 1] -= 0.05  # frames 1-5 sink 5 cm
+    rot = np.tile([1.0, 0.0, 0.0, 0.0], (7, sk.num_joints, 1))
+    rot[:, 0] = quat.from_yaw(np.full(7, np.pi / 2))  # +Z (the toes in the rest pose) turned to +X
+    m = Motion(sk, rot, root, 30.0)
+    legs = footing.legs(sk)
+    out = footing.plant_feet(m, 0, 6)
+    floor = footing._floor(m, 0, 6)
+    np.testing.assert_allclose(_lowest_foot(out[1:6], legs), floor, atol=1e-9)
+    np.testing.assert_array_equal(out.root_pos, m.root_pos)
+    knees = [k for _, k, _ in legs]
+    moved = out.global_positions()[1:6, knees] - m.global_positions()[1:6, knees]
+    toes = m.global_positions()[0, [sk.names.index("LeftToeBase")]] - m.global_positions()[0, [legs[0][2]]]
+    assert toes[0, 0] > 0.1 and abs(toes[0, 2]) < 1e-9  # the toes point along +X
+    assert np.all(moved[..., 0] > 0.05)  # the knees go forward, by centimetres
+    np.testing.assert_allclose(moved[..., 2], 0.0, atol=1e-9)  # not sideways
