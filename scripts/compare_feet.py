@@ -62,8 +62,9 @@ def score(motion, s: int, n: int) -> list[gap_eval.CutResult] | None:
 
 
 def all_cuts(root: Path, every: int, quick: bool) -> dict[str, list]:
-    """(motion loader, first removed frame, frames removed) per set."""
-    out = {name: [(f, s, n) for f, s, n in cuts] for name, cuts in cases(root, every, quick).items()}
+    """(file or loaded motion, first removed frame, frames removed) per set: files for CHOOSE and
+    VALIDATE (loaded one at a time), motions for parts 5-7 (as ``check_gaps.source_cuts`` gives them)."""
+    out = dict(cases(root, every, quick))
     parts = (("part 5", 5, check_gaps.OTHER_SOURCES), ("part 6", 7, check_gaps.FRESH_SOURCES),
              ("part 7", 11, check_gaps.UNSCORED_SOURCES))  # fmt: skip
     for name, seed, sources in parts:  # check_gaps.py main(): one generator per part
