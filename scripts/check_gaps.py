@@ -317,6 +317,13 @@ def graph_tracking(root: Path, quick: bool, rng) -> None:
     print(f"   {cases} cases with 10/20/30 frames removed: precision {tp / max(tp + fp, 1):.3f}, recall {tp / max(cases, 1):.3f}")  # fmt: skip
 
 
+def data_root() -> Path:
+    """The shared data folder ``$MOTIONLAB_DATA``; exits with how to set it when it is not set."""
+    if not os.environ.get("MOTIONLAB_DATA"):
+        sys.exit("set MOTIONLAB_DATA to the shared data folder (e.g. export MOTIONLAB_DATA=/path/to/shared/data)")
+    return Path(os.environ["MOTIONLAB_DATA"])
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="a sixth of the clips (for CI-sized runs)")
@@ -325,9 +332,7 @@ def main(argv=None) -> int:
     ap.add_argument("--dense-takes", action="store_true",
                     help="in --dense, also the count with the other takes of the action (several more minutes)")  # fmt: skip
     args = ap.parse_args(argv)
-    if not os.environ.get("MOTIONLAB_DATA"):
-        sys.exit("set MOTIONLAB_DATA to the shared data folder (e.g. export MOTIONLAB_DATA=/path/to/shared/data)")
-    root = Path(os.environ["MOTIONLAB_DATA"])
+    root = data_root()
     t0 = time.perf_counter()
     false_gaps(root)
     print("2. frames removed from real walks and runs (detector and fill of `motionlab fill-gaps`):")

@@ -23,8 +23,6 @@ error about the root.
 from __future__ import annotations
 
 import argparse
-import os
-import sys
 import time
 from contextlib import contextmanager
 from pathlib import Path
@@ -79,9 +77,7 @@ def main(argv=None) -> int:
     ap.add_argument("--every", type=int, default=90, help="a cut every EVERY frames of every walk take (default 90)")
     ap.add_argument("--quick", action="store_true", help="a sixth of the Bandai Namco clips, one cut per held-out clip")
     args = ap.parse_args(argv)
-    if not os.environ.get("MOTIONLAB_DATA"):
-        sys.exit("set MOTIONLAB_DATA to the shared data folder (e.g. export MOTIONLAB_DATA=/path/to/shared/data)")
-    root = Path(os.environ["MOTIONLAB_DATA"])
+    root = check_gaps.data_root()
     t0 = time.perf_counter()
     for name, cuts in all_cuts(root, args.every, args.quick).items():
         rows, loaded = [], {}

@@ -24,8 +24,6 @@ mean and worst root error over the gap relative to the true displacement, and th
 from __future__ import annotations
 
 import argparse
-import os
-import sys
 import time
 from contextlib import contextmanager
 from pathlib import Path
@@ -100,9 +98,7 @@ def main(argv=None) -> int:
     ap.add_argument("--every", type=int, default=30, help="a cut every EVERY frames of every walk take (default 30)")
     ap.add_argument("--quick", action="store_true", help="a sixth of the clips")
     args = ap.parse_args(argv)
-    if not os.environ.get("MOTIONLAB_DATA"):
-        sys.exit("set MOTIONLAB_DATA to the shared data folder (e.g. export MOTIONLAB_DATA=/path/to/shared/data)")
-    root = Path(os.environ["MOTIONLAB_DATA"])
+    root = check_gaps.data_root()
     t0 = time.perf_counter()
     for name, cuts in cases(root, args.every, args.quick).items():
         errors, loaded = [], {}

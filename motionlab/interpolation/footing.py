@@ -29,7 +29,7 @@ from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
 from motionlab.synthetic.ik import two_bone
 
-__all__ = ["legs", "plant_feet"]
+__all__ = ["legs", "lowest_joints", "plant_feet"]
 
 _SIDES = (("LeftUpLeg", "LeftLeg", "LeftFoot"), ("RightUpLeg", "RightLeg", "RightFoot"))
 
@@ -49,10 +49,12 @@ def legs(skeleton: Skeleton) -> list[tuple[int, int, int]]:
     return out
 
 
-def _floor(motion: Motion, a: int, b: int) -> float:
-    """The lower of the lowest joints (the root left out) of frames ``a`` and ``b``."""
-    height = motion[np.array([a, b])].global_positions()[..., 1]  # (2, J)
-    return float((height[:, 1:] if height.shape[1] > 1 else height).min())
+def lowest_joints(motion: Motion, a: int, b: int) -> np.ndarray:
+    """Height (b−a+1,), metres, of the lowest joint of each frame ``a … b``, the root left out: in
+    rigs that carry the body with a hips channel (Bandai Namco) it is a marker lying on the floor,
+    not a foot. A gap's floor is the lower of the two ends, ``min(low[0], low[-1])``."""
+    height = motion[a : b + 1].global_positions()[..., 1]  # (b-a+1, J)
+    return (height[:, 1:] if height.shape[1] > 1 else height).min(axis=-1)
 
 
 def plant_feet(motion: Motion, a: int, b: int) -> Motion:
@@ -68,11 +70,20 @@ def plant_feet(motion: Motion, a: int, b: int) -> Motion:
     -------
     Motion, a copy; the same values where no foot is below the floor
     """
+    a, b = int(a), int(b)
+    if not 0 <= a < b < motion.num_frames:
+        raise ValueError(
+            f"clip {motion.name!r}: the known frames around a gap must satisfy 0 <= a < b < {motion.num_frames} "
+            f"(its frame count), got a={a}, b={b}"
+        )
+    if not (np.all(np.isfinite(motion.local_rot[a : b + 1])) and np.all(np.isfinite(motion.root_pos[a : b + 1]))):
+        raise ValueError(f"clip {motion.name!r}: frames {a} … {b} must be filled (no NaN) before the feet are planted")
     out = motion.copy()
     chains = legs(motion.skeleton)
     if b - a < 2 or not chains:
         return out
-    floor = _floor(motion, a, b)
+    low = lowest_joints(motion, a, b)
+    floor = min(low[0], low[-1])
     frames = np.arange(a + 1, b)
     parents = motion.skeleton.parents
     for hip, knee, ankle in chains:  # two legs: a loop over legs, each vectorised over frames

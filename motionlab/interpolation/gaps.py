@@ -47,7 +47,7 @@ from motionlab.interpolation.alignment import apply as apply_rigid
 from motionlab.interpolation.alignment import estimate as estimate_rigid
 from motionlab.interpolation.alignment import reference_joint, reference_transform
 from motionlab.interpolation.features import pose_features
-from motionlab.interpolation.footing import plant_feet
+from motionlab.interpolation.footing import lowest_joints, plant_feet
 from motionlab.interpolation.library import MotionLibrary
 from motionlab.interpolation.slerp import alphas
 from motionlab.interpolation.stride import side_speeds, stride_fill, stride_path
@@ -417,18 +417,15 @@ def _floor_guard(motion: Motion, a: int, b: int, drop: np.ndarray) -> np.ndarray
     foot goes through the floor: a frame whose lowest joint is at ``g`` in ``motion`` may end at
     ``min(g, floor)``, no lower, ``floor`` being the lower of the lowest joints of frames ``a`` and
     ``b``. A foot above the floor does not go through it; one already below does not sink further.
-    The root joint is left out: in rigs that carry the body with a hips channel (Bandai Namco) it
-    is a marker lying on the floor, not a foot.
+    The root joint is left out (:func:`.footing.lowest_joints`).
 
     The limit is per frame, so where it acts the path follows the fill's own height (which the
     recorded pose put on the floor) instead of the smooth curve: a floor contact outranks C1 there.
     A smooth alternative — lifting each piece by a C1 bump that vanishes at its anchors — had to
     lift whole pieces by up to 14 cm to cover millimetres of contact next to an anchor.
     """
-    height = motion[a : b + 1].global_positions()[..., 1]  # (F+2, J)
-    low = (height[:, 1:] if height.shape[1] > 1 else height).min(axis=-1)  # the root is never a foot
-    floor = min(low[0], low[-1])
-    return np.maximum(drop, np.minimum(0.0, floor - low[1:-1]))
+    low = lowest_joints(motion, a, b)
+    return np.maximum(drop, np.minimum(0.0, min(low[0], low[-1]) - low[1:-1]))
 
 
 def lift_above_floor(motion: Motion, a: int, b: int) -> Motion:
@@ -444,8 +441,7 @@ def lift_above_floor(motion: Motion, a: int, b: int) -> Motion:
     out = motion.copy()
     if b - a < 2:
         return out
-    height = motion[a : b + 1].global_positions()[..., 1]  # (F+2, J)
-    low = (height[:, 1:] if height.shape[1] > 1 else height).min(axis=-1)
+    low = lowest_joints(motion, a, b)
     lift = np.maximum(0.0, min(low[0], low[-1]) - low[1:-1])
     out.root_pos[a + 1 : b, 1] += lift
     if out.local_pos is not None:

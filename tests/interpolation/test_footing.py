@@ -40,12 +40,12 @@ def test_a_rig_without_legs_is_left_alone():
 def test_sunk_feet_are_raised_onto_the_floor_by_the_legs_alone(real_walk):
     m = real_walk
     legs = footing.legs(m.skeleton)
-    assert len(legs) == 2 and all(m.skeleton.names[h].endswith("_L") for h, _, _ in legs[:1])
+    assert [m.skeleton.names[h] for h, _, _ in legs] == ["UpperLeg_L", "UpperLeg_R"]
     # a gap where SLERP sinks a foot into the floor
     for a in range(60, m.num_frames - 40, 7):
         b = a + 16
         filled = _slerp_gap(m, a, b)
-        floor = footing._floor(filled, a, b)
+        floor = min(footing.lowest_joints(filled, a, b)[[0, -1]])
         if _lowest_foot(filled[a + 1 : b], legs).min() < floor - 0.01:
             break
     else:
@@ -104,7 +104,7 @@ def test_a_straight_leg_bends_its_knee_towards_the_toes():
     m = Motion(sk, rot, root, 30.0)
     legs = footing.legs(sk)
     out = footing.plant_feet(m, 0, 6)
-    floor = footing._floor(m, 0, 6)
+    floor = min(footing.lowest_joints(m, 0, 6)[[0, -1]])
     np.testing.assert_allclose(_lowest_foot(out[1:6], legs), floor, atol=1e-9)
     np.testing.assert_array_equal(out.root_pos, m.root_pos)
     knees = [k for _, k, _ in legs]
@@ -113,3 +113,13 @@ def test_a_straight_leg_bends_its_knee_towards_the_toes():
     assert toes[0, 0] > 0.1 and abs(toes[0, 2]) < 1e-9  # the toes point along +X
     assert np.all(moved[..., 0] > 0.05)  # the knees go forward, by centimetres
     np.testing.assert_allclose(moved[..., 2], 0.0, atol=1e-9)  # not sideways
+
+
+def test_plant_feet_refuses_gap_ends_outside_the_clip_or_unfilled_frames():
+    m = toy_motion(20)
+    with pytest.raises(ValueError, match=r"'toy'.*0 <= a < b < 20.*a=12, b=20"):
+        footing.plant_feet(m, 12, 20)
+    holed = m.copy()
+    holed.local_rot[5] = np.nan
+    with pytest.raises(ValueError, match=r"'toy'.*frames 3 … 8 must be filled"):
+        footing.plant_feet(holed, 3, 8)
