@@ -5,6 +5,7 @@ Examples::
     motionlab fill-gaps take.bvh -o take_filled.bvh
     motionlab fill-gaps take.bvh -o out.bvh --method hermite --delta 3
     motionlab fill-gaps take_007.bvh -o out.bvh --takes take_001.bvh --takes take_002.bvh
+    motionlab fill-gaps session/take_007.bvh -o out.bvh --takes session/
     motionlab fill-gaps take.bvh -o out.bvh --times take_times.txt
     motionlab fill-gaps take.bvh -o out.bvh --method graph \\
         --action run=Running.bvh --action walk=Walk.bvh --action stand=Idle.bvh \\
@@ -58,9 +59,10 @@ def register(subparsers) -> None:
                    help="an action node of the graph and a clip of it (repeat)")  # fmt: skip
     p.add_argument("--allow", action="append", default=[], metavar="'A -> B'",
                    help="an allowed transition (repeat; default: every pair of actions, both ways)")  # fmt: skip
-    p.add_argument("--takes", action="append", default=[], metavar="FILE.bvh",
-                   help="another recording of the stream's action (repeat; never the input itself): the missing "
-                   "count also reads how long these take from the pose before a gap to the pose after it")  # fmt: skip
+    p.add_argument("--takes", action="append", default=[], metavar="FILE.bvh|FOLDER",
+                   help="another recording of the stream's action, or a folder of them (repeat; the input itself "
+                   "is never used): the missing count also reads how long these take from the pose before a gap "
+                   "to the pose after it")  # fmt: skip
     p.add_argument("--times", metavar="FILE", default=None,
                    help="the frames' capture times, one per line in seconds: the gaps and their counts are "
                    "read from them (exact), not detected or estimated")  # fmt: skip
@@ -100,17 +102,26 @@ def _takes(paths: list[str], src: Path):
     from motionlab.core import bvh
     from motionlab.interpolation.recorded import RecordedTakes
 
-    clips = []
+    files = []
     for path in paths:
         p = Path(path)
+        if p.is_dir():  # a session's folder: every take in it but the input
+            found = [f for f in sorted(p.glob("*.bvh")) if f.resolve() != src.resolve()]
+            if not found:
+                raise CLIError(f"--takes {path}: a folder without BVH files (other than the input)")
+            files += found
+            continue
         if not p.is_file():
-            raise CLIError(f"--takes: no such file {path!r}")
+            raise CLIError(f"--takes: no such file or folder {path!r}")
         if p.resolve() == src.resolve():
             raise CLIError(f"--takes {path}: the input itself cannot be one of the other recordings")
+        files.append(p)
+    clips = []
+    for p in dict.fromkeys(f.resolve() for f in files):  # a take named twice (a file and its folder) counts once
         try:
             clips.append(bvh.load(p))
         except bvh.BVHError as e:
-            raise CLIError(f"--takes {path}: {e}") from None
+            raise CLIError(f"--takes {p}: {e}") from None
     try:
         return RecordedTakes(clips)
     except ValueError as e:

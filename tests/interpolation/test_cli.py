@@ -95,6 +95,43 @@ def test_fill_gaps_with_other_takes(dropped, tmp_path, capsys):
     assert "no such file" in capsys.readouterr().err
 
 
+def test_fill_gaps_takes_from_a_folder(dropped, tmp_path, capsys, monkeypatch):
+    """``--takes FOLDER`` reads every BVH file in it but the input, each once; the same result as
+    naming them."""
+    from motionlab.interpolation import recorded
+
+    seen = []
+
+    class Spy(recorded.RecordedTakes):
+        def __init__(self, motions, mirror=True):
+            seen.append(sorted(m.name for m in motions))
+            super().__init__(motions, mirror)
+
+    monkeypatch.setattr(recorded, "RecordedTakes", Spy)
+    session = tmp_path / "session"
+    session.mkdir()
+    for i, (phase, speed) in enumerate([(0.7, 1.1), (0.3, 0.9)]):
+        bvh.save(session / f"take_{i}.bvh", toy_motion(150, phase=phase, speed=speed))
+    stream = session / "stream.bvh"
+    stream.write_bytes(dropped.read_bytes())
+    by_folder, by_name = tmp_path / "a.bvh", tmp_path / "b.bvh"
+    assert main(["fill-gaps", str(stream), "-o", str(by_folder), "--takes", str(session)]) == 0
+    names = [a for f in sorted(session.glob("take_*.bvh")) for a in ("--takes", str(f))]
+    assert main(["fill-gaps", str(stream), "-o", str(by_name), *names, "--takes", str(session)]) == 0
+    assert by_folder.read_bytes() == by_name.read_bytes()
+    assert seen == [["take_0", "take_1"], ["take_0", "take_1"]]  # the input left out, no take twice
+    capsys.readouterr()
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    assert main(["fill-gaps", str(stream), "-o", str(tmp_path / "c.bvh"), "--takes", str(empty)]) == 2
+    assert "a folder without BVH files" in capsys.readouterr().err
+    alone = tmp_path / "alone"
+    alone.mkdir()
+    (alone / "stream.bvh").write_bytes(dropped.read_bytes())
+    assert main(["fill-gaps", str(alone / "stream.bvh"), "-o", str(tmp_path / "d.bvh"), "--takes", str(alone)]) == 2
+    assert "other than the input" in capsys.readouterr().err
+
+
 def _times_file(path, times, header="# frame times (s)"):
     path.write_text(header + "\n" + "\n".join(f"{t:.6f}" for t in times) + "\n")
     return path
