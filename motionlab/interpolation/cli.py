@@ -62,7 +62,7 @@ def register(subparsers) -> None:
     p.add_argument("--takes", action="append", default=[], metavar="FILE.bvh|FOLDER",
                    help="another recording of the stream's action, or a folder of them (repeat; the input itself "
                    "is never used): the missing count also reads how long these take from the pose before a gap "
-                   "to the pose after it")  # fmt: skip
+                   "to the pose after it; best with takes of the same session and style (README)")  # fmt: skip
     p.add_argument("--times", metavar="FILE", default=None,
                    help="the frames' capture times, one per line in seconds: the gaps and their counts are "
                    "read from them (exact), not detected or estimated")  # fmt: skip
