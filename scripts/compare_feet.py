@@ -29,10 +29,8 @@ from pathlib import Path
 
 import check_gaps
 import numpy as np
-from compare_stride_root import cases
-from tqdm.auto import tqdm
+from compare_stride_root import cases, scored
 
-from motionlab.core import bvh
 from motionlab.interpolation import detect, gap_eval, gaps
 
 RULES = ("body lifted", "leg bent")
@@ -80,15 +78,7 @@ def main(argv=None) -> int:
     root = check_gaps.data_root()
     t0 = time.perf_counter()
     for name, cuts in all_cuts(root, args.every, args.quick).items():
-        rows, loaded = [], {}
-        for clip, s, n in tqdm(cuts, desc=name, mininterval=5):
-            if isinstance(clip, Path):  # parts 2 and 4 name files; parts 5-7 give loaded motions
-                if clip not in loaded:
-                    loaded = {clip: bvh.load(clip)}
-                clip = loaded[clip]
-            row = score(clip, s, n)
-            if row is not None:
-                rows.append(row)
+        rows = scored(cuts, score, name)  # parts 2 and 4 name files; parts 5-7 give loaded motions
         print(f"{name}: {len(rows)} cuts found of {len(cuts)}; root error over the gap / true displacement")
         for k, rule in enumerate(RULES):
             rel = np.array([r[k].root_rel for r in rows])

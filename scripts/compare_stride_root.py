@@ -93,6 +93,21 @@ def score(motion, s: int, n: int) -> list[float] | None:
     return [plain, chosen, everywhere, hermite]
 
 
+def scored(cuts: list, score, desc: str) -> list:
+    """``score(motion, s, n)`` of every cut ``(file or loaded motion, s, n)`` whose gap was found
+    (not ``None``), files loaded one at a time (cuts of one file come together)."""
+    rows, loaded = [], {}
+    for clip, s, n in tqdm(cuts, desc=desc, mininterval=5):
+        if isinstance(clip, Path):
+            if clip not in loaded:
+                loaded = {clip: bvh.load(clip)}
+            clip = loaded[clip]
+        row = score(clip, s, n)
+        if row is not None:
+            rows.append(row)
+    return rows
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--every", type=int, default=30, help="a cut every EVERY frames of every walk take (default 30)")
@@ -101,14 +116,7 @@ def main(argv=None) -> int:
     root = check_gaps.data_root()
     t0 = time.perf_counter()
     for name, cuts in cases(root, args.every, args.quick).items():
-        errors, loaded = [], {}
-        for f, s, n in tqdm(cuts, desc=name, mininterval=5):
-            if f not in loaded:
-                loaded = {f: bvh.load(f)}
-            row = score(loaded[f], s, n)
-            if row is not None:
-                errors.append(row)
-        e = np.array(errors)
+        e = np.array(scored(cuts, score, name))
         print(f"{name}: {len(e)} cuts found of {len(cuts)}; root error over the gap / true displacement")
         for k, rule in enumerate(RULES):
             print(f"   {rule:46s} mean {e[:, k].mean():6.2%}, worst {e[:, k].max():6.2%}, "
