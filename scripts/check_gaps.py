@@ -310,6 +310,7 @@ def other_sources(root: Path, rng, cuts: int = 4, sources: dict | None = None, l
               f"recall {s['recall']:.3f}; count within 10% (or one frame) {ok} of {len(results)} "
               f"({ok / len(results):.0%}); root error / displacement mean {s['root_rel_mean']:.1%}, "
               f"worst {s['root_rel_max']:.1%}")  # fmt: skip
+        print(f"     worst root: {worst_root(results)}")
         if with_takes:
             print(f"     count with the source's other clips as --takes (leave one out): {sum(with_takes)} of "
                   f"{len(with_takes)} ({np.mean(with_takes):.0%})")  # fmt: skip
@@ -319,6 +320,14 @@ def other_sources(root: Path, rng, cuts: int = 4, sources: dict | None = None, l
             print(f"     {held} cuts took frames of a held pose (exact copies of a kept frame, which no stream "
                   f"can count): count within 10% (or one frame) of the countable frames {ok} of "
                   f"{len(results)} ({ok / len(results):.0%})")  # fmt: skip
+
+
+def worst_root(results: list) -> str:
+    """The cut whose root is farthest off relative to its displacement, in centimetres too: a large
+    share of a displacement of millimetres is a small error."""
+    r = max((r for r in results if r.root_rel is not None), key=lambda r: r.root_rel)
+    return (f"{r.name}@{r.start}, {r.n} frames cut: {100 * r.root_rel * r.displacement:.1f} cm off over a "
+            f"{100 * r.displacement:.1f} cm displacement ({r.root_rel:.1%})")  # fmt: skip
 
 
 def graph_tracking(root: Path, quick: bool, rng) -> None:

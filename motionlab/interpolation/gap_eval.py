@@ -46,6 +46,8 @@ class CutResult:
                                 the gap (:func:`countable`; ``n`` but in held poses)
     estimate : int or None      missing count (None when the gap was not found)
     root_rel : float or None    mean root error over the gap / true displacement
+    displacement : float or None  the true displacement across the gap, metres (the root error
+                                in metres is ``root_rel * displacement``)
     below : float or None       lowest filled foot below the clip's floor, metres (>= 0)
     pose_cm : float or None     mean joint position error about the reference joint, centimetres
                                 (the body's shape, the root error left out)
@@ -59,6 +61,7 @@ class CutResult:
     countable: int
     estimate: int | None = None
     root_rel: float | None = None
+    displacement: float | None = None
     below: float | None = None
     pose_cm: float | None = None
 
@@ -168,6 +171,7 @@ def evaluate_cut(
     true_body = true_pos[start : start + n] - truth[start : start + n, None, :]
     res.pose_cm = float(100.0 * np.linalg.norm(body - true_body, axis=-1).mean())
     res.estimate, res.root_rel, res.below = int(est), err / max(disp, 1e-9), below if below > 1e-9 else 0.0
+    res.displacement = disp
     return res
 
 

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from motionlab.interpolation import gap_eval
+from motionlab.interpolation.alignment import reference_joint, reference_transform
 
 from .conftest import toy_motion
 
@@ -13,6 +14,8 @@ def test_evaluate_cut_on_a_toy_walk():
     res = gap_eval.evaluate_cut(m, 60, 12)
     assert res.hit and res.false == 0 and res.count_ok
     assert 0.0 <= res.root_rel < 0.1 and res.below == 0.0
+    _, truth = reference_transform(m, joint=reference_joint(m))
+    assert res.displacement == pytest.approx(np.linalg.norm(truth[72] - truth[59]))  # frames 59 and 72 kept
     s = gap_eval.summary([res])
     assert s["precision"] == s["recall"] == 1.0
     with pytest.raises(ValueError, match="cannot cut"):
