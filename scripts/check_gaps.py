@@ -52,7 +52,7 @@ from pathlib import Path
 
 import numpy as np
 
-from motionlab.core import bvh
+from motionlab.core import bvh, humanoid
 from motionlab.interpolation import detect, gap_eval
 from motionlab.interpolation.action_graph import ActionGraph
 from motionlab.interpolation.recorded import RecordedTakes
@@ -297,9 +297,10 @@ def other_sources(root: Path, rng, cuts: int = 4, sources: dict | None = None, l
     for name, patterns in (OTHER_SOURCES if sources is None else sources).items():
         files = sorted({f for p in patterns for f in root.glob(p)})
         takes = RecordedTakes([bvh.load(f) for f in files]) if name in SAME_ACTION and len(files) > 1 else None
-        results, with_takes = [], []
+        results, with_takes, legs = [], [], []
         for m, s, n in source_cuts(root, rng, cuts, patterns):
             results.append(gap_eval.evaluate_cut(m, s, n))
+            legs.append(humanoid.leg_length(m.skeleton))
             if takes is not None:
                 with_takes.append(within(count_with_takes(m, s, n, takes.without(m.name)), n))
         if not results:
@@ -310,7 +311,7 @@ def other_sources(root: Path, rng, cuts: int = 4, sources: dict | None = None, l
               f"recall {s['recall']:.3f}; count within 10% (or one frame) {ok} of {len(results)} "
               f"({ok / len(results):.0%}); root error / displacement mean {s['root_rel_mean']:.1%}, "
               f"worst {s['root_rel_max']:.1%}")  # fmt: skip
-        print(f"     worst root: {worst_root(results)}")
+        print(f"     worst root: {worst_root(results, legs)}")
         if with_takes:
             print(f"     count with the source's other clips as --takes (leave one out): {sum(with_takes)} of "
                   f"{len(with_takes)} ({np.mean(with_takes):.0%})")  # fmt: skip
@@ -322,12 +323,16 @@ def other_sources(root: Path, rng, cuts: int = 4, sources: dict | None = None, l
                   f"{len(results)} ({ok / len(results):.0%})")  # fmt: skip
 
 
-def worst_root(results: list) -> str:
-    """The cut whose root is farthest off relative to its displacement, in centimetres too: a large
-    share of a displacement of millimetres is a small error."""
-    r = max((r for r in results if r.root_rel is not None), key=lambda r: r.root_rel)
-    return (f"{r.name}@{r.start}, {r.n} frames cut: {100 * r.root_rel * r.displacement:.1f} cm off over a "
-            f"{100 * r.displacement:.1f} cm displacement ({r.root_rel:.1%})")  # fmt: skip
+def worst_root(results: list, legs: list[float]) -> str:
+    """The cut whose root is farthest off relative to its displacement, also in centimetres as
+    loaded and in leg lengths (thigh + shin, ``legs``: one per result): a large share of a small
+    displacement is a small error. Leg lengths compare rigs whose files use other length units (the
+    Xia and CMU files load with legs of 14–15 "cm")."""
+    k = max((k for k, r in enumerate(results) if r.root_rel is not None), key=lambda k: results[k].root_rel)
+    r, leg = results[k], legs[k]
+    err = r.root_rel * r.displacement
+    return (f"{r.name}@{r.start}, {r.n} frames cut: {100 * err:.1f} cm off over a {100 * r.displacement:.1f} cm "
+            f"displacement ({r.root_rel:.1%}); in leg lengths {err / leg:.3f} over {r.displacement / leg:.3f}")  # fmt: skip
 
 
 def graph_tracking(root: Path, quick: bool, rng) -> None:
