@@ -328,7 +328,10 @@ def worst_root(results: list, legs: list[float]) -> str:
     loaded and in leg lengths (thigh + shin, ``legs``: one per result): a large share of a small
     displacement is a small error. Leg lengths compare rigs whose files use other length units (the
     Xia and CMU files load with legs of 14–15 "cm")."""
-    k = max((k for k, r in enumerate(results) if r.root_rel is not None), key=lambda k: results[k].root_rel)
+    scored = [k for k, r in enumerate(results) if r.root_rel is not None]
+    if not scored:
+        return "none (no gap found)"
+    k = max(scored, key=lambda k: results[k].root_rel)
     r, leg = results[k], legs[k]
     err = r.root_rel * r.displacement
     return (f"{r.name}@{r.start}, {r.n} frames cut: {100 * err:.1f} cm off over a {100 * r.displacement:.1f} cm "
