@@ -69,3 +69,33 @@ def test_countable_leaves_out_copies_of_the_kept_frames():
     for start, n in ((0, 10), (85, 10), (20, 0)):  # no kept frame before / after, nothing cut
         with pytest.raises(ValueError, match=r"cannot cut .* from 'toy', a 90-frame motion"):
             gap_eval.countable(padded, start, n)
+
+
+def test_retimed_gap_leaves_the_same_stream():
+    """Known construction: 12 frames replayed over 18 (slower) or 8 (faster); cut them, and the stream
+    is the one cut 12 frames from the clip, bit for bit, so a count read from it is the same."""
+    from motionlab.interpolation import detect, gaps
+
+    m = toy_motion(150)
+    stream = gap_eval.cut(m, 60, 12)
+    for k in (18, 8, 12):
+        other = gap_eval.retimed(m, 60, 12, k)
+        assert other.num_frames == 150 + k - 12
+        assert np.array_equal(other.local_rot[:60], m.local_rot[:60])
+        assert np.array_equal(other.root_pos[60 + k :], m.root_pos[72:])
+        assert np.allclose(other.root_pos[60 + k - 1], m.root_pos[71])  # the stretch ends where it did
+        cut = gap_eval.cut(other, 60, k)
+        assert np.array_equal(cut.local_rot, stream.local_rot) and np.array_equal(cut.root_pos, stream.root_pos)
+        assert detect.detect(cut) == detect.detect(stream)
+        # the frames' capture times tell the three apart
+        times = np.r_[0:60, 60 + k : other.num_frames] / other.fps
+        assert gaps.timestamp_gaps(times, other.fps) == [(59, k)]
+    # the toy walks at a constant pace: replayed over 18 frames, each step is 12/18 of one
+    _, p = reference_transform(m, joint=reference_joint(m))
+    _, q = reference_transform(gap_eval.retimed(m, 60, 12, 18), joint=reference_joint(m))
+    step, slow = np.linalg.norm(np.diff(p[59:72], axis=0), axis=1), np.linalg.norm(np.diff(q[59:78], axis=0), axis=1)
+    assert slow.mean() == pytest.approx(step.mean() * 12 / 18, rel=0.02)
+    with pytest.raises(ValueError, match="expected at least one frame"):
+        gap_eval.retimed(m, 60, 12, 0)
+    with pytest.raises(ValueError, match="cannot cut 20 frames at 140 from 'toy'"):
+        gap_eval.retimed(m, 140, 20, 30)
