@@ -17,7 +17,7 @@ Cuts of 10, 20 and 30 frames: the CHOOSE and VALIDATE cases of ``scripts/check_g
 (as ``scripts/compare_stride_root.py`` makes them), and the cuts of parts 5, 6 and 7 (same seeds).
 Prints, per set and rule, the mean and worst root error over the gap relative to the true
 displacement, the cuts above 10%, the lowest filled foot below the clip's floor and the mean joint
-error about the root.
+error about the root; and every cut whose gap the detection did not find, with its D/Δ.
 """
 
 from __future__ import annotations
@@ -78,8 +78,12 @@ def main(argv=None) -> int:
     root = check_gaps.data_root()
     t0 = time.perf_counter()
     for name, cuts in all_cuts(root, args.every, args.quick).items():
-        rows = scored(cuts, score, name)  # parts 2 and 4 name files; parts 5-7 give loaded motions
+        missed = []
+        rows = scored(cuts, score, name, missed)  # parts 2 and 4 name files; parts 5-7 give loaded motions
         print(f"{name}: {len(rows)} cuts found of {len(cuts)}; root error over the gap / true displacement")
+        for motion, s, n in missed:  # D/Δ of the step that hides the gap (detect.consecutive_ratio)
+            ratio = detect.consecutive_ratio(gap_eval.cut(motion, s, n))[0][s - 1] / detect.DELTA
+            print(f"   not found: {motion.name}@{s}, {n} frames cut (D/Δ {ratio:.2f})")
         for k, rule in enumerate(RULES):
             rel = np.array([r[k].root_rel for r in rows])
             below = 1000 * max(r[k].below for r in rows)

@@ -93,9 +93,10 @@ def score(motion, s: int, n: int) -> list[float] | None:
     return [plain, chosen, everywhere, hermite]
 
 
-def scored(cuts: list, score, desc: str) -> list:
+def scored(cuts: list, score, desc: str, missed: list | None = None) -> list:
     """``score(motion, s, n)`` of every cut ``(file or loaded motion, s, n)`` whose gap was found
-    (not ``None``), files loaded one at a time (cuts of one file come together)."""
+    (not ``None``), files loaded one at a time (cuts of one file come together); the cuts whose gap
+    was not found are appended to ``missed`` as ``(motion, s, n)`` if it is given."""
     rows, loaded = [], {}
     for clip, s, n in tqdm(cuts, desc=desc, mininterval=5):
         if isinstance(clip, Path):
@@ -105,6 +106,8 @@ def scored(cuts: list, score, desc: str) -> list:
         row = score(clip, s, n)
         if row is not None:
             rows.append(row)
+        elif missed is not None:
+            missed.append((clip, s, n))
     return rows
 
 
