@@ -29,7 +29,7 @@ from pathlib import Path
 
 import check_gaps
 import numpy as np
-from compare_stride_root import cases, scored
+from compare_stride_root import cases, print_missed, scored
 
 from motionlab.interpolation import detect, gap_eval, gaps
 
@@ -81,9 +81,7 @@ def main(argv=None) -> int:
         missed = []
         rows = scored(cuts, score, name, missed)  # parts 2 and 4 name files; parts 5-7 give loaded motions
         print(f"{name}: {len(rows)} cuts found of {len(cuts)}; root error over the gap / true displacement")
-        for motion, s, n in missed:  # D/Δ of the step that hides the gap (detect.consecutive_ratio)
-            ratio = detect.consecutive_ratio(gap_eval.cut(motion, s, n))[0][s - 1] / detect.DELTA
-            print(f"   not found: {motion.name}@{s}, {n} frames cut (D/Δ {ratio:.2f})")
+        print_missed(missed)
         for k, rule in enumerate(RULES):
             rel = np.array([r[k].root_rel for r in rows])
             below = 1000 * max(r[k].below for r in rows)

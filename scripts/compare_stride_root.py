@@ -111,6 +111,14 @@ def scored(cuts: list, score, desc: str, missed: list | None = None) -> list:
     return rows
 
 
+def print_missed(missed: list) -> None:
+    """One line per cut ``(motion, s, n)`` whose gap the detection did not find, with the D/Δ of the
+    step that hides it (:func:`motionlab.interpolation.detect.consecutive_ratio`)."""
+    for motion, s, n in missed:
+        ratio = detect.consecutive_ratio(gap_eval.cut(motion, s, n))[0][s - 1] / detect.DELTA
+        print(f"   not found: {motion.name}@{s}, {n} frames cut (D/Δ {ratio:.2f})")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--every", type=int, default=30, help="a cut every EVERY frames of every walk take (default 30)")
@@ -119,8 +127,10 @@ def main(argv=None) -> int:
     root = check_gaps.data_root()
     t0 = time.perf_counter()
     for name, cuts in cases(root, args.every, args.quick).items():
-        e = np.array(scored(cuts, score, name))
+        missed = []
+        e = np.array(scored(cuts, score, name, missed))
         print(f"{name}: {len(e)} cuts found of {len(cuts)}; root error over the gap / true displacement")
+        print_missed(missed)
         for k, rule in enumerate(RULES):
             print(f"   {rule:46s} mean {e[:, k].mean():6.2%}, worst {e[:, k].max():6.2%}, "
                   f"above 10%: {int((e[:, k] > 0.1).sum())}")  # fmt: skip

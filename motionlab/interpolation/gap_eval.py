@@ -25,11 +25,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from motionlab.core import quat
 from motionlab.core.motion import Motion
 from motionlab.interpolation import detect, gaps
 from motionlab.interpolation.alignment import reference_joint, reference_transform
 from motionlab.interpolation.inbetween import concatenate
+from motionlab.interpolation.stride import _sample, _sample_rot
 
 __all__ = ["CutResult", "cut", "retimed", "countable", "evaluate_cut", "summary", "detection_counts"]
 
@@ -88,7 +88,7 @@ def cut(motion: Motion, start: int, n: int) -> Motion:
 def retimed(motion: Motion, start: int, n: int, m: int) -> Motion:
     """``motion`` with its frames ``start … start+n-1`` replayed over ``m`` frames: the same stretch
     of motion, from frame ``start-1`` to frame ``start+n-1``, at another pace (``m > n``: slower),
-    read between the frames as :meth:`.Motion.resample` does; every other frame unchanged.
+    read between the frames linearly (positions) and by SLERP (rotations); every other frame unchanged.
 
     Cut ``m`` frames at ``start`` from it, and the stream is exactly the one cut ``n`` frames at
     ``start`` from ``motion`` (:func:`cut`): how many frames a gap held, and how fast the body moved
@@ -96,15 +96,11 @@ def retimed(motion: Motion, start: int, n: int, m: int) -> Motion:
     _check_cut(motion, start, n)
     if m < 1:
         raise ValueError(f"cannot replay {n} frames over {m}: expected at least one frame")
-    piece = motion[start - 1 : start + n].copy(fps=motion.fps)  # n steps, from the frame kept before
-    t = np.arange(1, m + 1) * (n / m)  # m new frames, in the piece's frames; the last is frame n
-    lo = np.minimum(np.floor(t + 1e-9).astype(np.int64), n)
-    hi = np.minimum(lo + 1, n)
-    f = np.clip(t - lo, 0.0, 1.0)
-    rot = quat.slerp(piece.local_rot[lo], piece.local_rot[hi], f[:, None])
-    lerp = lambda x: x[lo] + (x[hi] - x[lo]) * f.reshape((-1,) + (1,) * (x.ndim - 1))  # noqa: E731
-    local_pos = None if motion.local_pos is None else lerp(piece.local_pos)
-    middle = Motion(motion.skeleton, rot, lerp(piece.root_pos), motion.fps, local_pos, motion.name)
+    frames = np.arange(start - 1, start + n)  # n steps, from the frame kept before
+    x = np.arange(1, m + 1) * (n / m)  # m new frames, at fractional rows of ``frames``; the last is row n
+    local_pos = None if motion.local_pos is None else _sample(motion.local_pos[frames], x)
+    middle = Motion(motion.skeleton, _sample_rot(motion.local_rot[frames], x), _sample(motion.root_pos[frames], x),
+                    motion.fps, local_pos, motion.name)  # fmt: skip
     return concatenate([motion[:start], middle, motion[start + n :]])
 
 
