@@ -285,7 +285,7 @@ def experiment_large(quick: bool) -> None:
     lib = clips.synthetic_library(seconds=20.0, styles=styles)
     rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     t = time.perf_counter()
-    g = structured.build_structured(lib, distance.threshold_from(THRESHOLD_M), dtype=np.float32)
+    g = structured.build_structured(lib, distance.threshold_from(THRESHOLD_M))
     dt = time.perf_counter() - t
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     req = "walk:normal:300,walk:s1:300,run:s2:300,run:normal:300,walk:s3:300"

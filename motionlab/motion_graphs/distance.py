@@ -28,6 +28,14 @@ Unit of :math:`D`: m² (a weighted *mean* squared point distance); :func:`rms` t
 into metres. Windows are centred (``window`` frames, clamped at the clip ends) and tapered;
 joints are weighted equally. Both choices are documented in ``notebooks/05_motion_graphs``.
 
+**Exact sums.** Which cells are candidates is decided by comparisons (local minimum, threshold),
+so :math:`D` must not depend on the order in which a BLAS kernel adds up the products. Point
+coordinates are therefore put on a grid of :data:`GRID` metres (a power of two, so they stay
+exact binary numbers) and the weights are small integers (:attr:`CloudFeatures.unit_weights`):
+every product and partial sum is then a whole multiple of ``GRID²`` below 2⁵³ of them, which
+float64 holds exactly, in any order, on any CPU, in any block size. Only the final few
+element-wise operations round, and those are the same everywhere (IEEE 754).
+
 Transition candidates are the *local minima* of :math:`D` (no smaller value among the 8
 neighbouring cells) below a threshold, see :func:`candidates` and :func:`threshold_from`.
 
@@ -54,10 +62,17 @@ __all__ = [
     "rms",
     "threshold_from",
     "DEFAULT_WINDOW",
+    "GRID",
 ]
 
 DEFAULT_WINDOW = 5
 """Frames per point cloud (centred on the frame): 5 frames ≈ 0.17 s at 30 fps."""
+
+GRID = 2.0**-18
+"""Spacing (metres, ≈ 3.8 µm) of the grid the cloud points are rounded to, so that sums are exact."""
+
+_JOINT_WEIGHT_LEVELS = 16  # joint weights are rounded to multiples of 1/16 of the largest
+_EXACT_LIMIT = 2.0**52  # sums of whole grid units below this are exact in float64
 
 _BLOCK_ELEMENTS = 4_000_000  # cells of D computed at once (≈ 32 MB in float64, plus temporaries)
 
@@ -68,11 +83,15 @@ class CloudFeatures:
 
     Attributes
     ----------
-    centred : ndarray, shape (T, 2n)   ``[c_x | c_z]`` horizontally centred window points, m
-    height  : ndarray, shape (T, n)    ``y`` of the window points, m
+    centred : ndarray, shape (T, 2n)   ``[c_x | c_z]`` horizontally centred window points, m,
+                                       whole multiples of :data:`GRID`
+    height  : ndarray, shape (T, n)    ``y`` of the window points, m, multiples of :data:`GRID`
     weights : ndarray, shape (n,)      point weights, summing to 1
     self_term : ndarray, shape (T,)    ``S = Σ w (c_x² + c_z² + y²)``, m²
     mean_xz : ndarray, shape (T, 2)    weighted horizontal centroid of each cloud, m
+    unit_weights : ndarray, shape (n,) whole numbers proportional to ``weights``
+                                       (``weights = unit_weights / unit_weights.sum()``): the
+                                       products use them, so that every sum is exact
     """
 
     centred: np.ndarray
@@ -80,57 +99,84 @@ class CloudFeatures:
     weights: np.ndarray
     self_term: np.ndarray
     mean_xz: np.ndarray
+    unit_weights: np.ndarray
 
     def __len__(self) -> int:
         return int(self.centred.shape[0])
 
     def __getitem__(self, frames) -> CloudFeatures:
         return CloudFeatures(
-            self.centred[frames], self.height[frames], self.weights, self.self_term[frames], self.mean_xz[frames]
+            self.centred[frames],
+            self.height[frames],
+            self.weights,
+            self.self_term[frames],
+            self.mean_xz[frames],
+            self.unit_weights,
         )
 
 
 def _window_weights(window: int) -> np.ndarray:
-    # a tent taper: the centre frame counts most, the window's ends least (never zero)
-    h = (window - 1) / 2
-    return 1.0 - np.abs(np.arange(window) - h) / (h + 1)
+    # a tent taper in whole numbers: the centre frame counts most, the window's ends least (1)
+    h = (window - 1) // 2
+    return (h + 1 - np.abs(np.arange(window) - h)).astype(np.float64)
 
 
-def cloud_features(global_pos, window: int = DEFAULT_WINDOW, joint_weights=None, dtype=np.float64) -> CloudFeatures:
+def _unit_joint_weights(joint_weights, num_joints: int) -> np.ndarray:
+    if joint_weights is None:
+        return np.ones(num_joints)
+    jw = np.asarray(joint_weights, dtype=np.float64)
+    if jw.shape != (num_joints,) or not np.all(np.isfinite(jw)) or np.any(jw < 0) or jw.sum() <= 0:
+        raise ValueError(f"joint_weights must be {num_joints} finite non-negative numbers with a positive sum")
+    return np.round(jw / jw.max() * _JOINT_WEIGHT_LEVELS)
+
+
+def cloud_features(global_pos, window: int = DEFAULT_WINDOW, joint_weights=None) -> CloudFeatures:
     """Point-cloud rows of every frame of a clip.
 
     Parameters
     ----------
     global_pos : ndarray, shape (T, J, 3)   world joint positions, metres, Y up
     window : odd int                         frames per cloud, centred (clamped at the ends)
-    joint_weights : ndarray, shape (J,), optional   (uniform by default)
-    dtype : float dtype of the products (float32 halves time and memory; ~1e-6 m² error)
+    joint_weights : ndarray, shape (J,), optional   (uniform by default; rounded to multiples
+        of 1/16 of the largest, so that sums stay exact)
+
+    Raises
+    ------
+    ValueError
+        for a bad shape, window or weights, and for clouds too large for exact sums (points
+        tens of metres from their window's centre or above the ground: not metres?)
     """
     pos = np.asarray(global_pos, dtype=np.float64)
     if pos.ndim != 3 or pos.shape[-1] != 3 or pos.shape[0] < 1:
         raise ValueError(f"expected global positions of shape (T, J, 3), got {pos.shape}")
     if not (isinstance(window, (int, np.integer)) and window >= 1 and window % 2 == 1):
         raise ValueError(f"window must be a positive odd number of frames, got {window}")
+    if not np.all(np.isfinite(pos)):
+        raise ValueError("global positions hold non-finite values (NaN or inf)")
     T, J, _ = pos.shape
-    jw = np.ones(J) if joint_weights is None else np.asarray(joint_weights, dtype=np.float64)
-    if jw.shape != (J,) or np.any(jw < 0) or jw.sum() <= 0:
-        raise ValueError(f"joint_weights must be {J} non-negative numbers with a positive sum")
+    units = (_window_weights(window)[:, None] * _unit_joint_weights(joint_weights, J)[None, :]).reshape(-1)
+    total = units.sum()
     h = window // 2
     idx = np.clip(np.arange(T)[:, None] + np.arange(-h, h + 1)[None, :], 0, T - 1)  # (T, K)
-    cloud = pos[idx].reshape(T, window * J, 3)  # (T, n, 3)
-    w = (_window_weights(window)[:, None] * jw[None, :]).reshape(-1)
-    w = w / w.sum()
-    mean_xz = cloud[:, :, [0, 2]].transpose(0, 2, 1) @ w  # (T, 2)
-    cx = cloud[:, :, 0] - mean_xz[:, :1]
-    cz = cloud[:, :, 2] - mean_xz[:, 1:]
+    cloud = np.round(pos / GRID)[idx].reshape(T, window * J, 3)  # (T, n, 3), whole grid units
+    mean_xz = np.stack([cloud[:, :, 0] @ units, cloud[:, :, 2] @ units], axis=1) / total  # exact sums
+    cx = np.round(cloud[:, :, 0] - mean_xz[:, :1])
+    cz = np.round(cloud[:, :, 2] - mean_xz[:, 1:])
     y = cloud[:, :, 1]
-    self_term = (cx * cx + cz * cz + y * y) @ w
+    self_units = (cx * cx + cz * cz + y * y) @ units
+    if self_units.max() >= _EXACT_LIMIT:
+        reach = float(np.sqrt(self_units.max() / total) * GRID)
+        raise ValueError(
+            f"point clouds reach {reach:.3g} m (root mean square) from their centre line: too large for "
+            f"exact distances (up to about {np.sqrt(_EXACT_LIMIT / total) * GRID:.3g} m); are the positions in metres?"
+        )
     return CloudFeatures(
-        np.concatenate([cx, cz], axis=1).astype(dtype),
-        y.astype(dtype),
-        w.astype(dtype),
-        self_term.astype(np.float64),
-        mean_xz,
+        np.concatenate([cx, cz], axis=1) * GRID,
+        y * GRID,
+        units / total,
+        self_units * GRID**2 / total,
+        mean_xz * GRID,
+        units,
     )
 
 
@@ -156,15 +202,22 @@ def _one_blas_thread():
 
 
 def _block(fa: CloudFeatures, fb: CloudFeatures, rows: slice, right: np.ndarray, yb: np.ndarray) -> np.ndarray:
-    n = fa.height.shape[1]
-    left = fa.centred[rows] * np.concatenate([fa.weights, fa.weights])  # (r, 2n)
+    units = fa.unit_weights
+    left = fa.centred[rows] * np.concatenate([units, units])  # (r, 2n); exact: see the module docstring
     tb = fb.centred.shape[0]
     with _one_blas_thread():
-        ab = left @ right  # (r, 2 Tb): [a | b]
-        cross_y = (fa.height[rows] * fa.weights[:n]) @ yb
+        ab = left @ right  # (r, 2 Tb): [a | b] times the weights' total, exact in any summation order
+        cross_y = (fa.height[rows] * units) @ yb
     a, b = ab[:, :tb], ab[:, tb:]
-    d = fa.self_term[rows, None] + fb.self_term[None, :] - 2.0 * cross_y - 2.0 * np.sqrt(a * a + b * b)
-    return np.maximum(d, 0.0, out=d.astype(np.float64, copy=False))
+    d = fa.self_term[rows, None] + fb.self_term[None, :] - (2.0 * cross_y + 2.0 * np.sqrt(a * a + b * b)) / units.sum()
+    return np.maximum(d, 0.0, out=d)
+
+
+def _check_pair(fa: CloudFeatures, fb: CloudFeatures) -> None:
+    if fa.height.shape[1] != fb.height.shape[1] or not np.array_equal(fa.unit_weights, fb.unit_weights):
+        raise ValueError(
+            "the two clips have different joint counts, window sizes or joint weights; they cannot be compared"
+        )
 
 
 def _right(fb: CloudFeatures) -> tuple[np.ndarray, np.ndarray]:
@@ -184,8 +237,7 @@ def distance_blocks(
     ``block_rows`` rows (default: about 4 million cells per block).
     """
     fa, fb = _as_features(a, window), _as_features(b, window)
-    if fa.height.shape[1] != fb.height.shape[1]:
-        raise ValueError("the two clips have different joint counts or window sizes; they cannot be compared")
+    _check_pair(fa, fb)
     right, yb = _right(fb)
     rows = block_rows or max(1, _BLOCK_ELEMENTS // max(len(fb), 1))
     for r0 in range(0, len(fa), rows):
@@ -279,6 +331,7 @@ def candidates(
     fb = fa if same else _as_features(b, window)
     r0_, r1_ = (rows.start or 0, len(fa) if rows.stop is None else rows.stop) if rows else (0, len(fa))
     c0_, c1_ = (cols.start or 0, len(fb) if cols.stop is None else cols.stop) if cols else (0, len(fb))
+    _check_pair(fa, fb)
     sub_a, sub_b = fa[r0_:r1_], fb[c0_:c1_]
     if len(sub_a) == 0 or len(sub_b) == 0:
         empty = np.zeros(0, dtype=np.int64)

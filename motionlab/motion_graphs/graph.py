@@ -446,7 +446,6 @@ def build_standard(
     min_gap: int | None = None,
     prune: bool = True,
     infos: Sequence[ClipInfo] | None = None,
-    dtype=np.float64,
 ) -> MotionGraph:
     """Kovar's unstructured motion graph: every clip against every clip.
 
@@ -458,7 +457,6 @@ def build_standard(
     min_gap : within one clip, ignore pairs closer than this many frames (default: 1/3 s)
     prune : keep only the largest strongly connected component
     infos : optional ClipInfo per clip (labels); default: names only
-    dtype : float type of the distance products
 
     Returns
     -------
@@ -468,7 +466,7 @@ def build_standard(
     infos = list(infos) if infos is not None else [ClipInfo(m.name or f"clip{k}") for k, m in enumerate(motions)]
     graph = MotionGraph.from_motions(motions, infos)
     min_gap = int(round(graph.fps / 3)) if min_gap is None else min_gap
-    feats = [_distance.cloud_features(m.global_positions(), window, dtype=dtype) for m in motions]
+    feats = [_distance.cloud_features(m.global_positions(), window) for m in motions]
     pairs = 0
     for a in range(len(motions)):
         for b in range(a, len(motions)):

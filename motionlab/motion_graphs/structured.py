@@ -145,7 +145,6 @@ def build_structured(
     force: bool = True,
     synthetic: Sequence[bool] | None = None,
     dwell: int | None = None,
-    dtype=np.float32,
     neighbours: int = NEIGHBOURS,
     rep_cycles: int = REP_CYCLES,
     progress: bool = False,
@@ -169,7 +168,6 @@ def build_structured(
         interpolation space or a transition clip (counted as ``forced``)
     synthetic : per clip, True if it is a synthetic stand-in (shown in tables)
     dwell : fewest frames a style route spends in each intermediate motion (default fps/5)
-    dtype : float type of the distance products (float32: half the memory, ~1e-6 m² error)
     neighbours : each take is compared with itself and the next ``neighbours`` takes of its style
     rep_cycles : whole cycles of each representative take that the interpolation space blends
     progress : show a tqdm bar per stage
@@ -288,7 +286,7 @@ def build_structured(
         if c not in feats_cache:
             st, sp = clips[c].start, clips[c].stop
             m = Motion(graph.skeleton, graph.local_rot[st:sp], graph.root_pos[st:sp], graph.fps, None, clips[c].name)
-            feats_cache[c] = _distance.cloud_features(m.global_positions(), window, dtype=dtype)
+            feats_cache[c] = _distance.cloud_features(m.global_positions(), window)
         return feats_cache[c]
 
     def cands(x, y, rows=None, cols=None, thr=None, min_gap=0):
@@ -665,7 +663,6 @@ def build_wcmg(
     style_pairs: str = "all",
     weights: Sequence[float] = _registration.BLEND_WEIGHTS,
     window: int = _distance.DEFAULT_WINDOW,
-    dtype=np.float64,
 ) -> MotionGraph:
     """An interpolation-space graph *without* structure or pruning, in the spirit of Zhao and
     Safonova's well-connected motion graphs (wcMG): the basic clips plus their intermediate
@@ -692,6 +689,6 @@ def build_wcmg(
                 if mid.num_frames >= 3:
                     all_motions.append(mid)
                     infos.append(ClipInfo(mid.name, "intermediate", b, f"{s1}~{s2}@{w:g}"))
-    g = build_standard(all_motions, threshold, window, prune=False, infos=infos, dtype=dtype)
+    g = build_standard(all_motions, threshold, window, prune=False, infos=infos)
     g.info.update(kind="wcmg", intermediates=len(all_motions) - len(basics), build_seconds=time.perf_counter() - t0)
     return g

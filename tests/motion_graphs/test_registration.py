@@ -49,7 +49,8 @@ def test_blend_endpoints(library):
     m1 = registration.blend(a, b, reg, 1.0)
     j0 = reg.path[0, 1]
     d = distance.distance_matrix(m1.global_positions(), b.global_positions()[j0 : j0 + len(m1)])
-    assert distance.rms(np.diag(d)).max() < 1e-6  # B itself, up to a ground transform
+    # B itself, up to a ground transform: apart only by the rounding of points to distance.GRID
+    assert distance.rms(np.diag(d)).max() < 2 * np.sqrt(3) * distance.GRID
     mid = registration.blend(a, b, reg, 0.5)
     assert min(len(m0), len(m1)) <= len(mid) <= max(len(m0), len(m1))
     np.testing.assert_allclose(np.linalg.norm(mid.local_rot, axis=-1), 1.0, atol=1e-9)
