@@ -1,0 +1,206 @@
+r"""Links between style pools where their poses match: stance to stance, a gait's double support.
+
+Paper B joins behaviours only through recorded transition clips, and styles of one behaviour
+through interpolation spaces. A recording session often holds no transition clip between two
+behaviours (a walk, then a wave), and an interpolation space between two standing actions may
+find no valid path. Yet a standing action begins and ends at rest, and a walk stands on both
+feet for a moment at every step (and at its start and stop): where two pools' poses match,
+Kovar's own transitions (local minima of the frame distance below the *same* threshold as every
+other transition) can join them.
+
+Only a pool's *ports* take part (:attr:`.segments.Segments.ports`: an action's stances, a gait's
+frames with both feet planted) — the frames where a change of style or behaviour looks natural —
+so the comparison is small. For two pools ``A`` and ``B`` the port frames of both are compared
+once; a candidate ``(i, j)`` gives the edge ``A_i → B_{j+1}`` and the edge ``B_j → A_{i+1}``,
+each kept only when both its frames are alive. Each direction becomes a structure-table link
+``{"from", "to", "via": "stance", "routes"}`` whose routes have no frames of their own (``exit``
+in ``A``'s pool, ``enter`` in ``B``'s, ``pieces: []``, ``frames: 0``), so the search
+(:mod:`.search`) uses them like any other link.
+
+Which pools are compared (:func:`pool_pairs`): every two styles of one behaviour, and the
+styles of one name in two behaviours (every two styles when the behaviours share no style name)
+that no recorded transition clip joins in that direction (recorded clips stay preferred, as
+the paper prescribes); a search changes style inside a behaviour and behaviour at one style.
+
+Taught in ``notebooks/05_motion_graphs.ipynb``.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Callable, Mapping, Sequence
+
+import numpy as np
+
+from motionlab.motion_graphs import distance as _distance
+from motionlab.motion_graphs.graph import MotionGraph
+
+__all__ = ["pool_pairs", "port_features", "link_within", "link_pools", "PORT_TAKES"]
+
+Key = tuple[str, str]
+
+PORT_TAKES = 1000
+"""Takes of a pool (evenly spaced in take order) whose ports are compared: the work grows with
+the number of styles, not of takes, as the ring of neighbours keeps it linear inside a style."""
+
+
+def pool_pairs(keys: Sequence[Key], recorded: set[tuple[str, str]]) -> list[tuple[Key, Key, bool, bool]]:
+    """Pools to compare, as ``(a, b, a_to_b, b_to_a)`` (which directions may be linked).
+
+    Parameters
+    ----------
+    keys : ``(behaviour, style)`` of every pool
+    recorded : ordered behaviour pairs ``(b1, b2)`` that a recorded transition clip joins
+
+    Returns
+    -------
+    list of tuples, in a fixed order (sorted keys); pairs with no direction left are omitted
+    """
+    styles: dict[str, set[str]] = {}
+    for b, s in keys:
+        styles.setdefault(b, set()).add(s)
+    out = []
+    for a, b in itertools.combinations(sorted(keys), 2):
+        same = a[0] == b[0]
+        if not same and a[1] != b[1] and styles[a[0]] & styles[b[0]]:
+            continue  # two behaviours that share style names are joined style by style
+        fwd = same or (a[0], b[0]) not in recorded
+        bwd = same or (b[0], a[0]) not in recorded
+        if fwd or bwd:
+            out.append((a, b, fwd, bwd))
+    return out
+
+
+def port_features(
+    graph: MotionGraph,
+    takes: Sequence[int],
+    ports: Mapping[int, np.ndarray],
+    features: Callable,
+    max_takes: int = PORT_TAKES,
+) -> tuple[_distance.CloudFeatures | None, np.ndarray]:
+    """Cloud features of the alive port frames of one pool's takes.
+
+    Parameters
+    ----------
+    graph : the graph holding the takes
+    takes : clip indices of the pool's takes (in take order)
+    ports : clip index → (frames,) bool port mask of that take
+    features : clip index → :class:`~.distance.CloudFeatures` of the whole take
+    max_takes : at most this many takes, evenly spaced in take order, offer ports
+
+    Returns
+    -------
+    features : CloudFeatures of the port frames (``None`` when there is none)
+    frames : int array, global frame index of each row
+    """
+    if len(takes) > max_takes:
+        takes = [takes[k] for k in np.linspace(0, len(takes) - 1, max_takes).round().astype(int)]
+    rows, frames = [], []
+    for c in takes:
+        clip = graph.clips[c]
+        f = np.flatnonzero(ports[c] & graph.alive[clip.start : clip.stop])
+        if f.size:
+            rows.append(features(c)[f])
+            frames.append(clip.start + f)
+    if not rows:
+        return None, np.zeros(0, dtype=np.int64)
+    first = rows[0]
+    cat = _distance.CloudFeatures(
+        np.concatenate([r.centred for r in rows]),
+        np.concatenate([r.height for r in rows]),
+        first.weights,
+        np.concatenate([r.self_term for r in rows]),
+        np.concatenate([r.mean_xz for r in rows]),
+        first.unit_weights,
+    )
+    return cat, np.concatenate(frames)
+
+
+def _direction(graph: MotionGraph, nxt: np.ndarray, src: np.ndarray, dst: np.ndarray, cost: np.ndarray):
+    """Edges ``src → dst + 1`` whose target is the next alive frame of the same clip (``nxt``:
+    :meth:`MotionGraph.next_in_clip`)."""
+    ok = nxt[dst] & graph.alive[src]
+    return src[ok], dst[ok] + 1, cost[ok]
+
+
+def _routes(src, dst, cost, s0: int, t0: int) -> list[dict]:
+    order = np.lexsort((dst, src, cost))  # best first; ties in a fixed order
+    return [
+        {"exit": int(src[k]) - s0, "enter": int(dst[k]) - t0, "pieces": [], "frames": 0, "cost": float(cost[k])}
+        for k in order
+    ]
+
+
+def link_within(
+    graph: MotionGraph, port: tuple, threshold: float, min_gap: int, window: int = _distance.DEFAULT_WINDOW
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Kovar transitions between the ports of one pool's takes: one take's end stance into
+    another's start stance (and back inside one take, at least ``min_gap`` frames away).
+
+    Parameters
+    ----------
+    graph : the graph holding the pool
+    port : ``(CloudFeatures or None, global frames)`` from :func:`port_features`
+    threshold : largest frame distance, m²
+    min_gap : fewest frames between the two ends of a jump inside one take
+
+    Returns
+    -------
+    src, dst, cost : global arrays of the edges ``i → j + 1``
+    """
+    fp, frames = port
+    if fp is None:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(0)
+    i, j, cost = _distance.candidates(fp, None, threshold, window)
+    gi, gj = frames[i], frames[j]
+    ok = (graph.clip_of(gi) != graph.clip_of(gj)) | (np.abs(gi - gj) >= min_gap)
+    return _direction(graph, graph.next_in_clip(), gi[ok], gj[ok], cost[ok])
+
+
+def link_pools(
+    graph: MotionGraph,
+    pairs: Sequence[tuple[Key, Key, bool, bool]],
+    port_feats: Mapping[Key, tuple],
+    pool_start: Callable[[Key], int],
+    threshold: float,
+    window: int = _distance.DEFAULT_WINDOW,
+) -> tuple[list[dict], tuple[np.ndarray, np.ndarray, np.ndarray], int]:
+    """Kovar transitions between the ports of pool pairs (see the module docstring).
+
+    Parameters
+    ----------
+    graph : the graph (its ``alive`` frames decide which edges are kept)
+    pairs : from :func:`pool_pairs`
+    port_feats : key → ``(CloudFeatures or None, global frames)`` from :func:`port_features`
+    pool_start : key → global index of the pool's first frame (routes count from it)
+    threshold : largest frame distance, m² (the graph's transition threshold)
+    window : frames per point cloud
+
+    Returns
+    -------
+    links : structure-table links (``via: "stance"``), one per linked direction
+    edges : ``(src, dst, cost)`` global arrays of every linked direction
+    comparisons : cells of the distance matrices computed
+    """
+    links, parts, comparisons = [], [], 0
+    nxt = graph.next_in_clip()
+    for a, b, fwd, bwd in pairs:
+        (fa, ga), (fb, gb) = port_feats[a], port_feats[b]
+        if fa is None or fb is None:
+            continue
+        comparisons += len(fa) * len(fb)
+        i, j, cost = _distance.candidates(fa, fb, threshold, window)
+        for ok, (x, y, sx, sy) in ((fwd, (ga[i], gb[j], a, b)), (bwd, (gb[j], ga[i], b, a))):
+            if not ok:
+                continue
+            src, dst, c = _direction(graph, nxt, x, y, cost)
+            if src.size == 0:
+                continue
+            parts.append((src, dst, c))
+            routes = _routes(src, dst, c, pool_start(sx), pool_start(sy))
+            links.append({"from": list(sx), "to": list(sy), "via": "stance", "routes": routes})
+    if parts:
+        edges = tuple(np.concatenate(p) for p in zip(*parts))
+    else:
+        edges = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(0))
+    return links, edges, comparisons
