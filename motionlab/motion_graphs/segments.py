@@ -26,8 +26,8 @@ mean of both legs, from the skeleton's rest offsets):
   next (boundary stances included), so every action take holds at least one;
 * a take's *ports*, the frames where links to other styles and behaviours may begin or end, are
   an action's boundary stances (so that takes connect stance to stance; a hold inside the take
-  cuts it but is no port) and a gait's frames with both feet planted (double support, and a
-  start or stop where the take records one).
+  cuts it but is no port) and, for a gait, its frames with both feet planted (double support)
+  and its first and last :data:`END_STANCE` seconds (where it starts and stops).
 
 Taught in ``notebooks/05_motion_graphs.ipynb``.
 """
@@ -94,7 +94,7 @@ class Segments:
     num_frames : frames of the take
     both_planted : share of the frames with both feet planted, in [0, 1]
     ports : bool array, shape (T,), frames where links to other styles and behaviours may
-        begin or end (an action's boundary stances, a gait's frames with both feet planted)
+        begin or end (an action's boundary stances; a gait's start, stop and double support)
     """
 
     kind: str
@@ -223,9 +223,11 @@ def segments_from_positions(pos, feet: tuple[int, int], fps: float, leg: float) 
     min_frames = max(1, int(round(MIN_STANCE * fps)))
     stances = _runs(both & (speed < STILL_SPEED * leg), min_frames)
     kind = classify(share)
-    if kind == "gait":
-        return Segments(kind, stances, np.zeros((0, 2), dtype=np.int64), T, share, both)
     end = min(max(1, int(round(END_STANCE * fps))), T)
+    if kind == "gait":
+        ports = both.copy()
+        ports[:end] = ports[-end:] = True  # where the take starts and stops
+        return Segments(kind, stances, np.zeros((0, 2), dtype=np.int64), T, share, ports)
     still = np.zeros(T, dtype=bool)
     for a, b in stances:
         still[a:b] = True

@@ -12,7 +12,10 @@ Only a pool's *ports* take part (:attr:`.segments.Segments.ports`: an action's s
 frames with both feet planted) — the frames where a change of style or behaviour looks natural —
 so the comparison is small. For two pools ``A`` and ``B`` the port frames of both are compared
 once; a candidate ``(i, j)`` gives the edge ``A_i → B_{j+1}`` and the edge ``B_j → A_{i+1}``,
-each kept only when both its frames are alive. Each direction becomes a structure-table link
+each kept only when it leaves an alive frame or a take's *lead-out* and enters an alive frame
+or a take's *lead-in* (:func:`leads`: a start or stop that the pruning inside the style
+removed, because nothing of the style enters a start); the lead frames it uses are brought
+back. Each direction becomes a structure-table link
 ``{"from", "to", "via": "stance", "routes"}`` whose routes have no frames of their own (``exit``
 in ``A``'s pool, ``enter`` in ``B``'s, ``pieces: []``, ``frames: 0``), so the search
 (:mod:`.search`) uses them like any other link.
@@ -35,7 +38,7 @@ import numpy as np
 from motionlab.motion_graphs import distance as _distance
 from motionlab.motion_graphs.graph import MotionGraph
 
-__all__ = ["pool_pairs", "port_features", "link_within", "link_pools", "PORT_TAKES"]
+__all__ = ["pool_pairs", "port_features", "leads", "link_within", "link_pools", "PORT_TAKES"]
 
 Key = tuple[str, str]
 
@@ -78,7 +81,8 @@ def port_features(
     features: Callable,
     max_takes: int = PORT_TAKES,
 ) -> tuple[_distance.CloudFeatures | None, np.ndarray]:
-    """Cloud features of the alive port frames of one pool's takes.
+    """Cloud features of the usable port frames of one pool's takes: alive, or on a take's
+    lead-in or lead-out (:func:`leads`).
 
     Parameters
     ----------
@@ -95,10 +99,12 @@ def port_features(
     """
     if len(takes) > max_takes:
         takes = [takes[k] for k in np.linspace(0, len(takes) - 1, max_takes).round().astype(int)]
+    lead_in, lead_out = leads(graph)
+    usable = graph.alive | lead_in | lead_out
     rows, frames = [], []
     for c in takes:
         clip = graph.clips[c]
-        f = np.flatnonzero(ports[c] & graph.alive[clip.start : clip.stop])
+        f = np.flatnonzero(ports[c] & usable[clip.start : clip.stop])
         if f.size:
             rows.append(features(c)[f])
             frames.append(clip.start + f)
@@ -116,11 +122,46 @@ def port_features(
     return cat, np.concatenate(frames)
 
 
-def _direction(graph: MotionGraph, nxt: np.ndarray, src: np.ndarray, dst: np.ndarray, cost: np.ndarray):
-    """Edges ``src → dst + 1`` whose target is the next alive frame of the same clip (``nxt``:
-    :meth:`MotionGraph.next_in_clip`)."""
-    ok = nxt[dst] & graph.alive[src]
+def leads(graph: MotionGraph) -> tuple[np.ndarray, np.ndarray]:
+    """(N,) bool masks of every clip's *lead-in* (the removed frames before its first alive frame)
+    and *lead-out* (the removed frames after its last alive frame); empty for a clip with no
+    alive frame. A take's start or stop is often removed by the pruning inside its style (no
+    transition of the style enters a start); a link from another pool may enter a lead-in and
+    step forward into the alive frames, or leave from a lead-out after stepping out of them."""
+    n = graph.num_frames
+    lead_in, lead_out = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+    for c in graph.clips:
+        a = graph.alive[c.start : c.stop]
+        if c.kind != "basic" or not a.any() or a.all():
+            continue
+        first, last = int(np.argmax(a)), c.num_frames - 1 - int(np.argmax(a[::-1]))
+        lead_in[c.start : c.start + first] = True
+        lead_out[c.start + last + 1 : c.stop] = True
+    return lead_in, lead_out
+
+
+def _direction(graph: MotionGraph, lead: tuple, src: np.ndarray, dst: np.ndarray, cost: np.ndarray):
+    """Edges ``src → dst + 1`` (same clip) that leave an alive or lead-out frame and enter an
+    alive or lead-in frame (``lead``: :func:`leads`)."""
+    lead_in, lead_out = lead
+    nxt = np.minimum(dst + 1, graph.num_frames - 1)
+    ok = (graph.clip_of(nxt) == graph.clip_of(dst)) & (dst + 1 < graph.num_frames)
+    ok &= (graph.alive[src] | lead_out[src]) & (graph.alive[nxt] | lead_in[nxt])
     return src[ok], dst[ok] + 1, cost[ok]
+
+
+def _revive(graph: MotionGraph, lead: tuple, src: np.ndarray, dst: np.ndarray) -> None:
+    """Bring back the lead-in frames from each entry ``dst`` up to the clip's first alive frame,
+    and the lead-out frames from the clip's last alive frame up to each exit ``src``."""
+    lead_in, lead_out = lead
+    for f in np.unique(dst[lead_in[dst]]):
+        c = graph.clips[int(graph.clip_of(f))]
+        first = c.start + int(np.argmax(graph.alive[c.start : c.stop] & ~lead_in[c.start : c.stop]))
+        graph.alive[f:first] = True
+    for f in np.unique(src[lead_out[src]]):
+        c = graph.clips[int(graph.clip_of(f))]
+        last = c.stop - 1 - int(np.argmax((graph.alive & ~lead_out)[c.start : c.stop][::-1]))
+        graph.alive[last + 1 : f + 1] = True
 
 
 def _routes(src, dst, cost, s0: int, t0: int) -> list[dict]:
@@ -154,7 +195,8 @@ def link_within(
     i, j, cost = _distance.candidates(fp, None, threshold, window)
     gi, gj = frames[i], frames[j]
     ok = (graph.clip_of(gi) != graph.clip_of(gj)) | (np.abs(gi - gj) >= min_gap)
-    return _direction(graph, graph.next_in_clip(), gi[ok], gj[ok], cost[ok])
+    none = np.zeros(graph.num_frames, dtype=bool)
+    return _direction(graph, (none, none), gi[ok], gj[ok], cost[ok])
 
 
 def link_pools(
@@ -183,7 +225,7 @@ def link_pools(
     comparisons : cells of the distance matrices computed
     """
     links, parts, comparisons = [], [], 0
-    nxt = graph.next_in_clip()
+    lead = leads(graph)
     for a, b, fwd, bwd in pairs:
         (fa, ga), (fb, gb) = port_feats[a], port_feats[b]
         if fa is None or fb is None:
@@ -193,7 +235,7 @@ def link_pools(
         for ok, (x, y, sx, sy) in ((fwd, (ga[i], gb[j], a, b)), (bwd, (gb[j], ga[i], b, a))):
             if not ok:
                 continue
-            src, dst, c = _direction(graph, nxt, x, y, cost)
+            src, dst, c = _direction(graph, lead, x, y, cost)
             if src.size == 0:
                 continue
             parts.append((src, dst, c))
@@ -201,6 +243,7 @@ def link_pools(
             links.append({"from": list(sx), "to": list(sy), "via": "stance", "routes": routes})
     if parts:
         edges = tuple(np.concatenate(p) for p in zip(*parts))
+        _revive(graph, lead, edges[0], edges[1])
     else:
         edges = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(0))
     return links, edges, comparisons
