@@ -150,8 +150,8 @@ class _Clip:
     allowed (same take, both alive); jumps ``loop_src → loop_dst`` (transitions inside the pool,
     self-loops included); the *main cycle* ``cycle_dst … cycle_src`` is the longest jump back
     inside one take whose frames in between are all steps (``-1`` when there is none).
-    ``sparse``: the cheapest jump into every frame (``None``: all jumps), which the search tries
-    first.
+    ``sparse``: the :data:`SPARSE_JUMPS` cheapest jumps into every frame (``None``: all jumps),
+    which the search tries first.
     """
 
     index: int
@@ -200,9 +200,9 @@ def _pool_walker(graph: MotionGraph, clips: list[int], index: int = 0) -> _Clip:
     else:
         last_src, last_dst = -1, -1
     offsets = np.array([graph.clips[c].start - st for c in clips], dtype=np.int64)
-    # the cheapest jump into every frame (ties: the nearer source first)
+    # the SPARSE_JUMPS cheapest jumps into every frame (ties: the nearer source first)
     order = np.lexsort((src, graph.cost[m], dst))
-    few = order[np.concatenate([[True], dst[order][1:] != dst[order][:-1]])] if order.size else order
+    few = order[np.arange(order.size) - np.searchsorted(dst[order], dst[order]) < SPARSE_JUMPS]
     return _Clip(
         index, sp - st, step, src, dst, last_src, last_dst, np.asarray(clips, dtype=np.int64), offsets,
         graph.alive[st:sp].copy(), (src[few], dst[few]),
@@ -281,6 +281,10 @@ def _runs(cw: _Clip | int, frames: list[int]) -> list[tuple[int, int, int]]:
 
 _NEVER = np.iinfo(np.int16).max
 
+SPARSE_JUMPS = 2
+"""Jumps into each frame (the cheapest) that a walk through a pool tries first: a pool of many
+takes holds dozens of jumps per frame, and the recursion's cost grows with them."""
+
 
 def _reach(cw: _Clip, start: int, steps: int, jumps: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """(steps, L) int16: fewest jumps of a walk of ``c + 1`` frames from ``start`` that ends at
@@ -296,8 +300,9 @@ def _reach(cw: _Clip, start: int, steps: int, jumps: tuple[np.ndarray, np.ndarra
     src, dst = (cw.loop_src, cw.loop_dst) if jumps is None else jumps
     order = np.argsort(dst, kind="stable")
     src, dst = src[order], dst[order]
-    if np.all(dst[1:] != dst[:-1]):
-        return _reach_one(out, step_ok, src, dst)
+    rank = np.arange(dst.size) - np.searchsorted(dst, dst)  # k-th jump into its frame
+    if rank.size == 0 or rank.max() < SPARSE_JUMPS:
+        return _reach_few(out, step_ok, [(src[rank == k], dst[rank == k]) for k in range(SPARSE_JUMPS)])
     if dst.size:
         heads = np.flatnonzero(np.concatenate([[True], dst[1:] != dst[:-1]]))
         targets = dst[heads]
@@ -311,19 +316,24 @@ def _reach(cw: _Clip, start: int, steps: int, jumps: tuple[np.ndarray, np.ndarra
     return out
 
 
-def _reach_one(out: np.ndarray, step_ok: np.ndarray, src: np.ndarray, dst: np.ndarray) -> np.ndarray:
-    """:func:`_reach` when at most one jump enters each frame: no grouping, two gathers a row."""
+def _reach_few(out: np.ndarray, step_ok: np.ndarray, layers: list) -> np.ndarray:
+    """:func:`_reach` when few jumps enter each frame: ``layers[k]`` holds the k-th jump into
+    each frame (at most one per frame), so a row is one gather per layer, with no grouping."""
     n = out.shape[1]
-    src_of = np.full(n, n)  # the jump into each frame, n (a frame that is never reached) if none
-    src_of[dst] = src
+    src_of = []
+    for src, dst in layers:
+        s = np.full(n, n)  # the jump into each frame, n (a frame that is never reached) if none
+        s[dst] = src
+        src_of.append(s)
     prev_x = np.full(n + 1, _NEVER, dtype=np.int16)
     for c in range(1, out.shape[0]):
         prev_x[:n] = out[c - 1]
-        via = prev_x[src_of]
-        np.add(via, 1, out=via, where=via < _NEVER)
         cur = out[c]
         np.copyto(cur[1:], prev_x[: n - 1], where=step_ok)  # the row starts all _NEVER
-        np.minimum(cur, via, out=cur)
+        for s in src_of:
+            via = prev_x[s]
+            np.add(via, 1, out=via, where=via < _NEVER)
+            np.minimum(cur, via, out=cur)
     return out
 
 
@@ -429,9 +439,27 @@ def _choose(reach: np.ndarray, need_c: np.ndarray, ex: np.ndarray, steps: int, w
     return best
 
 
+JUMP_FRAMES = 8
+"""What a jump costs a walk through a pool, in frames: a pool of many takes offers a jump almost
+everywhere, and the walk with the fewest frames can jump on every frame; each jump is a blend
+(8 frames by default in :mod:`.synthesis`), so a walk through a pool minimises frames plus this
+many per jump."""
+
+
 def _quick_exit(cw: _Clip, start: int, exits: list[int], name: str) -> tuple[list[tuple[int, int, int]], int, int]:
-    """The shortest walk to the nearest exit (a breadth-first search with the loop guard)."""
+    """The cheapest walk to an exit: frames plus :data:`JUMP_FRAMES` per jump, over the cheapest
+    jump into each frame; the shortest walk (a breadth-first search with the loop guard) when
+    nothing cheaper is found."""
     frames, r = _path(cw, start, exits, name)
+    jumps = sum(b != a + 1 for a, b in zip(frames[:-1], frames[1:]))
+    rows = len(frames) + JUMP_FRAMES * jumps  # no longer walk can cost less
+    ex = np.asarray(exits, dtype=np.int64)
+    reach = _reach(cw, start, rows, cw.sparse)
+    count = reach[:, ex].astype(np.int64)
+    cost = np.where(count < _NEVER, np.arange(1, rows + 1)[:, None] + JUMP_FRAMES * count, np.iinfo(np.int64).max)
+    c, k = np.unravel_index(int(np.argmin(cost)), cost.shape)  # shortest first, then the first exit
+    if cost[c, k] < len(frames) + JUMP_FRAMES * jumps:
+        frames, r = _backtrack(cw, reach, int(c), int(ex[k]), cw.sparse), int(k)
     return _runs(cw, frames), r, len(frames)
 
 
