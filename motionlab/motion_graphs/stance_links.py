@@ -20,8 +20,9 @@ back. Each direction becomes a structure-table link
 in ``A``'s pool, ``enter`` in ``B``'s, ``pieces: []``, ``frames: 0``), so the search
 (:mod:`.search`) uses them like any other link.
 
-Which pools are compared (:func:`pool_pairs`): every two styles of one behaviour, and the
-styles of one name in two behaviours (every two styles when the behaviours share no style name)
+Which pools are compared (:func:`pool_pairs`): every two styles of one standing action (a
+gait's styles meet in their interpolation space, as the paper prescribes), and the styles of
+one name in two behaviours (every two styles when the behaviours share no style name)
 that no recorded transition clip joins in that direction (recorded clips stay preferred, as
 the paper prescribes); a search changes style inside a behaviour and behaviour at one style.
 
@@ -47,13 +48,18 @@ PORT_TAKES = 1000
 the number of styles, not of takes, as the ring of neighbours keeps it linear inside a style."""
 
 
-def pool_pairs(keys: Sequence[Key], recorded: set[tuple[str, str]]) -> list[tuple[Key, Key, bool, bool]]:
+def pool_pairs(
+    keys: Sequence[Key], recorded: set[tuple[str, str]], kinds: Mapping[Key, str | None] | None = None
+) -> list[tuple[Key, Key, bool, bool]]:
     """Pools to compare, as ``(a, b, a_to_b, b_to_a)`` (which directions may be linked).
 
     Parameters
     ----------
     keys : ``(behaviour, style)`` of every pool
     recorded : ordered behaviour pairs ``(b1, b2)`` that a recorded transition clip joins
+    kinds : ``"gait"`` or ``"action"`` of every pool (default: all actions); two styles of one
+        behaviour are compared only when both are actions (a gait's styles meet in their
+        interpolation space, as the paper prescribes)
 
     Returns
     -------
@@ -63,8 +69,11 @@ def pool_pairs(keys: Sequence[Key], recorded: set[tuple[str, str]]) -> list[tupl
     for b, s in keys:
         styles.setdefault(b, set()).add(s)
     out = []
+    kinds = kinds or {}
     for a, b in itertools.combinations(sorted(keys), 2):
         same = a[0] == b[0]
+        if same and "gait" in (kinds.get(a), kinds.get(b)):
+            continue
         if not same and a[1] != b[1] and styles[a[0]] & styles[b[0]]:
             continue  # two behaviours that share style names are joined style by style
         fwd = same or (a[0], b[0]) not in recorded

@@ -14,15 +14,24 @@ and with its ``neighbours`` next takes in take order, cyclically (:func:`_ring_p
 work grows linearly with the number of takes and the ring joins them all; takes of one style are
 similar by construction, so they meet at many frames.
 
-**Between behaviours** only recorded transition clips ``B1_s1_to_B2_s2`` are used. A
+**Between behaviours** recorded transition clips ``B1_s1_to_B2_s2`` come first. A
 transition clip is compared with the takes of its two endpoint styles only (never with
 everything, as a standard graph would): entries ``A_i → T_{j+1}`` into the first half of ``T``,
 exits ``T_k → B_{l+1}`` from the second half, so a route always plays the recorded change.
+Where no clip records a change, *stance links* (:mod:`.stance_links`) join two behaviours
+wherever their stances match, under the same threshold.
+
+**Gaits and standing actions.** Every take is classified from its motion (:mod:`.segments`):
+a gait is cut into whole cycles, a standing action into segments between its stances, and the
+ends of every take of a style are compared with the ends of every other take of it, so that
+takes connect stance to stance. The styles of a standing action meet at their stances (stance
+links); a gait's styles meet in their interpolation space.
 
 **Between styles of one behaviour** an interpolation space bridges the gap
 (:mod:`~motionlab.motion_graphs.registration`), built from *representative cycles*: the take
-with most whole cycles (:mod:`.cycles`) represents its style, the same number of whole cycles
-of both styles (at most ``rep_cycles``, from the middle of the take) are registered by DTW and
+with most whole cycles (:mod:`.cycles`; whole segments for a standing action) represents its
+style, the same number of whole cycles of both styles (at most ``rep_cycles``, from the middle
+of the take) are registered by DTW and
 blended into intermediate motions M1…M4 at weights 0.2…0.8, and transitions are searched only
 between neighbours S1–M1, M1–M2, …, M4–S2. Which style pairs are bridged is a choice
 (``style_pairs``): ``"hub"`` links every style with the reference style (default ``normal``),
@@ -527,7 +536,8 @@ def build_structured(
     # ---- stance links: Kovar transitions between the ports of styles and behaviours
     t_stance = time.perf_counter()
     recorded = {(link["from"][0], link["to"][0]) for link in table["links"] if link["via"] != "interpolation"}
-    pairs = _stance_links.pool_pairs(list(pools), recorded)
+    kinds = {(b, s): cell["kind"] for b, cells in table["behaviours"].items() for s, cell in cells.items()}
+    pairs = _stance_links.pool_pairs(list(pools), recorded, kinds)
     links, (src, dst, cost), n_cmp = _stance_links.link_pools(graph, pairs, ports, pool_start, threshold, window)
     comparisons += n_cmp
     graph.add_edges(src, dst, cost, "transition")

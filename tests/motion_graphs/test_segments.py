@@ -100,6 +100,10 @@ def test_pool_pairs_prefer_recorded_transitions():
     assert pairs[(("walk", "normal"), ("walk", "sad"))] == (True, True)  # styles of one behaviour
     assert pairs[(("walk", "normal"), ("wave", "normal"))] == (False, True)  # walk -> wave is recorded
     assert (("walk", "normal"), ("wave", "sad")) not in pairs  # across behaviours: style by style
+    kinds = {k: ("gait" if k[0] == "walk" else "action") for k in keys}
+    pairs = {(a, b) for a, b, _, _ in stance_links.pool_pairs(keys, set(), kinds)}
+    assert (("walk", "normal"), ("walk", "sad")) not in pairs  # a gait's styles meet by interpolation
+    assert (("wave", "normal"), ("wave", "sad")) in pairs and (("walk", "sad"), ("wave", "sad")) in pairs
 
 
 @pytest.fixture(scope="module")
