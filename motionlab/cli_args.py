@@ -22,12 +22,9 @@ __all__ = ["positive", "non_negative", "positive_int", "non_negative_int", "chec
 
 def _number(text: str) -> float:
     try:
-        value = float(text)
+        return float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not math.isfinite(value):
-        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
-    return value
 
 
 def _whole(text: str) -> int:
@@ -40,7 +37,7 @@ def _whole(text: str) -> int:
 def positive(text: str) -> float:
     """argparse type: a finite number > 0 (``0``, ``-1.7``, ``nan`` refused)."""
     value = _number(text)
-    if not value > 0:
+    if not (math.isfinite(value) and value > 0):
         raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
     return value
 
@@ -48,7 +45,7 @@ def positive(text: str) -> float:
 def non_negative(text: str) -> float:
     """argparse type: a finite number >= 0 (``-1``, ``nan`` refused)."""
     value = _number(text)
-    if value < 0:
+    if not (math.isfinite(value) and value >= 0):
         raise argparse.ArgumentTypeError(f"expected 0 or a positive number, got {text!r}")
     return value
 
