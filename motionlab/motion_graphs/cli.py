@@ -76,6 +76,8 @@ def _load_graph(path: str):
 def _build_outputs(args: argparse.Namespace) -> tuple[Path, Path | None]:
     """The graph file and the report file, checked before any work."""
     out = Path(args.output)
+    if out.is_dir():  # before '.mlgraph' is added: -o FOLDER must not write FOLDER.mlgraph beside it
+        raise CLIError(f"-o {out} is a folder; expected a graph file name, such as {out / 'graph.mlgraph'}")
     if out.suffix == "":
         out = out.with_suffix(".mlgraph")
     if args.report and args.standard:

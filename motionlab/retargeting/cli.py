@@ -204,6 +204,11 @@ def _cmd_train(args) -> int:
 
 
 # ---------------------------------------------------------------------------- evaluate
+def _fold_path(path: Path, k: int, folds: int) -> Path:
+    """The checkpoint of fold ``k`` (0-based) of ``folds``: ``path`` itself when there is one fold."""
+    return path if folds == 1 else path.with_name(f"{path.stem}_fold{k + 1}of{folds}{path.suffix}")
+
+
 def _cmd_evaluate(args) -> int:
     from motionlab import data as mdata
     from motionlab.core import bvh
@@ -238,9 +243,11 @@ def _cmd_evaluate(args) -> int:
         raise _error(f"--folds {args.folds} is more than the {len(animations)} animations evaluated")
     # leave animations out: fold k is evaluated by a network trained without the fold's animations
     folds = [animations[k :: args.folds] for k in range(args.folds)]
+    fold_paths = [_fold_path(path, k, args.folds) for k in range(args.folds)]
+    trained = [("--checkpoint", p) for p in fold_paths if args.retrain or not p.is_file()]
+    check_outputs(trained, force=True, inputs=[("--csv", args.csv)])  # a checkpoint to train is written later
     result = Evaluation(rows=[])
-    for k, fold in enumerate(folds):
-        fpath = path if args.folds == 1 else path.with_name(f"{path.stem}_fold{k + 1}of{args.folds}{path.suffix}")
+    for fold, fpath in zip(folds, fold_paths):
         if fpath.is_file() and not args.retrain:
             ckpt = _load_checkpoint(str(fpath), args.device)
             if not args.quiet:
