@@ -17,7 +17,7 @@ import tempfile
 from pathlib import Path
 
 import pytest
-from hypothesis import HealthCheck, event, given, settings
+from hypothesis import HealthCheck, event, example, given, settings
 from hypothesis import strategies as st
 
 from motionlab import cli, synthetic
@@ -44,9 +44,7 @@ _WORK = (  # where each command's long work begins
     "motionlab.synthetic.sequence",
     "motionlab.core.motion.Motion.resample",
     "motionlab.demo.run_demo",
-    "motionlab.motion_graphs.clips.synthetic_library",
     "motionlab.motion_graphs.clips.load_folder",
-    "motionlab.motion_graphs.search.search",
     "motionlab.interpolation.detect.detect",
     "motionlab.interpolation.gaps.fill",
     "motionlab.viz.export.save_movie",
@@ -112,20 +110,25 @@ def _resolve(dotted: str):
         return getattr(importlib.import_module(module), name)
 
 
-BASE = {  # an argument list each command accepts, to which random options are added
-    "info": ["in.bvh"],
-    "convert": ["in.bvh", "-o", "out.bvh"],
-    "synth": ["walk", "-o", "out.bvh"],
-    "demo": ["--out", "new_dir"],
-    "expand": ["in.bvh", "--preset", "child", "-o", "new_dir"],
-    "retarget": ["in.bvh", "--scale-legs", "1.2", "-o", "out.bvh"],
-    "train": ["in.bvh", "-o", "out.pt"],
-    "evaluate": ["--data", "dir", "--animations", "walk_normal", "--checkpoint", "out.pt"],
-    "graph-build": ["--synthetic", "-o", "out.mlgraph"],
-    "graph-search": ["g.mlgraph", "--request", "walk:normal:30", "-o", "out.bvh"],
-    "graph-info": ["g.mlgraph"],
-    "fill-gaps": ["in.bvh", "-o", "out.bvh"],
-    "view": ["in.bvh", "--out", "out.gif"],
+BASE = {  # (inputs, options) each command accepts, to which random options are added
+    "info": (["in.bvh"], []),
+    "convert": (["in.bvh"], ["-o", "out.bvh"]),
+    "synth": (["walk"], ["-o", "out.bvh"]),
+    "demo": ([], ["--out", "new_dir"]),
+    "expand": (["in.bvh"], ["--preset", "child", "-o", "new_dir"]),
+    "retarget": (["in.bvh"], ["--scale-legs", "1.2", "-o", "out.bvh"]),
+    "train": (["in.bvh"], ["-o", "out.pt"]),
+    "evaluate": ([], ["--data", "dir", "--animations", "walk_normal", "--checkpoint", "out.pt"]),
+    "graph-build": ([], ["--synthetic", "-o", "out.mlgraph"]),
+    "graph-search": (["g.mlgraph"], ["--request", "walk:normal:30", "-o", "out.bvh"]),
+    "graph-info": (["g.mlgraph"], []),
+    "fill-gaps": (["in.bvh"], ["-o", "out.bvh"]),
+    "view": (["in.bvh"], ["--out", "out.gif"]),
+}
+
+EXAMPLES = {  # the cases of issue 34 that once wrote what they should not have
+    "graph-build": [([], ["--synthetic", "-o", "out.mlgraph", "--report", "out.mlgraph"])],
+    "graph-search": [(["g.mlgraph"], ["--request", "walk:normal:30", "-o", "g.mlgraph", "--force"])],
 }
 
 
@@ -138,47 +141,67 @@ def _option(draw, action: argparse.Action) -> list[str]:
 
 
 @st.composite
-def _argv(draw, command: str) -> list[str]:
-    """A random argument list for ``command``: half the time an accepted list with up to three
-    random options added, else every positional and a random subset of options, all random."""
+def _argv(draw, command: str) -> tuple[list[str], list[str]]:
+    """``(argv, inputs)``: a random argument list for ``command`` and its positional arguments (the
+    files it reads). Half the time an accepted list with up to three random options added, else
+    every positional and a random subset of options, all random."""
     actions = [a for a in COMMANDS[command]._actions if not isinstance(a, argparse._HelpAction)]
     options = [a for a in actions if a.option_strings]
     if command in BASE and draw(st.booleans()):
-        argv = [command, *BASE[command]]
+        inputs, argv = BASE[command][0], [command, *BASE[command][0], *BASE[command][1]]
         for _ in range(draw(st.integers(1 if options else 0, 3 if options else 0))):
             argv += _option(draw, draw(st.sampled_from(options)))
-        return argv
-    argv = [command]
+        return argv, inputs
+    argv, inputs = [command], []
     for action in actions:
         if action.option_strings:
             if action.required or draw(st.integers(0, 3)) == 0:
                 argv += _option(draw, action)
             continue
         n = {None: 1, "?": draw(st.integers(0, 1)), "*": draw(st.integers(0, 2)), "+": draw(st.integers(1, 2))}
-        argv += [draw(_values(action)) for _ in range(n.get(action.nargs, 1))]
-    return argv
+        inputs += [draw(_values(action)) for _ in range(n.get(action.nargs, 1))]
+    return argv[:1] + inputs + argv[1:], inputs
 
 
 @pytest.fixture(scope="module")
-def graph(tmp_path_factory) -> bytes:
-    """A small motion graph file (the synthetic clips)."""
+def graph_parts(tmp_path_factory) -> tuple[bytes, list]:
+    """A small motion graph file and the synthetic clips it was built from (30 fps)."""
+    from motionlab.motion_graphs import clips
+
     path = tmp_path_factory.mktemp("fuzz") / "g.mlgraph"
     assert cli.main(["graph-build", "--synthetic", "-o", str(path)]) == 0
-    return path.read_bytes()
+    return path.read_bytes(), clips.synthetic_library(fps=30.0)
+
+
+def _check(argv, inputs, code, err, before, after) -> None:
+    """The contract of every command, whatever its arguments."""
+    assert "Traceback" not in err
+    assert code in (0, 2, None), (argv, code, err)
+    if code in (2, None):  # refused, or work began: every output was checked and nothing written yet
+        assert after == before, (argv, err)
+    if "--force" not in argv:
+        assert all(after.get(k) == v for k, v in before.items()), argv  # nothing replaced
+    changed = [k for k in inputs if k in before and after.get(k) != before[k]]
+    assert not changed, (argv, changed)  # a file the command reads is never written, --force or not
+    assert not [k for k in after if k.endswith((".tmp", ".motionlab-tmp"))], argv
 
 
 @pytest.mark.parametrize("command", sorted(COMMANDS))
-def test_every_command_ends_cleanly_on_random_arguments(command, graph, monkeypatch, capsys):
+def test_every_command_ends_cleanly_on_random_arguments(command, graph_parts, monkeypatch, capsys):
     clip = bvh.dumps(synthetic.generate("walk", humanoid.canonical_skeleton(), num_frames=12, fps=30, seed=0))
+    graph, library = graph_parts
     for target in _WORK:
         owner, attr = target.rsplit(".", 1)
         monkeypatch.setattr(_resolve(owner), attr, _stop)
+    # graph-build builds for real, from the small library whatever --fps says
+    monkeypatch.setattr("motionlab.motion_graphs.clips.synthetic_library", lambda **kwargs: list(library))
     monkeypatch.setattr("motionlab.viz.backend.has_display", lambda: False)
     here = os.getcwd()
 
     @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
-    @given(argv=_argv(command))
-    def run(argv):
+    @given(case=_argv(command))
+    def run(case):
+        argv, inputs = case
         with tempfile.TemporaryDirectory() as name:
             folder = Path(name)
             _sandbox(folder, clip, graph)
@@ -193,16 +216,9 @@ def test_every_command_ends_cleanly_on_random_arguments(command, graph, monkeypa
             finally:
                 os.chdir(here)
             err = capsys.readouterr().err
-            after = _snapshot(folder)
             event({0: "exit 0", 2: "refused (exit 2)", None: "work began"}.get(code, f"exit {code}"))
-            assert "Traceback" not in err
-            assert code in (0, 2, None), (argv, code, err)
-            if code == 2:
-                assert after == before, (argv, err)  # a refusal writes nothing
-            if code is None:  # work began: every output was checked, nothing written yet
-                assert after == before, argv
-            if "--force" not in argv:
-                assert all(after.get(k) == v for k, v in before.items()), argv  # nothing replaced
-            assert not [k for k in after if k.endswith((".tmp", ".motionlab-tmp"))], argv
+            _check(argv, inputs, code, err, before, _snapshot(folder))
 
+    for inputs, options in EXAMPLES.get(command, []):
+        run = example(case=([command, *inputs, *options], inputs))(run)
     run()
