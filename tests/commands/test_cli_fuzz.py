@@ -61,7 +61,7 @@ RANDOM = st.one_of(
     st.sampled_from(NAMES),
     st.sampled_from(NUMBERS),
     st.integers(-10, 10**6).map(str),
-    st.text("abcxyz019:,./_=-", max_size=12),
+    st.text("abcxyz019:,._=-", max_size=12),  # no "/": a path never leaves the sandbox
 )
 GOOD_INTS = st.sampled_from(["1", "2", "3", "10"])
 GOOD_FLOATS = st.sampled_from(["0.5", "1", "0.03", "30", "1.2"])
