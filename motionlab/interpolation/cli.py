@@ -70,7 +70,7 @@ def register(subparsers) -> None:
     p.set_defaults(func=run_fill_gaps)
 
 
-def _graph(actions: list[str], allow: list[str]):
+def _graph(actions: list[str], allow: list[str], src: Path, motion):
     from motionlab.cli import CLIError
     from motionlab.core import bvh
     from motionlab.interpolation.action_graph import ActionGraph, GraphError
@@ -84,7 +84,9 @@ def _graph(actions: list[str], allow: list[str]):
         name, path = item.split("=", 1)
         if not Path(path).is_file():
             raise CLIError(f"--action {name}: no such file {path!r}")
-        g.add_node(name.strip(), bvh.load(path))
+        clip = bvh.load(path)
+        _check_rig(f"--action {name}={path}", clip, src, motion)
+        g.add_node(name.strip(), clip)
     try:
         if allow:
             g.allow(allow)
@@ -126,23 +128,30 @@ def _takes(paths: list[str], src: Path, motion):
             clips.append(bvh.load(p))
         except bvh.BVHError as e:
             raise CLIError(f"--takes {p}: {e}") from None
-        _check_take(p, clips[-1], src, motion)
+        _check_rig(f"--takes {p}", clips[-1], src, motion)
+        _check_rate(p, clips[-1], src, motion)
     try:
         return RecordedTakes(clips)
     except ValueError as e:
         raise CLIError(f"--takes: {e}") from None
 
 
-def _check_take(path: Path, take, src: Path, motion) -> None:
-    """Refuse a ``--takes`` file on another rig or at another frame rate than the input."""
+def _check_rig(what: str, clip, src: Path, motion) -> None:
+    """Refuse a clip (``what``: the option and file that named it) on another rig than the input."""
     from motionlab.cli import CLIError
 
-    if tuple(take.skeleton.names) != tuple(motion.skeleton.names):
-        sk, mine = take.skeleton, motion.skeleton
+    if tuple(clip.skeleton.names) != tuple(motion.skeleton.names):
+        sk, mine = clip.skeleton, motion.skeleton
         raise CLIError(
-            f"--takes {path}: another rig than the input {src} (root {sk.names[0]!r}, {sk.num_joints} joints; "
-            f"the input: root {mine.names[0]!r}, {mine.num_joints} joints); give takes recorded on the input's rig"
+            f"{what}: another rig than the input {src} (root {sk.names[0]!r}, {sk.num_joints} joints; "
+            f"the input: root {mine.names[0]!r}, {mine.num_joints} joints); give clips recorded on the input's rig"
         )
+
+
+def _check_rate(path: Path, take, src: Path, motion) -> None:
+    """Refuse a ``--takes`` file at another frame rate than the input."""
+    from motionlab.cli import CLIError
+
     if abs(take.fps - motion.fps) > 1e-6 * motion.fps:
         raise CLIError(
             f"--takes {path} is at {take.fps:g} fps, the input {src} at {motion.fps:g} fps; give takes at "
@@ -229,7 +238,7 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
         motion = bvh.load(src)
     except bvh.BVHError as e:
         raise CLIError(str(e)) from None
-    graph = _graph(args.action, args.allow) if args.method == "graph" else None
+    graph = _graph(args.action, args.allow, src, motion) if args.method == "graph" else None
     if args.times is not None:
         missing = _times_gaps(args.times, src, motion)
     else:

@@ -156,7 +156,7 @@ def characters(*specs: str, presets: Iterable[str] = ()) -> list[Character]:
             sk = humanoid.to_canonical_skeleton(bvh.load(p).skeleton)
             out.append(Character(name, sk, str(p)))
         except _ERRORS as err:
-            out.append(Character(name, None, str(p), _why(err, p)))
+            out.append(Character(name, None, str(p), _why(err, "character", p)))
     for spec in presets:
         name, factors = _preset(spec)
         out.append(Character(name, humanoid.scale_bones(humanoid.canonical_skeleton(), **factors), f"preset:{spec}"))
@@ -169,13 +169,12 @@ def characters(*specs: str, presets: Iterable[str] = ()) -> list[Character]:
     return out
 
 
-def _why(err: Exception, path) -> str:
-    """What went wrong with a file, in words a command-line user can act on."""
+def _why(err: Exception, role: str, path) -> str:
+    """What went wrong with the ``role`` (character, source) file ``path``, in words a command-line user can act on."""
     if isinstance(err, humanoid.RigMappingError):  # its Python hint (profile=...) has no command-line form
-        return (
-            f"{type(err).__name__}: {err.reason} Its joint names must follow one of the rig profiles "
-            f"{', '.join(humanoid.PROFILES)}; `motionlab info {path} --joints` lists its joints."
-        )
+        from motionlab.cli import rig_error
+
+        return f"{type(err).__name__}: {rig_error(err, role, path)}"
     return f"{type(err).__name__}: {err}"
 
 
@@ -535,7 +534,7 @@ def _load_pairs(todo, checkpoint, solver, rows, result):
             prepared = prepare_source(motion, checkpoint, "full", solver)
         except _ERRORS as err:
             for c in chars:
-                rows[(c.name, clip)] = _error_row(clip, c.name, str(path), c.origin, _why(err, path))
+                rows[(c.name, clip)] = _error_row(clip, c.name, str(path), c.origin, _why(err, "source", path))
                 result.failed += 1
             continue
         pos = prepared.motion.global_positions()

@@ -209,6 +209,19 @@ def test_fill_gaps_takes_on_another_rig_names_the_file(walk, tmp_path, capsys):
     assert not out.exists()
 
 
+def test_fill_gaps_action_on_another_rig_and_takes_at_another_rate_name_the_file(walk, tmp_path, capsys):
+    other = tmp_path / "other_rig.bvh"
+    other.write_text(walk.read_text().replace("Hips", "Pelvis"))
+    out = tmp_path / "out.bvh"
+    code, _, err = _run(capsys, "fill-gaps", walk, "-o", out, "--method", "graph", "--action", f"walk={other}")
+    assert code == 2 and f"--action walk={other}" in err and "rig" in err
+    fast = tmp_path / "fast.bvh"
+    bvh.save(fast, bvh.load(walk).resample(60))
+    code, _, err = _run(capsys, "fill-gaps", walk, "-o", out, "--takes", fast)
+    assert code == 2 and f"--takes {fast} is at 60 fps" in err and f"motionlab convert {fast}" in err
+    assert not out.exists()
+
+
 def test_graph_search_frame_limit_in_command_line_words(tmp_path, capsys):
     g = tmp_path / "g.mlgraph"
     assert _run(capsys, "graph-build", "--synthetic", "-o", g)[0] == 0
