@@ -74,6 +74,8 @@ def _error(message: str) -> Exception:
 
 def _check_folder(option: str, path: Path, folder: Path) -> None:
     """``folder`` (where ``path`` goes) exists and takes new files."""
+    if folder.exists() and not folder.is_dir():
+        raise _error(f"{option} {path}: {folder} is a file, not a folder; choose a file name in a folder")
     if not folder.is_dir():
         raise _error(f"{option} {path}: the folder {folder} does not exist; create it or choose another folder")
     if not os.access(folder, os.W_OK | os.X_OK):

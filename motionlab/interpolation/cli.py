@@ -220,7 +220,10 @@ def _check_args(args: argparse.Namespace):
         except ValueError as e:
             raise CLIError(str(e)) from None
     if args.times is not None and (args.takes or delta is not None):
-        raise CLIError("--times gives the gaps and their counts; --takes and --delta would not be used")
+        raise CLIError(
+            "--times gives the gaps and their counts, so --takes and --delta would not be used; "
+            "give --times alone, or leave it out"
+        )
     src = files.check_input(args.input)
     inputs = [("input", src), ("--times", args.times)] + [("--takes", t) for t in args.takes]
     inputs += [("--action", a.split("=", 1)[1]) for a in args.action if "=" in a]
