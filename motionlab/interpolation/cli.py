@@ -23,7 +23,9 @@ given by ``--root`` (``stride``: the strides' root path where one side repeats, 
 a Hermite curve with the velocities on both sides; ``linear``: the LaFAN1 baseline).
 Where the capture logged each frame's time, ``--times FILE`` (one time in seconds per frame,
 :func:`motionlab.interpolation.gaps.load_times`) gives the gaps and their counts exactly
-(:func:`~motionlab.interpolation.gaps.timestamp_gaps`): no rule, no estimate.
+(:func:`~motionlab.interpolation.gaps.timestamp_gaps`): no rule, no estimate. The times are
+checked against the file's ``Frame Time`` first: times in another unit (milliseconds), or ones
+that would make the clip more than :data:`MAX_GROWTH` times longer, are refused.
 A clean clip (nothing found) is copied byte for byte. A report lists every gap and how it was
 filled.
 """
