@@ -156,7 +156,7 @@ def characters(*specs: str, presets: Iterable[str] = ()) -> list[Character]:
             sk = humanoid.to_canonical_skeleton(bvh.load(p).skeleton)
             out.append(Character(name, sk, str(p)))
         except _ERRORS as err:
-            out.append(Character(name, None, str(p), f"{type(err).__name__}: {err}"))
+            out.append(Character(name, None, str(p), _why(err, "character", p)))
     for spec in presets:
         name, factors = _preset(spec)
         out.append(Character(name, humanoid.scale_bones(humanoid.canonical_skeleton(), **factors), f"preset:{spec}"))
@@ -167,6 +167,15 @@ def characters(*specs: str, presets: Iterable[str] = ()) -> list[Character]:
     for n in names:
         _check_name(n, "character")
     return out
+
+
+def _why(err: Exception, role: str, path) -> str:
+    """What went wrong with the ``role`` (character, source) file ``path``, in words a command-line user can act on."""
+    if isinstance(err, humanoid.RigMappingError):  # its Python hint (profile=...) has no command-line form
+        from motionlab.cli import rig_error
+
+        return f"{type(err).__name__}: {rig_error(err, role, path)}"
+    return f"{type(err).__name__}: {err}"
 
 
 def _check_name(name: str, what: str) -> None:
@@ -222,7 +231,10 @@ _MODE = _umask_mode()  # what open() would give a new file (mkstemp makes them p
 
 
 def _write_atomic(path: Path, text: str) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    except OSError as e:  # name the file the user knows, not the temporary one
+        raise type(e)(f"cannot write {path}: {(e.strerror or str(e)).lower()}") from None
     try:
         with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
             f.write(text)
@@ -288,12 +300,12 @@ class ExpandResult:
             rs = [r for r in self.rows if r["character"] == name]
             ok = [r for r in rs if r["status"] == "ok"]
 
-            def mean(key, ok=ok):
-                return float(np.mean([float(r[key]) for r in ok])) if ok else float("nan")
+            def mean(key, width, digits, ok=ok):  # "-" where no pair succeeded: no mean to show
+                return f"{np.mean([float(r[key]) for r in ok]):>{width}.{digits}f}" if ok else f"{'-':>{width}}"
 
             lines.append(
                 f"{name:<18} {len(ok):>4} {len(rs) - len(ok):>4} {sum(1 for r in ok if r['flag']):>4} "
-                f"{mean('steps'):>6.1f} {mean('loss'):>8.4f} {mean('penetration_cm'):>7.3f} {mean('skating_cm_s'):>10.2f}"
+                f"{mean('steps', 6, 1)} {mean('loss', 8, 4)} {mean('penetration_cm', 7, 3)} {mean('skating_cm_s', 10, 2)}"
             )
         lines.append(
             f"this run: {self.done} solved, {self.skipped} already done, {self.failed} failed; "
@@ -522,7 +534,7 @@ def _load_pairs(todo, checkpoint, solver, rows, result):
             prepared = prepare_source(motion, checkpoint, "full", solver)
         except _ERRORS as err:
             for c in chars:
-                rows[(c.name, clip)] = _error_row(clip, c.name, str(path), c.origin, f"{type(err).__name__}: {err}")
+                rows[(c.name, clip)] = _error_row(clip, c.name, str(path), c.origin, _why(err, "source", path))
                 result.failed += 1
             continue
         pos = prepared.motion.global_positions()
