@@ -8,5 +8,6 @@ cd "$(dirname "$0")/.."
 PY=${PYTHON:-$( [ -x .venv/bin/python ] && echo .venv/bin/python || echo python3 )}
 rm -rf docs/api/generated docs/generated
 bash scripts/vendor_three.sh   # three.js for the web players (npm, once; reused while its version stays)
-"$PY" -m sphinx -W --keep-going -q -b html docs docs/_build/html "$@"
+# the doctree cache goes beside the site, not into it (it is not part of what is published)
+"$PY" -m sphinx -W --keep-going -q -b html -d docs/_build/doctrees docs docs/_build/html "$@"
 echo "site: docs/_build/html/index.html"
