@@ -3,7 +3,11 @@ composition in ``tests/gltf_reader.py``) and must put the joints where motionlab
 
 from __future__ import annotations
 
+import json
+import shutil
 import struct
+import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -135,3 +139,36 @@ def test_real_bandai_namco_clip_matches_fk(tmp_path):
     g = assert_glb_matches(gltf.save(tmp_path / "bn.glb", motion), motion)
     assert read(tmp_path / "bn.glb").animations[0].extras["fps"] == pytest.approx(motion.fps)
     assert sum(c.target.path == "translation" for c in g.animations[0].channels) == motion.skeleton.num_joints
+
+
+THREE_PACKAGE = Path(__file__).resolve().parents[2] / "build" / "web-npm" / "node_modules" / "three"
+
+
+def _threejs_positions(path: Path, times) -> np.ndarray:
+    """World joint positions (len(times), J, 3) that three.js's GLTFLoader and AnimationMixer compute."""
+    if shutil.which("node") is None or not (THREE_PACKAGE / "package.json").is_file():
+        pytest.skip("needs node and three.js from npm: bash scripts/vendor_three.sh (the docs build runs it)")
+    script = Path(__file__).with_name("gltf_threejs.mjs")
+    run = subprocess.run(
+        ["node", str(script), str(THREE_PACKAGE), str(path), *(repr(float(t)) for t in times)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert run.returncode == 0, run.stderr
+    return np.array(json.loads(run.stdout)["positions"])
+
+
+@pytest.mark.parametrize("source", ["synthetic", "mixamo", "bandai_namco"])
+def test_threejs_puts_the_joints_where_fk_does(walk, tmp_path, source):
+    if source == "mixamo":
+        motion = bvh.load(sorted(require_data("mixamo", "Aj").glob("*.bvh"))[0])
+    elif source == "bandai_namco":
+        motion = bvh.load(sorted(require_data("bandai_namco").rglob("*.bvh"))[0])
+    else:
+        motion = walk
+    path = gltf.save(tmp_path / "clip.glb", motion)
+    frames = sorted({0, motion.num_frames // 2, motion.num_frames - 1})
+    got = _threejs_positions(path, [k / motion.fps for k in frames])
+    err = np.abs(got - motion.global_positions()[frames]).max()
+    assert err <= 1e-4 * motion.skeleton.height(), f"three.js joints {err:.3g} m from FK"
