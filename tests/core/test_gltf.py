@@ -172,3 +172,26 @@ def test_threejs_puts_the_joints_where_fk_does(walk, tmp_path, source):
     got = _threejs_positions(path, [k / motion.fps for k in frames])
     err = np.abs(got - motion.global_positions()[frames]).max()
     assert err <= 1e-4 * motion.skeleton.height(), f"three.js joints {err:.3g} m from FK"
+
+
+@pytest.mark.parametrize("source", ["synthetic", "bandai_namco"])
+def test_blender_imports_the_joints_where_fk_does(walk, tmp_path, source):
+    """Blender's own glTF importer (skipped where Blender is not installed; Z-up inside Blender)."""
+    if shutil.which("blender") is None:
+        pytest.skip("needs Blender on PATH (Debian: apt-get install blender python3-numpy)")
+    motion = walk if source == "synthetic" else bvh.load(sorted(require_data("bandai_namco").rglob("*.bvh"))[0])
+    path = gltf.save(tmp_path / "clip.glb", motion)
+    frames = sorted({0, motion.num_frames // 2, motion.num_frames - 1})
+    script, out = Path(__file__).with_name("gltf_blender.py"), tmp_path / "blender.json"
+    run = subprocess.run(
+        ["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python", str(script), "--",
+         str(path), repr(motion.fps), str(out), *map(str, frames)],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    result = json.loads(out.read_text())
+    z_up = np.array(result["positions"])
+    got = np.stack([z_up[..., 0], z_up[..., 2], -z_up[..., 1]], axis=-1)  # Blender (x, y, z) = glTF (x, -z, y)
+    order = [motion.skeleton.names.index(n) for n in result["names"]]
+    err = np.abs(got - motion.global_positions()[frames][:, order]).max()
+    assert err <= 1e-4 * motion.skeleton.height(), f"Blender {result['blender']}: joints {err:.3g} m from FK"
