@@ -77,7 +77,14 @@ html_theme_options = {
     "use_download_button": True,
     "home_page_in_toc": True,
 }
-html_static_path: list[str] = []
+# three.js for the web players in notebook outputs (motionlab.viz.web): scripts/build_docs.sh vendors
+# it from npm (scripts/vendor_three.sh) into build/web/three.min.js, one classic script that defines
+# window.THREE, copied into _static/ and loaded on every page, so players work from file:// offline.
+_THREE = ROOT / "build" / "web" / "three.min.js"
+if not _THREE.is_file():
+    raise FileNotFoundError(f"{_THREE} is missing: build the site with scripts/build_docs.sh (it runs vendor_three.sh)")
+html_static_path: list[str] = [str(_THREE.parent)]
+html_js_files = ["three.min.js"]
 
 # numpydoc parameter types here describe shapes and components ("ndarray, shape (T, J, 4),
 # (w, x, y, z)"), not Python objects; Sphinx looks up words such as `x` or `start` in them and

@@ -49,7 +49,7 @@ def _info(args) -> int:
 
 
 def _convert(args) -> int:
-    from motionlab.core import bvh, humanoid
+    from motionlab.core import bvh, gltf, humanoid
 
     (out,) = check_outputs([("-o", args.output)], args.force, inputs=[("input", args.input)])
     m = _load(args.input)
@@ -60,7 +60,7 @@ def _convert(args) -> int:
             raise _rig_error(e, "input", args.input) from None
     if args.fps is not None:
         m = m.resample(args.fps)
-    bvh.save(out, m, overwrite=args.force)
+    (gltf.save if out.suffix.lower() == gltf.SUFFIX else bvh.save)(out, m, overwrite=args.force)
     print(f"wrote {out}: {m.num_frames} frames at {m.fps:g} fps, {m.skeleton.num_joints} joints")
     return 0
 
@@ -102,9 +102,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--joints", action="store_true", help="also print the joint tree with channels")
     p.set_defaults(func=_info)
 
-    p = sub.add_parser("convert", help="reduce a BVH file to the 22-joint humanoid and/or resample it")
+    p = sub.add_parser(
+        "convert", help="reduce a BVH file to the 22-joint humanoid and/or resample it; write BVH or glTF (.glb)"
+    )
     p.add_argument("input", help="input .bvh")
-    p.add_argument("-o", "--output", required=True, help="output .bvh")
+    p.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        help="output file: .glb writes glTF 2.0 (Blender, web viewers, engines), any other name BVH",
+    )
     p.add_argument("--canonical", action="store_true", help="reduce to the canonical 22 joints")
     p.add_argument("--fps", type=positive, default=None, help="resample to this frame rate (frames per second)")
     p.add_argument("--force", action="store_true", help="overwrite the output if it exists")

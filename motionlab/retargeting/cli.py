@@ -109,12 +109,12 @@ def _add_solver_args(p: argparse.ArgumentParser) -> None:
 # ---------------------------------------------------------------------------- retarget
 def _cmd_retarget(args) -> int:
     from motionlab.cli import rig_error
-    from motionlab.core import bvh, files, humanoid
+    from motionlab.core import bvh, files, gltf, humanoid
     from motionlab.retargeting.pipeline import retarget
 
     out = Path(args.output)
-    if out.suffix.lower() != ".bvh":
-        raise _error(f"output {out} must end in .bvh")
+    if out.suffix.lower() not in (".bvh", gltf.SUFFIX):
+        raise _error(f"output {out} must end in .bvh or {gltf.SUFFIX} (glTF 2.0)")
     npz = Path(args.npz) if args.npz else None
     if npz is not None and npz.suffix.lower() != ".npz":  # np.savez would silently add '.npz' to another name
         raise _error(f"--npz {npz} must end in .npz")
@@ -139,8 +139,9 @@ def _cmd_retarget(args) -> int:
         raise _error("give --target TARGET.bvh and/or a --scale-* factor: otherwise the target is the source itself")
     ckpt = None if args.method == "copy" else _load_checkpoint(args.checkpoint, args.device)
     result = retarget(source, target, ckpt, args.method, _solver_config(args), args.root, progress=not args.quiet)
-    text = bvh.dumps(result.motion)  # any error in the result shows before a file is written
-    outputs = [(out, lambda f: f.write(text), False, "output")]
+    binary = out.suffix.lower() == gltf.SUFFIX
+    data = (gltf.dumps if binary else bvh.dumps)(result.motion)  # any error shows before a file is written
+    outputs = [(out, lambda f: f.write(data), binary, "output")]
     if npz is not None:  # both files or neither
         arrays = dict(
             local_rot=result.motion.local_rot,
@@ -311,11 +312,11 @@ def register(subparsers) -> None:
         help="retarget a BVH clip onto another character (latent iteration)",
         description="Generate TARGET's version of SOURCE.bvh. The target character is defined by the rest "
         "skeleton of --target (its motion is ignored) and/or --scale-* factors; the output is a BVH on the "
-        "22-joint canonical skeleton.",
+        "22-joint canonical skeleton (BVH, or glTF 2.0 when OUTPUT ends in .glb).",
     )
     p.add_argument("source", help="source motion (BVH, any rig that maps onto the 22 canonical joints)")
     p.add_argument("--target", help="BVH whose rest skeleton defines the target character")
-    p.add_argument("-o", "--output", required=True, help="output BVH file")
+    p.add_argument("-o", "--output", required=True, help="output file: .bvh, or .glb for glTF 2.0")
     p.add_argument("--npz", help="also write arrays (local_rot, root_pos, positions, offsets) to this .npz")
     p.add_argument(
         "--method",

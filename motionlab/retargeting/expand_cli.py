@@ -52,6 +52,7 @@ def _cmd_expand(args) -> int:
         skate_ratio=args.skate_ratio,
         progress=not args.quiet,
         threads=args.threads or None,
+        output_format=args.format,
     )
     if not args.quiet:
         print(job.summary())
@@ -76,7 +77,7 @@ def register(subparsers) -> None:
         "expand",
         help="retarget many clips onto many characters (batched, resumable; local or Ray)",
         description="Expand a motion database: every SOURCE clip onto every character, written as "
-        "OUT/<character>/<clip>.bvh with OUT/manifest.csv (one row per output). Rerunning the same command "
+        "OUT/<character>/<clip>.bvh (or .glb with --format glb) with OUT/manifest.csv (one row per output). Rerunning the same command "
         "redoes only what is missing. Exit status 1 when some pair failed (see the manifest's error column).",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="presets: long_legs, short_legs, long_arms, stocky, tall, child, or NAME:legs=1.2,arms=0.9,...",
@@ -91,6 +92,9 @@ def register(subparsers) -> None:
     )
     p.add_argument("--preset", action="append", default=[], help="a synthetic character (repeatable)")
     p.add_argument("-o", "--output", required=True, help="output folder")
+    p.add_argument(
+        "--format", choices=("bvh", "glb"), default="bvh", help="output files: bvh (default) or glb (glTF 2.0)"
+    )
     p.add_argument("--checkpoint", help="trained network (default: the shipped one)")
     p.add_argument("--root", choices=ROOT_MODES, default="stride", help="root trajectory rule (as in retarget)")
     p.add_argument("--batch-frames", type=positive_int, help="frames per solver batch (default: from free memory)")
