@@ -95,9 +95,9 @@ def _fidelity(ckpt, args):
     for src in sources:
         c = preprocess.prepare(src, ckpt.fps)
         f = clip_features(c)
-        x = torch.tensor(ckpt.stats.normalize(f.x), dtype=torch.float32)[None]
-        own = torch.tensor(c.skeleton.offsets, dtype=torch.float32)
-        target = torch.tensor(f.local_rot, dtype=torch.float32)[None]
+        x = torch.tensor(ckpt.stats.normalize(f.x), dtype=ckpt.dtype)[None]
+        own = torch.tensor(c.skeleton.offsets, dtype=ckpt.dtype)
+        target = torch.tensor(f.local_rot, dtype=ckpt.dtype)[None]
         with torch.no_grad():
             phi = model.encode(x)
             out = model.decode(phi, own)
@@ -135,19 +135,19 @@ def _fidelity(ckpt, args):
     )
     # q_delta: departure from the identity, and dependence on the skeleton
     c = preprocess.prepare(sources[0], ckpt.fps)
-    x = torch.tensor(ckpt.stats.normalize(clip_features(c).x), dtype=torch.float32)[None]
+    x = torch.tensor(ckpt.stats.normalize(clip_features(c).x), dtype=ckpt.dtype)[None]
     base = humanoid.to_canonical_skeleton(ckpt.skeleton)
     sweeps = {f"legs x{s}": humanoid.scale_bones(base, legs=s) for s in (0.6, 1.0, 1.6)}
     sweeps.update({f"arms x{s}": humanoid.scale_bones(base, arms=s) for s in (0.6, 1.6)})
     sweeps.update({"overall x0.5": humanoid.scale_bones(base, overall=0.5)})
     with torch.no_grad():
         phi = model.encode(x)
-        ref = model.decode(phi, torch.tensor(base.offsets, dtype=torch.float32)).q_delta[0].numpy()
+        ref = model.decode(phi, torch.tensor(base.offsets, dtype=ckpt.dtype)).q_delta[0].numpy()
         print(
             "q_delta on one clip's latent: median angle from the identity / median change from the training skeleton's q_delta"
         )
         for name, sk in {**targets, **sweeps}.items():
-            qd = model.decode(phi, torch.tensor(sk.offsets, dtype=torch.float32)).q_delta[0].numpy()
+            qd = model.decode(phi, torch.tensor(sk.offsets, dtype=ckpt.dtype)).q_delta[0].numpy()
             print(
                 f"  {name:<14} {np.median(_degrees(qd, np.array([1.0, 0, 0, 0]))):6.2f} deg  "
                 f"{np.median(_degrees(qd, ref)):6.3f} deg (max {_degrees(qd, ref).max():.2f})"
@@ -187,13 +187,13 @@ def _solve(ckpt, args):
             root = preprocess.pad_to(c.root_pos * np.array([r[0], r[1], r[0]]), 120)[:120]
             res = solve(
                 ckpt.model,
-                torch.tensor(x, dtype=torch.float32)[None],
-                torch.tensor(rot, dtype=torch.float32)[None],
-                torch.tensor(tgt.offsets, dtype=torch.float32),
-                torch.tensor(root[:, 1], dtype=torch.float32)[None],
+                torch.tensor(x, dtype=ckpt.dtype)[None],
+                torch.tensor(rot, dtype=ckpt.dtype)[None],
+                torch.tensor(tgt.offsets, dtype=ckpt.dtype),
+                torch.tensor(root[:, 1], dtype=ckpt.dtype)[None],
                 cfg,
-                root_xz=torch.tensor(root[:, [0, 2]], dtype=torch.float32)[None],
-                yaw=torch.tensor(yaw, dtype=torch.float32)[None],
+                root_xz=torch.tensor(root[:, [0, 2]], dtype=ckpt.dtype)[None],
+                yaw=torch.tensor(yaw, dtype=ckpt.dtype)[None],
                 planted=torch.tensor(planted)[None],
                 fps=ckpt.fps,
             )

@@ -3,21 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import math
 from pathlib import Path
 
+from motionlab.cli_args import check_output_folder, check_outputs, positive, positive_int
+
 __all__ = ["register", "positive"]
-
-
-def positive(text: str) -> float:
-    """argparse type: a finite number > 0 (``--fps 0`` or ``--height -1.7`` are refused by name)."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
-    return value
 
 
 def _rig_error(error, role, path):
@@ -30,22 +20,6 @@ def _load(path: str, what: str = "input"):
     from motionlab.core import bvh, files
 
     return bvh.load(files.check_input(path, what))
-
-
-def _count(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected 1 or more, got {text!r}")
-    return value
-
-
-def _check_output(path: str, force: bool) -> Path:
-    from motionlab.core import files
-
-    return files.check_output(path, force)
 
 
 def _info(args) -> int:
@@ -75,14 +49,10 @@ def _info(args) -> int:
 
 
 def _convert(args) -> int:
-    from motionlab.core import bvh, humanoid
+    from motionlab.core import bvh, gltf, humanoid
 
+    (out,) = check_outputs([("-o", args.output)], args.force, inputs=[("input", args.input)])
     m = _load(args.input)
-    out = _check_output(args.output, args.force)
-    if out.resolve() == Path(args.input).resolve():
-        from motionlab.cli import CLIError
-
-        raise CLIError(f"the output {out} is the input file; write to another file")
     if args.canonical:
         try:
             m = humanoid.to_canonical(m)
@@ -90,7 +60,7 @@ def _convert(args) -> int:
             raise _rig_error(e, "input", args.input) from None
     if args.fps is not None:
         m = m.resample(args.fps)
-    bvh.save(out, m, overwrite=args.force)
+    (gltf.save if out.suffix.lower() == gltf.SUFFIX else bvh.save)(out, m, overwrite=args.force)
     print(f"wrote {out}: {m.num_frames} frames at {m.fps:g} fps, {m.skeleton.num_joints} joints")
     return 0
 
@@ -99,7 +69,7 @@ def _synth(args) -> int:
     from motionlab import synthetic
     from motionlab.core import bvh, humanoid
 
-    out = _check_output(args.output, args.force)
+    (out,) = check_outputs([("-o", args.output)], args.force)
     if args.behaviour != "mix" and int(args.seconds * args.fps) < 1:
         from motionlab.cli import CLIError
 
@@ -122,6 +92,7 @@ def _synth(args) -> int:
 def _demo(args) -> int:
     from motionlab.demo import run_demo
 
+    check_output_folder("--out", args.out)
     return run_demo(out_dir=Path(args.out), characters=args.characters, seed=args.seed, force=args.force)
 
 
@@ -131,9 +102,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--joints", action="store_true", help="also print the joint tree with channels")
     p.set_defaults(func=_info)
 
-    p = sub.add_parser("convert", help="reduce a BVH file to the 22-joint humanoid and/or resample it")
+    p = sub.add_parser(
+        "convert", help="reduce a BVH file to the 22-joint humanoid and/or resample it; write BVH or glTF (.glb)"
+    )
     p.add_argument("input", help="input .bvh")
-    p.add_argument("-o", "--output", required=True, help="output .bvh")
+    p.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        help="output file: .glb writes glTF 2.0 (Blender, web viewers, engines), any other name BVH",
+    )
     p.add_argument("--canonical", action="store_true", help="reduce to the canonical 22 joints")
     p.add_argument("--fps", type=positive, default=None, help="resample to this frame rate (frames per second)")
     p.add_argument("--force", action="store_true", help="overwrite the output if it exists")
@@ -155,7 +133,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "demo", help="the main job on built-in data: retarget a synthetic performance onto new characters"
     )
     p.add_argument("--out", default="outputs/demo", help="output folder (default: outputs/demo)")
-    p.add_argument("--characters", type=_count, default=4, help="how many new characters (1 or more)")
+    p.add_argument("--characters", type=positive_int, default=4, help="how many new characters (1 or more)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument(
         "--force",

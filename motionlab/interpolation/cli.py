@@ -23,7 +23,9 @@ given by ``--root`` (``stride``: the strides' root path where one side repeats, 
 a Hermite curve with the velocities on both sides; ``linear``: the LaFAN1 baseline).
 Where the capture logged each frame's time, ``--times FILE`` (one time in seconds per frame,
 :func:`motionlab.interpolation.gaps.load_times`) gives the gaps and their counts exactly
-(:func:`~motionlab.interpolation.gaps.timestamp_gaps`): no rule, no estimate.
+(:func:`~motionlab.interpolation.gaps.timestamp_gaps`): no rule, no estimate. The times are
+checked against the file's ``Frame Time`` first: times in another unit (milliseconds), or ones
+that would make the clip more than :data:`MAX_GROWTH` times longer, are refused.
 A clean clip (nothing found) is copied byte for byte. A report lists every gap and how it was
 filled.
 """
@@ -70,7 +72,7 @@ def register(subparsers) -> None:
     p.set_defaults(func=run_fill_gaps)
 
 
-def _graph(actions: list[str], allow: list[str]):
+def _graph(actions: list[str], allow: list[str], src: Path, motion):
     from motionlab.cli import CLIError
     from motionlab.core import bvh
     from motionlab.interpolation.action_graph import ActionGraph, GraphError
@@ -84,7 +86,9 @@ def _graph(actions: list[str], allow: list[str]):
         name, path = item.split("=", 1)
         if not Path(path).is_file():
             raise CLIError(f"--action {name}: no such file {path!r}")
-        g.add_node(name.strip(), bvh.load(path))
+        clip = bvh.load(path)
+        _check_rig(f"--action {name}={path}", clip, src, motion)
+        g.add_node(name.strip(), clip)
     try:
         if allow:
             g.allow(allow)
@@ -96,8 +100,9 @@ def _graph(actions: list[str], allow: list[str]):
     return g
 
 
-def _takes(paths: list[str], src: Path):
-    """:class:`~.recorded.RecordedTakes` of the ``--takes`` files (none of them the input)."""
+def _takes(paths: list[str], src: Path, motion):
+    """:class:`~.recorded.RecordedTakes` of the ``--takes`` files (none of them the input), each on
+    the input ``motion``'s skeleton and frame rate."""
     from motionlab.cli import CLIError
     from motionlab.core import bvh
     from motionlab.interpolation.recorded import RecordedTakes
@@ -117,37 +122,98 @@ def _takes(paths: list[str], src: Path):
             raise CLIError(f"--takes {path}: the input itself cannot be one of the other recordings")
         files.append(p)
     clips = []
-    for p in dict.fromkeys(f.resolve() for f in files):  # a take named twice (a file and its folder) counts once
+    unique: dict[Path, Path] = {}
+    for f in files:  # a take named twice (a file and its folder) counts once
+        unique.setdefault(f.resolve(), f)
+    for p in unique.values():
         try:
             clips.append(bvh.load(p))
         except bvh.BVHError as e:
             raise CLIError(f"--takes {p}: {e}") from None
+        _check_rig(f"--takes {p}", clips[-1], src, motion)
+        _check_rate(p, clips[-1], src, motion)
     try:
         return RecordedTakes(clips)
     except ValueError as e:
         raise CLIError(f"--takes: {e}") from None
 
 
-def _copy(src: Path, dst: Path) -> None:
-    """Copy ``src`` to ``dst`` byte for byte, atomically (temporary file beside ``dst``, then rename)."""
-    import os
-    import shutil
-    import tempfile
-
-    fd, tmp = tempfile.mkstemp(prefix=f".{dst.name}.", suffix=".tmp", dir=dst.parent or ".")
-    os.close(fd)
-    try:
-        shutil.copyfile(src, tmp)
-        os.replace(tmp, dst)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def run_fill_gaps(args: argparse.Namespace) -> int:
+def _check_rig(what: str, clip, src: Path, motion) -> None:
+    """Refuse a clip (``what``: the option and file that named it) on another rig than the input."""
     from motionlab.cli import CLIError
-    from motionlab.core import bvh
-    from motionlab.interpolation import detect, gaps
+
+    if tuple(clip.skeleton.names) != tuple(motion.skeleton.names):
+        sk, mine = clip.skeleton, motion.skeleton
+        raise CLIError(
+            f"{what}: another rig than the input {src} (root {sk.names[0]!r}, {sk.num_joints} joints; "
+            f"the input: root {mine.names[0]!r}, {mine.num_joints} joints); give clips recorded on the input's rig"
+        )
+
+
+def _check_rate(path: Path, take, src: Path, motion) -> None:
+    """Refuse a ``--takes`` file at another frame rate than the input."""
+    from motionlab.cli import CLIError
+
+    if abs(take.fps - motion.fps) > 1e-6 * motion.fps:
+        raise CLIError(
+            f"--takes {path} is at {take.fps:g} fps, the input {src} at {motion.fps:g} fps; give takes at "
+            f"{motion.fps:g} fps (`motionlab convert {path} -o OUT.bvh --fps {motion.fps:g}` resamples one)"
+        )
+
+
+MAX_GROWTH = 10
+"""``--times`` may at most make the clip this many times longer: more means wrong times."""
+
+
+def _times_gaps(path: str, src: Path, motion) -> list[tuple[int, int]]:
+    """The gaps ``(after frame i, count)`` that the ``--times`` file gives, checked against the
+    input's Frame Time (times in another unit than seconds are refused, never filled)."""
+    import numpy as np
+
+    from motionlab.cli import CLIError
+    from motionlab.interpolation import gaps
+
+    try:
+        times = gaps.load_times(path, motion.num_frames)
+    except OSError as e:
+        raise CLIError(f"--times: {e}") from None
+    except ValueError as e:
+        raise CLIError(f"--times: {e}") from None
+    period = 1.0 / motion.fps
+    step = float(np.median(np.diff(times))) if len(times) > 1 else period
+    if not 0.5 <= step / period < 2.0:
+        units = {"milliseconds": 1e3, "microseconds": 1e6, "nanoseconds": 1e9}
+        hint = next((f"; they look like {u}: divide them by {f:.0f}" for u, f in units.items()
+                     if 0.5 <= step / period / f < 2.0), "")  # fmt: skip
+        raise CLIError(
+            f"--times {path}: consecutive times are {step:g} apart (median), but the Frame Time of {src} is "
+            f"{period:g} s; expected one time per frame in seconds{hint}"
+        )
+    missing = gaps.timestamp_gaps(times, motion.fps)
+    added = sum(n for _, n in missing)
+    if added > (MAX_GROWTH - 1) * motion.num_frames:
+        raise CLIError(
+            f"--times {path}: the times span {times[-1] - times[0]:g} s, {added} frames more than the "
+            f"{motion.num_frames} in {src} (at most {MAX_GROWTH} times the recorded frames can be filled); "
+            "check that the times are in seconds, one per frame"
+        )
+    return missing
+
+
+def _copy(src: Path, dst: Path, force: bool) -> None:
+    """Copy ``src`` to ``dst`` byte for byte, atomically."""
+    from motionlab.core import files
+
+    data = src.read_bytes()
+    files.atomic_write(dst, lambda f: f.write(data), overwrite=force, binary=True, what="-o file")
+
+
+def _check_args(args: argparse.Namespace):
+    """``(delta, src, dst)`` after checking the options and every output before any work."""
+    from motionlab.cli import CLIError
+    from motionlab.cli_args import check_outputs
+    from motionlab.core import files
+    from motionlab.interpolation import detect
 
     delta = None
     if args.delta is not None:
@@ -155,36 +221,43 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
             delta = detect.check_delta(args.delta, name="--delta (--threshold)")
         except ValueError as e:
             raise CLIError(str(e)) from None
-    src, dst = Path(args.input), Path(args.output)
-    if not src.is_file():
-        raise CLIError(f"input file {src} does not exist")
-    if dst.exists() and not args.force:
-        raise CLIError(f"{dst} exists; pass --force to overwrite it")
-    if dst.resolve() == src.resolve():
-        raise CLIError("the output must not be the input file")
+    if args.times is not None and (args.takes or delta is not None):
+        raise CLIError(
+            "--times gives the gaps and their counts, so --takes and --delta would not be used; "
+            "give --times alone, or leave it out"
+        )
+    src = files.check_input(args.input)
+    inputs = [("input", src), ("--times", args.times)] + [("--takes", t) for t in args.takes]
+    inputs += [("--action", a.split("=", 1)[1]) for a in args.action if "=" in a]
+    (dst,) = check_outputs([("-o", args.output)], args.force, inputs=inputs)
+    return delta, src, dst
+
+
+def run_fill_gaps(args: argparse.Namespace) -> int:
+    from motionlab.cli import CLIError
+    from motionlab.core import bvh
+    from motionlab.interpolation import detect, gaps
+
+    delta, src, dst = _check_args(args)
     try:
         motion = bvh.load(src)
     except bvh.BVHError as e:
         raise CLIError(str(e)) from None
-    if args.times is not None and (args.takes or delta is not None):
-        raise CLIError("--times gives the gaps and their counts; --takes and --delta would not be used")
-    graph = _graph(args.action, args.allow) if args.method == "graph" else None
-    takes = _takes(args.takes, src) if args.takes else None
-    try:
-        if args.times is not None:
-            missing = gaps.timestamp_gaps(gaps.load_times(args.times, motion.num_frames), motion.fps)
-        else:
+    graph = _graph(args.action, args.allow, src, motion) if args.method == "graph" else None
+    if args.times is not None:
+        missing = _times_gaps(args.times, src, motion)
+    else:
+        takes = _takes(args.takes, src, motion) if args.takes else None
+        try:
             missing = detect.detect(motion, graph=graph, delta=delta, takes=takes)
-    except OSError as e:
-        raise CLIError(f"--times: {e}") from None
-    except ValueError as e:
-        raise CLIError(str(e)) from None
+        except ValueError as e:
+            raise CLIError(str(e)) from None
     print(f"{src}: {motion.num_frames} frames at {motion.fps:g} fps")
     nothing = (
         f"no dropped frames in the times of {args.times}" if args.times else "no dropped frames found (D > Δ nowhere)"
     )
     if not missing:
-        _copy(src, dst)
+        _copy(src, dst, args.force)
         print(f"{nothing}; wrote an unchanged copy")
         print(f"wrote {dst} ({motion.num_frames} frames)")
         return 0

@@ -9,7 +9,8 @@
 Clip names must say behaviour and style, optionally a take (see
 :mod:`motionlab.motion_graphs.naming`); takes of one style are pooled. With ``--synthetic`` the
 built-in synthetic clips are used instead of a folder. ``graph-build`` prints the build report
-(:mod:`.report`) and ``--report`` writes it as JSON. A request may ask for at most
+(:mod:`.report`) and ``--report`` writes it as JSON; the graph and the report are written
+together, both or neither. A request may ask for at most
 :data:`~motionlab.motion_graphs.search.MAX_FRAMES` frames in all.
 """
 
@@ -21,6 +22,7 @@ import time
 from pathlib import Path
 
 from motionlab.cli import CLIError
+from motionlab.cli_args import check_outputs, non_negative_int, positive, positive_int
 
 __all__ = ["register"]
 
@@ -31,12 +33,14 @@ def register(subparsers) -> None:
     p.add_argument("-o", "--output", required=True, help="graph file to write (.mlgraph)")
     p.add_argument("--synthetic", action="store_true", help="use the built-in synthetic clips instead of a folder")
     p.add_argument("--standard", action="store_true", help="build Kovar's unstructured graph instead")
-    p.add_argument("--threshold", type=float, default=0.03, help="transition threshold, metres RMS (default 0.03)")
-    p.add_argument("--fps", type=float, default=30.0, help="frame rate every clip is resampled to (default 30)")
+    p.add_argument("--threshold", type=positive, default=0.03, help="transition threshold, metres RMS (default 0.03)")
+    p.add_argument("--fps", type=positive, default=30.0, help="frame rate every clip is resampled to (default 30)")
     p.add_argument(
         "--style-pairs", choices=("hub", "chain", "all"), default="hub", help="styles bridged by interpolation"
     )
-    p.add_argument("--neighbours", type=int, default=3, help="takes each take of a style is compared with (default 3)")
+    p.add_argument(
+        "--neighbours", type=positive_int, default=3, help="takes each take of a style is compared with (default 3)"
+    )
     p.add_argument("--name-map", help="JSON file {clip stem: 'behaviour_style[_take]'} for names that do not parse")
     p.add_argument("--report", help="also write the build report as JSON to this file")
     p.add_argument("--force", action="store_true", help="overwrite the output files")
@@ -51,7 +55,7 @@ def register(subparsers) -> None:
         "(at most 100000 frames in all)",
     )
     p.add_argument("-o", "--output", required=True, help="BVH file to write")
-    p.add_argument("--blend", type=int, default=8, help="transition blend length in frames (default 8)")
+    p.add_argument("--blend", type=non_negative_int, default=8, help="transition blend length in frames (default 8)")
     p.add_argument("--force", action="store_true", help="overwrite the output file")
     p.set_defaults(func=_search)
 
@@ -69,39 +73,49 @@ def _load_graph(path: str):
         raise CLIError(str(e)) from None
 
 
-def _build(args: argparse.Namespace) -> int:
-    from motionlab.motion_graphs import clips, distance, graph, io, report, structured
-    from motionlab.motion_graphs.naming import NamingError, parse_name
-
+def _build_outputs(args: argparse.Namespace) -> tuple[Path, Path | None]:
+    """The graph file and the report file, checked before any work."""
     out = Path(args.output)
+    if out.is_dir():  # before '.mlgraph' is added: -o FOLDER must not write FOLDER.mlgraph beside it
+        raise CLIError(f"-o {out} is a folder; expected a graph file name, such as {out / 'graph.mlgraph'}")
     if out.suffix == "":
         out = out.with_suffix(".mlgraph")
-    if out.exists() and not args.force:
-        raise CLIError(f"{out} exists; pass --force to overwrite it")
-    if args.report and Path(args.report).exists() and not args.force:
-        raise CLIError(f"--report {args.report} exists; pass --force to overwrite it")
-    if args.threshold <= 0:
-        raise CLIError(f"--threshold must be positive metres, got {args.threshold}")
-    if args.neighbours < 1:
-        raise CLIError(f"--neighbours must be at least 1, got {args.neighbours}")
+    if args.report and args.standard:
+        raise CLIError("--report needs a structured graph (leave out --standard, or leave out --report)")
+    if not args.synthetic and not args.folder:
+        raise CLIError("give a FOLDER of BVH clips or --synthetic")
+    inputs = [("--name-map", args.name_map)]
+    out, rep = check_outputs([("-o", out), ("--report", args.report)], args.force, inputs=inputs)
+    return out, rep
+
+
+def _load_clips(args: argparse.Namespace) -> list:
+    from motionlab.motion_graphs import clips
+    from motionlab.motion_graphs.naming import NamingError
+
     name_map = None
     if args.name_map:
         try:
             name_map = json.loads(Path(args.name_map).read_text())
-        except (OSError, json.JSONDecodeError) as e:
-            raise CLIError(f"cannot read name map {args.name_map}: {e}") from None
+        except (OSError, json.JSONDecodeError, UnicodeDecodeError) as e:
+            raise CLIError(f"--name-map {args.name_map}: cannot read it as JSON ({e})") from None
+        if not isinstance(name_map, dict):
+            raise CLIError(f"--name-map {args.name_map}: expected a JSON object {{clip stem: 'behaviour_style'}}")
     if args.synthetic:
         motions = clips.synthetic_library(fps=args.fps)
         print(f"using {len(motions)} synthetic clips (no real data)")
-    else:
-        if not args.folder:
-            raise CLIError("give a FOLDER of BVH clips or --synthetic")
-        try:
-            motions = clips.load_folder(args.folder, args.fps, name_map, progress=True)
-        except NamingError as e:
-            raise CLIError(str(e)) from None
+        return motions
+    try:
+        return clips.load_folder(args.folder, args.fps, name_map, progress=True)
+    except NamingError as e:
+        raise CLIError(str(e)) from None
+
+
+def _build_graph(args: argparse.Namespace, motions: list):
+    from motionlab.motion_graphs import distance, graph, structured
+    from motionlab.motion_graphs.naming import parse_name
+
     thr = distance.threshold_from(args.threshold)
-    t0 = time.perf_counter()
     try:
         if args.standard:
             labels = [parse_name(m.name) for m in motions]
@@ -109,21 +123,36 @@ def _build(args: argparse.Namespace) -> int:
                 graph.ClipInfo(m.name, "clip", *(lab.key if lab.kind == "basic" else (None, None)))
                 for m, lab in zip(motions, labels)
             ]
-            g = graph.build_standard(motions, thr, infos=infos)
-        else:
-            g = structured.build_structured(
-                motions,
-                thr,
-                style_pairs=args.style_pairs,
-                synthetic=[args.synthetic] * len(motions),
-                neighbours=args.neighbours,
-                progress=True,
-            )
+            return graph.build_standard(motions, thr, infos=infos)
+        return structured.build_structured(
+            motions,
+            thr,
+            style_pairs=args.style_pairs,
+            synthetic=[args.synthetic] * len(motions),
+            neighbours=args.neighbours,
+            progress=True,
+        )
     except graph.GraphError as e:
         raise CLIError(str(e)) from None
+
+
+def _build(args: argparse.Namespace) -> int:
+    from motionlab.core import files
+    from motionlab.motion_graphs import io, report
+
+    out, report_path = _build_outputs(args)
+    motions = _load_clips(args)
+    t0 = time.perf_counter()
+    g = _build_graph(args, motions)
     dt = time.perf_counter() - t0
     g.info["input_clips"] = len(motions)
-    io.save(out, g, overwrite=args.force)
+    rep = report.build_report(g) if g.table.get("behaviours") else None
+    outputs = [(out, io.writer(g), True, "graph (-o)")]
+    if report_path is not None:
+        if rep is None:
+            raise CLIError("--report needs a structured graph, and these clips gave none; leave out --report")
+        outputs.append((report_path, lambda f: f.write(report.to_json(rep)), False, "report (--report)"))
+    files.atomic_write_all(outputs, overwrite=args.force)  # both files or neither
     s = g.summary()
     styles = sum(len(v) for v in g.table.get("behaviours", {}).values())
     n_trans = sum(c.kind == "transition" for c in g.clips)
@@ -132,16 +161,12 @@ def _build(args: argparse.Namespace) -> int:
         f"built {g.info['kind']} graph from {len(motions)} clips{pooled} in {dt:.2f} s: {s['alive']} frames alive, "
         f"{s['transitions']} transitions -> {out}"
     )
-    if g.table.get("behaviours"):
-        rep = report.build_report(g)
+    if rep is not None:
         print(report.format_report(rep))
-        if args.report:
-            report.write_report(args.report, rep, overwrite=args.force)
-            print(f"report -> {args.report}")
+        if report_path is not None:
+            print(f"report -> {report_path}")
     else:
         print(f"largest strongly connected component: {s['largest_scc']} frames")
-        if args.report:
-            raise CLIError("--report needs a structured graph (leave out --standard)")
     return 0
 
 
@@ -149,11 +174,14 @@ def _search(args: argparse.Namespace) -> int:
     from motionlab.core import bvh
     from motionlab.motion_graphs import search, synthesis
 
-    out = Path(args.output)
-    if out.exists() and not args.force:
-        raise CLIError(f"{out} exists; pass --force to overwrite it")
+    (out,) = check_outputs([("-o", args.output)], args.force, inputs=[("graph", args.graph)])
     try:
         segs = search.parse_request(args.request)
+    except search.RequestTooLong as e:
+        raise CLIError(
+            f"--request asks for {e.total} frames in all; at most {search.MAX_FRAMES} frames are accepted "
+            "(about 55 minutes at 30 fps): split it into several graph-search runs"
+        ) from None
     except ValueError as e:
         raise CLIError(f"--request: {e}") from None
     g = _load_graph(args.graph)

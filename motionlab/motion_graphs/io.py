@@ -18,10 +18,11 @@ from pathlib import Path
 
 import numpy as np
 
+from motionlab.core import files
 from motionlab.core.skeleton import Skeleton
 from motionlab.motion_graphs.graph import ClipInfo, GraphError, MotionGraph
 
-__all__ = ["save", "load", "FORMAT"]
+__all__ = ["save", "load", "writer", "FORMAT"]
 
 FORMAT = "motionlab-graph-2"
 """Version 2: style cells hold pooled takes (version 1 held one clip per style)."""
@@ -39,16 +40,9 @@ def _jsonable(x):
     return x
 
 
-def save(path: str | os.PathLike, graph: MotionGraph, overwrite: bool = False) -> Path:
-    """Write ``graph`` to ``path`` (``.mlgraph`` added if there is no suffix).
-
-    Raises ``FileExistsError`` when the file exists and ``overwrite`` is False.
-    """
-    path = Path(path)
-    if path.suffix == "":
-        path = path.with_suffix(".mlgraph")
-    if path.exists() and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --force) to replace it")
+def writer(graph: MotionGraph):
+    """``write(fh)``: writes ``graph`` in the ``.mlgraph`` format to a binary file ``fh`` (for
+    :func:`motionlab.core.files.atomic_write_all`, which writes several files as one)."""
     sk = graph.skeleton
     meta = {
         "format": FORMAT,
@@ -59,8 +53,8 @@ def save(path: str | os.PathLike, graph: MotionGraph, overwrite: bool = False) -
         "table": graph.table,
         "info": graph.info,
     }
-    tmp = path.with_name(path.name + ".tmp")
-    with open(tmp, "wb") as fh:
+
+    def write(fh) -> None:
         np.savez_compressed(
             fh,
             meta=np.array(json.dumps(_jsonable(meta))),
@@ -74,8 +68,19 @@ def save(path: str | os.PathLike, graph: MotionGraph, overwrite: bool = False) -
             offsets=sk.offsets,
             parents=sk.parents,
         )
-    os.replace(tmp, path)
-    return path
+
+    return write
+
+
+def save(path: str | os.PathLike, graph: MotionGraph, overwrite: bool = False) -> Path:
+    """Write ``graph`` to ``path`` (``.mlgraph`` added if there is no suffix), atomically.
+
+    Raises ``FileExistsError`` when the file exists and ``overwrite`` is False.
+    """
+    path = Path(path)
+    if path.suffix == "":
+        path = path.with_suffix(".mlgraph")
+    return files.atomic_write(path, writer(graph), overwrite=overwrite, binary=True, what="motion graph")
 
 
 def load(path: str | os.PathLike) -> MotionGraph:

@@ -27,9 +27,10 @@ from pathlib import Path
 
 import numpy as np
 
+from motionlab.core import files
 from motionlab.motion_graphs.graph import MotionGraph
 
-__all__ = ["build_report", "format_report", "write_report", "COLUMNS"]
+__all__ = ["build_report", "format_report", "to_json", "write_report", "COLUMNS"]
 
 COLUMNS = ("behaviour", "style", "takes", "frames", "cycles", "transitions", "in largest", "pruned")
 
@@ -51,7 +52,7 @@ def build_report(graph: MotionGraph) -> dict:
     links)), ``behaviour_links`` (ordered behaviour pairs joined directly: ``source``,
     ``target``, ``via`` → number of links), ``largest_scc`` and ``recorded_frames``
     (whole graph), ``percent``, ``conditions`` (kind → ``count``, ``example``) and ``info``
-    (build times and counts).
+    (build times and counts; ``threshold`` in metres RMS, the unit of ``graph-build --threshold``).
     """
     n = graph.num_frames
     recorded = np.zeros(n, dtype=bool)
@@ -107,6 +108,8 @@ def build_report(graph: MotionGraph) -> dict:
         if lines
     }
     info = {k: v for k, v in graph.info.items() if k != "conditions"}
+    if "threshold" in info:  # the graph keeps it squared (m²); the report says it as --threshold does
+        info["threshold"] = round(float(np.sqrt(info["threshold"])), 9)
     return dict(
         rows=rows,
         behaviours=behaviours,
@@ -196,15 +199,15 @@ def format_report(report: dict) -> str:
     return "\n".join(lines)
 
 
+def to_json(report: dict) -> str:
+    """The report as JSON text (what :func:`write_report` writes)."""
+    return json.dumps(report, indent=1, default=float)
+
+
 def write_report(path: str | os.PathLike, report: dict, overwrite: bool = False) -> Path:
-    """Write the report as JSON (atomically); refuses to replace a file unless ``overwrite``."""
-    path = Path(path)
-    if path.exists() and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True (CLI: --force) to replace it")
-    tmp = path.with_name(f".{path.name}.tmp")
-    try:
-        tmp.write_text(json.dumps(report, indent=1, default=float))
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
-    return path
+    """Write the report as JSON (atomically); refuses to replace a file unless ``overwrite``.
+
+    Raises ``FileExistsError`` (exists), ``IsADirectoryError`` (a folder) or another ``OSError``
+    naming the path.
+    """
+    return files.atomic_write(path, lambda f: f.write(to_json(report)), overwrite=overwrite, what="report")

@@ -48,6 +48,7 @@ __all__ = [
     "search",
     "search_standard",
     "SearchError",
+    "RequestTooLong",
     "TOLERANCE",
     "MAX_FRAMES",
 ]
@@ -115,7 +116,13 @@ class SearchResult:
 def parse_request(text: str) -> list[Segment]:
     """``"walk:angry:300,run:normal:200"`` → segments. Raises ValueError on bad syntax."""
     segs = []
-    for part in [p.strip() for p in re.split(r"[,;]", text) if p.strip()]:
+    parts = [p.strip() for p in re.split(r"[,;]", text)]
+    if len(parts) > 1 and not all(parts):
+        raise ValueError(
+            f"request segment {parts.index('') + 1} of {text!r} is empty; "
+            "give segments like walk:angry:300,run:normal:200, one comma between two"
+        )
+    for part in [p for p in parts if p]:
         bits = part.split(":")
         if len(bits) != 3:
             raise ValueError(f"request segment {part!r} should be behaviour:style:frames, e.g. walk:angry:300")
@@ -132,12 +139,21 @@ def parse_request(text: str) -> list[Segment]:
     return segs
 
 
+class RequestTooLong(ValueError):
+    """A request for more than :data:`MAX_FRAMES` frames; ``total`` is what it asked for."""
+
+    def __init__(self, message: str, total: int) -> None:
+        super().__init__(message)
+        self.total = total
+
+
 def _check_total(segs: list[Segment]) -> None:
     total = sum(s.frames for s in segs)
     if total > MAX_FRAMES:
-        raise ValueError(
+        raise RequestTooLong(
             f"the request asks for {total} frames in all; the limit is {MAX_FRAMES} frames "
-            f"(search.MAX_FRAMES, {MAX_FRAMES / 30 / 60:.0f} minutes at 30 fps): split it into shorter requests"
+            f"(search.MAX_FRAMES, {MAX_FRAMES / 30 / 60:.0f} minutes at 30 fps): split it into shorter requests",
+            total,
         )
 
 

@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from motionlab.cli_args import check_outputs, non_negative, non_negative_int, positive, positive_int
+
 ROOT_MODES = ("stride", "hips", "legs", "contacts")
 """``pipeline.ROOT_MODES``, repeated so that ``--help`` does not import torch (a test keeps them equal)."""
 
@@ -27,16 +29,6 @@ def _error(msg: str):
     from motionlab.cli import CLIError
 
     return CLIError(msg)
-
-
-def _positive(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not (np.isfinite(v) and v > 0):
-        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
-    return v
 
 
 def _load_bvh(path: str, what: str):
@@ -79,14 +71,21 @@ def _solver_config(args):
 
 def _add_solver_args(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("latent iteration")
-    g.add_argument("--steps", type=int, default=100, help="step limit of the latent iteration (default 100)")
     g.add_argument(
-        "--lr", type=float, default=0.02, help="Adam step on the latent, relative to its spread std(φ₀) (default 0.02)"
+        "--steps", type=non_negative_int, default=100, help="step limit of the latent iteration (default 100)"
     )
-    g.add_argument("--threshold", type=float, default=2e-3, help="stop when L_iter drops below this (default 2e-3)")
+    g.add_argument(
+        "--lr",
+        type=positive,
+        default=0.02,
+        help="Adam step on the latent, relative to its spread std(φ₀) (default 0.02)",
+    )
+    g.add_argument(
+        "--threshold", type=non_negative, default=2e-3, help="stop when L_iter drops below this (default 2e-3)"
+    )
     g.add_argument(
         "--contact-weight",
-        type=float,
+        type=non_negative,
         default=0.5,
         metavar="W",
         help="weight of the foot-contact term (motionlab's addition; 0 = the paper's two losses; default 0.5)",
@@ -100,7 +99,7 @@ def _add_solver_args(p: argparse.ArgumentParser) -> None:
     )
     g.add_argument(
         "--exact-rounds",
-        type=int,
+        type=non_negative_int,
         default=4,
         metavar="K",
         help="of the projection's 8 Gauss-Newton rounds, how many last ones are not smoothed over time (default 4)",
@@ -110,20 +109,17 @@ def _add_solver_args(p: argparse.ArgumentParser) -> None:
 # ---------------------------------------------------------------------------- retarget
 def _cmd_retarget(args) -> int:
     from motionlab.cli import rig_error
-    from motionlab.core import bvh, files, humanoid
+    from motionlab.core import bvh, files, gltf, humanoid
     from motionlab.retargeting.pipeline import retarget
 
     out = Path(args.output)
-    if out.suffix.lower() != ".bvh":
-        raise _error(f"output {out} must end in .bvh")
-    files.check_output(out, args.force)
+    if out.suffix.lower() not in (".bvh", gltf.SUFFIX):
+        raise _error(f"output {out} must end in .bvh or {gltf.SUFFIX} (glTF 2.0)")
     npz = Path(args.npz) if args.npz else None
-    if npz is not None:  # checked before any work: np.savez would silently add '.npz' to another name
-        if npz.suffix.lower() != ".npz":
-            raise _error(f"--npz {npz} must end in .npz")
-        if npz.resolve() == out.resolve():
-            raise _error(f"--npz {npz} is the BVH output too")
-        files.check_output(npz, args.force, "--npz file")
+    if npz is not None and npz.suffix.lower() != ".npz":  # np.savez would silently add '.npz' to another name
+        raise _error(f"--npz {npz} must end in .npz")
+    inputs = [("source", args.source), ("--target", args.target), ("--checkpoint", args.checkpoint)]
+    check_outputs([("-o", out), ("--npz", npz)], args.force, inputs=inputs)  # before any work
     source = _load_bvh(args.source, "source")
     try:
         humanoid.find_mapping(source.skeleton)
@@ -143,8 +139,9 @@ def _cmd_retarget(args) -> int:
         raise _error("give --target TARGET.bvh and/or a --scale-* factor: otherwise the target is the source itself")
     ckpt = None if args.method == "copy" else _load_checkpoint(args.checkpoint, args.device)
     result = retarget(source, target, ckpt, args.method, _solver_config(args), args.root, progress=not args.quiet)
-    text = bvh.dumps(result.motion)  # any error in the result shows before a file is written
-    outputs = [(out, lambda f: f.write(text), False, "output")]
+    binary = out.suffix.lower() == gltf.SUFFIX
+    data = (gltf.dumps if binary else bvh.dumps)(result.motion)  # any error shows before a file is written
+    outputs = [(out, lambda f: f.write(data), binary, "output")]
     if npz is not None:  # both files or neither
         arrays = dict(
             local_rot=result.motion.local_rot,
@@ -171,9 +168,7 @@ def _cmd_train(args) -> int:
     from motionlab.retargeting.model import ModelConfig
     from motionlab.retargeting.train import TrainConfig, train, training_set
 
-    out = Path(args.output)
-    if out.exists() and not args.force:
-        raise _error(f"{out} exists; pass --force to overwrite it")
+    (out,) = check_outputs([("-o", args.output)], args.force, inputs=[("clip", c) for c in args.clips])
     if not 0.0 <= args.pose_augment <= 0.5:  # also refuses nan; skeleton augmentation takes the other half
         raise _error(f"--pose-augment must be between 0 and 0.5, got {args.pose_augment}")
     if args.synthetic:
@@ -210,6 +205,11 @@ def _cmd_train(args) -> int:
 
 
 # ---------------------------------------------------------------------------- evaluate
+def _fold_path(path: Path, k: int, folds: int) -> Path:
+    """The checkpoint of fold ``k`` (0-based) of ``folds``: ``path`` itself when there is one fold."""
+    return path if folds == 1 else path.with_name(f"{path.stem}_fold{k + 1}of{folds}{path.suffix}")
+
+
 def _cmd_evaluate(args) -> int:
     from motionlab import data as mdata
     from motionlab.core import bvh
@@ -225,10 +225,7 @@ def _cmd_evaluate(args) -> int:
     from motionlab.retargeting.train import TrainConfig, train
 
     folder = Path(args.data) if args.data else mdata.data_root() / "mixamo"
-    if args.csv:  # refuse before hours of work, not after
-        from motionlab.core import files
-
-        files.check_output(args.csv, args.force, "--csv file")
+    check_outputs([("--csv", args.csv)], args.force)  # refuse before hours of work, not after
     if not folder.is_dir():
         raise _error(f"data folder {folder} not found")
     if args.folds < 1:
@@ -247,9 +244,11 @@ def _cmd_evaluate(args) -> int:
         raise _error(f"--folds {args.folds} is more than the {len(animations)} animations evaluated")
     # leave animations out: fold k is evaluated by a network trained without the fold's animations
     folds = [animations[k :: args.folds] for k in range(args.folds)]
+    fold_paths = [_fold_path(path, k, args.folds) for k in range(args.folds)]
+    trained = [("--checkpoint", p) for p in fold_paths if args.retrain or not p.is_file()]
+    check_outputs(trained, force=True, inputs=[("--csv", args.csv)])  # a checkpoint to train is written later
     result = Evaluation(rows=[])
-    for k, fold in enumerate(folds):
-        fpath = path if args.folds == 1 else path.with_name(f"{path.stem}_fold{k + 1}of{args.folds}{path.suffix}")
+    for fold, fpath in zip(folds, fold_paths):
         if fpath.is_file() and not args.retrain:
             ckpt = _load_checkpoint(str(fpath), args.device)
             if not args.quiet:
@@ -313,11 +312,11 @@ def register(subparsers) -> None:
         help="retarget a BVH clip onto another character (latent iteration)",
         description="Generate TARGET's version of SOURCE.bvh. The target character is defined by the rest "
         "skeleton of --target (its motion is ignored) and/or --scale-* factors; the output is a BVH on the "
-        "22-joint canonical skeleton.",
+        "22-joint canonical skeleton (BVH, or glTF 2.0 when OUTPUT ends in .glb).",
     )
     p.add_argument("source", help="source motion (BVH, any rig that maps onto the 22 canonical joints)")
     p.add_argument("--target", help="BVH whose rest skeleton defines the target character")
-    p.add_argument("-o", "--output", required=True, help="output BVH file")
+    p.add_argument("-o", "--output", required=True, help="output file: .bvh, or .glb for glTF 2.0")
     p.add_argument("--npz", help="also write arrays (local_rot, root_pos, positions, offsets) to this .npz")
     p.add_argument(
         "--method",
@@ -336,9 +335,9 @@ def register(subparsers) -> None:
     )
     for name in ("legs", "arms", "spine", "neck"):
         p.add_argument(
-            f"--scale-{name}", type=_positive, default=1.0, metavar="F", help=f"scale the target's {name} bones by F"
+            f"--scale-{name}", type=positive, default=1.0, metavar="F", help=f"scale the target's {name} bones by F"
         )
-    p.add_argument("--scale", type=_positive, default=1.0, metavar="F", help="scale the whole target by F")
+    p.add_argument("--scale", type=positive, default=1.0, metavar="F", help="scale the whole target by F")
     p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
     p.add_argument("--force", action="store_true", help="overwrite existing output files")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary")
@@ -351,20 +350,22 @@ def register(subparsers) -> None:
         description="Train the retargeting network on the clips of ONE character (L_recon) and save a checkpoint.",
     )
     p.add_argument("clips", nargs="*", help="BVH clips of one character")
-    p.add_argument("--synthetic", type=int, default=0, metavar="N", help="train on N built-in synthetic clips instead")
+    p.add_argument(
+        "--synthetic", type=non_negative_int, default=0, metavar="N", help="train on N built-in synthetic clips instead"
+    )
     p.add_argument("-o", "--output", required=True, help="checkpoint file to write (.pt)")
-    p.add_argument("--train-steps", type=int, default=1500, help="Adam steps (default 1500)")
-    p.add_argument("--batch-size", type=int, default=32)
+    p.add_argument("--train-steps", type=positive_int, default=1500, help="Adam steps (default 1500)")
+    p.add_argument("--batch-size", type=positive_int, default=32)
     p.add_argument(
         "--pose-augment",
-        type=float,
+        type=non_negative,
         default=0.0,
         metavar="F",
         help="fraction of each batch with joints turned at random (up to 0.3 rad; 0..0.5, default 0 = off)",
     )
-    p.add_argument("--train-lr", type=float, default=2e-3)
-    p.add_argument("--latent", type=int, default=128, help="latent channels D per frame")
-    p.add_argument("--hidden", type=int, default=96, help="hidden channels")
+    p.add_argument("--train-lr", type=positive, default=2e-3)
+    p.add_argument("--latent", type=positive_int, default=128, help="latent channels D per frame")
+    p.add_argument("--hidden", type=positive_int, default=96, help="hidden channels")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
     p.add_argument("--force", action="store_true", help="overwrite an existing checkpoint")
@@ -391,13 +392,13 @@ def register(subparsers) -> None:
     p.add_argument("--retrain", action="store_true", help="train even if the checkpoint exists")
     p.add_argument(
         "--folds",
-        type=int,
+        type=positive_int,
         default=1,
         metavar="K",
         help="leave animations out: split the evaluated animations into K folds and evaluate each with a network "
         "trained on the source's other clips (checkpoints <checkpoint>_fold<k>of<K>.pt); default 1",
     )
-    p.add_argument("--train-steps", type=int, default=1500)
+    p.add_argument("--train-steps", type=positive_int, default=1500)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--csv", help="write the per-clip records to this CSV")
     p.add_argument("--force", action="store_true", help="overwrite an existing --csv file")

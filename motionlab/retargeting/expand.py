@@ -2,8 +2,8 @@
 
 The retargeting paper's stated purpose is to *expand motion databases*: one performer's
 library, generated for every new character (``seeds/000_*.txt``, Abstract). :func:`expand` takes
-source clips × target characters and writes ``OUT/<character>/<clip>.bvh`` plus
-``OUT/manifest.csv``, one row per (clip, character)::
+source clips × target characters and writes ``OUT/<character>/<clip>.bvh`` (or ``.glb``, glTF 2.0,
+with ``output_format="glb"``) plus ``OUT/manifest.csv``, one row per (clip, character)::
 
     job = expand(["Aj/*.bvh"], characters("Kaya/Running.bvh", "long_legs"), "out/")
     print(job.summary())
@@ -45,7 +45,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from motionlab.core import bvh, humanoid, metrics
+from motionlab.core import bvh, gltf, humanoid, metrics
 from motionlab.core.skeleton import Skeleton
 from motionlab.retargeting.batching import Pair, PairResult, batch_frames, plan_batches, quality, solve_pairs
 from motionlab.retargeting.checkpoint import Checkpoint
@@ -56,6 +56,7 @@ __all__ = [
     "PRESETS",
     "MANIFEST",
     "COLUMNS",
+    "FORMATS",
     "Character",
     "characters",
     "find_sources",
@@ -84,6 +85,9 @@ COLUMNS = (
 """Manifest columns: ``status`` is ``ok`` or ``error``; ``loss``/``angle``/``foot``/``contact`` the
 final (best) L_iter, L_angle, L_foot (metres), L_contact (m/s); ``seconds`` the pair's share of its batch's wall time;
 ``flag`` lists the quality thresholds exceeded (``penetration``, ``skating``), empty if none."""
+FORMATS = ("bvh", "glb")
+"""Output formats of :func:`expand`: BVH text or binary glTF 2.0 (:mod:`motionlab.core.gltf`)."""
+
 
 _ERRORS = (
     ValueError,
@@ -156,7 +160,7 @@ def characters(*specs: str, presets: Iterable[str] = ()) -> list[Character]:
             sk = humanoid.to_canonical_skeleton(bvh.load(p).skeleton)
             out.append(Character(name, sk, str(p)))
         except _ERRORS as err:
-            out.append(Character(name, None, str(p), f"{type(err).__name__}: {err}"))
+            out.append(Character(name, None, str(p), _why(err, "character", p)))
     for spec in presets:
         name, factors = _preset(spec)
         out.append(Character(name, humanoid.scale_bones(humanoid.canonical_skeleton(), **factors), f"preset:{spec}"))
@@ -167,6 +171,15 @@ def characters(*specs: str, presets: Iterable[str] = ()) -> list[Character]:
     for n in names:
         _check_name(n, "character")
     return out
+
+
+def _why(err: Exception, role: str, path) -> str:
+    """What went wrong with the ``role`` (character, source) file ``path``, in words a command-line user can act on."""
+    if isinstance(err, humanoid.RigMappingError):  # its Python hint (profile=...) has no command-line form
+        from motionlab.cli import rig_error
+
+        return f"{type(err).__name__}: {rig_error(err, role, path)}"
+    return f"{type(err).__name__}: {err}"
 
 
 def _check_name(name: str, what: str) -> None:
@@ -222,7 +235,10 @@ _MODE = _umask_mode()  # what open() would give a new file (mkstemp makes them p
 
 
 def _write_atomic(path: Path, text: str) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    except OSError as e:  # name the file the user knows, not the temporary one
+        raise type(e)(f"cannot write {path}: {(e.strerror or str(e)).lower()}") from None
     try:
         with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
             f.write(text)
@@ -288,12 +304,12 @@ class ExpandResult:
             rs = [r for r in self.rows if r["character"] == name]
             ok = [r for r in rs if r["status"] == "ok"]
 
-            def mean(key, ok=ok):
-                return float(np.mean([float(r[key]) for r in ok])) if ok else float("nan")
+            def mean(key, width, digits, ok=ok):  # "-" where no pair succeeded: no mean to show
+                return f"{np.mean([float(r[key]) for r in ok]):>{width}.{digits}f}" if ok else f"{'-':>{width}}"
 
             lines.append(
                 f"{name:<18} {len(ok):>4} {len(rs) - len(ok):>4} {sum(1 for r in ok if r['flag']):>4} "
-                f"{mean('steps'):>6.1f} {mean('loss'):>8.4f} {mean('penetration_cm'):>7.3f} {mean('skating_cm_s'):>10.2f}"
+                f"{mean('steps', 6, 1)} {mean('loss', 8, 4)} {mean('penetration_cm', 7, 3)} {mean('skating_cm_s', 10, 2)}"
             )
         lines.append(
             f"this run: {self.done} solved, {self.skipped} already done, {self.failed} failed; "
@@ -304,7 +320,7 @@ class ExpandResult:
 
 
 # ---------------------------------------------------------------------------- the job
-def _row(pr: PairResult, source: str, char: Character, source_skate: float, limits) -> dict:
+def _row(pr: PairResult, source: str, char: Character, source_skate: float, limits, suffix: str) -> dict:
     res = pr.result
     h = res.history
     q = quality(res)
@@ -318,7 +334,7 @@ def _row(pr: PairResult, source: str, char: Character, source_skate: float, limi
         "clip": pr.clip,
         "character": pr.character,
         "status": "ok",
-        "output": f"{pr.character}/{pr.clip}.bvh",
+        "output": f"{pr.character}/{pr.clip}{suffix}",
         "source": source,
         "character_file": char.origin,
         "frames": str(res.motion.num_frames),
@@ -338,12 +354,12 @@ def _row(pr: PairResult, source: str, char: Character, source_skate: float, limi
     }
 
 
-def _error_row(clip: str, character: str, source: str, origin: str, message: str) -> dict:
+def _error_row(clip: str, character: str, source: str, origin: str, message: str, suffix: str = ".bvh") -> dict:
     return {
         "clip": clip,
         "character": character,
         "status": "error",
-        "output": f"{character}/{clip}.bvh",
+        "output": f"{character}/{clip}{suffix}",
         "source": source,
         "character_file": origin,
         "error": message.replace("\n", " "),
@@ -374,6 +390,7 @@ def expand(
     progress: bool = False,
     on_batch: Callable[[int, list[dict]], None] | None = None,
     threads: int | None = None,
+    output_format: str = "bvh",
 ) -> ExpandResult:
     """Retarget every source clip onto every character; see the module docstring.
 
@@ -396,6 +413,8 @@ def expand(
         step's tensors are small, and on the shared 2-core CPU one thread ran the same batches
         many times faster than two (17x in the README's run of ``benchmarks/bench_expand.py``,
         which prints both); unchanged on a GPU.
+    output_format : ``"bvh"`` (default) or ``"glb"`` (glTF 2.0, :func:`motionlab.core.gltf.dumps`):
+        the outputs' format and file suffix. A rerun in another format redoes every pair.
 
     Returns
     -------
@@ -403,6 +422,8 @@ def expand(
     """
     if backend not in ("local", "ray"):
         raise ValueError(f"backend must be 'local' or 'ray', got {backend!r}")
+    if output_format not in FORMATS:
+        raise ValueError(f"output_format must be one of {FORMATS}, got {output_format!r}")
     before = torch.get_num_threads()
     if threads is None:
         threads = 1 if checkpoint.device.type == "cpu" else before
@@ -410,7 +431,7 @@ def expand(
     try:
         return _expand(
             sources, targets, out, checkpoint, solver, root_mode, force, max_frames, backend, address, workers,
-            max_penetration_cm, skate_ratio, progress, on_batch,
+            max_penetration_cm, skate_ratio, progress, on_batch, "." + output_format,
         )  # fmt: skip
     finally:
         torch.set_num_threads(before)
@@ -418,7 +439,7 @@ def expand(
 
 def _expand(
     sources, targets, out, checkpoint, solver, root_mode, force, max_frames, backend, address, workers,
-    max_penetration_cm, skate_ratio, progress, on_batch,
+    max_penetration_cm, skate_ratio, progress, on_batch, suffix,
 ) -> ExpandResult:  # fmt: skip
     start = time.perf_counter()
     out = Path(out)
@@ -438,18 +459,20 @@ def _expand(
     for clip, path in clips:
         for c in targets:
             key = (c.name, clip)
-            file = out / c.name / f"{clip}.bvh"
+            file = out / c.name / f"{clip}{suffix}"
             old = known.get(key)
-            if not force and old is not None and old["status"] == "ok" and file.is_file():
+            ours = old is not None and old["status"] == "ok" and old["output"] == f"{c.name}/{clip}{suffix}"
+            if not force and ours and file.is_file():
                 rows[key] = old
                 result.skipped += 1
-            elif file.exists() and not force and (old is None or old["status"] != "ok"):
+            elif file.exists() and not force and not ours:
                 rows[key] = _error_row(
                     clip,
                     c.name,
                     str(path),
                     c.origin,
                     f"{file} exists and is not an output of this job; pass --force to replace it",
+                    suffix,
                 )
                 result.failed += 1
             else:
@@ -459,7 +482,7 @@ def _expand(
     for key, r in known.items():
         if key not in rows and key not in planned and (r["status"] != "ok" or (out / r["output"]).is_file()):
             rows[key] = r
-    pairs, sources_by_clip = _load_pairs(todo, checkpoint, solver, rows, result)
+    pairs, sources_by_clip = _load_pairs(todo, checkpoint, solver, rows, result, suffix)
     _write_manifest(out, list(rows.values()))
     chars = {c.name: c for c in targets}
     limits = (max_penetration_cm, skate_ratio)
@@ -479,12 +502,14 @@ def _expand(
         try:
             for pr in solved:
                 src_path, src_skate = sources_by_clip[pr.clip]
-                row = _row(pr, src_path, chars[pr.character], src_skate, limits)
+                row = _row(pr, src_path, chars[pr.character], src_skate, limits, suffix)
                 file = out / row["output"]
                 file.parent.mkdir(parents=True, exist_ok=True)
                 fd, tmp = tempfile.mkstemp(dir=file.parent, prefix=f".{file.name}.", suffix=".tmp")
-                with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
-                    f.write(bvh.dumps(pr.result.motion))
+                motion = pr.result.motion
+                data = gltf.dumps(motion) if suffix == gltf.SUFFIX else bvh.dumps(motion).encode("utf-8")
+                with os.fdopen(fd, "wb") as f:
+                    f.write(data)
                 os.chmod(tmp, _MODE)
                 staged.append((tmp, file))
                 new.append(row)
@@ -508,7 +533,7 @@ def _expand(
     return result
 
 
-def _load_pairs(todo, checkpoint, solver, rows, result):
+def _load_pairs(todo, checkpoint, solver, rows, result, suffix):
     """Read each source once; a clip or character that fails becomes ``error`` rows."""
     pairs: list[Pair] = []
     sources_by_clip: dict[str, tuple[str, float]] = {}
@@ -522,14 +547,14 @@ def _load_pairs(todo, checkpoint, solver, rows, result):
             prepared = prepare_source(motion, checkpoint, "full", solver)
         except _ERRORS as err:
             for c in chars:
-                rows[(c.name, clip)] = _error_row(clip, c.name, str(path), c.origin, f"{type(err).__name__}: {err}")
+                rows[(c.name, clip)] = _error_row(clip, c.name, str(path), c.origin, _why(err, "source", path), suffix)
                 result.failed += 1
             continue
         pos = prepared.motion.global_positions()
         sources_by_clip[clip] = (str(path), 100.0 * metrics.foot_skating(pos, feet, prepared.motion.fps))
         for c in chars:
             if c.skeleton is None:
-                rows[(c.name, clip)] = _error_row(clip, c.name, str(path), c.origin, c.error)
+                rows[(c.name, clip)] = _error_row(clip, c.name, str(path), c.origin, c.error, suffix)
                 result.failed += 1
                 continue
             pairs.append(Pair(clip, c.name, motion, c.skeleton, prepared.motion.num_frames, prepared))

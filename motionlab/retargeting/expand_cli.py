@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import argparse
 
+from motionlab.cli_args import check_output_folder, non_negative, non_negative_int, positive, positive_int
+
 __all__ = ["register"]
 
 
@@ -28,6 +30,7 @@ def _cmd_expand(args) -> int:
             raise CLIError(INSTALL_HINT) from None
     if not args.characters and not args.preset:
         raise CLIError("give target characters: --characters FILE.bvh ... and/or --preset NAME ...")
+    check_output_folder("-o", args.output)  # before any work
     try:
         targets = ex.characters(*args.characters, presets=args.preset)
     except ValueError as e:
@@ -49,10 +52,21 @@ def _cmd_expand(args) -> int:
         skate_ratio=args.skate_ratio,
         progress=not args.quiet,
         threads=args.threads or None,
+        output_format=args.format,
     )
     if not args.quiet:
         print(job.summary())
+        _print_failures(job)
     return 1 if job.failed else 0
+
+
+def _print_failures(job, most: int = 10) -> None:
+    """Why pairs failed: one line per ``error`` row of the manifest (the first ``most``)."""
+    failed = [r for r in job.rows if r["status"] == "error"]
+    for r in failed[:most]:
+        print(f"failed {r['character']}/{r['clip']}: {r['error']}")
+    if len(failed) > most:
+        print(f"... and {len(failed) - most} more failed pairs: see the error column of {job.out / 'manifest.csv'}")
 
 
 def register(subparsers) -> None:
@@ -63,7 +77,7 @@ def register(subparsers) -> None:
         "expand",
         help="retarget many clips onto many characters (batched, resumable; local or Ray)",
         description="Expand a motion database: every SOURCE clip onto every character, written as "
-        "OUT/<character>/<clip>.bvh with OUT/manifest.csv (one row per output). Rerunning the same command "
+        "OUT/<character>/<clip>.bvh (or .glb with --format glb) with OUT/manifest.csv (one row per output). Rerunning the same command "
         "redoes only what is missing. Exit status 1 when some pair failed (see the manifest's error column).",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="presets: long_legs, short_legs, long_arms, stocky, tall, child, or NAME:legs=1.2,arms=0.9,...",
@@ -78,17 +92,24 @@ def register(subparsers) -> None:
     )
     p.add_argument("--preset", action="append", default=[], help="a synthetic character (repeatable)")
     p.add_argument("-o", "--output", required=True, help="output folder")
+    p.add_argument(
+        "--format", choices=("bvh", "glb"), default="bvh", help="output files: bvh (default) or glb (glTF 2.0)"
+    )
     p.add_argument("--checkpoint", help="trained network (default: the shipped one)")
     p.add_argument("--root", choices=ROOT_MODES, default="stride", help="root trajectory rule (as in retarget)")
-    p.add_argument("--batch-frames", type=int, help="frames per solver batch (default: from free memory)")
+    p.add_argument("--batch-frames", type=positive_int, help="frames per solver batch (default: from free memory)")
     p.add_argument("--backend", choices=("local", "ray"), default="local")
     p.add_argument("--address", help="Ray cluster address (default: $RAY_ADDRESS, else a local Ray instance)")
-    p.add_argument("--workers", type=int, default=2, help="Ray actors (default 2)")
-    p.add_argument("--threads", type=int, default=0, help="torch threads (default: 1 on the CPU, see expand())")
-    p.add_argument("--max-penetration", type=float, default=1.0, metavar="CM", help="flag above this (default 1 cm)")
+    p.add_argument("--workers", type=positive_int, default=2, help="Ray actors (default 2)")
+    p.add_argument(
+        "--threads", type=non_negative_int, default=0, help="torch threads (default: 1 on the CPU, see expand())"
+    )
+    p.add_argument(
+        "--max-penetration", type=non_negative, default=1.0, metavar="CM", help="flag above this (default 1 cm)"
+    )
     p.add_argument(
         "--skate-ratio",
-        type=float,
+        type=positive,
         default=2.0,
         help="flag when skating exceeds this times the source's own (scaled by the root ratio; default 2)",
     )

@@ -243,10 +243,11 @@ class RetargetNet(nn.Module):
 
     # ------------------------------------------------------------------ the five steps
     def encode(self, x: torch.Tensor) -> torch.Tensor:
-        """φ = F_enc(X): normalised features (B, T, 70) → per-frame latent (B, T, D)."""
+        """φ = F_enc(X): normalised features (B, T, 70) → per-frame latent (B, T, D), in the
+        network's float type (``x`` is cast to it)."""
         if x.ndim != 3 or x.shape[-1] != FEATURE_DIM:
             raise ValueError(f"expected normalised features (B, T, {FEATURE_DIM}), got {tuple(x.shape)}")
-        return self.f_enc(x)
+        return self.f_enc(x.to(self.f_qlinear.weight.dtype))
 
     def rotations(self, phi: torch.Tensor) -> torch.Tensor:
         """q = F_qlinear(φ) / ‖·‖: latent (B, T, D) → unit quaternions (B, T, J, 4)."""

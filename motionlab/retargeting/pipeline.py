@@ -47,7 +47,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import torch
 
-from motionlab.core import humanoid, preprocess, quat
+from motionlab.core import humanoid, preprocess, quat, threads
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
 from motionlab.retargeting import contacts
@@ -206,12 +206,12 @@ def _to_world(local_rot: np.ndarray, yaw: np.ndarray) -> np.ndarray:
 
 def _network_inputs(ckpt: Checkpoint, feats: ClipFeatures, theta: str) -> tuple[torch.Tensor, torch.Tensor]:
     """A's normalised features (1, T, 70) and θ(A): rotations (1, T, 22, 4) or positions (1, T, 22, 3)."""
-    device = ckpt.device
+    device, dtype = ckpt.device, ckpt.dtype
     x = ckpt.stats.normalize(feats.x)
     source = feats.local_rot if theta == "rotations" else feats.positions
     return (
-        torch.as_tensor(x, dtype=torch.float32, device=device)[None],
-        torch.as_tensor(source, dtype=torch.float32, device=device)[None],
+        torch.as_tensor(x, dtype=dtype, device=device)[None],
+        torch.as_tensor(source, dtype=dtype, device=device)[None],
     )
 
 
@@ -278,7 +278,7 @@ def prepare_source(
         return PreparedSource(source.name, src)
     feats = clip_features(src)
     x, theta = _network_inputs(checkpoint, feats, (solver or SolverConfig()).theta)
-    yaw = torch.as_tensor(feats.yaw, dtype=torch.float32, device=x.device)[None]
+    yaw = torch.as_tensor(feats.yaw, dtype=x.dtype, device=x.device)[None]
     planted = torch.as_tensor(source_contacts(src), device=x.device)[None]
     return PreparedSource(source.name, src, feats, x, theta, yaw, planted)
 
@@ -294,10 +294,10 @@ def prepare_pair(source: PreparedSource, target: Skeleton | Motion, root_mode: s
     root_pos = src.root_pos * np.array([r[0], r[1], r[0]])
     if source.x is None:
         return PreparedPair(source, tgt, r, root_pos)
-    device = source.x.device
-    offsets = torch.tensor(tgt.offsets, dtype=torch.float32, device=device)
-    height = torch.as_tensor(root_pos[:, 1], dtype=torch.float32)[None]
-    root_xz = torch.as_tensor(root_pos[:, [0, 2]], dtype=torch.float32, device=device)[None]
+    device, dtype = source.x.device, source.x.dtype
+    offsets = torch.tensor(tgt.offsets, dtype=dtype, device=device)
+    height = torch.as_tensor(root_pos[:, 1], dtype=dtype)[None]
+    root_xz = torch.as_tensor(root_pos[:, [0, 2]], dtype=dtype, device=device)[None]
     return PreparedPair(source, tgt, r, root_pos, offsets, height, root_xz)
 
 
@@ -372,7 +372,7 @@ def retarget(
     reason, steps, heading_rot = "", 0, None
     start = time.perf_counter()
     if method == "network":
-        with torch.no_grad():
+        with torch.no_grad(), threads.torch_threads(threads.threads_for(pair.source.x.shape[1])):
             heading_rot = checkpoint.model(pair.source.x, pair.offsets).local_rot[0].cpu().numpy()
     elif method == "full":
         src = pair.source

@@ -43,6 +43,10 @@ Gaussian filter along time (σ = ``smooth_sigma`` frames) and optimise the free 
 still only the latent moves and the loss is unchanged, but every update is temporally smooth.
 ``smooth_sigma=0`` optimises φ directly, as the paper states.
 
+**The same iterates on every CPU (``step_grid``).** The start and every Adam iterate are rounded
+to a grid a four-thousandth of a step fine, so that last-bit differences between CPUs' kernels
+cannot grow into other results or another stopping step. The network computes in float64.
+
 θ, what "joint angles" means, is our choice: the local joint rotations (see
 :mod:`motionlab.retargeting.losses` for why, and ``theta="directions"`` for the
 position-based alternative). The foot loss needs world heights: ``y = root_height(t) + FK_y``,
@@ -54,6 +58,7 @@ Taught in ``notebooks/03_latent_iteration.ipynb``.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -62,6 +67,7 @@ import numpy as np
 import torch
 from tqdm.auto import tqdm
 
+from motionlab.core import threads
 from motionlab.retargeting import losses
 from motionlab.retargeting.contacts import CONTACT_JOINTS
 from motionlab.retargeting.model import NUM_JOINTS, Decoded, RetargetNet
@@ -69,6 +75,7 @@ from motionlab.retargeting.model import NUM_JOINTS, Decoded, RetargetNet
 __all__ = [
     "SolverConfig",
     "SolverResult",
+    "step_grid",
     "iteration_loss",
     "sequence_losses",
     "project_latent",
@@ -186,6 +193,22 @@ class SolverResult:
     steps: int = 0
     seconds: float = 0.0
     best_step: int = 0
+
+
+def step_grid(size: float) -> float:
+    """The spacing iterates are rounded to: the power of two just below ``size · 2⁻¹²``.
+
+    The latent iteration rounds its start φ₀ to ``step_grid(std(φ₀))`` and the latent offset,
+    after each Adam step, to ``step_grid(lr)`` (``lr`` the group's actual step size): a
+    four-thousandth of a step. Why: the Gauss–Newton start is a damped least-squares solve, which
+    turns a difference in the last bit of its inputs (another CPU's kernels add in another order)
+    into one in the eleventh digit, and Adam, which divides each gradient by its own running size,
+    lets such a difference grow step by step, until after some 50 steps the loss, and with it
+    where the stopping rule stops, differ in the third digit. On the grid, differences that small
+    are rounded away, so the iterates are the same on every CPU
+    (``benchmarks/bench_reproducibility.py`` prints the comparison).
+    """
+    return 2.0 ** math.floor(math.log2(size) - 12)
 
 
 def _smoother(sigma: float, channels: int, dtype, device):
@@ -359,6 +382,11 @@ def sequence_losses(
     )
 
 
+def _in_model_type(model: RetargetNet, x: torch.Tensor) -> torch.Tensor:
+    """``x`` in the network's float type: every tensor of the iteration follows ``x``."""
+    return torch.as_tensor(x).to(next(model.parameters()).dtype)
+
+
 def _check_inputs(x, source, offsets, root_height, cfg) -> None:
     last = 4 if cfg.theta == "rotations" else 3
     if x.ndim != 3 or source.shape != x.shape[:2] + (22, last) or root_height.shape != x.shape[:2]:
@@ -436,9 +464,11 @@ def solve(
     SolverResult
     """
     cfg = config or SolverConfig()
+    x = _in_model_type(model, x)
     _check_inputs(x, source, offsets, root_height, cfg)
     contact = _contact_inputs(x, root_height, cfg, root_xz, yaw, planted, fps)
-    return _iterate(model, x, source, offsets, root_height, cfg, [x.shape[0]], callback, progress, contact)[0]
+    with threads.torch_threads(threads.threads_for(x.shape[0] * x.shape[1])):
+        return _iterate(model, x, source, offsets, root_height, cfg, [x.shape[0]], callback, progress, contact)[0]
 
 
 def solve_many(
@@ -468,9 +498,11 @@ def solve_many(
     ``seconds`` is the wall time of the whole batch.
     """
     cfg = config or SolverConfig()
+    x = _in_model_type(model, x)
     _check_inputs(x, source, offsets, root_height, cfg)
     contact = _contact_inputs(x, root_height, cfg, root_xz, yaw, planted, fps)
-    return _iterate(model, x, source, offsets, root_height, cfg, [1] * x.shape[0], None, progress, contact)
+    with threads.torch_threads(threads.threads_for(x.shape[0] * x.shape[1])):
+        return _iterate(model, x, source, offsets, root_height, cfg, [1] * x.shape[0], None, progress, contact)
 
 
 def _iterate(
@@ -522,12 +554,15 @@ def _iterate(
                         for i in range(x.shape[0])
                     ]
                 )
-        deltas, param_groups = [], []
+        deltas, param_groups, grids = [], [], []
         for g in range(groups):
             part = phi0[bounds[g] : bounds[g + 1]]
-            scale = float(part.std()) if part.numel() > 1 else 1.0
+            scale = max(float(part.std()) if part.numel() > 1 else 1.0, 1e-6)
+            with torch.no_grad():  # the start on the grid too (see step_grid)
+                part.copy_(torch.round(part / step_grid(scale)) * step_grid(scale))
             deltas.append(torch.zeros_like(part, requires_grad=True))
-            param_groups.append({"params": [deltas[-1]], "lr": cfg.lr * max(scale, 1e-6)})
+            param_groups.append({"params": [deltas[-1]], "lr": cfg.lr * scale})
+            grids.append(step_grid(param_groups[-1]["lr"]))
         opt = torch.optim.Adam(param_groups)
         best = [float("inf")] * groups  # best loss that counted as an improvement (plateau rule)
         since_best, reasons = [0] * groups, ["max_steps"] * groups
@@ -602,6 +637,9 @@ def _iterate(
                 deltas[active[k]].grad = None  # Adam skips it: a stopped problem keeps its latent
             opt.step()
             active = [g for k, g in enumerate(active) if k not in stopped]
+            with torch.no_grad():  # on the grid: the same iterates on every CPU (see step_grid)
+                for g in active:
+                    deltas[g].copy_(torch.round(deltas[g] / grids[g]) * grids[g])
             for g in active:
                 steps[g] += 1
             bar.update(1)

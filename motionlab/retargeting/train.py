@@ -41,7 +41,7 @@ from motionlab.core.motion import Motion
 from motionlab.core.preprocess import NormStats
 from motionlab.core.skeleton import Skeleton
 from motionlab.retargeting import losses
-from motionlab.retargeting.checkpoint import Checkpoint
+from motionlab.retargeting.checkpoint import DTYPES, Checkpoint
 from motionlab.retargeting.features import clip_features
 from motionlab.retargeting.model import NUM_JOINTS, ModelConfig, RetargetNet
 
@@ -184,6 +184,8 @@ class TrainConfig:
     pose_noise : float      largest angle (radians) of those rotations
     log_every : int         steps between history entries / callback calls
     device : str or None    None: CUDA when available, else CPU
+    dtype : str             ``"float64"`` (default: the same numbers on every CPU, to the digits
+                            the notebooks print) or ``"float32"`` (faster on a GPU)
     """
 
     steps: int = 1500
@@ -199,8 +201,11 @@ class TrainConfig:
     pose_noise: float = 0.3
     log_every: int = 10
     device: str | None = None
+    dtype: str = "float64"
 
     def __post_init__(self) -> None:
+        if self.dtype not in DTYPES:
+            raise ValueError(f"dtype must be one of {tuple(DTYPES)}, got {self.dtype!r}")
         if self.steps < 1 or self.batch_size < 1 or self.log_every < 1:
             raise ValueError(
                 f"steps, batch_size and log_every must be positive, got {self.steps}, {self.batch_size}, {self.log_every}"
@@ -304,14 +309,15 @@ def train(
     device = pick_device(cfg.device)
     torch.manual_seed(cfg.seed)
     gen = torch.Generator().manual_seed(cfg.seed)
-    model = RetargetNet(model_config).to(device)
+    dtype = DTYPES[cfg.dtype]
+    model = RetargetNet(model_config).to(device=device, dtype=dtype)
     model.train()
-    mean = torch.as_tensor(data.stats.mean, dtype=torch.float32)
-    std = torch.as_tensor(data.stats.std, dtype=torch.float32)
-    x_all = ((torch.from_numpy(data.x) - mean) / std).to(device)
-    pos_all = torch.from_numpy(data.positions).to(device)
-    rot_all = torch.from_numpy(data.local_rot).to(device)
-    base = torch.tensor(data.skeleton.offsets, dtype=torch.float32)
+    mean = torch.as_tensor(data.stats.mean, dtype=dtype)
+    std = torch.as_tensor(data.stats.std, dtype=dtype)
+    x_all = ((torch.from_numpy(data.x).to(dtype) - mean) / std).to(device)
+    pos_all = torch.from_numpy(data.positions).to(device=device, dtype=dtype)
+    rot_all = torch.from_numpy(data.local_rot).to(device=device, dtype=dtype)
+    base = torch.tensor(data.skeleton.offsets, dtype=dtype)
     base[0] = 0.0
     opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, cfg.steps, eta_min=cfg.lr / 10)
@@ -336,7 +342,7 @@ def train(
         if n_pose:  # the last n_pose rows: A's skeleton, joints turned, features recomputed
             rows = slice(cfg.batch_size - n_pose, None)
             x, rot, target = x.clone(), rot.clone(), target.clone()
-            turns = random_turns(n_pose, cfg, gen).to(device)
+            turns = random_turns(n_pose, cfg, gen).to(device=device, dtype=dtype)
             x[rows], rot[rows], target[rows] = turned_window(x[rows], rot[rows], offsets[rows], turns, mean, std)
         out = model(x, offsets)
         recon = losses.recon_loss(out.positions, target, cfg.recon_weight)

@@ -16,6 +16,8 @@ import argparse
 import time
 from pathlib import Path
 
+from motionlab.cli_args import check_outputs, non_negative_int, positive, positive_int
+
 __all__ = ["register"]
 
 
@@ -33,16 +35,6 @@ def _size(text: str) -> tuple[int, int]:
     if width < 16 or height < 16:
         raise argparse.ArgumentTypeError(f"the window must be at least 16x16 pixels, got {text!r}")
     return width, height
-
-
-def _positive(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
-    return value
 
 
 def _open_window(scene) -> None:
@@ -96,7 +88,7 @@ def _cmd_view(args) -> int:
     if out is not None:
         if out.suffix.lower() not in MOVIE_SUFFIXES:
             raise _error(f"--out must end in .mp4 or .gif, got {str(out)!r}")
-        files.check_output(out, args.force, "movie")
+        check_outputs([("--out", out)], args.force, inputs=[("input", source)])
     try:
         motion = bvh.load(source, scale=args.scale)
     except bvh.BVHError as e:
@@ -110,8 +102,6 @@ def _cmd_view(args) -> int:
             from motionlab.cli import rig_error
 
             raise rig_error(e, "input", source) from None
-    if args.start < 0:
-        raise _error(f"--start must be 0 or more, got {args.start}")
     if args.start or args.stop is not None:
         motion = motion[args.start : args.stop]
         if motion.num_frames == 0:
@@ -130,8 +120,22 @@ def _cmd_view(args) -> int:
     kwargs = {"stride": args.stride} if args.stride else {}
     save_movie(motion, out, overwrite=args.force, off_screen=True, anti_aliasing=args.smooth, **kwargs, **options)
     seconds = time.perf_counter() - start
-    print(f"wrote {out} ({motion.num_frames} frames of {motion.name or source.name}, {seconds:.1f} s)")
+    frames, length = _movie_length(out, motion, args.stride)
+    print(
+        f"wrote {out}: {frames} frames, {length:.2f} s of {motion.name or source.name} "
+        f"({motion.num_frames} frames at {motion.fps:g} fps; rendered in {seconds:.1f} s)"
+    )
     return 0
+
+
+def _movie_length(out: Path, motion, stride: int | None) -> tuple[int, float]:
+    """``(frames, seconds)`` of the movie written: read from a GIF, from the stride for an MP4."""
+    from motionlab.viz.export import gif_length
+
+    if out.suffix.lower() == ".gif":
+        return gif_length(out)
+    frames = len(range(0, motion.num_frames, stride or 1))
+    return frames, frames * (stride or 1) / motion.fps
 
 
 def register(subparsers) -> None:
@@ -152,10 +156,12 @@ def register(subparsers) -> None:
         help="follow the character (default) or frame the whole clip from one place",
     )
     p.add_argument("--size", type=_size, default=(640, 480), metavar="WxH", help="picture size in pixels (640x480)")
-    p.add_argument("--scale", type=_positive, default=0.01, help="BVH units to metres (default 0.01: centimetres)")
-    p.add_argument("--start", type=int, default=0, help="first frame")
+    p.add_argument("--scale", type=positive, default=0.01, help="BVH units to metres (default 0.01: centimetres)")
+    p.add_argument("--start", type=non_negative_int, default=0, help="first frame")
     p.add_argument("--stop", type=int, default=None, help="frame to stop before (default: the end)")
-    p.add_argument("--stride", type=int, default=None, help="movie: keep every N-th frame (GIF default: ~15 fps)")
+    p.add_argument(
+        "--stride", type=positive_int, default=None, help="movie: keep every N-th frame (GIF default: ~15 fps)"
+    )
     p.add_argument("--canonical", action="store_true", help="show the 22-joint humanoid instead of the full rig")
     p.add_argument("--no-trail", action="store_true", help="do not draw the root's path on the ground")
     p.add_argument("--feet-trails", action="store_true", help="draw the feet's paths")

@@ -34,6 +34,7 @@ __all__ = [
     "snapshot",
     "filmstrip",
     "to_png",
+    "gif_length",
     "MOVIE_SUFFIXES",
 ]
 
@@ -165,6 +166,20 @@ def save_gif(
 
     _write_atomically(path, write)
     return path
+
+
+def gif_length(path) -> tuple[int, float]:
+    """``(frames, seconds)`` of a GIF file as a viewer plays it: the frames stored in the file
+    (Pillow merges identical neighbours) and their display times summed, seconds."""
+    from PIL import Image
+
+    with Image.open(os.fspath(path)) as image:
+        frames = int(getattr(image, "n_frames", 1))
+        milliseconds = 0
+        for k in range(frames):
+            image.seek(k)
+            milliseconds += int(image.info.get("duration", 0))
+    return frames, milliseconds / 1000.0
 
 
 def save_mp4(

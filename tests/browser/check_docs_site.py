@@ -18,7 +18,12 @@ What it does:
 4. for the notebooks stored with outputs, requires at least one figure on the page;
 5. saves screenshots of notebooks 00, 04 and 05 (the first figure in view) and of the home page
    into ``--out``; prints a JSON summary. Requests to other hosts (the MathJax CDN) are blocked,
-   as on an offline machine; they are counted, not failures.
+   as on an offline machine; they are counted, not failures;
+6. opens every notebook page that has a web player (``motionlab.viz.web``) again, from ``file://``
+   with every non-file request blocked: the player must start (three.js loaded, a WebGL context on
+   its canvas); the check presses play and requires the canvas to change between two screenshots
+   0.5 s apart, kept in ``--out/players/``. Every notebook that shows motion
+   (:data:`MOTION_NOTEBOOKS`) must have a working player.
 
 Exit status 0 when every check passed, 1 otherwise.
 """
@@ -44,6 +49,16 @@ SCREENSHOTS = {
     "04_playback_and_bone_proportions": "notebooks/04_playback_and_bone_proportions.html",
     "05_motion_graphs": "notebooks/05_motion_graphs.html",
 }
+MOTION_NOTEBOOKS = (
+    "00_quaternions_and_fk",
+    "01_preprocessing",
+    "03_latent_iteration",
+    "04_playback_and_bone_proportions",
+    "05_motion_graphs",
+    "06_keypose_interpolation",
+    "07_expanding_a_database",
+)
+"""Notebooks that show motion: each page must hold at least one working web player."""
 
 
 def _stored_notebooks() -> list[str]:
@@ -97,13 +112,61 @@ def _local_file(url: str, base: str) -> Path | None:
     return target
 
 
+def _changed_fraction(a: bytes, b: bytes) -> float:
+    """Share of pixels that differ between two PNG screenshots of the same size."""
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    x, y = (np.asarray(Image.open(io.BytesIO(d)).convert("RGB"), dtype=np.int16) for d in (a, b))
+    return float((np.abs(x - y).sum(axis=-1) > 0).mean()) if x.shape == y.shape else 1.0
+
+
+def _check_player(browser, rel: str, out: Path, timeout_ms: int = 20_000) -> dict:
+    """Open ``rel`` from file:// (network blocked), start its first player and watch it move."""
+    page = browser.new_page(viewport={"width": 1200, "height": 900})
+    errors: list[str] = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    page.route("**/*", lambda r: r.continue_() if r.request.url.startswith("file://") else r.abort())
+    result: dict = {"page": rel, "ok": False}
+    try:
+        page.goto((SITE / rel).as_uri(), wait_until="load", timeout=timeout_ms)
+        result["players"] = page.locator(".motionlab-player").count()
+        player = page.locator(".motionlab-player").first
+        player.scroll_into_view_if_needed()
+        try:
+            page.wait_for_selector(".motionlab-player[data-ready='1']", timeout=timeout_ms)
+        except Exception:
+            result["why"] = "player did not start: " + (player.locator(".motionlab-message").text_content() or "")
+            return result
+        canvas = player.locator("canvas")
+        result["webgl"] = canvas.evaluate("c => !!(c.getContext('webgl2') || c.getContext('webgl'))")
+        player.locator("button.motionlab-play").click()
+        page.wait_for_timeout(200)
+        stem = Path(rel).stem
+        (out / "players").mkdir(parents=True, exist_ok=True)
+        first = canvas.screenshot(path=str(out / "players" / f"{stem}_0.png"))
+        page.wait_for_timeout(500)
+        second = canvas.screenshot(path=str(out / "players" / f"{stem}_1.png"))
+        result["changed"] = round(_changed_fraction(first, second), 4)
+        result["errors"] = errors
+        result["ok"] = bool(result["webgl"]) and result["changed"] > 0.001 and not errors
+        if not result["ok"]:
+            result["why"] = "no WebGL context" if not result["webgl"] else errors[0] if errors else "no motion"
+    finally:
+        page.close()
+    return result
+
+
 def check(out: Path, timeout_ms: int = 30_000) -> dict:
     from playwright.sync_api import sync_playwright
 
     server = _serve(SITE)
     base = f"http://127.0.0.1:{server.server_address[1]}/"
     report: dict = {"pages": 0, "images": 0, "broken_images": [], "links_checked": 0, "broken_links": [],
-                    "external_requests_blocked": 0, "figures_per_notebook": {}, "screenshots": []}  # fmt: skip
+                    "external_requests_blocked": 0, "figures_per_notebook": {}, "screenshots": [],
+              "players_per_notebook": {}, "players": []}  # fmt: skip
     stored = _stored_notebooks()
     out.mkdir(parents=True, exist_ok=True)
     start = time.time()
@@ -141,6 +204,7 @@ def check(out: Path, timeout_ms: int = 30_000) -> dict:
                 if rel.startswith("notebooks/"):
                     name = Path(rel).stem
                     report["figures_per_notebook"][name] = page.locator(".cell_output img").count()
+                    report["players_per_notebook"][name] = page.locator(".motionlab-player").count()
                 for href in page.eval_on_selector_all("a[href]", "els => els.map(e => e.href)"):
                     if not href.startswith(base):
                         continue
@@ -157,6 +221,9 @@ def check(out: Path, timeout_ms: int = 30_000) -> dict:
                     shot = out / f"docs_{name}.png"
                     page.screenshot(path=str(shot))
                     report["screenshots"].append(str(shot))
+            for name, count in sorted(report["players_per_notebook"].items()):
+                if count:
+                    report["players"].append(_check_player(browser, f"notebooks/{name}.html", out))
             browser.close()
         for page_rel, href in sorted(links):
             target_url, fragment = urldefrag(href)
@@ -170,9 +237,15 @@ def check(out: Path, timeout_ms: int = 30_000) -> dict:
         server.shutdown()
     missing_figures = [n for n in stored if report["figures_per_notebook"].get(n, 0) == 0]
     report["stored_notebooks_without_figures"] = missing_figures
+    working = {Path(p["page"]).stem for p in report["players"] if p["ok"]}
+    report["motion_notebooks_without_a_working_player"] = [n for n in MOTION_NOTEBOOKS if n not in working]
     report["seconds"] = round(time.time() - start, 1)
     report["ok"] = (
-        bool(report["pages"]) and not report["broken_images"] and not report["broken_links"] and not missing_figures
+        bool(report["pages"])
+        and not report["broken_images"]
+        and not report["broken_links"]
+        and not missing_figures
+        and not report["motion_notebooks_without_a_working_player"]
     )
     return report
 

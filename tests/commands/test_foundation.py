@@ -141,3 +141,14 @@ def test_convert_output_is_not_the_input(clip, tmp_path, capsys):
     np.testing.assert_array_equal(
         np.frombuffer(copy.read_bytes(), np.uint8), np.frombuffer(clip.read_bytes(), np.uint8)
     )
+
+
+def test_convert_to_glb_chooses_the_format_by_suffix(clip, tmp_path, capsys):
+    from tests.gltf_reader import assert_glb_matches
+
+    code, out, err = _run(capsys, "convert", clip, "-o", tmp_path / "x.glb", "--fps", "15")
+    assert code == 0 and "wrote" in out, err
+    assert (tmp_path / "x.glb").read_bytes()[:4] == b"glTF"
+    assert_glb_matches(tmp_path / "x.glb", bvh.load(clip).resample(15))
+    code, _, err = _run(capsys, "convert", clip, "-o", tmp_path / "x.glb")
+    assert code == 2 and "--force" in err

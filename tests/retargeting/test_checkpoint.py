@@ -23,8 +23,8 @@ def test_save_load_round_trip(tmp_path, tiny_checkpoint):
     assert (back.fps, back.window) == (tiny_checkpoint.fps, tiny_checkpoint.window)
     assert back.info["final_loss"] == tiny_checkpoint.info["final_loss"]
     assert not back.model.training
-    x = torch.randn(1, 30, 70)
-    off = torch.tensor(back.skeleton.offsets, dtype=torch.float32)
+    x = torch.randn(1, 30, 70, dtype=back.dtype)
+    off = torch.tensor(back.skeleton.offsets, dtype=back.dtype)
     with torch.no_grad():
         np.testing.assert_array_equal(back.model(x, off).positions, tiny_checkpoint.model.cpu()(x, off).positions)
 
@@ -68,3 +68,14 @@ def test_corrupt_and_foreign_files_are_clear_errors(tmp_path, tiny_checkpoint):
         checkpoint.load(other)
     with pytest.raises(FileNotFoundError):
         checkpoint.load(tmp_path / "missing.pt")
+
+
+def test_load_computes_in_the_asked_float_type(tmp_path, tiny_checkpoint):
+    path = checkpoint.save(tmp_path / "net.pt", tiny_checkpoint)
+    assert checkpoint.load(path, device="cpu").dtype == torch.float64  # the default
+    single = checkpoint.load(path, device="cpu", dtype="float32")
+    assert single.dtype == torch.float32
+    for a, b in zip(tiny_checkpoint.model.state_dict().values(), single.model.state_dict().values()):
+        assert torch.equal(a.cpu().float(), b)
+    with pytest.raises(ValueError, match="dtype must be one of"):
+        checkpoint.load(path, device="cpu", dtype="float16")

@@ -113,8 +113,8 @@ def test_world_feet_turns_and_moves_the_heading_frame():
 def test_rotation_jacobian_matches_autograd():
     model = retargeting.load_default().model
     torch.manual_seed(0)
-    phi = torch.randn(3, model.config.latent)
-    emb = model.skeleton_embedding(torch.tensor(retargeting.load_default().skeleton.offsets, dtype=torch.float32))
+    phi = torch.randn(3, model.config.latent, dtype=torch.float64)
+    emb = model.skeleton_embedding(torch.tensor(retargeting.load_default().skeleton.offsets))
 
     def decoded(p):
         return model.combine(model.rotations(p[:, None]), model.correction(p[:, None], emb.expand(3, -1)))[:, 0]

@@ -58,7 +58,9 @@ def _ok_outputs(out):
     return sorted(r["output"] for r in ex.read_manifest(out) if r["status"] == "ok")
 
 
-def test_solve_many_is_solve_per_sequence_bit_for_bit(ckpt):
+def test_solve_many_is_solve_per_sequence(ckpt):
+    """The same numbers up to rounding: a batched matrix product may add in another order than
+    one row alone, so rotations agree to 1e-9 (float64), and the steps and stops are the same."""
     clip = synthetic.dataset(1, seed=3, num_frames=30)[0]
     from motionlab.retargeting.pipeline import prepare_pair, prepare_source
 
@@ -69,9 +71,10 @@ def test_solve_many_is_solve_per_sequence_bit_for_bit(ckpt):
     many = solve_many(ckpt.model, x, th, off, h, SolverConfig(max_steps=15))
     for i, p in enumerate(pairs):
         one = solve(ckpt.model, src.x, src.theta, p.offsets, p.root_height, SolverConfig(max_steps=15))
-        assert np.array_equal(one.local_rot, many[i].local_rot)
-        assert one.history == many[i].history and one.steps == many[i].steps
-        assert one.stop_reason == many[i].stop_reason
+        np.testing.assert_allclose(one.local_rot, many[i].local_rot, atol=1e-9)
+        for key, values in one.history.items():
+            np.testing.assert_allclose(values, many[i].history[key], rtol=1e-9, atol=1e-12)
+        assert one.steps == many[i].steps and one.stop_reason == many[i].stop_reason
 
 
 def test_outputs_equal_single_pair_path(ckpt, library, tmp_path):
@@ -82,8 +85,11 @@ def test_outputs_equal_single_pair_path(ckpt, library, tmp_path):
     for clip in ("walk", "turn", "short"):
         source = bvh.load(library / "clips" / f"{clip}.bvh")
         for c in targets:
-            single = retarget(source, c.skeleton, ckpt, solver=FAST)
-            assert (tmp_path / c.name / f"{clip}.bvh").read_text() == bvh.dumps(single.motion), (clip, c.name)
+            single = retarget(source, c.skeleton, ckpt, solver=FAST).motion
+            written = bvh.load(tmp_path / c.name / f"{clip}.bvh")
+            # batched and single solves agree to rounding (test above); the file holds 6 decimals
+            np.testing.assert_allclose(written.global_positions(), single.global_positions(), atol=1e-5)
+            assert written.num_frames == single.num_frames and written.skeleton.names == single.skeleton.names
     row = next(r for r in job.rows if r["clip"] == "walk" and r["character"] == "rig0")
     assert int(row["frames"]) == 40 and int(row["steps"]) <= FAST.max_steps and row["stop_reason"]
     expected = 0.3 * float(row["angle"]) + 0.5 * float(row["foot"]) + 0.5 * float(row["contact"])

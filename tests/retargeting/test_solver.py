@@ -122,3 +122,19 @@ def test_bad_shapes_refused(tiny_checkpoint, data):
         solve(tiny_checkpoint.model, x, src, off, h, SolverConfig(theta="directions"))
     with pytest.raises(ValueError, match="theta"):
         SolverConfig(theta="angles")
+
+
+def test_a_last_bit_difference_does_not_change_the_iteration():
+    """Another CPU's kernels round the last bits of the gradients differently; the latent is kept
+    on a grid (solver.step_grid), so the same steps, stop and losses follow (to rounding)."""
+    from motionlab import retargeting, synthetic
+
+    ckpt = retargeting.load_default("cpu")
+    clip = synthetic.generate("run", ckpt.skeleton, 150, ckpt.fps, seed=2)
+    nudged = clip.copy(local_rot=clip.local_rot * (1 + 2.0**-52))  # the last bit, as another CPU's sin/cos
+    target = humanoid.scale_bones(ckpt.skeleton, legs=1.3, arms=0.8)
+    cfg = SolverConfig(max_steps=100)
+    runs = [retargeting.retarget(m, target, ckpt, solver=cfg) for m in (clip, nudged)]
+    assert runs[0].steps == runs[1].steps and runs[0].stop_reason == runs[1].stop_reason
+    np.testing.assert_allclose(runs[0].history["loss"], runs[1].history["loss"], rtol=1e-9)
+    np.testing.assert_allclose(runs[0].positions, runs[1].positions, atol=1e-9)

@@ -38,6 +38,17 @@ def test_view_gif(can_render, clip, tmp_path):
     assert out.read_bytes()[:3] == b"GIF"
 
 
+def test_view_prints_the_gifs_own_frame_count_and_length(can_render, clip, tmp_path, capsys):
+    """Not the clip's frame count, nor the render time as the duration."""
+    from motionlab.viz.export import gif_length
+
+    out = tmp_path / "walk.gif"
+    assert main(["view", str(clip), "--out", str(out), "--stride", "4", *FAST]) == 0
+    frames, seconds = gif_length(out)
+    assert frames == 3  # 12 frames, every 4th
+    assert f"wrote {out}: {frames} frames, {seconds:.2f} s of" in capsys.readouterr().out
+
+
 def test_view_without_display_needs_out_and_writes_nothing(clip, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr("motionlab.viz.backend.has_display", lambda: False)
@@ -59,7 +70,11 @@ def test_view_without_display_needs_out_and_writes_nothing(clip, tmp_path, monke
 def test_view_user_errors(clip, tmp_path, monkeypatch, capsys, args, message):
     monkeypatch.chdir(tmp_path)
     args = [a.replace("{clip}", str(clip)) for a in args]
-    assert main(["view", *args]) == 2
+    try:
+        code = main(["view", *args])
+    except SystemExit as e:  # refused by argparse, naming the option
+        code = e.code
+    assert code == 2
     assert message in capsys.readouterr().err
 
 
