@@ -8,9 +8,10 @@ feet for a moment at every step (and at its start and stop): where two pools' po
 Kovar's own transitions (local minima of the frame distance below the *same* threshold as every
 other transition) can join them.
 
-Only a pool's *ports* take part (:attr:`.segments.Segments.ports`: an action's stances, a gait's
-frames with both feet planted) — the frames where a change of style or behaviour looks natural —
-so the comparison is small. For two pools ``A`` and ``B`` the port frames of both are compared
+Only a pool's *ports* take part (:attr:`.segments.Segments.ports`: an action's boundary
+stances; a gait's start, stop and frames with both feet planted) — the frames where a change of
+style or behaviour looks natural — so the comparison is small. Inside one pool the same ports
+join its takes stance to stance (:func:`link_within`). For two pools ``A`` and ``B`` the port frames of both are compared
 once; a candidate ``(i, j)`` gives the edge ``A_i → B_{j+1}`` and the edge ``B_j → A_{i+1}``,
 each kept only when it leaves an alive frame or a take's *lead-out* and enters an alive frame
 or a take's *lead-in* (:func:`leads`: a start or stop that the pruning inside the style
@@ -22,9 +23,9 @@ in ``A``'s pool, ``enter`` in ``B``'s, ``pieces: []``, ``frames: 0``), so the se
 
 Which pools are compared (:func:`pool_pairs`): every two styles of one standing action (a
 gait's styles meet in their interpolation space, as the paper prescribes), and the styles of
-one name in two behaviours (every two styles when the behaviours share no style name)
-that no recorded transition clip joins in that direction (recorded clips stay preferred, as
-the paper prescribes); a search changes style inside a behaviour and behaviour at one style.
+one name in two behaviours (every two styles when the behaviours share no style name) that no
+recorded transition clip joins in that direction (recorded clips stay preferred, as the paper
+prescribes). A search then changes style inside a behaviour, and behaviour within one style.
 
 Taught in ``notebooks/05_motion_graphs.ipynb``.
 """
@@ -43,9 +44,10 @@ __all__ = ["pool_pairs", "port_features", "leads", "link_within", "link_pools", 
 
 Key = tuple[str, str]
 
-PORT_TAKES = 1000
-"""Takes of a pool (evenly spaced in take order) whose ports are compared: the work grows with
-the number of styles, not of takes, as the ring of neighbours keeps it linear inside a style."""
+PORT_TAKES = 128
+"""Most takes of a pool (evenly spaced in take order) whose ports are compared: two thirds of a
+second of ports per action take at 30 fps is 20 frames, so two pools compare at most 2560 × 2560
+frames, whatever the session's size."""
 
 
 def pool_pairs(
