@@ -51,6 +51,11 @@ def build_parser() -> argparse.ArgumentParser:
                 continue  # that part has no commands (yet)
             raise
         module.register(sub)
+    from motionlab.cli_args import HelpFormatter, RawDescriptionHelpFormatter
+
+    for command in sub.choices.values():  # every option's default in its --help
+        raw = issubclass(command.formatter_class, argparse.RawDescriptionHelpFormatter)
+        command.formatter_class = RawDescriptionHelpFormatter if raw else HelpFormatter
     return parser
 
 

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from motionlab.cli_args import check_outputs, non_negative, non_negative_int, positive, positive_int
+from motionlab.cli_args import add_quiet, check_outputs, non_negative, non_negative_int, positive, positive_int, renamed
 
 ROOT_MODES = ("stride", "hips", "legs", "contacts")
 """``pipeline.ROOT_MODES``, repeated so that ``--help`` does not import torch (a test keeps them equal)."""
@@ -53,7 +53,7 @@ def _solver_config(args):
     for option, value, ok, expected in (
         ("--steps", args.steps, args.steps >= 0, ">= 0"),
         ("--lr", args.lr, args.lr > 0, "> 0"),
-        ("--threshold", args.threshold, args.threshold >= 0, ">= 0"),
+        ("--stop-loss", args.stop_loss, args.stop_loss >= 0, ">= 0"),
         ("--contact-weight", args.contact_weight, args.contact_weight >= 0, ">= 0"),
         ("--exact-rounds", args.exact_rounds, 0 <= args.exact_rounds <= rounds, f"between 0 and {rounds}"),
     ):
@@ -62,7 +62,7 @@ def _solver_config(args):
     return SolverConfig(
         max_steps=args.steps,
         lr=args.lr,
-        threshold=args.threshold,
+        threshold=args.stop_loss,
         lambda_contact=args.contact_weight,
         init=args.init,
         project_exact=args.exact_rounds,
@@ -80,8 +80,16 @@ def _add_solver_args(p: argparse.ArgumentParser) -> None:
         default=0.02,
         help="Adam step on the latent, relative to its spread std(φ₀) (default 0.02)",
     )
-    g.add_argument(
-        "--threshold", type=non_negative, default=2e-3, help="stop when L_iter drops below this (default 2e-3)"
+    renamed(
+        g,
+        "--threshold",
+        g.add_argument(
+            "--stop-loss",
+            type=non_negative,
+            default=2e-3,
+            metavar="L",
+            help="stop when L_iter drops below this (the paper's threshold; default 2e-3)",
+        ),
     )
     g.add_argument(
         "--contact-weight",
@@ -340,7 +348,7 @@ def register(subparsers) -> None:
     p.add_argument("--scale", type=positive, default=1.0, metavar="F", help="scale the whole target by F")
     p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
     p.add_argument("--force", action="store_true", help="overwrite existing output files")
-    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary")
+    add_quiet(p)
     _add_solver_args(p)
     p.set_defaults(func=_cmd_retarget)
 
@@ -355,7 +363,7 @@ def register(subparsers) -> None:
     )
     p.add_argument("-o", "--output", required=True, help="checkpoint file to write (.pt)")
     p.add_argument("--train-steps", type=positive_int, default=1500, help="Adam steps (default 1500)")
-    p.add_argument("--batch-size", type=positive_int, default=32)
+    p.add_argument("--batch-size", type=positive_int, default=32, help="windows per Adam step")
     p.add_argument(
         "--pose-augment",
         type=non_negative,
@@ -363,13 +371,13 @@ def register(subparsers) -> None:
         metavar="F",
         help="fraction of each batch with joints turned at random (up to 0.3 rad; 0..0.5, default 0 = off)",
     )
-    p.add_argument("--train-lr", type=positive, default=2e-3)
+    p.add_argument("--train-lr", type=positive, default=2e-3, help="Adam learning rate of the training")
     p.add_argument("--latent", type=positive_int, default=128, help="latent channels D per frame")
     p.add_argument("--hidden", type=positive_int, default=96, help="hidden channels")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, default=0, help="random seed")
     p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
     p.add_argument("--force", action="store_true", help="overwrite an existing checkpoint")
-    p.add_argument("-q", "--quiet", action="store_true")
+    add_quiet(p)
     p.set_defaults(func=_cmd_train)
 
     p = subparsers.add_parser(
@@ -380,9 +388,12 @@ def register(subparsers) -> None:
         "other clips first if the checkpoint does not exist.",
     )
     p.add_argument("--data", help="folder laid out as <Character>/<Animation>.bvh (default: $MOTIONLAB_DATA/mixamo)")
-    p.add_argument("--source", default="Aj")
+    p.add_argument("--source", default="Aj", help="the character trained on and retargeted from (a folder of --data)")
     p.add_argument(
-        "--targets", nargs="+", default=["BigVegas", "Kaya", "SportyGranny", "Goblin_m", "Mousey_m", "Vampire_m"]
+        "--targets",
+        nargs="+",
+        default=["BigVegas", "Kaya", "SportyGranny", "Goblin_m", "Mousey_m", "Vampire_m"],
+        help="the characters retargeted onto (folders of --data)",
     )
     p.add_argument("--animations", nargs="+", help="clip stems (default: the 10 retarget_gt animations)")
     p.add_argument("--all-animations", action="store_true", help="use every animation shared by source and targets")
@@ -398,8 +409,10 @@ def register(subparsers) -> None:
         help="leave animations out: split the evaluated animations into K folds and evaluate each with a network "
         "trained on the source's other clips (checkpoints <checkpoint>_fold<k>of<K>.pt); default 1",
     )
-    p.add_argument("--train-steps", type=positive_int, default=1500)
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument(
+        "--train-steps", type=positive_int, default=1500, help="Adam steps when the network is trained (default 1500)"
+    )
+    p.add_argument("--seed", type=int, default=0, help="random seed")
     p.add_argument("--csv", help="write the per-clip records to this CSV")
     p.add_argument("--force", action="store_true", help="overwrite an existing --csv file")
     p.add_argument(
@@ -411,7 +424,7 @@ def register(subparsers) -> None:
         default="stride",
         help="root trajectory of every row but the plain baseline (default stride, as in `motionlab retarget`)",
     )
-    p.add_argument("--device")
-    p.add_argument("-q", "--quiet", action="store_true")
+    p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
+    add_quiet(p)
     _add_solver_args(p)
     p.set_defaults(func=_cmd_evaluate)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import argparse
 
-from motionlab.cli_args import check_output_folder, non_negative, non_negative_int, positive, positive_int
+from motionlab.cli_args import add_quiet, check_output_folder, non_negative, non_negative_int, positive, positive_int
 
 __all__ = ["register"]
 
@@ -98,7 +98,12 @@ def register(subparsers) -> None:
     p.add_argument("--checkpoint", help="trained network (default: the shipped one)")
     p.add_argument("--root", choices=ROOT_MODES, default="stride", help="root trajectory rule (as in retarget)")
     p.add_argument("--batch-frames", type=positive_int, help="frames per solver batch (default: from free memory)")
-    p.add_argument("--backend", choices=("local", "ray"), default="local")
+    p.add_argument(
+        "--backend",
+        choices=("local", "ray"),
+        default="local",
+        help='local: batches in this process; ray: the same batches on Ray actors (pip install "motionlab[cluster]")',
+    )
     p.add_argument("--address", help="Ray cluster address (default: $RAY_ADDRESS, else a local Ray instance)")
     p.add_argument("--workers", type=positive_int, default=2, help="Ray actors (default 2)")
     p.add_argument(
@@ -115,6 +120,6 @@ def register(subparsers) -> None:
     )
     p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
     p.add_argument("--force", action="store_true", help="redo every pair and replace existing outputs")
-    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary")
+    add_quiet(p)
     _add_solver_args(p)
     p.set_defaults(func=_cmd_expand)
