@@ -25,6 +25,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 __all__ = [
+    "CLIError",
     "positive",
     "non_negative",
     "positive_int",
@@ -86,9 +87,14 @@ def non_negative_int(text: str) -> int:
     return value
 
 
-def _error(message: str) -> Exception:
-    from motionlab.cli import CLIError
+class CLIError(Exception):
+    """A user-facing error: printed as ``motionlab: error: …`` with exit status 2, no traceback.
 
+    Defined here, beside the checks that raise it, and re-exported by :mod:`motionlab.cli`.
+    """
+
+
+def _error(message: str) -> Exception:
     return CLIError(message)
 
 

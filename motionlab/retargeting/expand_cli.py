@@ -12,6 +12,8 @@ from __future__ import annotations
 import argparse
 
 from motionlab.cli_args import add_quiet, check_output_folder, non_negative, non_negative_int, positive, positive_int
+from motionlab.retargeting import cli_options
+from motionlab.retargeting.cli_options import ROOT_MODES
 
 __all__ = ["register"]
 
@@ -19,7 +21,6 @@ __all__ = ["register"]
 def _cmd_expand(args) -> int:
     from motionlab.cli import CLIError
     from motionlab.retargeting import expand as ex
-    from motionlab.retargeting.cli import _load_checkpoint, _solver_config
 
     if args.backend == "ray":
         from motionlab.retargeting.cluster import INSTALL_HINT
@@ -35,13 +36,13 @@ def _cmd_expand(args) -> int:
         targets = ex.characters(*args.characters, presets=args.preset)
     except ValueError as e:
         raise CLIError(str(e)) from None
-    ckpt = _load_checkpoint(args.checkpoint, args.device)
+    ckpt = cli_options.load_checkpoint(args.checkpoint, args.device)
     job = ex.expand(
         args.sources,
         targets,
         args.output,
         ckpt,
-        _solver_config(args),
+        cli_options.solver_config(args),
         root_mode=args.root,
         force=args.force,
         max_frames=args.batch_frames,
@@ -71,8 +72,6 @@ def _print_failures(job, most: int = 10) -> None:
 
 def register(subparsers) -> None:
     """Add ``expand`` to the ``motionlab`` command."""
-    from motionlab.retargeting.cli import ROOT_MODES, _add_solver_args
-
     p = subparsers.add_parser(
         "expand",
         help="retarget many clips onto many characters (batched, resumable; local or Ray)",
@@ -121,5 +120,5 @@ def register(subparsers) -> None:
     p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
     p.add_argument("--force", action="store_true", help="redo every pair and replace existing outputs")
     add_quiet(p)
-    _add_solver_args(p)
+    cli_options.add_solver_args(p)
     p.set_defaults(func=_cmd_expand)

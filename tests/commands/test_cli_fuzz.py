@@ -33,7 +33,7 @@ def _stop(*args, **kwargs):
 
 
 _WORK = (  # where each command's long work begins
-    "motionlab.retargeting.cli._load_checkpoint",
+    "motionlab.retargeting.cli_options.load_checkpoint",
     "motionlab.retargeting.pipeline.retarget",
     "motionlab.retargeting.train.training_set",
     "motionlab.retargeting.train.train",
