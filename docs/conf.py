@@ -7,8 +7,8 @@ is generated from the docstrings (autodoc + autosummary, numpydoc style through 
 
 from __future__ import annotations
 
+import json
 import os
-import shutil
 import sys
 from pathlib import Path
 
@@ -41,10 +41,28 @@ _copies.mkdir(exist_ok=True)
 for _old in _copies.glob("*.ipynb"):
     if not (NOTEBOOKS / _old.name).exists():
         _old.unlink()
+
+
+def _page_copy(notebook: Path) -> bytes:
+    """The notebook as its page shows it: with a note under the title when its stored outputs were
+    made in quick mode (``motionlab.quick`` in its metadata, written by store_notebook_outputs)."""
+    nb = json.loads(notebook.read_text(encoding="utf-8"))
+    meta = nb.get("metadata", {}).get("motionlab", {})
+    if meta.get("quick"):
+        data = "with the course data" if meta.get("data") else "on motionlab's synthetic data"
+        note = (
+            f"```{{note}}\nThe outputs on this page were made in **quick mode** (`MOTIONLAB_QUICK=1`: "
+            f"fewer clips, frames and steps, the mode CI checks) {data}. Run the notebook without "
+            "`MOTIONLAB_QUICK` for the full-size results; its first output says which mode it ran in.\n```"
+        )
+        nb["cells"].insert(1, {"cell_type": "markdown", "id": "quick-mode-note", "metadata": {}, "source": note})
+    return (json.dumps(nb, indent=1, ensure_ascii=False) + "\n").encode("utf-8")
+
+
 for _nb in sorted(NOTEBOOKS.glob("*.ipynb")):
-    _target = _copies / _nb.name
-    if not _target.exists() or _target.read_bytes() != _nb.read_bytes():
-        shutil.copyfile(_nb, _target)
+    _target, _page = _copies / _nb.name, _page_copy(_nb)
+    if not _target.exists() or _target.read_bytes() != _page:
+        _target.write_bytes(_page)
 
 exclude_patterns = ["_build", "**/.ipynb_checkpoints"]
 # .rst first: autosummary writes its generated API pages with the first suffix

@@ -99,7 +99,8 @@ def tidy(nb, used_data: bool) -> None:
                 data["image/png"] = compress_png(data["image/png"])
             output.get("metadata", {}).pop("execution", None)
     nb.metadata.pop("widgets", None)
-    nb.metadata["motionlab"] = {"outputs": "stored", "data": used_data, "code_sha256": code_hash(nb)}
+    quick = ENV["MOTIONLAB_QUICK"] == "1"  # the docs site says so on the notebook's page
+    nb.metadata["motionlab"] = {"outputs": "stored", "data": used_data, "quick": quick, "code_sha256": code_hash(nb)}
 
 
 def run(name: str, used_data: bool, timeout: int) -> Path:

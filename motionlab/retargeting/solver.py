@@ -43,6 +43,10 @@ Gaussian filter along time (σ = ``smooth_sigma`` frames) and optimise the free 
 still only the latent moves and the loss is unchanged, but every update is temporally smooth.
 ``smooth_sigma=0`` optimises φ directly, as the paper states.
 
+**The same iterates on every CPU (``step_grid``).** The start and every Adam iterate are rounded
+to a grid a four-thousandth of a step fine, so that last-bit differences between CPUs' kernels
+cannot grow into other results or another stopping step. The network computes in float64.
+
 θ, what "joint angles" means, is our choice: the local joint rotations (see
 :mod:`motionlab.retargeting.losses` for why, and ``theta="directions"`` for the
 position-based alternative). The foot loss needs world heights: ``y = root_height(t) + FK_y``,
@@ -191,18 +195,20 @@ class SolverResult:
     best_step: int = 0
 
 
-def step_grid(lr: float) -> float:
-    """The spacing the latent offset is rounded to after each Adam step: the power of two just
-    below ``lr · 2⁻¹²`` (``lr`` the group's actual step size), a four-thousandth of a step.
+def step_grid(size: float) -> float:
+    """The spacing iterates are rounded to: the power of two just below ``size · 2⁻¹²``.
 
-    Adam divides each gradient by its own running size, so a difference in the last bits of a
-    gradient (another CPU's kernels add in another order) grows step by step: after some 50
-    steps the loss, and with it where the stopping rule stops, differ in the third digit. On the
-    grid, a difference that small is rounded away, so the iterates are the same on every CPU;
-    only a difference that falls across a rounding boundary survives, and at this spacing the
-    gradients' rounding noise is too small for that to happen in practice.
+    The latent iteration rounds its start φ₀ to ``step_grid(std(φ₀))`` and the latent offset,
+    after each Adam step, to ``step_grid(lr)`` (``lr`` the group's actual step size): a
+    four-thousandth of a step. Why: the Gauss–Newton start is a damped least-squares solve, which
+    turns a difference in the last bit of its inputs (another CPU's kernels add in another order)
+    into one in the eleventh digit, and Adam, which divides each gradient by its own running size,
+    lets such a difference grow step by step, until after some 50 steps the loss, and with it
+    where the stopping rule stops, differ in the third digit. On the grid, differences that small
+    are rounded away, so the iterates are the same on every CPU
+    (``benchmarks/bench_reproducibility.py`` prints the comparison).
     """
-    return 2.0 ** math.floor(math.log2(lr) - 12)
+    return 2.0 ** math.floor(math.log2(size) - 12)
 
 
 def _smoother(sigma: float, channels: int, dtype, device):
@@ -551,9 +557,11 @@ def _iterate(
         deltas, param_groups, grids = [], [], []
         for g in range(groups):
             part = phi0[bounds[g] : bounds[g + 1]]
-            scale = float(part.std()) if part.numel() > 1 else 1.0
+            scale = max(float(part.std()) if part.numel() > 1 else 1.0, 1e-6)
+            with torch.no_grad():  # the start on the grid too (see step_grid)
+                part.copy_(torch.round(part / step_grid(scale)) * step_grid(scale))
             deltas.append(torch.zeros_like(part, requires_grad=True))
-            param_groups.append({"params": [deltas[-1]], "lr": cfg.lr * max(scale, 1e-6)})
+            param_groups.append({"params": [deltas[-1]], "lr": cfg.lr * scale})
             grids.append(step_grid(param_groups[-1]["lr"]))
         opt = torch.optim.Adam(param_groups)
         best = [float("inf")] * groups  # best loss that counted as an improvement (plateau rule)
