@@ -14,6 +14,18 @@ then checked, untouched, on the check half and on all takes.
 Run::
 
     MOTIONLAB_DATA=/path/to/shared/data python benchmarks/bench_motion_graph_sessions.py [--behaviour walk]
+
+**Whole session** (``--session``): every behaviour folder under ``sessions/`` at once (gaits and
+standing actions, :mod:`motionlab.motion_graphs.segments`). It prints, per take kind, the
+share of frames with both feet planted (the gait/action rule) and a leave-one-style-out check of
+it; the threshold is again the smallest of the grid for which the pick half meets the goals —
+every behaviour's largest component >= 90% of its frames, every ordered style pair of each
+behaviour joined by its links, and the request :data:`REQUEST` answered within the tolerance —
+and it is then checked on the check half and on all takes. For all takes it prints the report,
+the request's frame counts, the median search time over :data:`REPEATS` runs of the request and
+of each behaviour's style pairs, and the build's seconds and peak memory (a fresh process)::
+
+    MOTIONLAB_DATA=/path/to/shared/data python benchmarks/bench_motion_graph_sessions.py --session
 """
 
 from __future__ import annotations
@@ -26,7 +38,7 @@ import time
 import numpy as np
 
 from motionlab import data
-from motionlab.motion_graphs import clips, distance, report, search, structured
+from motionlab.motion_graphs import clips, distance, report, search, segments, structured
 
 GRID = (0.015, 0.02, 0.025, 0.03, 0.04, 0.05)
 """Thresholds tried, metres RMS."""
@@ -89,10 +101,160 @@ def line(name: str, e: dict) -> str:
     )
 
 
+REQUEST = "walk:normal:100,wave-both-hands:normal:60,walk:normal:100"
+"""The cross-behaviour request of the session goals (issue 32)."""
+
+REPEATS = 9
+"""Runs of each timed search (the median is printed)."""
+
+
+def take_number(name: str) -> int:
+    return int(re.search(r"_(\d+)$", name).group(1))
+
+
+def kinds_check(motions) -> None:
+    """The gait/action rule on every take, and a leave-one-style-out check of its boundary."""
+    rows = []
+    for m in motions:
+        lab = m.name.split("_")
+        rows.append((lab[0], lab[1], segments.segment_take(m)))
+    for b in sorted({r[0] for r in rows}):
+        mine = [r[2] for r in rows if r[0] == b]
+        share = np.array([x.both_planted for x in mine])
+        kinds = sorted({x.kind for x in mine})
+        print(
+            f"  {b}: {len(mine)} takes, kinds {kinds}, both feet planted {share.min():.2f}..{share.max():.2f} "
+            f"of the frames, {sum(x.count for x in mine)} segments, {sum(x.stances.shape[0] for x in mine)} stances"
+        )
+    # leave one style out: the boundary fitted on the other styles (halfway between the largest
+    # gait share and the smallest action share; the folder says which is which) classifies it alike
+    gait = {b for b, _, x in rows if x.kind == "gait"}
+    styles = sorted({r[1] for r in rows})
+    agree = 0
+    for s in styles:
+        rest = [(b in gait, x.both_planted) for b, st, x in rows if st != s]
+        cut = (max(v for g, v in rest if g) + min(v for g, v in rest if not g)) / 2 if len(gait) and len(rest) else 0.5
+        held = [(b in gait, x.both_planted) for b, st, x in rows if st == s]
+        agree += sum((v < cut) == g for g, v in held)
+    print(f"  leave one style out: {agree}/{len(rows)} held-out takes classified as their folder says")
+
+
+def session_goals(g, request: str = REQUEST) -> dict:
+    rep = report.build_report(g)
+    out = dict(report=rep, request=None, error=None)
+    try:
+        r = search.search(g, request)
+        g.check_path(r.pieces)
+        out["request"] = r
+    except search.SearchError as e:
+        out["error"] = str(e)
+    beh = rep["behaviours"]
+    within = out["request"] is not None and all(
+        abs(a - q) <= max(2, search.TOLERANCE * q) for a, q in zip(out["request"].achieved, out["request"].requested)
+    )
+    out["meets"] = (
+        all(v["percent"] >= GOAL_BEHAVIOUR for v in beh.values())
+        and all(v["reachable_pairs"] == v["style_pairs"] for v in beh.values())
+        and within
+    )
+    return out
+
+
+def session_line(name: str, rms: float, seconds: float, e: dict) -> str:
+    beh = e["report"]["behaviours"]
+    shares = "  ".join(
+        f"{b} {v['percent']:.1f}% {v['reachable_pairs']}/{v['style_pairs']}" for b, v in sorted(beh.items())
+    )
+    req = "request " + ("/".join(map(str, e["request"].achieved)) if e["request"] else "fails")
+    return f"{name:<6} {rms:.3f} m  build {seconds:5.1f} s  {shares}  {req}  {'meets goals' if e['meets'] else 'misses goals'}"
+
+
+def build_only(folder, rms: float) -> int:
+    """Load and build every take once; print seconds and this process's peak memory."""
+    import resource
+
+    motions = clips.load_folder(folder)
+    t0 = time.perf_counter()
+    graph = structured.build_structured(motions, distance.threshold_from(rms))
+    dt = time.perf_counter() - t0
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2  # KiB -> GiB (Linux)
+    print(
+        f"build of {len(motions)} takes at {rms} m: {dt:.1f} s, {graph.num_frames} frames, "
+        f"peak memory {peak:.2f} GiB (loading included)"
+    )
+    return 0
+
+
+def timed(g, request) -> tuple[float, object]:
+    times, r = [], None
+    for _ in range(REPEATS):
+        t0 = time.perf_counter()
+        r = search.search(g, request)
+        times.append(time.perf_counter() - t0)
+    return 1000 * float(np.median(times)), r
+
+
+def session(folder) -> int:
+    import subprocess
+
+    motions = clips.load_folder(folder)
+    pick = [m for m in motions if take_number(m.name) % 2 == 1]
+    check = [m for m in motions if take_number(m.name) % 2 == 0]
+    print(f"session {folder}: {len(motions)} takes; pick half (odd takes) {len(pick)}, check half {len(check)}")
+    print("kinds from the motion (folder names only check them):")
+    kinds_check(motions)
+    print(f"goals: every behaviour SCC >= {GOAL_BEHAVIOUR}%, every style pair joined, {REQUEST} within tolerance")
+    chosen = None
+    for rms in GRID:
+        t0 = time.perf_counter()
+        g = structured.build_structured(pick, distance.threshold_from(rms))
+        e = session_goals(g)
+        print(session_line("pick", rms, time.perf_counter() - t0, e))
+        if e["meets"]:
+            chosen = rms
+            break
+    if chosen is None:
+        print("no threshold of the grid meets the goals on the pick half")
+        return 1
+    print(f"chosen threshold (smallest meeting the goals on the pick half): {chosen} m")
+    for name, ms in (("check", check), ("all", motions)):
+        t0 = time.perf_counter()
+        g = structured.build_structured(ms, distance.threshold_from(chosen))
+        e = session_goals(g)
+        print(session_line(name, chosen, time.perf_counter() - t0, e))
+    print(report.format_report(e["report"]))
+    if e["request"] is not None:
+        print(f"request {REQUEST}:")
+        print(e["request"].report())
+    else:
+        print(f"request {REQUEST} fails: {e['error']}")
+    ms_req, _ = timed(g, REQUEST) if e["request"] is not None else (float("nan"), None)
+    pair_times = []
+    for b, cells in sorted(g.table["behaviours"].items()):
+        styles = sorted(cells)
+        for a, c in zip(styles, styles[1:] + styles[:1]):
+            pair_times.append(timed(g, f"{b}:{a}:150,{b}:{c}:150")[0])
+    print(
+        f"search median over {REPEATS} runs: request {ms_req:.1f} ms; style pairs (each style to the next, "
+        f"{len(pair_times)} requests) median {np.median(pair_times):.1f} ms, worst {max(pair_times):.1f} ms"
+    )
+    subprocess.run([sys.executable, __file__, "--build-only", str(chosen), "--folder", str(folder)], check=True)
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--behaviour", default="walk")
+    ap.add_argument("--session", action="store_true", help="every behaviour of the session at once")
+    ap.add_argument("--build-only", type=float, help="only time one build of all takes at this threshold (m)")
+    ap.add_argument("--folder", help="session folder (default MOTIONLAB_DATA/bandai_namco/sessions)")
     args = ap.parse_args(argv)
+    if args.session or args.build_only:
+        folder = args.folder or data.data_root() / "bandai_namco" / "sessions"
+        if not (data.data_root() / "bandai_namco" / "sessions").is_dir() and not args.folder:
+            print(f"needs {folder}: {data.HOW_TO}")
+            return 1
+        return build_only(folder, args.build_only) if args.build_only else session(folder)
     folder = data.data_root() / "bandai_namco" / "sessions" / args.behaviour
     if not folder.is_dir():
         print(f"needs {folder}: {data.HOW_TO}")

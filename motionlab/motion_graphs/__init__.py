@@ -4,7 +4,9 @@
 * :mod:`.graph` — the graph data structure, the standard graph and its pruning;
 * :mod:`.registration` — DTW time registration, root alignment and blends;
 * :mod:`.structured` — structure table of pooled takes, transition clips, interpolation space,
-  local pruning; :mod:`.cycles` — gait cycles from foot contacts; :mod:`.report` — the build report;
+  local pruning; :mod:`.cycles` — gait cycles from foot contacts; :mod:`.segments` — gait or
+  standing action from the motion, stances and segments; :mod:`.stance_links` — links between
+  styles and behaviours where their stances match; :mod:`.report` — the build report;
 * :mod:`.search` — requests of (behaviour, style, frames) segments; the standard-graph baseline;
 * :mod:`.synthesis` — a path turned into one continuous, blended motion;
 * :mod:`.io` — save/load (``.mlgraph``, npz + JSON); :mod:`.naming` — clip-name labels;
@@ -13,7 +15,19 @@
 Taught in ``notebooks/05_motion_graphs.ipynb``.
 """
 
-from motionlab.motion_graphs import clips, cycles, distance, io, naming, registration, report, search, synthesis
+from motionlab.motion_graphs import (
+    clips,
+    cycles,
+    distance,
+    io,
+    naming,
+    registration,
+    report,
+    search,
+    segments,
+    stance_links,
+    synthesis,
+)
 from motionlab.motion_graphs.graph import ClipInfo, GraphError, MotionGraph, build_standard
 from motionlab.motion_graphs.search import SearchError, SearchResult, Segment, parse_request, search_standard
 from motionlab.motion_graphs.search import search as search_path
@@ -29,6 +43,8 @@ __all__ = [
     "naming",
     "clips",
     "cycles",
+    "segments",
+    "stance_links",
     "report",
     "ClipInfo",
     "GraphError",

@@ -46,7 +46,11 @@ def build_report(graph: MotionGraph) -> dict:
     -------
     dict with ``rows`` (one per behaviour/style: ``behaviour``, ``style``, ``takes``, ``frames``,
     ``cycles``, ``transitions``, ``in_largest`` (frames), ``in_largest_percent``, ``pruned``),
-    ``behaviours`` (per behaviour: ``frames``, ``largest_scc``, ``percent``), ``largest_scc`` and ``recorded_frames``
+    ``behaviours`` (per behaviour: ``frames``, ``largest_scc``, ``percent``, ``kind`` (gait or
+    action), ``segments`` (whole segments of an action, cycles of a gait), ``styles``,
+    ``style_pairs`` and ``reachable_pairs`` (ordered style pairs joined by the behaviour's own
+    links)), ``behaviour_links`` (ordered behaviour pairs joined directly: ``source``,
+    ``target``, ``via`` → number of links), ``largest_scc`` and ``recorded_frames``
     (whole graph), ``percent``, ``conditions`` (kind → ``count``, ``example``) and ``info``
     (build times and counts; ``threshold`` in metres RMS, the unit of ``graph-build --threshold``).
     """
@@ -94,7 +98,8 @@ def build_report(graph: MotionGraph) -> dict:
             )
         total = int(takes_b.sum())
         got = int((comp & takes_b).sum())
-        behaviours[b] = dict(frames=total, largest_scc=got, percent=_pct(got, total))
+        behaviours[b] = dict(frames=total, largest_scc=got, percent=_pct(got, total), **_kind(cells.get(b, {})))
+        behaviours[b].update(_reachable(graph.table.get("links", []), b, sorted(cells.get(b, {}))))
     comp = graph.largest_component()
     got, total = int((comp & recorded).sum()), int(recorded.sum())
     conditions = {
@@ -108,12 +113,51 @@ def build_report(graph: MotionGraph) -> dict:
     return dict(
         rows=rows,
         behaviours=behaviours,
+        behaviour_links=_behaviour_links(graph.table.get("links", [])),
         recorded_frames=total,
         largest_scc=got,
         percent=_pct(got, total),
         conditions=conditions,
         info=info,
     )
+
+
+def _kind(cells: dict) -> dict:
+    """Kind of a behaviour (the kind of most of its takes) and its whole segments or cycles."""
+    takes = [t for cell in cells.values() for t in cell.get("takes", [])]
+    kinds = [t.get("kind") for t in takes if t.get("kind")]
+    kind = max(sorted(set(kinds)), key=kinds.count) if kinds else "-"
+    cuts = sum(int(t.get("segments" if kind == "action" else "cycles", 0)) for t in takes)
+    return dict(kind=kind, segments=cuts)
+
+
+def _reachable(links: list[dict], behaviour: str, styles: list[str]) -> dict:
+    """Ordered style pairs of ``behaviour`` joined by a chain of its own links (the search's hops)."""
+    out: dict[str, set[str]] = {s: set() for s in styles}
+    for link in links:
+        if link["from"][0] == behaviour and link["to"][0] == behaviour and link["routes"]:
+            out[link["from"][1]].add(link["to"][1])
+    reached = 0
+    for s in styles:
+        seen, todo = {s}, [s]
+        while todo:
+            for t in out[todo.pop()] - seen:
+                seen.add(t)
+                todo.append(t)
+        reached += len(seen) - 1
+    return dict(styles=len(styles), style_pairs=len(styles) * (len(styles) - 1), reachable_pairs=reached)
+
+
+def _behaviour_links(links: list[dict]) -> list[dict]:
+    """Ordered behaviour pairs joined directly, and through what (links and their style pairs)."""
+    found: dict[tuple[str, str], dict[str, int]] = {}
+    for link in links:
+        a, b = link["from"][0], link["to"][0]
+        if a != b and link["routes"]:
+            via = "stance" if link["via"] == "stance" else link["via"]
+            n = found.setdefault((a, b), {})
+            n[via] = n.get(via, 0) + 1
+    return [dict(source=a, target=b, via=v) for (a, b), v in sorted(found.items())]
 
 
 def format_report(report: dict) -> str:
@@ -136,6 +180,19 @@ def format_report(report: dict) -> str:
             lines.append(f"  {kind}: {c['count']} (e.g. {c['example']})")
     else:
         lines.append("conditions: none")
+    lines.append(
+        "behaviour: kind, whole segments (actions) or cycles (gaits), share in its largest component, styles reachable"
+    )
+    for b, v in sorted(report["behaviours"].items()):
+        lines.append(
+            f"  {b}: {v.get('kind', '-')}, {v.get('segments', 0)} segments/cycles, {v['percent']:.1f}%, "
+            f"{v.get('reachable_pairs', 0)}/{v.get('style_pairs', 0)} style pairs reachable"
+        )
+    links = report.get("behaviour_links", [])
+    lines.append("links between behaviours:" + ("" if links else " none"))
+    for x in links:
+        via = ", ".join(f"{k} ({n} style pair{'s' * (n != 1)})" for k, n in sorted(x["via"].items()))
+        lines.append(f"  {x['source']} -> {x['target']}: {via}")
     lines.append(f"largest strongly connected component: {report['largest_scc']} frames ({report['percent']:.1f}%)")
     for b, v in sorted(report["behaviours"].items()):
         lines.append(f"largest strongly connected component of {b}: {v['largest_scc']} frames ({v['percent']:.1f}%)")

@@ -166,6 +166,8 @@ class _Clip:
     allowed (same take, both alive); jumps ``loop_src → loop_dst`` (transitions inside the pool,
     self-loops included); the *main cycle* ``cycle_dst … cycle_src`` is the longest jump back
     inside one take whose frames in between are all steps (``-1`` when there is none).
+    ``sparse``: the :data:`SPARSE_JUMPS` cheapest jumps into every frame (``None``: all jumps),
+    which the search tries first.
     """
 
     index: int
@@ -178,6 +180,7 @@ class _Clip:
     clips: np.ndarray = field(default_factory=lambda: np.zeros(1, dtype=np.int64))
     offsets: np.ndarray = field(default_factory=lambda: np.zeros(1, dtype=np.int64))
     alive: np.ndarray | None = None
+    sparse: tuple[np.ndarray, np.ndarray] | None = None
 
     def first_alive(self) -> int:
         """The first alive frame, preferring one on the main cycle."""
@@ -213,9 +216,12 @@ def _pool_walker(graph: MotionGraph, clips: list[int], index: int = 0) -> _Clip:
     else:
         last_src, last_dst = -1, -1
     offsets = np.array([graph.clips[c].start - st for c in clips], dtype=np.int64)
+    # the SPARSE_JUMPS cheapest jumps into every frame (ties: the nearer source first)
+    order = np.lexsort((src, graph.cost[m], dst))
+    few = order[np.arange(order.size) - np.searchsorted(dst[order], dst[order]) < SPARSE_JUMPS]
     return _Clip(
         index, sp - st, step, src, dst, last_src, last_dst, np.asarray(clips, dtype=np.int64), offsets,
-        graph.alive[st:sp].copy(),
+        graph.alive[st:sp].copy(), (src[few], dst[few]),
     )  # fmt: skip
 
 
@@ -291,8 +297,12 @@ def _runs(cw: _Clip | int, frames: list[int]) -> list[tuple[int, int, int]]:
 
 _NEVER = np.iinfo(np.int16).max
 
+SPARSE_JUMPS = 2
+"""Jumps into each frame (the cheapest) that a walk through a pool tries first: a pool of many
+takes holds dozens of jumps per frame, and the recursion's cost grows with them."""
 
-def _reach(cw: _Clip, start: int, steps: int) -> np.ndarray:
+
+def _reach(cw: _Clip, start: int, steps: int, jumps: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """(steps, L) int16: fewest jumps of a walk of ``c + 1`` frames from ``start`` that ends at
     each frame (``_NEVER`` where no walk of that length ends there).
 
@@ -303,8 +313,12 @@ def _reach(cw: _Clip, start: int, steps: int) -> np.ndarray:
     out = np.full((max(steps, 1), cw.length), _NEVER, dtype=np.int16)
     out[0, start] = 0
     step_ok = cw.step[:-1]
-    order = np.argsort(cw.loop_dst, kind="stable")
-    src, dst = cw.loop_src[order], cw.loop_dst[order]
+    src, dst = (cw.loop_src, cw.loop_dst) if jumps is None else jumps
+    order = np.argsort(dst, kind="stable")
+    src, dst = src[order], dst[order]
+    rank = np.arange(dst.size) - np.searchsorted(dst, dst)  # k-th jump into its frame
+    if rank.size == 0 or rank.max() < SPARSE_JUMPS:
+        return _reach_few(out, step_ok, [(src[rank == k], dst[rank == k]) for k in range(SPARSE_JUMPS)])
     if dst.size:
         heads = np.flatnonzero(np.concatenate([[True], dst[1:] != dst[:-1]]))
         targets = dst[heads]
@@ -318,17 +332,41 @@ def _reach(cw: _Clip, start: int, steps: int) -> np.ndarray:
     return out
 
 
-def _backtrack(cw: _Clip, reach: np.ndarray, c: int, x: int) -> list[int]:
+def _reach_few(out: np.ndarray, step_ok: np.ndarray, layers: list) -> np.ndarray:
+    """:func:`_reach` when few jumps enter each frame: ``layers[k]`` holds the k-th jump into
+    each frame (at most one per frame), so a row is one gather per layer, with no grouping."""
+    n = out.shape[1]
+    src_of = []
+    for src, dst in layers:
+        s = np.full(n, n)  # the jump into each frame, n (a frame that is never reached) if none
+        s[dst] = src
+        src_of.append(s)
+    prev_x = np.full(n + 1, _NEVER, dtype=np.int16)
+    for c in range(1, out.shape[0]):
+        prev_x[:n] = out[c - 1]
+        cur = out[c]
+        np.copyto(cur[1:], prev_x[: n - 1], where=step_ok)  # the row starts all _NEVER
+        for s in src_of:
+            via = prev_x[s]
+            np.add(via, 1, out=via, where=via < _NEVER)
+            np.minimum(cur, via, out=cur)
+    return out
+
+
+def _backtrack(
+    cw: _Clip, reach: np.ndarray, c: int, x: int, jumps: tuple[np.ndarray, np.ndarray] | None = None
+) -> list[int]:
     """Frames of a walk with the fewest jumps reaching ``x`` after ``c + 1`` frames
     (reverse-engineered from ``reach``, see :func:`_reach`); each jump is a blend in the
     synthesised motion, so fewer is better."""
+    src, dst = (cw.loop_src, cw.loop_dst) if jumps is None else jumps
     frames = [x]
     while c > 0:
         j = int(reach[c, x])
         if x > 0 and cw.step[x - 1] and reach[c - 1, x - 1] == j:
             x -= 1
         else:
-            cand = cw.loop_src[(cw.loop_dst == x) & (reach[c - 1, cw.loop_src] == j - 1)]
+            cand = src[(dst == x) & (reach[c - 1, src] == j - 1)]
             if cand.size == 0:
                 raise GraphError("internal: walk reconstruction failed")
             x = int(cand[0])
@@ -356,7 +394,7 @@ def _walk(
     played = 0
     ex = np.array(exits)
     lo = min(need)
-    if cw.last_src >= 0:
+    if cw.last_src >= 0 and lo > 2 * (3 * cw.cycle + 2):  # (the budget below is at least this)
         fixed = ex[ex >= 0]
         dist, _ = _distances(cw, cw.last_dst, fixed if fixed.size else None)
         far = int(dist[fixed].max()) if fixed.size and (dist[fixed] >= 0).all() else 0
@@ -372,10 +410,30 @@ def _walk(
             start = cw.last_dst
     steps = max(n - played for n in need) + max(cw.cycle, 2)
     steps = max(steps, 2)
-    reach = _reach(cw, start, steps)
     need_c = np.array(need) - played - 1
+    # first the cheapest jump into each frame and just the rows an exact length needs (a pool of
+    # many takes holds dozens of jumps per frame, and the recursion's cost grows with them);
+    # when that gives no walk of exactly the requested length, every jump and the full width
+    short = min(steps, int(need_c.max()) + 2)
+    for rows, jumps, widest in ((short, cw.sparse, 0), (steps, None, steps)):
+        reach = _reach(cw, start, rows, jumps)
+        best = _choose(reach, need_c, ex, rows, widest)
+        if best is not None:
+            break
+    if best is None:
+        raise SearchError(f"{name}: no walk from frame {start} reaches any exit")
+    r, c, x = best
+    frames = _backtrack(cw, reach, c, x, jumps)
+    pieces.extend(_runs(cw, frames))
+    return pieces, r, played + c + 1
+
+
+def _choose(reach: np.ndarray, need_c: np.ndarray, ex: np.ndarray, steps: int, widest: int):
+    """``(option, row, exit frame)`` of the walk nearest the requested length (``None``: none
+    within ``widest`` rows of it): an option's exit frame, or (``-1``) any frame, the one with
+    the fewest jumps."""
     best = None
-    for delta in _deltas(steps):
+    for delta in _deltas(widest + 1):
         c = need_c + delta
         ok = np.flatnonzero((c >= 0) & (c < steps))
         if ok.size == 0:
@@ -394,17 +452,30 @@ def _walk(
             r = int(fixed[np.argmin(jumps)])  # of the exits met, the one with the fewest jumps
             best = (r, int(c[r]), int(ex[r]))
             break
-    if best is None:
-        raise SearchError(f"{name}: no walk from frame {start} reaches any exit")
-    r, c, x = best
-    frames = _backtrack(cw, reach, c, x)
-    pieces.extend(_runs(cw, frames))
-    return pieces, r, played + c + 1
+    return best
+
+
+JUMP_FRAMES = 8
+"""What a jump costs a walk through a pool, in frames: a pool of many takes offers a jump almost
+everywhere, and the walk with the fewest frames can jump on every frame; each jump is a blend
+(8 frames by default in :mod:`.synthesis`), so a walk through a pool minimises frames plus this
+many per jump."""
 
 
 def _quick_exit(cw: _Clip, start: int, exits: list[int], name: str) -> tuple[list[tuple[int, int, int]], int, int]:
-    """The shortest walk to the nearest exit (a breadth-first search with the loop guard)."""
+    """The cheapest walk to an exit: frames plus :data:`JUMP_FRAMES` per jump, over the cheapest
+    jump into each frame; the shortest walk (a breadth-first search with the loop guard) when
+    nothing cheaper is found."""
     frames, r = _path(cw, start, exits, name)
+    jumps = sum(b != a + 1 for a, b in zip(frames[:-1], frames[1:]))
+    rows = len(frames) + JUMP_FRAMES * jumps  # no longer walk can cost less
+    ex = np.asarray(exits, dtype=np.int64)
+    reach = _reach(cw, start, rows, cw.sparse)
+    count = reach[:, ex].astype(np.int64)
+    cost = np.where(count < _NEVER, np.arange(1, rows + 1)[:, None] + JUMP_FRAMES * count, np.iinfo(np.int64).max)
+    c, k = np.unravel_index(int(np.argmin(cost)), cost.shape)  # shortest first, then the first exit
+    if cost[c, k] < len(frames) + JUMP_FRAMES * jumps:
+        frames, r = _backtrack(cw, reach, int(c), int(ex[k]), cw.sparse), int(k)
     return _runs(cw, frames), r, len(frames)
 
 

@@ -14,15 +14,24 @@ and with its ``neighbours`` next takes in take order, cyclically (:func:`_ring_p
 work grows linearly with the number of takes and the ring joins them all; takes of one style are
 similar by construction, so they meet at many frames.
 
-**Between behaviours** only recorded transition clips ``B1_s1_to_B2_s2`` are used. A
+**Between behaviours** recorded transition clips ``B1_s1_to_B2_s2`` come first. A
 transition clip is compared with the takes of its two endpoint styles only (never with
 everything, as a standard graph would): entries ``A_i → T_{j+1}`` into the first half of ``T``,
 exits ``T_k → B_{l+1}`` from the second half, so a route always plays the recorded change.
+Where no clip records a change, *stance links* (:mod:`.stance_links`) join two behaviours
+wherever their stances match, under the same threshold.
+
+**Gaits and standing actions.** Every take is classified from its motion (:mod:`.segments`):
+a gait is cut into whole cycles, a standing action into segments between its stances, and the
+ends of every take of a style are compared with the ends of every other take of it, so that
+takes connect stance to stance. The styles of a standing action meet at their stances (stance
+links); a gait's styles meet in their interpolation space.
 
 **Between styles of one behaviour** an interpolation space bridges the gap
 (:mod:`~motionlab.motion_graphs.registration`), built from *representative cycles*: the take
-with most whole cycles (:mod:`.cycles`) represents its style, the same number of whole cycles
-of both styles (at most ``rep_cycles``, from the middle of the take) are registered by DTW and
+with most whole cycles (:mod:`.cycles`; whole segments for a standing action) represents its
+style, the same number of whole cycles of both styles (at most ``rep_cycles``, from the middle
+of the take) are registered by DTW and
 blended into intermediate motions M1…M4 at weights 0.2…0.8, and transitions are searched only
 between neighbours S1–M1, M1–M2, …, M4–S2. Which style pairs are bridged is a choice
 (``style_pairs``): ``"hub"`` links every style with the reference style (default ``normal``),
@@ -58,6 +67,8 @@ from motionlab.core.motion import Motion
 from motionlab.motion_graphs import cycles as _cycles
 from motionlab.motion_graphs import distance as _distance
 from motionlab.motion_graphs import registration as _registration
+from motionlab.motion_graphs import segments as _segments
+from motionlab.motion_graphs import stance_links as _stance_links
 from motionlab.motion_graphs.graph import EDGE_KINDS, ClipInfo, GraphError, MotionGraph, check_motions, pair_edges
 from motionlab.motion_graphs.naming import ClipLabel, label_name, parse_name
 
@@ -206,23 +217,26 @@ def build_structured(
 
     # ---- cycles and representative cycles of every style
     t_cyc = time.perf_counter()
-    cyc = {}
+    cyc, seg, cuts = {}, {}, {}
     for _key, ks in _progress(sorted(pools.items()), "cycles", enabled=progress):
         for c in ks:
             try:
                 cyc[c] = _cycles.segment_cycles(gmotions[c])
+                seg[c] = _segments.segment_take(gmotions[c])
             except ValueError:
-                cyc[c] = None
+                cyc[c] = seg[c] = None
+            # a gait is cut into whole cycles, a standing action into segments between stances
+            cuts[c] = seg[c] if seg[c] is not None and seg[c].kind == "action" else cyc[c]
     rep: dict[tuple[str, str], int] = {}
     for key, ks in pools.items():
-        # the take with the most whole cycles (ties: the first take) represents the style
-        rep[key] = max(ks, key=lambda c: (cyc[c].count if cyc[c] is not None else -1, -c))
-        if cyc[rep[key]] is None or cyc[rep[key]].count == 0:
+        # the take with the most whole cycles or segments (ties: the first take) represents the style
+        rep[key] = max(ks, key=lambda c: (cuts[c].count if cuts[c] is not None else -1, -c))
+        if cuts[rep[key]] is None or cuts[rep[key]].count == 0:
             notes.add("no whole cycle", f"{gmotions[rep[key]].name}: the whole take represents its style")
 
     def rep_span(key, n: int) -> tuple[int, int]:
-        """``n`` whole cycles from the middle of the representative take (all of it without cycles)."""
-        cy = cyc[rep[key]]
+        """``n`` whole cycles (or segments) from the middle of the representative take (all of it without)."""
+        cy = cuts[rep[key]]
         if cy is None or cy.count == 0:
             return (0, take_frames[rep[key]])
         n = min(n, cy.count)
@@ -230,7 +244,7 @@ def build_structured(
         return int(cy.bounds[mid, 0]), int(cy.bounds[mid + n - 1, 1])
 
     def rep_count(key) -> int:
-        cy = cyc[rep[key]]
+        cy = cuts[rep[key]]
         return rep_cycles if cy is None or cy.count == 0 else min(rep_cycles, cy.count)
 
     t_cyc = time.perf_counter() - t_cyc
@@ -301,6 +315,8 @@ def build_structured(
     t_pool = time.perf_counter()
     table: dict = {"behaviours": {}, "links": []}
     loop_kind = EDGE_KINDS.index("loop")
+    ports: dict = {}
+    port_masks = {c: (s.ports if s is not None else np.zeros(clips[c].num_frames, dtype=bool)) for c, s in seg.items()}
     for key, ks in _progress(sorted(pools.items()), "takes", enabled=progress):
         found = {"loop": [], "transition": []}  # (src, dst, cost) global, added at once
         for c in ks:
@@ -313,6 +329,11 @@ def build_structured(
             src, dst, which = pair_edges(i, j, clips[a].start, clips[z].start, clips[z].num_frames,
                                          clips[a].num_frames, False)  # fmt: skip
             found["transition"].append((src, dst, cost[which]))
+        # takes connect stance to stance: every take's ports with every other take's
+        found["transition"].append(
+            _stance_links.link_within(graph, _stance_links.port_features(graph, ks, port_masks, feats), threshold,
+                                      min_loop, window)
+        )  # fmt: skip
         for kind, parts in found.items():
             if parts:
                 graph.add_edges(*(np.concatenate(p) for p in zip(*parts)), kind)
@@ -342,6 +363,7 @@ def build_structured(
         for c in ks:
             if not graph.alive[clips[c].start : clips[c].stop].any():
                 notes.add("take pruned", f"{clips[c].name}: no transition under the threshold joins it to its style")
+        ports[key] = _stance_links.port_features(graph, ks, port_masks, feats)
     graph.drop_dead_edges()
     t_pool = time.perf_counter() - t_pool
 
@@ -365,9 +387,14 @@ def build_structured(
                     "alive": int(graph.alive[ci.start : ci.stop].sum()),
                     "cycles": 0 if cy is None else cy.count,
                     "cycle_span": [0, 0] if cy is None else list(cy.span),
+                    "kind": None if seg[c] is None else seg[c].kind,
+                    "segments": 0 if seg[c] is None else seg[c].count,
+                    "stances": 0 if seg[c] is None else int(seg[c].stances.shape[0]),
                 }
             )
+        kinds = [t["kind"] for t in takes if t["kind"] is not None]
         table["behaviours"].setdefault(b, {})[s] = {
+            "kind": max(sorted(set(kinds)), key=kinds.count) if kinds else None,
             "start": st,
             "frames": sp - st,
             "alive": int(graph.alive[st:sp].sum()),
@@ -506,6 +533,18 @@ def build_structured(
         graph.add_edges(src, dst, cost, "clip")
     t_links = time.perf_counter() - t_links
 
+    # ---- stance links: Kovar transitions between the ports of styles and behaviours
+    t_stance = time.perf_counter()
+    recorded = {(link["from"][0], link["to"][0]) for link in table["links"] if link["via"] != "interpolation"}
+    kinds = {(b, s): cell["kind"] for b, cells in table["behaviours"].items() for s, cell in cells.items()}
+    pairs = _stance_links.pool_pairs(list(pools), recorded, kinds)
+    links, (src, dst, cost), n_cmp = _stance_links.link_pools(graph, pairs, ports, pool_start, threshold, window)
+    comparisons += n_cmp
+    graph.add_edges(src, dst, cost, "transition")
+    table["links"].extend(links)
+    del ports
+    t_stance = time.perf_counter() - t_stance
+
     # ---- intermediate and transition frames live only on recorded routes
     for c in clips:
         if c.kind in ("intermediate", "transition"):
@@ -529,6 +568,7 @@ def build_structured(
         registration_seconds=t_reg,
         takes_seconds=t_pool,
         links_seconds=t_links,
+        stance_seconds=t_stance,
         intermediates=len(extra),
         conditions=notes.lines,
         build_seconds=time.perf_counter() - t0,

@@ -53,7 +53,15 @@ def test_numbers(hand_graph):
     assert (a["in_largest"], a["in_largest_percent"], a["pruned"]) == (16, 80.0, 2)
     assert (b["style"], b["takes"], b["frames"], b["cycles"], b["transitions"]) == ("b", 1, 10, 3, 1)
     assert (b["in_largest"], b["in_largest_percent"], b["pruned"]) == (0, 0.0, 0)
-    assert r["behaviours"]["walk"] == {"frames": 30, "largest_scc": 16, "percent": 53.3}
+    walk = r["behaviours"]["walk"]
+    assert {k: walk[k] for k in ("frames", "largest_scc", "percent")} == {
+        "frames": 30,
+        "largest_scc": 16,
+        "percent": 53.3,
+    }
+    # no take says its kind; no link joins a and b
+    assert (walk["kind"], walk["styles"], walk["style_pairs"], walk["reachable_pairs"]) == ("-", 2, 2, 0)
+    assert r["behaviour_links"] == []
     assert (r["recorded_frames"], r["largest_scc"], r["percent"]) == (30, 16, 53.3)
     assert r["conditions"] == {"take pruned": {"count": 2, "example": "walk_x_9: example"}}
 
@@ -112,3 +120,28 @@ def test_component_agrees_with_networkx():
         comps = [c for c in nx.strongly_connected_components(ref) if len(c) > 1 or ref.has_edge(*(list(c) * 2))]
         best = max((len(c) for c in comps), default=0)
         assert g.largest_component().sum() == best, trial
+
+
+def test_kinds_reachability_and_behaviour_links(hand_graph):
+    """Kinds and segments come from the takes; reachability follows the behaviour's own links."""
+    cells = hand_graph.table["behaviours"]["walk"]
+    for cell in cells.values():
+        for t in cell["takes"]:
+            t.update(kind="action", segments=2)
+    route = {"exit": 0, "enter": 0, "pieces": [], "frames": 0, "cost": 0.0}
+    hand_graph.table["links"] = [
+        {"from": ["walk", "a"], "to": ["walk", "b"], "via": "stance", "routes": [route]},
+        {"from": ["walk", "b"], "to": ["wave", "a"], "via": "stance", "routes": [route]},
+        {"from": ["walk", "b"], "to": ["wave", "b"], "via": "stance", "routes": [route]},
+        {"from": ["wave", "a"], "to": ["walk", "a"], "via": "transition clip wave_a_to_walk_a", "routes": [route]},
+    ]
+    r = report.build_report(hand_graph)
+    walk = r["behaviours"]["walk"]
+    assert (walk["kind"], walk["segments"], walk["reachable_pairs"], walk["style_pairs"]) == ("action", 6, 1, 2)
+    assert r["behaviour_links"] == [
+        {"source": "walk", "target": "wave", "via": {"stance": 2}},
+        {"source": "wave", "target": "walk", "via": {"transition clip wave_a_to_walk_a": 1}},
+    ]
+    text = report.format_report(r)
+    assert "walk: action, 6 segments/cycles, 53.3%, 1/2 style pairs reachable" in text
+    assert "walk -> wave: stance (2 style pairs)" in text

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from motionlab.motion_graphs import graph, search, structured
@@ -117,3 +118,36 @@ def test_walk_takes_the_fewest_jumps():
     assert n == 15 and pieces == [(0, 0, 8), (0, 11, 16)]  # one jump; 0..5 -> 12..19 is a frame short
     reach = search._reach(cw, 0, 15)
     assert reach[14].min() == 1 and reach[5, 5] == 0 and reach[6, 12] == 1
+
+
+def _reach_by_hand(step, src, dst, start, rows):
+    never = np.iinfo(np.int16).max
+    n = step.size
+    ref = np.full((rows, n), never, dtype=np.int64)
+    ref[0, start] = 0
+    for c in range(1, rows):
+        for f in range(n):
+            best = ref[c - 1, f - 1] if f > 0 and step[f - 1] else never
+            for s, d in zip(src, dst):
+                if d == f and ref[c - 1, s] < never:
+                    best = min(best, ref[c - 1, s] + 1)
+            ref[c, f] = best
+    return ref
+
+
+def test_reach_with_few_jumps_per_frame_matches_the_recursion():
+    """The per-layer recursion (at most SPARSE_JUMPS jumps into a frame) and the grouped one
+    (any number) both give the fewest jumps of every walk length, as a loop by hand does."""
+    rng = np.random.default_rng(3)
+    n = 30
+    step = rng.random(n) < 0.8
+    step[-1] = False
+    src, dst = rng.integers(0, n, 40), rng.integers(0, n, 40)
+    order = np.argsort(dst, kind="stable")
+    rank = np.arange(40) - np.searchsorted(dst[order], dst[order])
+    few = order[rank < search.SPARSE_JUMPS]
+    assert rank.max() >= search.SPARSE_JUMPS  # the full set takes the grouped path
+    cw = search._Clip(0, n, step, src, dst, -1, -1)
+    for s, d in ((src[few], dst[few]), (src, dst)):
+        got = search._reach(cw, 2, 25, (s, d))
+        np.testing.assert_array_equal(got, _reach_by_hand(step, s, d, 2, 25))
