@@ -100,10 +100,10 @@ def _per_process(sources, specs, out: Path, args) -> float:
 
 def _expand(sources, specs, out: Path, args, backend: str, threads=None):
     from motionlab.retargeting import expand as ex
-    from motionlab.retargeting.cli import _load_checkpoint
+    from motionlab.retargeting.cli_options import load_checkpoint
 
     start = time.perf_counter()
-    ckpt = _load_checkpoint(None, args.device)
+    ckpt = load_checkpoint(None, args.device)
     job = ex.expand(sources, ex.characters(*specs), out, ckpt, backend=backend, workers=2, threads=threads)
     return time.perf_counter() - start, job
 

@@ -93,10 +93,11 @@ def sizes(ckpt, lengths=(120, 480, 1920, 7680, 15360), repeats=3) -> None:
 
 def slider_seconds(repeats: int) -> float:
     """Median release-to-view seconds of notebook 04's editor (latent solver, 120-frame walk)."""
-    from motionlab.viz.proportions import ProportionEditor, default_solver
+    from motionlab.retargeting.proportions import proportion_solver
+    from motionlab.viz.proportions import ProportionEditor
 
     source = synthetic.generate("walk", None, 120, 30.0, seed=1)  # as in notebook 04
-    editor = ProportionEditor(source, default_solver(source, max_steps=30), window_size=(420, 330), off_screen=True)
+    editor = ProportionEditor(source, proportion_solver(source, max_steps=30), window_size=(420, 330), off_screen=True)
     totals = []
     for k in range(repeats + 1):
         editor.update(legs=1.1 + 0.05 * k)

@@ -33,8 +33,8 @@ extensions = [
 
 # --- sources --------------------------------------------------------------------------------
 # The site renders the notebooks as committed: they are copied from ../notebooks into
-# docs/notebooks (git-ignored) on every build. The instructor's key (notebooks/solutions) is not
-# copied: it stays out of the students' site.
+# docs/notebooks (git-ignored) on every build. The instructor's key (instructor/solutions, outside
+# notebooks/) is not copied: it stays out of the students' site.
 NOTEBOOKS = ROOT / "notebooks"
 _copies = Path(__file__).resolve().parent / "notebooks"
 _copies.mkdir(exist_ok=True)

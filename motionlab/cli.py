@@ -11,6 +11,8 @@ import argparse
 import importlib
 import sys
 
+from motionlab.cli_args import CLIError, HelpFormatter, RawDescriptionHelpFormatter
+
 __all__ = ["main", "build_parser", "CLIError", "rig_error"]
 
 _PARTS = (
@@ -20,10 +22,6 @@ _PARTS = (
     "motionlab.interpolation.cli",
     "motionlab.viz.cli",
 )
-
-
-class CLIError(Exception):
-    """A user-facing error: printed as ``motionlab: error: …`` with exit status 2, no traceback."""
 
 
 def rig_error(error, role: str, path) -> Exception:
@@ -51,6 +49,9 @@ def build_parser() -> argparse.ArgumentParser:
                 continue  # that part has no commands (yet)
             raise
         module.register(sub)
+    for command in sub.choices.values():  # every option's default in its --help
+        raw = issubclass(command.formatter_class, argparse.RawDescriptionHelpFormatter)
+        command.formatter_class = RawDescriptionHelpFormatter if raw else HelpFormatter
     return parser
 
 

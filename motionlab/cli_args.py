@@ -7,6 +7,12 @@ which names the option (``argument --workers: expected 1 or more, got '0'``).
 Outputs: :func:`check_outputs` and :func:`check_output_folder` are called *before* a command does
 any work, so a refused output costs nothing and leaves nothing behind. Every message names the
 option as the user typed it (``-o``, ``--report``) and says what would be accepted.
+
+Vocabulary: one option name has one meaning across sub-commands (``tests/commands/
+test_cli_vocabulary.py`` checks it). :func:`add_quiet` adds ``-q/--quiet``; :func:`renamed` keeps
+an option's old spelling working as a hidden, deprecated alias that prints a note;
+:class:`HelpFormatter` shows every option's default in ``--help``; :class:`Stages` is the progress
+bar of a command that runs in a few long stages.
 """
 
 from __future__ import annotations
@@ -14,10 +20,25 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-__all__ = ["positive", "non_negative", "positive_int", "non_negative_int", "check_outputs", "check_output_folder"]
+__all__ = [
+    "CLIError",
+    "positive",
+    "non_negative",
+    "positive_int",
+    "non_negative_int",
+    "check_outputs",
+    "check_output_folder",
+    "HelpFormatter",
+    "RawDescriptionHelpFormatter",
+    "DeprecatedAlias",
+    "add_quiet",
+    "renamed",
+    "Stages",
+]
 
 
 def _number(text: str) -> float:
@@ -66,9 +87,14 @@ def non_negative_int(text: str) -> int:
     return value
 
 
-def _error(message: str) -> Exception:
-    from motionlab.cli import CLIError
+class CLIError(Exception):
+    """A user-facing error: printed as ``motionlab: error: …`` with exit status 2, no traceback.
 
+    Defined here, beside the checks that raise it, and re-exported by :mod:`motionlab.cli`.
+    """
+
+
+def _error(message: str) -> Exception:
     return CLIError(message)
 
 
@@ -154,3 +180,90 @@ def check_output_folder(option: str, given: str | os.PathLike) -> Path:
             "choose a folder you can write to"
         )
     return path
+
+
+def _shown(default) -> bool:
+    """A default worth printing: not ``None``, a flag's ``False``, an empty list or SUPPRESS (0 is)."""
+    return not (default is None or default is False or default is argparse.SUPPRESS or default == [])
+
+
+class HelpFormatter(argparse.HelpFormatter):
+    """``--help`` that ends every option's text with its default, unless the text already says it.
+
+    No default is shown where there is none to show (``None``, a flag's ``False``, an empty list).
+    """
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        if action.option_strings and "default" not in text and _shown(action.default):
+            text += " (default: %(default)s)"
+        return text
+
+
+class RawDescriptionHelpFormatter(argparse.RawDescriptionHelpFormatter, HelpFormatter):
+    """:class:`HelpFormatter` for a command whose description is laid out by hand."""
+
+
+class DeprecatedAlias(argparse.Action):
+    """An option's old spelling: stores its value as the new option does, and prints on stderr
+    ``motionlab: note: OLD is deprecated; use NEW``. Hidden from ``--help``."""
+
+    def __init__(self, option_strings, dest, new: str = "", **kwargs):
+        super().__init__(option_strings, dest, **kwargs)
+        self.new = new
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(f"motionlab: note: {option_string} is deprecated here; use {self.new}", file=sys.stderr)
+        setattr(namespace, self.dest, True if self.nargs == 0 else values)
+
+
+def renamed(parser, old: str, new: argparse.Action) -> argparse.Action:
+    """Keep ``old`` working as a deprecated alias of the option ``new`` (the action that
+    ``add_argument`` returned): same destination, type and choices, hidden from ``--help``."""
+    return parser.add_argument(
+        old,
+        dest=new.dest,
+        type=new.type,
+        choices=new.choices,
+        metavar=new.metavar,
+        nargs=new.nargs,
+        default=argparse.SUPPRESS,
+        help=argparse.SUPPRESS,
+        action=DeprecatedAlias,
+        new=new.option_strings[-1],
+    )
+
+
+def add_quiet(parser) -> argparse.Action:
+    """``-q/--quiet``: no progress bars and no status lines; results and errors still print."""
+    return parser.add_argument(
+        "-q", "--quiet", action="store_true", help="no progress bars or status lines; results and errors still print"
+    )
+
+
+class Stages:
+    """A progress bar over a command's named stages, on stderr: it names the stage that runs, so a
+    long job is never silent. Call :meth:`start` as each stage begins and :meth:`close` at the end.
+
+    Parameters
+    ----------
+    names : the stages in order (their count is the bar's length)
+    desc : the bar's label, e.g. the command's name
+    disable : no bar (``--quiet``, or input too short to need one)
+    """
+
+    def __init__(self, names: Sequence[str], desc: str, disable: bool = False):
+        from tqdm.auto import tqdm
+
+        self._bar = tqdm(total=len(names), desc=desc, unit="stage", disable=disable, leave=False)
+        self._started = False
+
+    def start(self, name: str) -> None:
+        """Mark the previous stage done and show ``name`` as running."""
+        if self._started:
+            self._bar.update(1)
+        self._started = True
+        self._bar.set_postfix_str(name, refresh=True)
+
+    def close(self) -> None:
+        self._bar.close()

@@ -16,7 +16,9 @@ import torch
 from motionlab import exercises
 from motionlab.core import fk, humanoid, quat
 
-KEYS = Path(__file__).resolve().parents[1] / "notebooks" / "solutions"
+ROOT = Path(__file__).resolve().parents[1]
+KEYS = ROOT / "instructor" / "solutions"  # the instructor's key, outside the students' notebooks/
+NOTEBOOKS = ROOT / "notebooks"
 
 
 def _key(name: str):
@@ -535,7 +537,7 @@ def test_generic_check_compares_quaternions_up_to_sign_and_angles_up_to_turns():
 # ----------------------------------------------------------------------------- the notebooks use them
 def test_every_named_exercise_is_checked_in_a_notebook_and_no_cell_expects_an_error():
     """The notebooks check each exercise by name and run top to bottom: no cell is allowed to raise."""
-    notebooks = {p.stem: p.read_text(encoding="utf-8") for p in (KEYS.parent).glob("*.ipynb")}
+    notebooks = {p.stem: p.read_text(encoding="utf-8") for p in NOTEBOOKS.glob("*.ipynb")}
     for name in exercises.EXERCISES:
         assert any(f"exercises.{name}.check(" in text for text in notebooks.values()), f"{name} is checked nowhere"
     for stem, text in notebooks.items():

@@ -57,3 +57,65 @@ def test_every_command_is_still_registered():
     commands = build_parser()._subparsers._group_actions[0].choices
     for name in ("info", "convert", "synth", "demo", "retarget", "view"):
         assert name in commands
+
+
+SYSTEMS = ("retargeting", "motion_graphs", "interpolation")
+
+
+def _part(module: str) -> str | None:
+    """The top-level part of ``motionlab`` that a dotted module name lies in (``None`` outside)."""
+    parts = module.split(".")
+    return parts[1] if parts[0] == "motionlab" and len(parts) > 1 else None
+
+
+def _package_imports() -> dict[str, list[tuple[str, int, str]]]:
+    """For each part of the package, ``(file, line, imported module)`` of every import in it."""
+    found: dict[str, list[tuple[str, int, str]]] = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        name = path.relative_to(PACKAGE.parent).with_suffix("").parts
+        if name[-1] == "__init__":
+            name = name[:-1] + ("__init__",)  # relative imports resolve against the package itself
+        part = name[1] if len(name) > 2 else None
+        for line, module in _imports(path.read_text(), name if name[-1] != "__init__" else name[:-1] + ("x",)):
+            found.setdefault(part, []).append((str(path.relative_to(PACKAGE.parent)), line, module))
+    return found
+
+
+def test_the_three_systems_do_not_import_each_other_and_viz_imports_none_of_them():
+    bad = []
+    for part, imports in _package_imports().items():
+        if part not in SYSTEMS + ("viz",):
+            continue
+        forbidden = set(SYSTEMS) - {part}
+        bad += [f"{f}:{line} ({part}) imports {m}" for f, line, m in imports if _part(m) in forbidden]
+    assert not bad, "the systems and viz depend on core and synthetic only:\n" + "\n".join(bad)
+
+
+def test_no_import_loop_between_modules():
+    """Imports between motionlab's modules, lazy ones inside functions included, form no cycle."""
+    modules = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        rel = path.relative_to(PACKAGE.parent).with_suffix("").parts
+        dotted = ".".join(rel[:-1] if rel[-1] == "__init__" else rel)
+        resolve = rel if rel[-1] != "__init__" else rel[:-1] + ("x",)
+        modules[dotted] = [m for _, m in _imports(path.read_text(), resolve)]
+    graph = {
+        name: {m for m in imports if m in modules and m != name and not name.startswith(m + ".")}
+        for name, imports in modules.items()
+    }
+    state: dict[str, int] = {}
+    loops = []
+
+    def visit(node: str, stack: list[str]) -> None:
+        state[node] = 1
+        for nxt in sorted(graph[node]):
+            if state.get(nxt) == 1:
+                loops.append(" -> ".join(stack[stack.index(nxt) :] + [nxt]))
+            elif nxt not in state:
+                visit(nxt, stack + [nxt])
+        state[node] = 2
+
+    for name in sorted(graph):
+        if name not in state:
+            visit(name, [name])
+    assert not loops, "import loops:\n" + "\n".join(loops)

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
 from pathlib import Path
 
-from motionlab.cli_args import check_output_folder, check_outputs, positive, positive_int
+from motionlab.cli_args import add_quiet, check_output_folder, check_outputs, positive, positive_int, renamed
 
 __all__ = ["register", "positive"]
 
@@ -61,7 +63,8 @@ def _convert(args) -> int:
     if args.fps is not None:
         m = m.resample(args.fps)
     (gltf.save if out.suffix.lower() == gltf.SUFFIX else bvh.save)(out, m, overwrite=args.force)
-    print(f"wrote {out}: {m.num_frames} frames at {m.fps:g} fps, {m.skeleton.num_joints} joints")
+    if not args.quiet:
+        print(f"wrote {out}: {m.num_frames} frames at {m.fps:g} fps, {m.skeleton.num_joints} joints")
     return 0
 
 
@@ -85,25 +88,41 @@ def _synth(args) -> int:
         )
     motion.name = args.behaviour
     bvh.save(out, motion, overwrite=args.force)
-    print(f"wrote {out}: {motion.num_frames} frames of {args.behaviour} at {motion.fps:g} fps")
+    if not args.quiet:
+        print(f"wrote {out}: {motion.num_frames} frames of {args.behaviour} at {motion.fps:g} fps")
     return 0
 
 
 def _demo(args) -> int:
     from motionlab.demo import run_demo
 
-    check_output_folder("--out", args.out)
-    return run_demo(out_dir=Path(args.out), characters=args.characters, seed=args.seed, force=args.force)
+    check_output_folder("-o", args.output)
+    out = Path(args.output)
+    if not args.quiet:
+        return run_demo(out_dir=out, characters=args.num_characters, seed=args.seed, force=args.force)
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):  # no bar, no status
+        code = run_demo(out_dir=out, characters=args.num_characters, seed=args.seed, force=args.force)
+    print((out / "summary.md").read_text().removeprefix("# motionlab demo\n\n"), end="")  # the result: the table
+    return code
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("info", help="describe a BVH file: skeleton, frames, fps, 22-joint mapping")
+    p = sub.add_parser(
+        "info",
+        help="describe a BVH file: skeleton, frames, fps, 22-joint mapping",
+        description="Print a BVH file's skeleton, frame count, frame rate, rest height and whether (and by "
+        "which rig profile) it maps onto the canonical 22-joint humanoid.",
+    )
     p.add_argument("file", help="a .bvh file")
     p.add_argument("--joints", action="store_true", help="also print the joint tree with channels")
+    add_quiet(p)
     p.set_defaults(func=_info)
 
     p = sub.add_parser(
-        "convert", help="reduce a BVH file to the 22-joint humanoid and/or resample it; write BVH or glTF (.glb)"
+        "convert",
+        help="reduce a BVH file to the 22-joint humanoid and/or resample it; write BVH or glTF (.glb)",
+        description="Read a BVH file, optionally reduce it to the canonical 22 joints (--canonical) and resample "
+        "it (--fps), and write it as BVH or, when OUTPUT ends in .glb, as binary glTF 2.0 (docs/gltf.md).",
     )
     p.add_argument("input", help="input .bvh")
     p.add_argument(
@@ -115,29 +134,45 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--canonical", action="store_true", help="reduce to the canonical 22 joints")
     p.add_argument("--fps", type=positive, default=None, help="resample to this frame rate (frames per second)")
     p.add_argument("--force", action="store_true", help="overwrite the output if it exists")
+    add_quiet(p)
     p.set_defaults(func=_convert)
 
-    p = sub.add_parser("synth", help="write synthetic motion (idle, walk, run, jump, squat or mix) as BVH")
-    p.add_argument("behaviour", choices=["idle", "walk", "run", "jump", "squat", "mix"])
+    p = sub.add_parser(
+        "synth",
+        help="write synthetic motion (idle, walk, run, jump, squat or mix) as BVH",
+        description="Generate procedural humanoid motion on a character of the given height and limb "
+        "proportions and write it as BVH (mix: idle -> walk -> run -> jump -> walk -> squat).",
+    )
+    p.add_argument("behaviour", choices=["idle", "walk", "run", "jump", "squat", "mix"], help="what the body does")
     p.add_argument("-o", "--output", required=True, help="output .bvh")
-    p.add_argument("--seconds", type=positive, default=4.0, help="length (ignored for mix)")
-    p.add_argument("--fps", type=positive, default=60.0)
+    p.add_argument("--seconds", type=positive, default=4.0, help="length in seconds (ignored for mix)")
+    p.add_argument("--fps", type=positive, default=60.0, help="frame rate (frames per second)")
     p.add_argument("--height", type=positive, default=1.75, help="character height, metres")
     p.add_argument("--legs", type=positive, default=1.0, help="leg length factor")
     p.add_argument("--arms", type=positive, default=1.0, help="arm length factor")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, default=0, help="random seed")
     p.add_argument("--force", action="store_true", help="overwrite the output if it exists")
+    add_quiet(p)
     p.set_defaults(func=_synth)
 
     p = sub.add_parser(
-        "demo", help="the main job on built-in data: retarget a synthetic performance onto new characters"
+        "demo",
+        help="the main job on built-in data: retarget a synthetic performance onto new characters",
+        description="Make a synthetic performance, retarget it onto new synthetic characters with the shipped "
+        "network (copy, network alone, full method), write BVH files, a figure and a table to the output "
+        "folder, and print the table.",
     )
-    p.add_argument("--out", default="outputs/demo", help="output folder (default: outputs/demo)")
-    p.add_argument("--characters", type=positive_int, default=4, help="how many new characters (1 or more)")
-    p.add_argument("--seed", type=int, default=0)
+    renamed(p, "--out", p.add_argument("-o", "--output", default="outputs/demo", help="output folder"))
+    renamed(
+        p,
+        "--characters",
+        p.add_argument("--num-characters", type=positive_int, default=4, help="how many new characters (1 or more)"),
+    )
+    p.add_argument("--seed", type=int, default=0, help="random seed")
     p.add_argument(
         "--force",
         action="store_true",
         help="replace files in an output folder that an earlier demo did not write (a demo folder is always re-used)",
     )
+    add_quiet(p)
     p.set_defaults(func=_demo)

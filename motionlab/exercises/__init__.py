@@ -28,8 +28,8 @@ typical mistakes):
 * :mod:`~motionlab.exercises.motion_graphs`: 05 ``local_minima``, ``distance_matrix``;
 * :mod:`~motionlab.exercises.interpolation`: 06 ``ease``, ``sigma2``, ``jumps``.
 
-Their reference solutions, as a student would write them, are in ``notebooks/solutions/`` (the
-instructor's key), and ``tests/test_exercises.py`` runs every check against the key, typical wrong
+Their reference solutions, as a student would write them, are in ``instructor/solutions/`` (the
+instructor's key, outside the students' ``notebooks/`` folder), and ``tests/test_exercises.py`` runs every check against the key, typical wrong
 answers and an alternative correct answer. :func:`check` is the same machinery for ad-hoc checks
 (:mod:`~motionlab.exercises.core`).
 """

@@ -19,7 +19,7 @@ other recordings of the action need between the poses at the gap's ends (the two
 :mod:`motionlab.interpolation.recorded`); the frames are inserted and filled: by
 default the whole body continues the recorded strides on both sides across the gap
 (:mod:`motionlab.interpolation.stride`); where the motion does not repeat, SLERP with the root
-given by ``--root`` (``stride``: the strides' root path where one side repeats, else ``hermite``,
+given by ``--gap-root`` (``stride``: the strides' root path where one side repeats, else ``hermite``,
 a Hermite curve with the velocities on both sides; ``linear``: the LaFAN1 baseline).
 Where the capture logged each frame's time, ``--times FILE`` (one time in seconds per frame,
 :func:`motionlab.interpolation.gaps.load_times`) gives the gaps and their counts exactly
@@ -34,6 +34,8 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+
+from motionlab.cli_args import Stages, add_quiet, renamed
 
 __all__ = ["register", "run_fill_gaps"]
 
@@ -50,13 +52,17 @@ def register(subparsers) -> None:
     p.add_argument("--method", choices=("stride", "slerp", "hermite", "graph"), default="stride",
                    help="stride: the strides on both sides continued (default; slerp where the motion does not "
                    "repeat); slerp: SLERP; hermite: velocity-matched; graph: key-pose guided (needs --action)")  # fmt: skip
-    p.add_argument("--curve", choices=("linear", "ease", "smoothstep"), default="linear", help="α(k) curve")
-    p.add_argument("--root", choices=("stride", "hermite", "linear"), default="stride",
-                   help="root path across a gap: the strides on both sides continued (default; Hermite where "
-                   "the motion does not repeat), Hermite with the velocities on both sides, or linear")  # fmt: skip
-    p.add_argument("--delta", "--threshold", "--factor", dest="delta", type=str, default=None, metavar="Δ",
-                   help="Δ: a step this many times the typical step means dropped frames (a number above 1; "
-                   "default 2.5, against the stream itself or, with --action, against the graph)")  # fmt: skip
+    p.add_argument("--curve", choices=("linear", "ease", "smoothstep"), default="linear",
+                   help="α(k) curve of the blend weights across a gap")  # fmt: skip
+    root = p.add_argument("--gap-root", dest="root", choices=("stride", "hermite", "linear"), default="stride",
+                          help="root path across a gap: the strides on both sides continued (default; Hermite where "
+                          "the motion does not repeat), Hermite with the velocities on both sides, or linear")  # fmt: skip
+    renamed(p, "--root", root)
+    delta = p.add_argument("--delta", dest="delta", type=str, default=None, metavar="Δ",
+                           help="Δ: a step this many times the typical step means dropped frames (a number above 1; "
+                           "default 2.5, against the stream itself or, with --action, against the graph)")  # fmt: skip
+    renamed(p, "--threshold", delta)
+    renamed(p, "--factor", delta)
     p.add_argument("--action", action="append", default=[], metavar="NAME=FILE.bvh",
                    help="an action node of the graph and a clip of it (repeat)")  # fmt: skip
     p.add_argument("--allow", action="append", default=[], metavar="'A -> B'",
@@ -64,11 +70,12 @@ def register(subparsers) -> None:
     p.add_argument("--takes", action="append", default=[], metavar="FILE.bvh|FOLDER",
                    help="another recording of the stream's action, or a folder of them (repeat; the input itself "
                    "is never used): the missing count also reads how long these take from the pose before a gap "
-                   "to the pose after it; best with takes of the same session and style (README)")  # fmt: skip
+                   "to the pose after it; best with takes of the same session and style (docs/results_interpolation.md)")  # fmt: skip
     p.add_argument("--times", metavar="FILE", default=None,
                    help="the frames' capture times, one per line in seconds: the gaps and their counts are "
                    "read from them (exact), not detected or estimated")  # fmt: skip
     p.add_argument("--force", action="store_true", help="overwrite the output file if it exists")
+    add_quiet(p)
     p.set_defaults(func=run_fill_gaps)
 
 
@@ -161,6 +168,9 @@ def _check_rate(path: Path, take, src: Path, motion) -> None:
         )
 
 
+PROGRESS_FRAMES = 2000
+"""Inputs of at least this many frames show a progress bar of the stages (unless ``--quiet``)."""
+
 MAX_GROWTH = 10
 """``--times`` may at most make the clip this many times longer: more means wrong times."""
 
@@ -218,7 +228,7 @@ def _check_args(args: argparse.Namespace):
     delta = None
     if args.delta is not None:
         try:
-            delta = detect.check_delta(args.delta, name="--delta (--threshold)")
+            delta = detect.check_delta(args.delta, name="--delta")
         except ValueError as e:
             raise CLIError(str(e)) from None
     if args.times is not None and (args.takes or delta is not None):
@@ -243,6 +253,8 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
         motion = bvh.load(src)
     except bvh.BVHError as e:
         raise CLIError(str(e)) from None
+    bar = Stages(("find gaps", "fill", "write"), "fill-gaps", disable=args.quiet or motion.num_frames < PROGRESS_FRAMES)
+    bar.start("find gaps")
     graph = _graph(args.action, args.allow, src, motion) if args.method == "graph" else None
     if args.times is not None:
         missing = _times_gaps(args.times, src, motion)
@@ -252,21 +264,27 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
             missing = detect.detect(motion, graph=graph, delta=delta, takes=takes)
         except ValueError as e:
             raise CLIError(str(e)) from None
-    print(f"{src}: {motion.num_frames} frames at {motion.fps:g} fps")
+    if not args.quiet:
+        print(f"{src}: {motion.num_frames} frames at {motion.fps:g} fps")
     nothing = (
         f"no dropped frames in the times of {args.times}" if args.times else "no dropped frames found (D > Δ nowhere)"
     )
     if not missing:
+        bar.close()
         _copy(src, dst, args.force)
         print(f"{nothing}; wrote an unchanged copy")
-        print(f"wrote {dst} ({motion.num_frames} frames)")
+        if not args.quiet:
+            print(f"wrote {dst} ({motion.num_frames} frames)")
         return 0
+    bar.start("fill")
     expanded, _ = gaps.insert_missing(motion, missing)
     try:
         filled, report = gaps.fill(expanded, method=args.method, graph=graph, curve=args.curve, root=args.root)
     except ValueError as e:
         raise CLIError(str(e)) from None
+    bar.start("write")
     bvh.save(dst, filled, overwrite=args.force)
+    bar.close()
     if not report:
         print(f"{nothing}; wrote an unchanged copy")
     else:
@@ -274,5 +292,6 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
         print(f"filled {len(report)} gap(s), {total} frame(s) in all (method: {args.method}):")
         for r in report:
             print(f"  {r}")
-    print(f"wrote {dst} ({filled.num_frames} frames)")
+    if not args.quiet:
+        print(f"wrote {dst} ({filled.num_frames} frames)")
     return 0

@@ -2,7 +2,7 @@
 
 ::
 
-    motionlab graph-build FOLDER -o walk.mlgraph [--report walk.json] [--threshold 0.03] [--force]
+    motionlab graph-build FOLDER -o walk.mlgraph [--report walk.json] [--distance-threshold 0.03] [--force]
     motionlab graph-search walk.mlgraph --request "walk:angry:300,run:normal:200" -o out.bvh
     motionlab graph-info walk.mlgraph
 
@@ -22,21 +22,41 @@ import time
 from pathlib import Path
 
 from motionlab.cli import CLIError
-from motionlab.cli_args import check_outputs, non_negative_int, positive, positive_int
+from motionlab.cli_args import add_quiet, check_outputs, non_negative_int, positive, positive_int, renamed
 
 __all__ = ["register"]
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("graph-build", help="build a motion graph from a folder of BVH clips")
+    p = subparsers.add_parser(
+        "graph-build",
+        help="build a motion graph from a folder of BVH clips",
+        description="Build a structured motion graph (behaviours, styles, takes, recorded transition clips and "
+        "interpolation spaces between styles) or, with --standard, Kovar's graph, from a folder of BVH clips; "
+        "write it to a .mlgraph file and print its structure table.",
+    )
     p.add_argument("folder", nargs="?", help="folder of BVH files named Behaviour_style / B1_s1_to_B2_s2")
     p.add_argument("-o", "--output", required=True, help="graph file to write (.mlgraph)")
     p.add_argument("--synthetic", action="store_true", help="use the built-in synthetic clips instead of a folder")
     p.add_argument("--standard", action="store_true", help="build Kovar's unstructured graph instead")
-    p.add_argument("--threshold", type=positive, default=0.03, help="transition threshold, metres RMS (default 0.03)")
+    renamed(
+        p,
+        "--threshold",
+        p.add_argument(
+            "--distance-threshold",
+            dest="threshold",
+            type=positive,
+            default=0.03,
+            metavar="M",
+            help="largest frame distance of a transition, metres RMS (default 0.03)",
+        ),
+    )
     p.add_argument("--fps", type=positive, default=30.0, help="frame rate every clip is resampled to (default 30)")
     p.add_argument(
-        "--style-pairs", choices=("hub", "chain", "all"), default="hub", help="styles bridged by interpolation"
+        "--style-pairs",
+        choices=("hub", "chain", "all"),
+        default="hub",
+        help="styles bridged by interpolation spaces: each to a hub, a chain, or all pairs",
     )
     p.add_argument(
         "--neighbours", type=positive_int, default=3, help="takes each take of a style is compared with (default 3)"
@@ -44,9 +64,15 @@ def register(subparsers) -> None:
     p.add_argument("--name-map", help="JSON file {clip stem: 'behaviour_style[_take]'} for names that do not parse")
     p.add_argument("--report", help="also write the build report as JSON to this file")
     p.add_argument("--force", action="store_true", help="overwrite the output files")
+    add_quiet(p)
     p.set_defaults(func=_build)
 
-    p = subparsers.add_parser("graph-search", help="synthesise a motion for a request from a graph")
+    p = subparsers.add_parser(
+        "graph-search",
+        help="synthesise a motion for a request from a graph",
+        description="Search a graph from graph-build for a path that meets a request of behaviour, style and "
+        "frame count per segment, and write the synthesised motion as BVH.",
+    )
     p.add_argument("graph", help=".mlgraph file from graph-build")
     p.add_argument(
         "--request",
@@ -57,10 +83,16 @@ def register(subparsers) -> None:
     p.add_argument("-o", "--output", required=True, help="BVH file to write")
     p.add_argument("--blend", type=non_negative_int, default=8, help="transition blend length in frames (default 8)")
     p.add_argument("--force", action="store_true", help="overwrite the output file")
+    add_quiet(p)
     p.set_defaults(func=_search)
 
-    p = subparsers.add_parser("graph-info", help="print a graph's structure table and counts")
+    p = subparsers.add_parser(
+        "graph-info",
+        help="print a graph's structure table and counts",
+        description="Print the structure table (behaviours, styles, frames) and the counts of a .mlgraph file.",
+    )
     p.add_argument("graph", help=".mlgraph file")
+    add_quiet(p)
     p.set_defaults(func=_info)
 
 
@@ -106,7 +138,7 @@ def _load_clips(args: argparse.Namespace) -> list:
         print(f"using {len(motions)} synthetic clips (no real data)")
         return motions
     try:
-        return clips.load_folder(args.folder, args.fps, name_map, progress=True)
+        return clips.load_folder(args.folder, args.fps, name_map, progress=not args.quiet)
     except NamingError as e:
         raise CLIError(str(e)) from None
 
@@ -130,7 +162,7 @@ def _build_graph(args: argparse.Namespace, motions: list):
             style_pairs=args.style_pairs,
             synthetic=[args.synthetic] * len(motions),
             neighbours=args.neighbours,
-            progress=True,
+            progress=not args.quiet,
         )
     except graph.GraphError as e:
         raise CLIError(str(e)) from None
@@ -188,7 +220,7 @@ def _search(args: argparse.Namespace) -> int:
     try:
         t0 = time.perf_counter()
         if g.table.get("behaviours"):
-            result = search.search(g, segs, progress=True)
+            result = search.search(g, segs, progress=not args.quiet)
         else:
             result = search.search_standard(g, segs)
         dt = time.perf_counter() - t0

@@ -11,16 +11,14 @@ Examples::
 
 from __future__ import annotations
 
-import argparse
 import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from motionlab.cli_args import check_outputs, non_negative, non_negative_int, positive, positive_int
-
-ROOT_MODES = ("stride", "hips", "legs", "contacts")
-"""``pipeline.ROOT_MODES``, repeated so that ``--help`` does not import torch (a test keeps them equal)."""
+from motionlab.cli_args import add_quiet, check_outputs, non_negative, non_negative_int, positive, positive_int
+from motionlab.retargeting import cli_options
+from motionlab.retargeting.cli_options import ROOT_MODES
 
 __all__ = ["register"]
 
@@ -37,76 +35,6 @@ def _load_bvh(path: str, what: str):
     return bvh.load(files.check_input(path, what))
 
 
-def _load_checkpoint(path: str | None, device: str | None):
-    from motionlab import retargeting
-
-    try:
-        return retargeting.load(path, device) if path else retargeting.load_default(device)
-    except retargeting.CheckpointError as e:
-        raise _error(str(e)) from None
-
-
-def _solver_config(args):
-    from motionlab.retargeting.solver import SolverConfig
-
-    rounds = SolverConfig().project_iters
-    for option, value, ok, expected in (
-        ("--steps", args.steps, args.steps >= 0, ">= 0"),
-        ("--lr", args.lr, args.lr > 0, "> 0"),
-        ("--threshold", args.threshold, args.threshold >= 0, ">= 0"),
-        ("--contact-weight", args.contact_weight, args.contact_weight >= 0, ">= 0"),
-        ("--exact-rounds", args.exact_rounds, 0 <= args.exact_rounds <= rounds, f"between 0 and {rounds}"),
-    ):
-        if not ok:  # also refuses nan
-            raise _error(f"{option} must be {expected}, got {value}")
-    return SolverConfig(
-        max_steps=args.steps,
-        lr=args.lr,
-        threshold=args.threshold,
-        lambda_contact=args.contact_weight,
-        init=args.init,
-        project_exact=args.exact_rounds,
-    )
-
-
-def _add_solver_args(p: argparse.ArgumentParser) -> None:
-    g = p.add_argument_group("latent iteration")
-    g.add_argument(
-        "--steps", type=non_negative_int, default=100, help="step limit of the latent iteration (default 100)"
-    )
-    g.add_argument(
-        "--lr",
-        type=positive,
-        default=0.02,
-        help="Adam step on the latent, relative to its spread std(φ₀) (default 0.02)",
-    )
-    g.add_argument(
-        "--threshold", type=non_negative, default=2e-3, help="stop when L_iter drops below this (default 2e-3)"
-    )
-    g.add_argument(
-        "--contact-weight",
-        type=non_negative,
-        default=0.5,
-        metavar="W",
-        help="weight of the foot-contact term (motionlab's addition; 0 = the paper's two losses; default 0.5)",
-    )
-    g.add_argument(
-        "--init",
-        choices=("auto", "project", "encoder"),
-        default="auto",
-        help="start of the iteration: least-squares projection onto the source's rotations, the encoder's "
-        "latent (the paper), or auto (default: projection)",
-    )
-    g.add_argument(
-        "--exact-rounds",
-        type=non_negative_int,
-        default=4,
-        metavar="K",
-        help="of the projection's 8 Gauss-Newton rounds, how many last ones are not smoothed over time (default 4)",
-    )
-
-
-# ---------------------------------------------------------------------------- retarget
 def _cmd_retarget(args) -> int:
     from motionlab.cli import rig_error
     from motionlab.core import bvh, files, gltf, humanoid
@@ -137,8 +65,10 @@ def _cmd_retarget(args) -> int:
         target = humanoid.scale_bones(target, **scales)
     if not args.target and all(v == 1.0 for v in scales.values()):
         raise _error("give --target TARGET.bvh and/or a --scale-* factor: otherwise the target is the source itself")
-    ckpt = None if args.method == "copy" else _load_checkpoint(args.checkpoint, args.device)
-    result = retarget(source, target, ckpt, args.method, _solver_config(args), args.root, progress=not args.quiet)
+    ckpt = None if args.method == "copy" else cli_options.load_checkpoint(args.checkpoint, args.device)
+    result = retarget(
+        source, target, ckpt, args.method, cli_options.solver_config(args), args.root, progress=not args.quiet
+    )
     binary = out.suffix.lower() == gltf.SUFFIX
     data = (gltf.dumps if binary else bvh.dumps)(result.motion)  # any error shows before a file is written
     outputs = [(out, lambda f: f.write(data), binary, "output")]
@@ -250,7 +180,7 @@ def _cmd_evaluate(args) -> int:
     result = Evaluation(rows=[])
     for fold, fpath in zip(folds, fold_paths):
         if fpath.is_file() and not args.retrain:
-            ckpt = _load_checkpoint(str(fpath), args.device)
+            ckpt = cli_options.load_checkpoint(str(fpath), args.device)
             if not args.quiet:
                 print(f"using checkpoint {fpath}")
         else:
@@ -273,7 +203,7 @@ def _cmd_evaluate(args) -> int:
             targets=args.targets,
             animations=fold,
             rows=rows_with_root(args.root, ablations=not args.no_ablations),
-            solver=_solver_config(args),
+            solver=cli_options.solver_config(args),
             progress=not args.quiet,
         )
         result.rows = part.rows
@@ -340,8 +270,8 @@ def register(subparsers) -> None:
     p.add_argument("--scale", type=positive, default=1.0, metavar="F", help="scale the whole target by F")
     p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
     p.add_argument("--force", action="store_true", help="overwrite existing output files")
-    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary")
-    _add_solver_args(p)
+    add_quiet(p)
+    cli_options.add_solver_args(p)
     p.set_defaults(func=_cmd_retarget)
 
     p = subparsers.add_parser(
@@ -355,7 +285,7 @@ def register(subparsers) -> None:
     )
     p.add_argument("-o", "--output", required=True, help="checkpoint file to write (.pt)")
     p.add_argument("--train-steps", type=positive_int, default=1500, help="Adam steps (default 1500)")
-    p.add_argument("--batch-size", type=positive_int, default=32)
+    p.add_argument("--batch-size", type=positive_int, default=32, help="windows per Adam step")
     p.add_argument(
         "--pose-augment",
         type=non_negative,
@@ -363,13 +293,13 @@ def register(subparsers) -> None:
         metavar="F",
         help="fraction of each batch with joints turned at random (up to 0.3 rad; 0..0.5, default 0 = off)",
     )
-    p.add_argument("--train-lr", type=positive, default=2e-3)
+    p.add_argument("--train-lr", type=positive, default=2e-3, help="Adam learning rate of the training")
     p.add_argument("--latent", type=positive_int, default=128, help="latent channels D per frame")
     p.add_argument("--hidden", type=positive_int, default=96, help="hidden channels")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, default=0, help="random seed")
     p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
     p.add_argument("--force", action="store_true", help="overwrite an existing checkpoint")
-    p.add_argument("-q", "--quiet", action="store_true")
+    add_quiet(p)
     p.set_defaults(func=_cmd_train)
 
     p = subparsers.add_parser(
@@ -380,9 +310,12 @@ def register(subparsers) -> None:
         "other clips first if the checkpoint does not exist.",
     )
     p.add_argument("--data", help="folder laid out as <Character>/<Animation>.bvh (default: $MOTIONLAB_DATA/mixamo)")
-    p.add_argument("--source", default="Aj")
+    p.add_argument("--source", default="Aj", help="the character trained on and retargeted from (a folder of --data)")
     p.add_argument(
-        "--targets", nargs="+", default=["BigVegas", "Kaya", "SportyGranny", "Goblin_m", "Mousey_m", "Vampire_m"]
+        "--targets",
+        nargs="+",
+        default=["BigVegas", "Kaya", "SportyGranny", "Goblin_m", "Mousey_m", "Vampire_m"],
+        help="the characters retargeted onto (folders of --data)",
     )
     p.add_argument("--animations", nargs="+", help="clip stems (default: the 10 retarget_gt animations)")
     p.add_argument("--all-animations", action="store_true", help="use every animation shared by source and targets")
@@ -398,8 +331,10 @@ def register(subparsers) -> None:
         help="leave animations out: split the evaluated animations into K folds and evaluate each with a network "
         "trained on the source's other clips (checkpoints <checkpoint>_fold<k>of<K>.pt); default 1",
     )
-    p.add_argument("--train-steps", type=positive_int, default=1500)
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument(
+        "--train-steps", type=positive_int, default=1500, help="Adam steps when the network is trained (default 1500)"
+    )
+    p.add_argument("--seed", type=int, default=0, help="random seed")
     p.add_argument("--csv", help="write the per-clip records to this CSV")
     p.add_argument("--force", action="store_true", help="overwrite an existing --csv file")
     p.add_argument(
@@ -411,7 +346,7 @@ def register(subparsers) -> None:
         default="stride",
         help="root trajectory of every row but the plain baseline (default stride, as in `motionlab retarget`)",
     )
-    p.add_argument("--device")
-    p.add_argument("-q", "--quiet", action="store_true")
-    _add_solver_args(p)
+    p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
+    add_quiet(p)
+    cli_options.add_solver_args(p)
     p.set_defaults(func=_cmd_evaluate)

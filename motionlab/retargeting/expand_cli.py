@@ -11,7 +11,9 @@ from __future__ import annotations
 
 import argparse
 
-from motionlab.cli_args import check_output_folder, non_negative, non_negative_int, positive, positive_int
+from motionlab.cli_args import add_quiet, check_output_folder, non_negative, non_negative_int, positive, positive_int
+from motionlab.retargeting import cli_options
+from motionlab.retargeting.cli_options import ROOT_MODES
 
 __all__ = ["register"]
 
@@ -19,7 +21,6 @@ __all__ = ["register"]
 def _cmd_expand(args) -> int:
     from motionlab.cli import CLIError
     from motionlab.retargeting import expand as ex
-    from motionlab.retargeting.cli import _load_checkpoint, _solver_config
 
     if args.backend == "ray":
         from motionlab.retargeting.cluster import INSTALL_HINT
@@ -35,13 +36,13 @@ def _cmd_expand(args) -> int:
         targets = ex.characters(*args.characters, presets=args.preset)
     except ValueError as e:
         raise CLIError(str(e)) from None
-    ckpt = _load_checkpoint(args.checkpoint, args.device)
+    ckpt = cli_options.load_checkpoint(args.checkpoint, args.device)
     job = ex.expand(
         args.sources,
         targets,
         args.output,
         ckpt,
-        _solver_config(args),
+        cli_options.solver_config(args),
         root_mode=args.root,
         force=args.force,
         max_frames=args.batch_frames,
@@ -71,8 +72,6 @@ def _print_failures(job, most: int = 10) -> None:
 
 def register(subparsers) -> None:
     """Add ``expand`` to the ``motionlab`` command."""
-    from motionlab.retargeting.cli import ROOT_MODES, _add_solver_args
-
     p = subparsers.add_parser(
         "expand",
         help="retarget many clips onto many characters (batched, resumable; local or Ray)",
@@ -98,7 +97,12 @@ def register(subparsers) -> None:
     p.add_argument("--checkpoint", help="trained network (default: the shipped one)")
     p.add_argument("--root", choices=ROOT_MODES, default="stride", help="root trajectory rule (as in retarget)")
     p.add_argument("--batch-frames", type=positive_int, help="frames per solver batch (default: from free memory)")
-    p.add_argument("--backend", choices=("local", "ray"), default="local")
+    p.add_argument(
+        "--backend",
+        choices=("local", "ray"),
+        default="local",
+        help='local: batches in this process; ray: the same batches on Ray actors (pip install "motionlab[cluster]")',
+    )
     p.add_argument("--address", help="Ray cluster address (default: $RAY_ADDRESS, else a local Ray instance)")
     p.add_argument("--workers", type=positive_int, default=2, help="Ray actors (default 2)")
     p.add_argument(
@@ -115,6 +119,6 @@ def register(subparsers) -> None:
     )
     p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
     p.add_argument("--force", action="store_true", help="redo every pair and replace existing outputs")
-    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary")
-    _add_solver_args(p)
+    add_quiet(p)
+    cli_options.add_solver_args(p)
     p.set_defaults(func=_cmd_expand)

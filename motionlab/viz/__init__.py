@@ -12,7 +12,7 @@ from motionlab.viz import backend, compare, export, player, proportions, scene
 from motionlab.viz.compare import joint_errors, side_by_side
 from motionlab.viz.export import filmstrip, save_gif, save_movie, save_mp4, snapshot
 from motionlab.viz.player import Player, play, still
-from motionlab.viz.proportions import ProportionEditor, copy_rotation_solver, default_solver
+from motionlab.viz.proportions import ProportionEditor, copy_rotation_solver
 from motionlab.viz.scene import Scene, build_scene, contact_labels, foot_joints
 
 __all__ = [
@@ -38,5 +38,4 @@ __all__ = [
     "filmstrip",
     "ProportionEditor",
     "copy_rotation_solver",
-    "default_solver",
 ]

@@ -3,10 +3,10 @@
 Examples::
 
     motionlab view $MOTIONLAB_DATA/mixamo/Aj/Running.bvh                 # window (needs a display)
-    motionlab view Running.bvh --out running.mp4 --camera follow          # movie, off-screen
-    motionlab view Running.bvh --out running.gif --size 480x360 --force   # replace an old GIF
+    motionlab view Running.bvh -o running.mp4 --camera follow          # movie, off-screen
+    motionlab view Running.bvh -o running.gif --size 480x360 --force   # replace an old GIF
 
-Without a display, ``--out`` is needed (nothing is written that was not asked for). Existing
+Without a display, ``-o`` is needed (nothing is written that was not asked for). Existing
 files are never overwritten without ``--force``.
 """
 
@@ -16,7 +16,7 @@ import argparse
 import time
 from pathlib import Path
 
-from motionlab.cli_args import check_outputs, non_negative_int, positive, positive_int
+from motionlab.cli_args import add_quiet, check_outputs, non_negative_int, positive, positive_int, renamed
 
 __all__ = ["register"]
 
@@ -80,17 +80,15 @@ def _cmd_view(args) -> int:
     from motionlab.viz.scene import Scene
 
     source = files.check_input(args.file, "BVH")
-    out = Path(args.out) if args.out else None
+    out = Path(args.output) if args.output else None
     if out is None and not backend.has_display():  # never write into the current folder unasked
-        raise _error(
-            f"no display found to open a window for {source}; write a movie instead with --out {source.stem}.mp4"
-        )
+        raise _error(f"no display found to open a window for {source}; write a movie instead with -o {source.stem}.mp4")
     if out is not None:
         if out.suffix.lower() not in MOVIE_SUFFIXES:
-            raise _error(f"--out must end in .mp4 or .gif, got {str(out)!r}")
-        check_outputs([("--out", out)], args.force, inputs=[("input", source)])
+            raise _error(f"-o must end in .mp4 or .gif, got {str(out)!r}")
+        check_outputs([("-o", out)], args.force, inputs=[("input", source)])
     try:
-        motion = bvh.load(source, scale=args.scale)
+        motion = bvh.load(source, scale=args.unit_scale)
     except bvh.BVHError as e:
         raise _error(str(e)) from None
     if args.canonical:
@@ -121,10 +119,11 @@ def _cmd_view(args) -> int:
     save_movie(motion, out, overwrite=args.force, off_screen=True, anti_aliasing=args.smooth, **kwargs, **options)
     seconds = time.perf_counter() - start
     frames, length = _movie_length(out, motion, args.stride)
-    print(
-        f"wrote {out}: {frames} frames, {length:.2f} s of {motion.name or source.name} "
-        f"({motion.num_frames} frames at {motion.fps:g} fps; rendered in {seconds:.1f} s)"
-    )
+    if not args.quiet:
+        print(
+            f"wrote {out}: {frames} frames, {length:.2f} s of {motion.name or source.name} "
+            f"({motion.num_frames} frames at {motion.fps:g} fps; rendered in {seconds:.1f} s)"
+        )
     return 0
 
 
@@ -144,10 +143,16 @@ def register(subparsers) -> None:
         "view",
         help="play a BVH file in 3D, or write it to an MP4/GIF movie",
         description="Play FILE.bvh in a 3D window (where a display exists) or render it off-screen to a movie "
-        "with --out (needed where there is no display). Foot contacts light up red.",
+        "with -o (needed where there is no display). Foot contacts light up red.",
     )
     p.add_argument("file", help="BVH file to play")
-    p.add_argument("--out", metavar="MOVIE", help="write a movie instead of opening a window (.mp4 or .gif)")
+    renamed(
+        p,
+        "--out",
+        p.add_argument(
+            "-o", "--output", metavar="MOVIE", help="write a movie instead of opening a window (.mp4 or .gif)"
+        ),
+    )
     p.add_argument("--force", action="store_true", help="overwrite an existing movie")
     p.add_argument(
         "--camera",
@@ -155,8 +160,16 @@ def register(subparsers) -> None:
         default="follow",
         help="follow the character (default) or frame the whole clip from one place",
     )
-    p.add_argument("--size", type=_size, default=(640, 480), metavar="WxH", help="picture size in pixels (640x480)")
-    p.add_argument("--scale", type=positive, default=0.01, help="BVH units to metres (default 0.01: centimetres)")
+    p.add_argument(
+        "--size", type=_size, default=(640, 480), metavar="WxH", help="picture size in pixels (default 640x480)"
+    )
+    renamed(
+        p,
+        "--scale",
+        p.add_argument(
+            "--unit-scale", type=positive, default=0.01, help="BVH units to metres (default 0.01: centimetres)"
+        ),
+    )
     p.add_argument("--start", type=non_negative_int, default=0, help="first frame")
     p.add_argument("--stop", type=int, default=None, help="frame to stop before (default: the end)")
     p.add_argument(
@@ -167,4 +180,5 @@ def register(subparsers) -> None:
     p.add_argument("--feet-trails", action="store_true", help="draw the feet's paths")
     p.add_argument("--no-contacts", action="store_true", help="do not highlight foot contacts")
     p.add_argument("--smooth", action="store_true", help="anti-aliased movie (slower in software rendering)")
+    add_quiet(p)
     p.set_defaults(func=_cmd_view)

@@ -7,10 +7,10 @@ skeleton goes to a solver, a callable ``solve(skeleton) -> Motion`` (or ``-> (Mo
 with a loss history), and the view updates: the source character on the left, the new one on
 the right, and a small plot of the feet's height over the clip (and the solver's loss).
 
-The default solver is the latent iteration of :mod:`motionlab.retargeting` (imported only when
-it is first used); :func:`copy_rotation_solver` is a dependency-free stand-in that copies the
-local rotations, scales the root path by the hip-height ratio and lifts the clip so no foot goes
-below the ground.
+The solver is injected, so ``viz`` imports none of the three systems: pass
+:func:`motionlab.retargeting.proportions.proportion_solver` for the latent iteration. The default,
+:func:`copy_rotation_solver`, is a dependency-free stand-in that copies the local rotations,
+scales the root path by the hip-height ratio and lifts the clip so no foot goes below the ground.
 
 Taught in ``notebooks/04_playback_and_bone_proportions.ipynb``.
 """
@@ -18,7 +18,6 @@ Taught in ``notebooks/04_playback_and_bone_proportions.ipynb``.
 from __future__ import annotations
 
 import time
-import warnings
 from collections.abc import Callable, Mapping
 
 import numpy as np
@@ -35,7 +34,6 @@ __all__ = [
     "canonical_source",
     "feet_height",
     "copy_rotation_solver",
-    "default_solver",
     "ProportionEditor",
 ]
 
@@ -101,33 +99,6 @@ def copy_rotation_solver(source: Motion) -> Callable[[Skeleton], Motion]:
     return solve
 
 
-def default_solver(source: Motion, method: str = "full", max_steps: int | None = None) -> Solver:
-    """``solve(skeleton) -> (Motion, history)`` by :func:`motionlab.retargeting.retarget`.
-
-    Falls back (with a warning) to :func:`copy_rotation_solver` when the retargeting package or
-    its shipped network cannot be loaded. ``max_steps`` caps the latent iteration (default: the
-    solver's own, 30 in ``MOTIONLAB_QUICK`` mode).
-    """
-    source = canonical_source(source)
-    try:
-        from motionlab import retargeting
-        from motionlab.settings import pick
-
-        checkpoint = retargeting.load_default() if method != "copy" else None
-        config = retargeting.SolverConfig(max_steps=max_steps if max_steps is not None else pick(100, 30))
-    except Exception as e:  # ImportError, a missing checkpoint, ...: keep the widgets usable
-        warnings.warn(
-            f"latent retargeting unavailable ({e}); using the copy-rotation stand-in", RuntimeWarning, stacklevel=2
-        )
-        return copy_rotation_solver(source)
-
-    def solve(skeleton: Skeleton):
-        result = retargeting.retarget(source, skeleton, checkpoint, method=method, solver=config)
-        return result.motion, result.history
-
-    return solve
-
-
 def _split(result) -> tuple[Motion, dict]:
     """A solver's result as (Motion, history dict)."""
     history: dict = {}
@@ -152,7 +123,8 @@ class ProportionEditor:
     source : the motion to retarget (any rig :func:`humanoid.find_mapping` knows; reduced to the
         22-joint humanoid)
     solve : ``solve(skeleton) -> Motion`` or ``-> (Motion, history)``; default
-        :func:`default_solver` (the latent iteration)
+        :func:`copy_rotation_solver`; the latent iteration is
+        :func:`motionlab.retargeting.proportions.proportion_solver`
     backend : Jupyter view, ``"static"``/``"trame"``/None, see :class:`~motionlab.viz.player.Player`
     slider_range : (low, high) of the group sliders
     **scene_options : window_size, camera, trails, ... for the 3D view
@@ -178,7 +150,7 @@ class ProportionEditor:
 
         self.source = canonical_source(source)
         self.base = self.source.skeleton
-        self.solve = solve if solve is not None else default_solver(self.source)
+        self.solve = solve if solve is not None else copy_rotation_solver(self.source)
         if not callable(self.solve):
             raise ValueError(f"solve must be callable as solve(skeleton), got {type(self.solve).__name__}")
         low, high = (float(v) for v in slider_range)

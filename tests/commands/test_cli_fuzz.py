@@ -33,7 +33,7 @@ def _stop(*args, **kwargs):
 
 
 _WORK = (  # where each command's long work begins
-    "motionlab.retargeting.cli._load_checkpoint",
+    "motionlab.retargeting.cli_options.load_checkpoint",
     "motionlab.retargeting.pipeline.retarget",
     "motionlab.retargeting.train.training_set",
     "motionlab.retargeting.train.train",
@@ -114,7 +114,7 @@ BASE = {  # (inputs, options) each command accepts, to which random options are 
     "info": (["in.bvh"], []),
     "convert": (["in.bvh"], ["-o", "out.bvh"]),
     "synth": (["walk"], ["-o", "out.bvh"]),
-    "demo": ([], ["--out", "new_dir"]),
+    "demo": ([], ["-o", "new_dir"]),
     "expand": (["in.bvh"], ["--preset", "child", "-o", "new_dir"]),
     "retarget": (["in.bvh"], ["--scale-legs", "1.2", "-o", "out.bvh"]),
     "train": (["in.bvh"], ["-o", "out.pt"]),
@@ -123,7 +123,7 @@ BASE = {  # (inputs, options) each command accepts, to which random options are 
     "graph-search": (["g.mlgraph"], ["--request", "walk:normal:30", "-o", "out.bvh"]),
     "graph-info": (["g.mlgraph"], []),
     "fill-gaps": (["in.bvh"], ["-o", "out.bvh"]),
-    "view": (["in.bvh"], ["--out", "out.gif"]),
+    "view": (["in.bvh"], ["-o", "out.gif"]),
 }
 
 EXAMPLES = {  # the cases of issue 34 that once wrote what they should not have

@@ -58,7 +58,7 @@ def test_fill_gaps_with_graph(dropped, tmp_path, capsys):
 def test_fill_gaps_refuses_nonsense_delta(dropped, tmp_path, capsys, flag, value):
     out = tmp_path / "o.bvh"
     assert main(["fill-gaps", str(dropped), "-o", str(out), flag, value]) == 2
-    assert "--delta (--threshold) must be a finite number above 1" in capsys.readouterr().err
+    assert "--delta must be a finite number above 1" in capsys.readouterr().err
     assert not out.exists()
 
 

@@ -172,6 +172,7 @@ def test_evaluate_leaves_animations_out_by_folds(tmp_path, clips, capsys):
         ("--lr", "nan"),
         ("--lr", "0"),
         ("--steps", "-3"),
+        ("--stop-loss", "-1"),
         ("--threshold", "-1"),
         ("--exact-rounds", "9"),
     ],

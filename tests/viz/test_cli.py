@@ -22,19 +22,19 @@ FAST = ["--size", "96x80"]
 
 def test_view_writes_a_movie_and_refuses_to_overwrite(can_render, clip, tmp_path, capsys):
     out = tmp_path / "walk.mp4"
-    assert main(["view", str(clip), "--out", str(out), *FAST]) == 0
+    assert main(["view", str(clip), "-o", str(out), *FAST]) == 0
     assert out.stat().st_size > 0
     assert "wrote" in capsys.readouterr().out
     size = out.stat().st_size
-    assert main(["view", str(clip), "--out", str(out), *FAST]) == 2
+    assert main(["view", str(clip), "-o", str(out), *FAST]) == 2
     assert "--force" in capsys.readouterr().err
     assert out.stat().st_size == size
-    assert main(["view", str(clip), "--out", str(out), "--force", "--stop", "6", *FAST]) == 0
+    assert main(["view", str(clip), "-o", str(out), "--force", "--stop", "6", *FAST]) == 0
 
 
 def test_view_gif(can_render, clip, tmp_path):
     out = tmp_path / "walk.gif"
-    assert main(["view", str(clip), "--out", str(out), "--camera", "frame", *FAST]) == 0
+    assert main(["view", str(clip), "-o", str(out), "--camera", "frame", *FAST]) == 0
     assert out.read_bytes()[:3] == b"GIF"
 
 
@@ -43,7 +43,7 @@ def test_view_prints_the_gifs_own_frame_count_and_length(can_render, clip, tmp_p
     from motionlab.viz.export import gif_length
 
     out = tmp_path / "walk.gif"
-    assert main(["view", str(clip), "--out", str(out), "--stride", "4", *FAST]) == 0
+    assert main(["view", str(clip), "-o", str(out), "--stride", "4", *FAST]) == 0
     frames, seconds = gif_length(out)
     assert frames == 3  # 12 frames, every 4th
     assert f"wrote {out}: {frames} frames, {seconds:.2f} s of" in capsys.readouterr().out
@@ -54,17 +54,17 @@ def test_view_without_display_needs_out_and_writes_nothing(clip, tmp_path, monke
     monkeypatch.setattr("motionlab.viz.backend.has_display", lambda: False)
     assert main(["view", str(clip), "--stop", "4", *FAST]) == 2
     err = capsys.readouterr().err
-    assert "no display" in err and "--out walk.mp4" in err
+    assert "no display" in err and "-o walk.mp4" in err
     assert not list(tmp_path.glob("*.mp4")) and not list(tmp_path.glob("*.gif"))  # nothing written here
 
 
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["missing.bvh", "--out", "x.mp4"], "not found"),
-        (["{clip}", "--out", "x.avi"], ".mp4 or .gif"),
-        (["{clip}", "--out", "nowhere/x.mp4"], "does not exist"),
-        (["{clip}", "--out", "x.mp4", "--start", "-3"], "--start"),
+        (["missing.bvh", "-o", "x.mp4"], "not found"),
+        (["{clip}", "-o", "x.avi"], ".mp4 or .gif"),
+        (["{clip}", "-o", "nowhere/x.mp4"], "does not exist"),
+        (["{clip}", "-o", "x.mp4", "--start", "-3"], "--start"),
     ],
 )
 def test_view_user_errors(clip, tmp_path, monkeypatch, capsys, args, message):

@@ -9,8 +9,7 @@ import numpy as np
 import pytest
 
 from motionlab.core import humanoid
-from motionlab.viz import proportions
-from motionlab.viz.proportions import GROUPS, ProportionEditor, copy_rotation_solver, feet_height
+from motionlab.viz.proportions import GROUPS, ProportionEditor, canonical_source, copy_rotation_solver, feet_height
 from tests.viz.conftest import stepping_motion
 
 VIEW = {"window_size": (200, 150), "off_screen": True, "backend": "static"}
@@ -107,25 +106,29 @@ def test_copy_rotation_solver_keeps_feet_on_the_ground():
         np.testing.assert_array_equal(out.local_rot, source.local_rot)
 
 
-def test_default_solver_falls_back_without_retargeting(monkeypatch):
+def test_the_editor_needs_no_retargeting_its_default_solver_copies_rotations(monkeypatch, can_render):
     import motionlab
 
-    monkeypatch.setitem(sys.modules, "motionlab.retargeting", None)  # import fails
+    monkeypatch.setitem(sys.modules, "motionlab.retargeting", None)  # any import of it fails
     monkeypatch.delattr(motionlab, "retargeting", raising=False)
-    with pytest.warns(RuntimeWarning, match="copy-rotation stand-in"):
-        solve = proportions.default_solver(stepping_motion(5))
-    out = solve(humanoid.scale_bones(humanoid.canonical_skeleton(), legs=1.1))
+    source = stepping_motion(5)
+    ed = ProportionEditor(source, **VIEW)
+    out = ed.solve(humanoid.scale_bones(source.skeleton, legs=1.1))
+    ed.close()
     assert out.num_frames == 5
+    np.testing.assert_array_equal(out.local_rot, canonical_source(source).local_rot)
 
 
-def test_default_solver_uses_latent_retargeting(can_render):
+def test_the_latent_solver_is_injected_from_retargeting(can_render):
     retargeting = pytest.importorskip("motionlab.retargeting")
     try:
         retargeting.load_default()
     except (FileNotFoundError, retargeting.CheckpointError) as e:
         pytest.skip(f"no shipped retargeting network: {e}")
     source = stepping_motion(16)
-    solve = proportions.default_solver(source, max_steps=3)
+    from motionlab.retargeting.proportions import proportion_solver
+
+    solve = proportion_solver(source, max_steps=3)
     motion, history = solve(humanoid.scale_bones(source.skeleton, legs=1.2))
     assert motion.skeleton.bone_lengths()[motion.skeleton.index("LeftLeg")] == pytest.approx(
         1.2 * source.skeleton.bone_lengths()[source.skeleton.index("LeftLeg")]
