@@ -32,3 +32,16 @@ def my_angle_loss(source_rot, generated_rot):
     minus = (source_rot - generated_rot).norm(dim=-1)
     plus = (source_rot + generated_rot).norm(dim=-1)
     return torch.minimum(minus, plus).mean()
+
+
+def my_foot_weight_experiment(source, target_rig, ckpt):
+    """Exercise 4: the paper's set-up with λ_foot = 5; mean angle to A's rotations, degrees."""
+    from motionlab import retargeting
+    from motionlab.core import preprocess
+    from motionlab.retargeting import plots
+    from motionlab.retargeting.solver import SolverConfig
+
+    cfg = SolverConfig(init="encoder", lambda_contact=0.0, lr=0.1, lambda_foot=5.0)
+    run = retargeting.retarget(source, target_rig, ckpt, "full", cfg)
+    src = preprocess.prepare(source, ckpt.fps)
+    return plots.joint_angle_errors(run.motion.local_rot, src.local_rot).mean()

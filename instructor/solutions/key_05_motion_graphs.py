@@ -30,3 +30,18 @@ def my_distance_matrix(pos_a, pos_b):
     y = (fa.height * w) @ fb.height.T
     d = fa.self_term[:, None] + fb.self_term[None, :] - 2 * y - 2 * np.sqrt(a**2 + b**2)
     return np.maximum(d, 0.0)  # rounding can leave tiny negative values
+
+
+THRESHOLDS_CM = (3, 4, 5, 6, 8, 10)  # as in the notebook (exercises.THRESHOLDS_CM)
+
+
+def my_vanishing_threshold(motions, style):
+    """Exercise 3: the first threshold (cm) at which ``style`` keeps frames in the pruned standard graph."""
+    from motionlab.motion_graphs import graph
+
+    for cm in THRESHOLDS_CM:
+        g = graph.build_standard(motions, distance.threshold_from(cm / 100.0), prune=True)
+        kept = sum(int(g.alive[c.start : c.stop].sum()) for c in g.clips if f"_{style}_" in f"_{c.name}_")
+        if kept:
+            return cm
+    return 0

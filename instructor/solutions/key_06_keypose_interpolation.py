@@ -22,3 +22,20 @@ def my_jumps(steps):
     s = np.asarray(steps)
     t = np.arange(1, len(s) - 1)
     return t[s[t] > 2.5 * np.maximum(s[t - 1], s[t + 1])]
+
+
+def my_held_out_q(clips):
+    """Exercise 4: q in (1, 2, 4, 8, 16, 32) with the best likelihood on the last quarter of every clip."""
+    from motionlab.interpolation import features
+    from motionlab.interpolation.ppca import PPCA
+
+    train, test = [], []
+    for clip in clips.values():
+        f = features.pose_features(clip)
+        k = len(f) - max(int(round(0.25 * len(f))), 1)
+        train.append(f[:k])
+        test.append(f[k:])
+    train, test = np.concatenate(train), np.concatenate(test)
+    mean, std = train.mean(axis=0), np.maximum(train.std(axis=0), 1e-6)
+    best = max((1, 2, 4, 8, 16, 32), key=lambda q: PPCA(q).fit((train - mean) / std).log_likelihood((test - mean) / std))
+    return best

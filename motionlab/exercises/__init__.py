@@ -28,6 +28,11 @@ typical mistakes):
 * :mod:`~motionlab.exercises.motion_graphs`: 05 ``local_minima``, ``distance_matrix``;
 * :mod:`~motionlab.exercises.interpolation`: 06 ``ease``, ``sigma2``, ``jumps``.
 
+Experiments (:class:`Question`: change a parameter, run the experiment, type the number it gives;
+the check reruns it on the notebook's own inputs): 03 ``foot_weight`` (λ_foot in the paper's
+set-up), 06 ``held_out_q`` (q by likelihood on truly held-out frames), 05
+``vanishing_threshold`` (the graph threshold at which a style leaves the pruned standard graph).
+
 Their reference solutions, as a student would write them, are in ``instructor/solutions/`` (the
 instructor's key, outside the students' ``notebooks/`` folder), and ``tests/test_exercises.py`` runs every check against the key, typical wrong
 answers and an alternative correct answer. :func:`check` is the same machinery for ad-hoc checks
@@ -37,14 +42,15 @@ answers and an alternative correct answer. :func:`check` is the same machinery f
 from __future__ import annotations
 
 from .basics import conj, hand_height, heading, joint_speed, pose_error, slerp, window_count
-from .core import Exercise, Mistake, Result, check
-from .interpolation import ease, jumps, sigma2
-from .motion_graphs import distance_matrix, local_minima
-from .retargeting import angle_loss, combine, foot_loss, recon_loss, root_scale, rotations
+from .core import Exercise, Mistake, Question, Result, check
+from .interpolation import ease, held_out_q, jumps, sigma2
+from .motion_graphs import distance_matrix, local_minima, vanishing_threshold
+from .retargeting import angle_loss, combine, foot_loss, foot_weight, recon_loss, root_scale, rotations
 
 __all__ = [
     "Exercise",
     "Mistake",
+    "Question",
     "Result",
     "check",
     "conj",
@@ -65,7 +71,11 @@ __all__ = [
     "ease",
     "sigma2",
     "jumps",
+    "foot_weight",
+    "held_out_q",
+    "vanishing_threshold",
     "EXERCISES",
+    "EXPERIMENTS",
 ]
 
 EXERCISES: dict[str, Exercise] = {
@@ -88,7 +98,17 @@ EXERCISES: dict[str, Exercise] = {
     "sigma2": sigma2,
     "jumps": jumps,
 }
-"""Every named exercise of the notebooks, by the attribute name the notebooks use.
+"""Every named exercise of the notebooks that asks for a function, by the attribute name the notebooks use.
+
+:meta hide-value:
+"""
+
+EXPERIMENTS: dict[str, Question] = {
+    "foot_weight": foot_weight,
+    "held_out_q": held_out_q,
+    "vanishing_threshold": vanishing_threshold,
+}
+"""Every experiment exercise (a :class:`Question`: change a parameter, run, report a number).
 
 :meta hide-value:
 """

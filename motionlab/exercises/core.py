@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["Exercise", "Mistake", "Result", "check"]
+__all__ = ["Exercise", "Mistake", "Question", "Result", "check"]
 
 
 # --------------------------------------------------------------------------- results and comparison
@@ -204,3 +204,64 @@ def check(
     """
     ex = Exercise("", reference, lambda: list(cases), accept, mistakes, atol, sign_free, period)
     return _run_check(student, reference, ex._cases(), accept, mistakes, ex._agrees, label=None)
+
+
+# --------------------------------------------------------------------------- experiments
+@dataclass
+class Question:
+    """An experiment whose answer is one number (or one choice among numbers).
+
+    The student changes a parameter, runs the experiment in the notebook and types the number it
+    gives. The check recomputes the experiment on the *same inputs* the notebook used (its own
+    data, real or synthetic), so one key fits every data set, and compares:
+    ``|answer − reference| ≤ atol + rtol · |reference|``.
+
+    Parameters
+    ----------
+    name : shown in messages
+    reference : ``reference(*inputs) -> float``, the right answer for the notebook's inputs
+    accept : other correct answers (e.g. another reasonable convention), same signature
+    mistakes : typical wrong experiments (:class:`Mistake`, ``answer(*inputs) -> float``) with hints
+    atol, rtol : tolerance (0 and 0 for a choice among integers)
+    unit : appended to messages ("°", "")
+    """
+
+    name: str
+    reference: Callable[..., float]
+    accept: Sequence[Callable[..., float]] = ()
+    mistakes: Sequence[Mistake] = ()
+    atol: float = 0.0
+    rtol: float = 0.0
+
+    def _close(self, answer: float, value: float) -> bool:
+        return bool(abs(answer - value) <= self.atol + self.rtol * abs(value))
+
+    def check(self, answer, *inputs) -> Result:
+        """``✓``, ``…`` (the answer is still ``...``) or ``✗`` with a hint; never shows the reference."""
+        head = f"{self.name}: "
+        if answer is ... or answer is None:
+            return Result(
+                False,
+                False,
+                f"… {head}not answered yet (the answer is still `...`). Run the experiment, put its "
+                "number in place of `...` and run this cell again; the notebook goes on.",
+            )
+        try:
+            value = float(answer)
+        except (TypeError, ValueError):
+            return Result(False, True, f"✗ {head}expected a number, got {type(answer).__name__}")
+        if not np.isfinite(value):
+            return Result(False, True, f"✗ {head}the answer is NaN or infinite")
+        if self._close(value, float(self.reference(*inputs))):
+            return Result(True, True, f"✓ {head}{answer} is right")
+        for alternative in self.accept:
+            if self._close(value, float(alternative(*inputs))):
+                return Result(True, True, f"✓ {head}{answer} is right (an accepted variant)")
+        for mistake in self.mistakes:
+            try:
+                same = self._close(value, float(mistake.answer(*inputs)))
+            except Exception:  # a mistake that cannot run on these inputs is simply not this one
+                same = False
+            if same:
+                return Result(False, True, f"✗ {head}{answer} is not right yet. Hint: {mistake.hint}", mistake.hint)
+        return Result(False, True, f"✗ {head}{answer} is not right yet.")

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .core import Exercise, Mistake
+from .core import Exercise, Mistake, Question
 
-__all__ = ["ease", "sigma2", "jumps", "DELTA"]
+__all__ = ["ease", "sigma2", "jumps", "DELTA", "held_out_q", "Q_CHOICES", "HELD_OUT"]
 
 DELTA = 2.5
 """Δ of exercise 3 (the same threshold as ``motionlab.interpolation.detect.DELTA``)."""
@@ -156,5 +156,56 @@ jumps = Exercise(
             "compare with the *larger* of the two neighbours: two large steps side by side are not an isolated jump.",
         ),
         Mistake(_jumps_variant("mean"), "compare with the larger of the two neighbours, not with their mean."),
+    ],
+)
+
+
+# --------------------------------------------------------------------------- exercise 4 (experiment)
+Q_CHOICES = (1, 2, 4, 8, 16, 32)
+"""The latent sizes exercise 4 chooses among."""
+
+HELD_OUT = 0.25
+"""Exercise 4 holds out the last quarter of every clip's frames."""
+
+
+def _best_q(clips, split: str = "tail", stats: str = "train") -> int:
+    """The q of :data:`Q_CHOICES` with the highest PPCA log-likelihood per frame on the held-out frames.
+
+    ``split``: ``"tail"`` (the last :data:`HELD_OUT` of each clip, the right way) or
+    ``"interleaved"`` (every second frame); ``stats``: standardise with the training frames'
+    mean and std (``"train"``) or all frames' (``"all"``).
+    """
+    from motionlab.interpolation import features
+    from motionlab.interpolation.ppca import PPCA
+
+    feats = [features.pose_features(c) for c in clips.values()]
+    if split == "tail":
+        cut = [len(f) - max(int(round(HELD_OUT * len(f))), 1) for f in feats]
+        train = np.concatenate([f[:k] for f, k in zip(feats, cut)])
+        test = np.concatenate([f[k:] for f, k in zip(feats, cut)])
+    else:
+        every = np.concatenate(feats)
+        train, test = every[::2], every[1::2]
+    basis = train if stats == "train" else np.concatenate(feats)
+    mean, std = basis.mean(0), np.maximum(basis.std(0), 1e-6)
+    scores = [PPCA(q).fit((train - mean) / std).log_likelihood((test - mean) / std) for q in Q_CHOICES]
+    return int(Q_CHOICES[int(np.argmax(scores))])
+
+
+held_out_q = Question(
+    "06 · exercise 4 (experiment: q by held-out likelihood)",
+    lambda clips: _best_q(clips),
+    accept=[lambda clips: _best_q(clips, stats="all")],
+    mistakes=[
+        Mistake(
+            lambda clips: _best_q(clips, split="interleaved"),
+            "your test frames interleave the training frames (each sits between two frames the model "
+            "was fitted on), so a larger q always looks better: hold out the *last quarter* of each clip.",
+        ),
+        Mistake(
+            lambda clips: max(Q_CHOICES),
+            "the largest q is the best only on frames the model has (nearly) seen: score frames held out "
+            "in one block at the end of each clip.",
+        ),
     ],
 )

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .core import Exercise, Mistake
+from .core import Exercise, Mistake, Question
 
-__all__ = ["local_minima", "distance_matrix"]
+__all__ = ["local_minima", "distance_matrix", "vanishing_threshold", "style_frames_kept", "THRESHOLDS_CM"]
 
 
 # --------------------------------------------------------------------------- exercise 1
@@ -155,6 +155,64 @@ distance_matrix = Exercise(
         Mistake(
             _distance_variant("plus"),
             "D is a squared distance, ‖p − p'‖² = ‖p‖² + ‖p'‖² − 2 p·p': the cross terms are subtracted.",
+        ),
+    ],
+)
+
+
+# --------------------------------------------------------------------------- exercise 3 (experiment)
+THRESHOLDS_CM = (3, 4, 5, 6, 8, 10)
+"""The RMS thresholds (cm, :func:`distance.threshold_from`) exercise 3 moves through."""
+
+_KEPT: dict = {}
+
+
+def style_frames_kept(motions, style: str, rms_cm: float, prune: bool = True) -> int:
+    """Frames of the takes named ``*_<style>_*`` alive in the standard graph at ``rms_cm`` cm RMS.
+
+    The standard graph (:func:`graph.build_standard`) of all ``motions``, pruned to its largest
+    strongly connected component when ``prune``.
+    """
+    from motionlab.motion_graphs import distance, graph
+
+    key = (tuple(id(m) for m in motions), style, float(rms_cm), bool(prune))
+    if key not in _KEPT:
+        g = graph.build_standard(motions, distance.threshold_from(rms_cm / 100.0), prune=prune)
+        _KEPT[key] = int(sum(g.alive[c.start : c.stop].sum() for c in g.clips if f"_{style}_" in f"_{c.name}_"))
+    return _KEPT[key]
+
+
+def _first_keeping(motions, style: str, prune: bool = True) -> float:
+    """The smallest threshold of :data:`THRESHOLDS_CM` at which ``style`` keeps frames (0: at none)."""
+    for cm in THRESHOLDS_CM:
+        if style_frames_kept(motions, style, cm, prune) > 0:
+            return float(cm)
+    return 0.0
+
+
+def _last_losing(motions, style: str) -> float:
+    """The largest threshold of :data:`THRESHOLDS_CM` at which ``style`` has no frame left (0: none)."""
+    lost = [cm for cm in THRESHOLDS_CM if style_frames_kept(motions, style, cm) == 0]
+    return float(max(lost)) if lost else 0.0
+
+
+vanishing_threshold = Question(
+    "05 · exercise 3 (experiment: the threshold and a lost style)",
+    _first_keeping,
+    mistakes=[
+        Mistake(
+            lambda motions, style: _first_keeping(motions, style, prune=False),
+            "that is the unpruned graph, which keeps every frame: build it with prune=True (the "
+            "largest strongly connected component) and count the style's frames that stay alive.",
+        ),
+        Mistake(
+            _last_losing,
+            "that is the largest threshold at which the style is still lost; the question asks for the "
+            "first threshold at which it keeps frames.",
+        ),
+        Mistake(
+            lambda motions, style: _first_keeping(motions, style) / 100.0,
+            "answer in centimetres, as THRESHOLDS_CM lists them.",
         ),
     ],
 )

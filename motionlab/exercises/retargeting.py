@@ -7,9 +7,11 @@ is imported only when a check runs.
 
 from __future__ import annotations
 
-from .core import Exercise, Mistake
+import numpy as np
 
-__all__ = ["recon_loss", "combine", "rotations", "foot_loss", "root_scale", "angle_loss"]
+from .core import Exercise, Mistake, Question
+
+__all__ = ["recon_loss", "combine", "rotations", "foot_loss", "root_scale", "angle_loss", "foot_weight"]
 
 
 def _gen(seed: int):
@@ -352,6 +354,54 @@ angle_loss = Exercise(
         Mistake(
             lambda a, b: _angle_between(a, b).mean(),
             "that is the rotation angle α; L_angle uses the length of the quaternions' difference (2 sin(α/4)).",
+        ),
+    ],
+)
+
+
+# --------------------------------------------------------------------------- notebook 03, experiment
+_RUNS: dict = {}
+
+
+def _paper_angle(source, target, checkpoint, lambda_foot: float = 5.0, paper: bool = True, degrees: bool = True):
+    """Mean angle (over joints and frames) between A's rotations and the full method's, in the
+    paper's set-up (encoder start, no contact term, lr 0.1) or motionlab's, for ``lambda_foot``."""
+    from motionlab import retargeting
+    from motionlab.core import preprocess
+    from motionlab.retargeting import plots
+    from motionlab.retargeting.solver import SolverConfig
+
+    key = (id(source), id(target), id(checkpoint), lambda_foot, paper)
+    if key not in _RUNS:
+        if paper:
+            cfg = SolverConfig(init="encoder", lambda_contact=0.0, lr=0.1, lambda_foot=lambda_foot)
+        else:
+            cfg = SolverConfig(lambda_foot=lambda_foot)
+        run = retargeting.retarget(source, target, checkpoint, "full", cfg)
+        src = preprocess.prepare(source, checkpoint.fps)
+        _RUNS[key] = float(plots.joint_angle_errors(run.motion.local_rot, src.local_rot).mean())
+    value = _RUNS[key]
+    return value if degrees else float(np.radians(value))
+
+
+foot_weight = Question(
+    "03 · exercise 4 (experiment: λ_foot in the paper's set-up)",
+    lambda source, target, ckpt: _paper_angle(source, target, ckpt, 5.0),
+    atol=0.006,  # an answer typed with two decimals passes
+    rtol=0.005,
+    mistakes=[
+        Mistake(
+            lambda source, target, ckpt: _paper_angle(source, target, ckpt, 0.5),
+            "that is the result with the paper's weight λ_foot = 0.5; the exercise asks for λ_foot = 5.",
+        ),
+        Mistake(
+            lambda source, target, ckpt: _paper_angle(source, target, ckpt, 5.0, paper=False),
+            "that is motionlab's set-up (Gauss–Newton start, contact term); the paper's is "
+            "SolverConfig(init='encoder', lambda_contact=0.0, lr=0.1, lambda_foot=5.0).",
+        ),
+        Mistake(
+            lambda source, target, ckpt: _paper_angle(source, target, ckpt, 5.0, degrees=False),
+            "that number is in radians; plots.joint_angle_errors gives degrees.",
         ),
     ],
 )

@@ -6,7 +6,7 @@
   (in a Jupyter kernel with an inline/widget backend), or only draws the final figure when it
   runs headless (CI), so a notebook never fills up with frames;
 * :func:`plot_reconstruction` — true vs reconstructed joint coordinates over time;
-* :func:`plot_iteration` — ``L_iter``, ``L_angle`` and ``L_foot`` over the latent iteration;
+* :func:`plot_iteration` — ``L_iter``, ``L_angle``, ``L_foot`` (and ``L_contact``) over the latent iteration;
 * :func:`foot_heights` / :func:`plot_foot_heights` — lowest point of each foot over time;
 * :func:`joint_angle_errors` / :func:`plot_joint_errors` — per-joint rotation differences;
 * :func:`plot_summary` — bars of a few columns of :meth:`Evaluation.summary`.
@@ -288,24 +288,55 @@ def plot_reconstruction(true_pos, pred_pos, joints: Sequence[str], fps: float | 
 
 
 # ----------------------------------------------------------------------------- latent iteration
-def plot_iteration(history: Mapping[str, Sequence[float]], axes=None, title: str = ""):
-    """``L_angle`` (unitless) and ``L_foot`` (cm) over the iteration steps, ``L_iter`` on the first panel."""
+def plot_iteration(history: Mapping[str, Sequence[float]], axes=None, title: str = "", config=None):
+    """The latent iteration's losses over its steps, labelled from the terms that were actually used.
+
+    Parameters
+    ----------
+    history : a solver history (:attr:`SolverResult.history`): ``loss`` (L_iter), ``angle``
+        (L_angle), ``foot`` (L_foot, metres) and, optionally, ``contact`` (L_contact, m/s)
+    axes : two Axes, or three when the contact term is shown; None: a new figure
+    title : suptitle
+    config : the :class:`~motionlab.retargeting.solver.SolverConfig` of the run (default: the
+        defaults). Its weights write the L_iter legend; its ``init`` names step 0 (the
+        Gauss–Newton start for ``"project"``/``"auto"``, ``φ = F_enc(X_A)`` for ``"encoder"``).
+        L_contact is in the legend, and gets its own panel, when its weight is positive and the
+        history holds a nonzero value (the solver was given contact labels).
+
+    Returns
+    -------
+    the Axes
+    """
+    from motionlab.retargeting.solver import SolverConfig
+
     for k in ("loss", "angle", "foot"):
         if k not in history or not len(history[k]):
             raise ValueError(f"plot_iteration needs a solver history with 'loss', 'angle' and 'foot'; {k!r} is missing")
+    cfg = config or SolverConfig()
+    contact = np.asarray(history.get("contact", []), dtype=float)
+    with_contact = cfg.lambda_contact > 0 and contact.size > 0 and bool(np.any(contact != 0))
+    terms = [f"{cfg.lambda_angle:g} L_{{angle}}", f"{cfg.lambda_foot:g} L_{{foot}}"]
+    if with_contact:
+        terms.append(f"{cfg.lambda_contact:g} L_{{contact}}")
+    uses_encoder = cfg.init == "encoder" or (cfg.init == "auto" and cfg.theta != "rotations")
+    start = "$\\varphi = F_{enc}(X_A)$" if uses_encoder else "the Gauss–Newton start"
     if axes is None:
-        _, axes = _plt().subplots(1, 2, figsize=(11, 3.2))
+        _, axes = _plt().subplots(1, 3 if with_contact else 2, figsize=(15 if with_contact else 11, 3.2))
     steps = np.arange(len(history["loss"]))
     ax = axes[0]
     ax.plot(steps, history["angle"], color="C0", label="$L_{angle}$")
-    ax.plot(steps, history["loss"], color="0.4", ls=":", label="$L_{iter} = 0.3 L_{angle} + 0.5 L_{foot}$")
+    ax.plot(steps, history["loss"], color="0.4", ls=":", label="$L_{iter} = " + " + ".join(terms) + "$")
     ax.set_title("joint-angle loss (unitless)", fontsize=10)
     ax.legend(fontsize=8)
     ax = axes[1]
     ax.plot(steps, 100 * np.asarray(history["foot"]), color="C3", label="$L_{foot}$")
     ax.set_title("foot loss: mean depth below the ground (cm)", fontsize=10)
+    if with_contact:
+        ax = axes[2]
+        ax.plot(steps, 100 * contact, color="C2", label="$L_{contact}$")
+        ax.set_title("contact loss: planted feet's speed (cm/s)", fontsize=10)
     for ax in axes:
-        ax.set_xlabel("iteration step (0 = $\\varphi = F_{enc}(X_A)$)")
+        ax.set_xlabel(f"iteration step (0 = {start})")
         ax.grid(alpha=0.3)
     if title:
         axes[0].figure.suptitle(title, fontsize=11)

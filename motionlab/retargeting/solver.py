@@ -76,6 +76,7 @@ __all__ = [
     "SolverConfig",
     "SolverResult",
     "step_grid",
+    "smoother",
     "iteration_loss",
     "sequence_losses",
     "project_latent",
@@ -225,6 +226,15 @@ def _smoother(sigma: float, channels: int, dtype, device):
         return torch.nn.functional.conv1d(padded, kernel, groups=channels).transpose(1, 2)
 
     return apply
+
+
+def smoother(sigma: float, channels: int, dtype=torch.float64, device="cpu") -> Callable[[torch.Tensor], torch.Tensor]:
+    """The filter ``δ ↦ G_σ * δ`` along time that :func:`solve` applies to latent updates (N, T, D).
+
+    ``sigma`` in frames (``SolverConfig.smooth_sigma``; 0: the identity), ``channels`` = D. The
+    same filter smooths the Gauss–Newton steps of :func:`project_latent` (its ``smooth`` argument).
+    """
+    return _smoother(sigma, channels, dtype, device)
 
 
 def iteration_loss(

@@ -89,3 +89,19 @@ def test_figures_draw():
     assert len(plots.plot_summary(summary, keys=("pose_mse_h2", "pen"))) == 2
     with pytest.raises(ValueError, match="solver history"):
         plots.plot_iteration({"loss": [1.0]})
+
+
+def test_iteration_plot_is_labelled_from_the_terms_and_the_start():
+    from motionlab.retargeting.solver import SolverConfig
+
+    history = {"loss": [0.3, 0.2], "angle": [0.0, 0.1], "foot": [0.01, 0.0], "contact": [0.2, 0.1]}
+    axes = plots.plot_iteration(history)  # defaults: Gauss-Newton start, contact term on
+    assert len(axes) == 3
+    assert "0.5 L_{contact}" in axes[0].get_legend().get_texts()[1].get_text()
+    assert "Gauss–Newton" in axes[0].get_xlabel()
+    paper = SolverConfig(init="encoder", lambda_contact=0.0)
+    axes = plots.plot_iteration(dict(history, contact=[0.0, 0.0]), config=paper)
+    assert len(axes) == 2
+    label = axes[0].get_legend().get_texts()[1].get_text()
+    assert "contact" not in label and "0.3 L_{angle} + 0.5 L_{foot}" in label
+    assert "F_{enc}" in axes[0].get_xlabel()
