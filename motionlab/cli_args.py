@@ -17,7 +17,15 @@ import os
 from collections.abc import Sequence
 from pathlib import Path
 
-__all__ = ["positive", "non_negative", "positive_int", "non_negative_int", "check_outputs", "check_output_folder"]
+__all__ = [
+    "positive",
+    "non_negative",
+    "positive_int",
+    "non_negative_int",
+    "check_outputs",
+    "check_output_folder",
+    "add_rate_and_plausibility_args",
+]
 
 
 def _number(text: str) -> float:
@@ -154,3 +162,19 @@ def check_output_folder(option: str, given: str | os.PathLike) -> Path:
             "choose a folder you can write to"
         )
     return path
+
+
+def add_rate_and_plausibility_args(p: argparse.ArgumentParser) -> None:
+    """``--fps`` (output frame rate) and ``--keep-implausible``, shared by ``retarget`` and ``expand``."""
+    p.add_argument(
+        "--fps",
+        type=positive,
+        metavar="FPS",
+        help="frame rate of the output (default: the source's; a resample is always reported)",
+    )
+    p.add_argument(
+        "--keep-implausible",
+        action="store_true",
+        help="write outputs that fail the plausibility check (feet on the floor, hip height, bone lengths) "
+        "instead of refusing them",
+    )
