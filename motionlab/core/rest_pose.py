@@ -146,8 +146,8 @@ def _apply(motion: Motion, turn: np.ndarray) -> Motion:
     sk, parents = motion.skeleton, humanoid.PARENTS
     offsets = sk.offsets.copy()
     offsets[1:] = quat.rotate(turn[parents[1:]], sk.offsets[1:])
-    rest = Skeleton(sk.names, parents, offsets)
-    offsets[0] = sk.offsets[0] * np.array([1.0, 0.0, 1.0]) + [0.0, -rest.rest_positions()[:, 1].min(), 0.0]
+    offsets[0] = sk.offsets[0] * np.array([1.0, 0.0, 1.0])
+    offsets[0, 1] = -Skeleton(sk.names, parents, offsets).rest_positions()[:, 1].min()  # lowest joint on y = 0
     ends = {j: quat.rotate(turn[j], e) for j, e in sk.end_sites.items()}
     inv = quat.conj(turn)
     local = quat.mul(motion.local_rot, inv[None])
