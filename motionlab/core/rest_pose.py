@@ -25,8 +25,9 @@ network's offsets) or compares joint rotations across rigs needs one convention.
 The motion is re-expressed on the new rest offsets with world positions unchanged: with
 ``A_j`` the rotation that carries joint ``j``'s child offsets from the old rest to the new one,
 ``offset'_c = A_p offset_c`` and ``local_rot'_j = A_p local_rot_j A_j⁻¹`` (``p``: parent).
-
-Taught in ``notebooks/01_preprocessing.ipynb``.
+Retargeting (:func:`motionlab.retargeting.pipeline.retarget`, ``expand``, training) uses it
+through ``preprocess.prepare(..., stand=True)`` and :func:`standing_skeleton`; ``docs/rigs.md``
+shows it on every pair of the shared data's rig families.
 """
 
 from __future__ import annotations
@@ -120,7 +121,7 @@ def _straighten(offsets: np.ndarray, legs_down: bool) -> tuple[np.ndarray, tuple
     """Per-joint rotations (22, 4) turning bones onto the T-pose (module docstring, stage 2), and
     the names of the joints whose incoming bone turned; ``legs_down``: thighs and shins straight down."""
     ref = humanoid.canonical_skeleton().offsets.copy()
-    turn = np.tile(np.array([1.0, 0.0, 0.0, 0.0]), (len(_J), 1))
+    turn = np.tile(quat.IDENTITY, (len(_J), 1))
     names = []
     for name in STRAIGHTENED:
         c = _J.index(name)
@@ -220,7 +221,7 @@ def standing_skeleton(rig: Skeleton | Motion, what: str = "skeleton") -> tuple[S
         motion = humanoid.to_canonical(rig)
     else:
         sk = humanoid.to_canonical_skeleton(rig)
-        motion = Motion(sk, np.tile([1.0, 0.0, 0.0, 0.0], (1, len(_J), 1)), sk.offsets[None, 0].copy(), 30.0)
+        motion = Motion(sk, np.tile(quat.IDENTITY, (1, len(_J), 1)), sk.offsets[None, 0].copy(), 30.0)
         worst, which = _uprightness(sk.rest_positions())
         if not worst <= TOLERANCE_DEG:
             raise RestPoseError(

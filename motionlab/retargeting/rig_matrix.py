@@ -56,7 +56,8 @@ def family_clips(root: str | Path | None, seconds: float = 3.0) -> dict[str, Mot
 def pair_matrix(clips: dict[str, Motion], checkpoint, solver=None, pairs=None) -> list[dict]:
     """Retarget each clip onto each other family's rig (``pairs``: the ``(source, target)`` to run).
 
-        Returns one dict per pair: ``source``, ``target``, ``ok``, ``failed``, ``hip_ratio`` (B's median
+        Returns one dict per pair: ``source``, ``target``, ``ok``, ``failed``, ``root_scale_y`` (the vertical
+    root scale B / A, standing hip heights), ``hip_ratio`` (B's median
         hip height / B's standing hip height), ``source_hip_ratio``, ``foot_cm`` (median height of
         planted feet above contact height, cm), ``foot_leg`` (the same / B's leg length),
         ``source_foot_leg`` (A's, / A's leg length),
@@ -84,6 +85,7 @@ def pair_matrix(clips: dict[str, Motion], checkpoint, solver=None, pairs=None) -
                     "target": b,
                     "ok": p.ok,
                     "failed": "+".join(p.failed),
+                    "root_scale_y": res.root_scale[1],
                     "hip_ratio": p.hip_ratio,
                     "source_hip_ratio": p.source_hip_ratio,
                     "foot_leg": p.foot_height,
@@ -102,13 +104,13 @@ def pair_matrix(clips: dict[str, Motion], checkpoint, solver=None, pairs=None) -
 def table(rows: list[dict]) -> str:
     """The rows of :func:`pair_matrix` as a fixed-width text table."""
     head = (
-        f"{'source':<10} {'target':<10} {'hip ratio':>9} {'(source)':>8} {'foot cm':>8} {'foot/leg':>8} {'(source)':>8} "
+        f"{'source':<10} {'target':<10} {'r_y':>6} {'hip ratio':>9} {'(source)':>8} {'foot cm':>8} {'foot/leg':>8} {'(source)':>8} "
         f"{'skate cm/s':>10} {'(source)':>8} {'fps':>5}  verdict"
     )
     lines = [head, "-" * len(head)]
     for r in rows:
         lines.append(
-            f"{r['source']:<10} {r['target']:<10} {r['hip_ratio']:>9.2f} {r['source_hip_ratio']:>8.2f} "
+            f"{r['source']:<10} {r['target']:<10} {r['root_scale_y']:>6.3f} {r['hip_ratio']:>9.2f} {r['source_hip_ratio']:>8.2f} "
             f"{r['foot_cm']:>8.1f} {r['foot_leg']:>+8.3f} {r['source_foot_leg']:>+8.3f} {r['skating_cm_s']:>10.1f} {r['source_skating_cm_s']:>8.1f} "
             f"{r['fps']:>5.0f}  {'ok' if r['ok'] else 'IMPLAUSIBLE ' + r['failed']}"
         )
