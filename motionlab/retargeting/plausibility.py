@@ -14,7 +14,8 @@ A retargeted clip of B is **plausible** when, with ``leg`` = B's thigh + shin
   (mocap markers, a rig's foot joints off the sole) does not condemn every output: it flags
   what the retargeting did;
 * **nothing deep under the floor** (``floor``): no joint in any frame lower than
-  :data:`FOOT_TOL` × ``leg`` below ``y = 0``;
+  :data:`FOOT_TOL` × ``leg`` below ``y = 0`` or below A's own lowest joint (as a fraction of A's
+  leg; a source whose toes dip under its floor passes that on);
 * **hips at a standing height for B's legs** (``hips``): B's median root height as a fraction of
   ``hip`` differs from A's median root height as a fraction of A's standing hip height by at most
   :data:`HIP_TOL` (a crouch stays a crouch, a stand a stand, whatever the legs);
@@ -55,6 +56,7 @@ class Plausibility:
     foot_height : float     median height of B's planted foot joints above contact height, / leg (nan: no contacts)
     source_foot_height : float   the same for A, / A's leg
     lowest : float          lowest joint height over the clip, / leg (negative: under the floor)
+    source_lowest : float   the same for A, / A's leg
     hip_ratio : float       B's median root height / B's standing hip height
     source_hip_ratio : float   the same for A on A
     bone_error : float      largest relative bone-length deviation
@@ -64,6 +66,7 @@ class Plausibility:
     foot_height: float
     source_foot_height: float
     lowest: float
+    source_lowest: float
     hip_ratio: float
     source_hip_ratio: float
     bone_error: float
@@ -79,7 +82,7 @@ class Plausibility:
         verdict = "plausible" if self.ok else "IMPLAUSIBLE (" + ", ".join(self.failed) + ")"
         return (
             f"{verdict}: hip height {self.hip_ratio:.2f} of standing (source {self.source_hip_ratio:.2f}), "
-            f"foot in contact {self.foot_height:+.3f} leg (source {self.source_foot_height:+.3f}), lowest joint {self.lowest:+.3f} leg, "
+            f"foot in contact {self.foot_height:+.3f} leg (source {self.source_foot_height:+.3f}), lowest joint {self.lowest:+.3f} leg (source {self.source_lowest:+.3f}), "
             f"bone lengths within {100 * self.bone_error:.2g} %"
         )
 
@@ -125,9 +128,11 @@ def check(positions: np.ndarray, target, source: Motion, planted: np.ndarray | N
         planted = source_contacts(source)
     leg = humanoid.leg_length(target)
     foot = _foot_height(positions, target, planted)
-    src_foot = _foot_height(source.global_positions(), source.skeleton, planted)
+    src_pos = source.global_positions()
+    src_foot = _foot_height(src_pos, source.skeleton, planted)
     lowest = float(positions[..., 1].min() / leg)
-    hip, src_hip = _hip_ratio(positions, target), _hip_ratio(source.global_positions(), source.skeleton)
+    src_lowest = float(src_pos[..., 1].min() / humanoid.leg_length(source.skeleton))
+    hip, src_hip = _hip_ratio(positions, target), _hip_ratio(src_pos, source.skeleton)
     bones = np.linalg.norm(positions[:, 1:] - positions[:, humanoid.PARENTS[1:]], axis=-1)
     rest = target.bone_lengths()[1:]
     long = rest > 1e-9
@@ -135,10 +140,10 @@ def check(positions: np.ndarray, target, source: Motion, planted: np.ndarray | N
     failed = []
     if not abs(foot - src_foot) <= FOOT_TOL and not np.isnan(foot - src_foot):
         failed.append("foot")
-    if not lowest >= -FOOT_TOL:
+    if not lowest >= min(0.0, src_lowest) - FOOT_TOL:
         failed.append("floor")
     if not abs(hip - src_hip) <= HIP_TOL:
         failed.append("hips")
     if not bone_error <= BONE_TOL:
         failed.append("bones")
-    return Plausibility(foot, src_foot, lowest, hip, src_hip, bone_error, tuple(failed))
+    return Plausibility(foot, src_foot, lowest, src_lowest, hip, src_hip, bone_error, tuple(failed))
