@@ -115,6 +115,19 @@ def _add_solver_args(p: argparse.ArgumentParser) -> None:
 
 
 # ---------------------------------------------------------------------------- retarget
+def _check_result(args, result):
+    """Print a resample (always, also under -q); refuse an implausible output unless --keep-implausible."""
+    if result.resampled:
+        print(f"{args.source}: {result.resampled}", file=sys.stderr)
+    check = result.plausibility
+    if not check.ok and not args.keep_implausible:
+        raise _error(
+            f"{args.source} -> {args.target or 'scaled source'}: {check.describe()}; nothing written "
+            "(--keep-implausible writes it anyway)"
+        )
+    return check
+
+
 def _cmd_retarget(args) -> int:
     from motionlab.cli import rig_error
     from motionlab.core import bvh, files, gltf, humanoid, rest_pose
@@ -149,14 +162,7 @@ def _cmd_retarget(args) -> int:
     result = retarget(
         source, target, ckpt, args.method, _solver_config(args), args.root, progress=not args.quiet, fps=args.fps
     )
-    if result.resampled:  # always shown, also under -q: the output's frame rate is not the solver's
-        print(f"{args.source}: {result.resampled}", file=sys.stderr)
-    check = result.plausibility
-    if not check.ok and not args.keep_implausible:
-        raise _error(
-            f"{args.source} -> {args.target or 'scaled source'}: {check.describe()}; nothing written "
-            "(--keep-implausible writes it anyway)"
-        )
+    check = _check_result(args, result)
     binary = out.suffix.lower() == gltf.SUFFIX
     data = (gltf.dumps if binary else bvh.dumps)(result.motion)  # any error shows before a file is written
     outputs = [(out, lambda f: f.write(data), binary, "output")]

@@ -89,7 +89,8 @@ class RetargetResult:
 
     Attributes
     ----------
-    motion : Motion           on B's canonical 22-joint skeleton, world space, checkpoint fps
+    motion : Motion           on B's canonical 22-joint standing skeleton, world space, at the
+                              checkpoint's fps (:func:`finish`) or the one :func:`at_rate` chose
     positions : ndarray (T, 22, 3)   world joint positions (FK of ``motion``), metres
     method : str              one of :data:`METHODS`
     root_scale : (float, float)  ``(r_xz, r_y)`` that scaled A's root trajectory

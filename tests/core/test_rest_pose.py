@@ -95,3 +95,14 @@ def test_bandai_namco_stands_like_a_mixamo_character():
     aj = require_data("mixamo", "Aj", "Running.bvh")
     r = pipeline.root_scale(pipeline.target_skeleton(bvh.load(aj)), sk)
     assert 0.8 < r[1] < 1.3  # was 0.063 (and 15.9 the other way)
+
+
+def test_info_says_which_pose_it_used(tmp_path, capsys):
+    from motionlab.cli import main
+
+    bvh.save(tmp_path / "tpose.bvh", _walk(20))
+    bvh.save(tmp_path / "lying.bvh", _lying(_walk(20)))
+    assert main(["info", str(tmp_path / "tpose.bvh")]) == 0
+    assert "rest      standing pose from the rest offsets" in capsys.readouterr().out
+    assert main(["info", str(tmp_path / "lying.bvh")]) == 0
+    assert "standing pose from frame" in capsys.readouterr().out
