@@ -25,8 +25,9 @@ about the world origin, with one ratio for the ground plane and one for the heig
 * horizontally by ``r_xz`` = B's / A's **leg chain**, the summed bone lengths from the Hips
   down to the toe (Hips→UpLeg→Leg→Foot→ToeBase, :func:`leg_chain`): with the same joint
   angles, a longer leg takes a longer stride, and the hip offset and the foot count too;
-* vertically by ``r_y`` = B's / A's **hip height** (rest height of the Hips above the lowest
-  rest joint, :func:`hip_height`), so a standing pose keeps its feet on the ground;
+* vertically by ``r_y`` = B's / A's **hip height** (height of the Hips above the lowest joint in
+  the canonical standing rest pose, :func:`hip_height`, :mod:`motionlab.core.rest_pose`), so a
+  standing pose keeps its feet on the ground whatever rest pose each studio rigged;
 * the heading (facing direction) of every frame is A's: the network's root rotation, expressed
   in A's heading frame, is turned back by A's heading.
 
@@ -115,7 +116,11 @@ class RetargetResult:
 
 
 def hip_height(skeleton: Skeleton) -> float:
-    """Rest-pose height of the root above the lowest joint (metres) of a canonical skeleton."""
+    """Rest-pose height of the root above the lowest joint (metres) of a canonical skeleton.
+
+    A standing height only for a skeleton in its canonical standing rest pose
+    (:func:`target_skeleton`, :func:`motionlab.core.rest_pose.standing_skeleton`).
+    """
     rest = skeleton.rest_positions()
     return float(rest[0, 1] - rest[:, 1].min())
 
