@@ -38,6 +38,7 @@ __all__ = [
     "add_quiet",
     "renamed",
     "Stages",
+    "add_rate_and_plausibility_args",
 ]
 
 
@@ -267,3 +268,19 @@ class Stages:
 
     def close(self) -> None:
         self._bar.close()
+
+
+def add_rate_and_plausibility_args(p: argparse.ArgumentParser) -> None:
+    """``--fps`` (output frame rate) and ``--keep-implausible``, shared by ``retarget`` and ``expand``."""
+    p.add_argument(
+        "--fps",
+        type=positive,
+        metavar="FPS",
+        help="frame rate of the output (default: the source's; a resample is always reported)",
+    )
+    p.add_argument(
+        "--keep-implausible",
+        action="store_true",
+        help="write outputs that fail the plausibility check (feet on the floor, hip height, bone lengths) "
+        "instead of refusing them",
+    )

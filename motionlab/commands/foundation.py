@@ -25,7 +25,7 @@ def _load(path: str, what: str = "input"):
 
 
 def _info(args) -> int:
-    from motionlab.core import humanoid
+    from motionlab.core import humanoid, rest_pose
 
     m = _load(args.file)
     sk = m.skeleton
@@ -42,6 +42,12 @@ def _info(args) -> int:
         )
     except humanoid.RigMappingError as e:
         print(f"humanoid  does not map: {e.reason}")
+    else:
+        try:
+            stand, pose = rest_pose.standing(humanoid.to_canonical(m), args.file)
+            print(f"rest      {pose.describe()}; standing height {stand.skeleton.height():.4f} m")
+        except rest_pose.RestPoseError as e:
+            print(f"rest      {e}")
     if args.joints:
         depth = sk.depth()
         for j, name in enumerate(sk.names):

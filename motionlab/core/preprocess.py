@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from motionlab.core import humanoid, quat
+from motionlab.core import humanoid, quat, rest_pose
 from motionlab.core.motion import Motion
 
 __all__ = [
@@ -43,9 +43,16 @@ _L_HIP, _R_HIP = humanoid.JOINTS.index("LeftUpLeg"), humanoid.JOINTS.index("Righ
 _L_SH, _R_SH = humanoid.JOINTS.index("LeftArm"), humanoid.JOINTS.index("RightArm")
 
 
-def prepare(motion: Motion, fps: float | None = 60.0, profile=None) -> Motion:
-    """Reduce a motion to the 22-joint humanoid and resample it to ``fps`` (``None``: keep)."""
+def prepare(motion: Motion, fps: float | None = 60.0, profile=None, stand: bool = False) -> Motion:
+    """Reduce a motion to the 22-joint humanoid and resample it to ``fps`` (``None``: keep).
+
+    ``stand=True`` also brings the rig to its canonical standing rest pose
+    (:func:`motionlab.core.rest_pose.standing`; world positions unchanged), as retargeting
+    does, and raises :class:`~motionlab.core.rest_pose.RestPoseError` when there is none.
+    """
     out = humanoid.to_canonical(motion, profile)
+    if stand:
+        out = rest_pose.standing(out)[0]
     if fps is not None:
         out = out.resample(fps)
     bad = ~np.isfinite(out.local_rot).all(axis=(1, 2)) | ~np.isfinite(out.root_pos).all(axis=1)

@@ -11,12 +11,21 @@ Examples::
 
 from __future__ import annotations
 
+import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from motionlab.cli_args import add_quiet, check_outputs, non_negative, non_negative_int, positive, positive_int
+from motionlab.cli_args import (
+    add_quiet,
+    add_rate_and_plausibility_args,
+    check_outputs,
+    non_negative,
+    non_negative_int,
+    positive,
+    positive_int,
+)
 from motionlab.retargeting import cli_options
 from motionlab.retargeting.cli_options import ROOT_MODES
 
@@ -35,9 +44,23 @@ def _load_bvh(path: str, what: str):
     return bvh.load(files.check_input(path, what))
 
 
+# ---------------------------------------------------------------------------- retarget
+def _check_result(args, result):
+    """Print a resample (always, also under -q); refuse an implausible output unless --keep-implausible."""
+    if result.resampled:
+        print(f"{args.source}: {result.resampled}", file=sys.stderr)
+    check = result.plausibility
+    if not check.ok and not args.keep_implausible:
+        raise _error(
+            f"{args.source} -> {args.target or 'scaled source'}: {check.describe()}; nothing written "
+            "(--keep-implausible writes it anyway)"
+        )
+    return check
+
+
 def _cmd_retarget(args) -> int:
     from motionlab.cli import rig_error
-    from motionlab.core import bvh, files, gltf, humanoid
+    from motionlab.core import bvh, files, gltf, humanoid, rest_pose
     from motionlab.retargeting.pipeline import retarget
 
     out = Path(args.output)
@@ -53,9 +76,9 @@ def _cmd_retarget(args) -> int:
         humanoid.find_mapping(source.skeleton)
     except humanoid.RigMappingError as e:
         raise rig_error(e, "source", args.source) from None
-    base = _load_bvh(args.target, "target").skeleton if args.target else source.skeleton
+    base = _load_bvh(args.target, "target") if args.target else source
     try:
-        target = humanoid.to_canonical_skeleton(base)
+        target = rest_pose.standing_skeleton(base, f"target file {args.target or args.source}")[0]
     except humanoid.RigMappingError as e:
         raise rig_error(e, "target", args.target) from None
     scales = dict(
@@ -67,8 +90,16 @@ def _cmd_retarget(args) -> int:
         raise _error("give --target TARGET.bvh and/or a --scale-* factor: otherwise the target is the source itself")
     ckpt = None if args.method == "copy" else cli_options.load_checkpoint(args.checkpoint, args.device)
     result = retarget(
-        source, target, ckpt, args.method, cli_options.solver_config(args), args.root, progress=not args.quiet
+        source,
+        target,
+        ckpt,
+        args.method,
+        cli_options.solver_config(args),
+        args.root,
+        progress=not args.quiet,
+        fps=args.fps,
     )
+    check = _check_result(args, result)
     binary = out.suffix.lower() == gltf.SUFFIX
     data = (gltf.dumps if binary else bvh.dumps)(result.motion)  # any error shows before a file is written
     outputs = [(out, lambda f: f.write(data), binary, "output")]
@@ -89,6 +120,8 @@ def _cmd_retarget(args) -> int:
             h = result.history
             msg += f"; L_iter {h['loss'][0]:.4g} -> {h['loss'][-1]:.4g} in {result.steps} steps ({result.stop_reason})"
         print(msg + f", {result.seconds:.2f} s)")
+    if not check.ok:
+        print(f"warning: {out}: {check.describe()}", file=sys.stderr)
     return 0
 
 
@@ -270,6 +303,7 @@ def register(subparsers) -> None:
     p.add_argument("--scale", type=positive, default=1.0, metavar="F", help="scale the whole target by F")
     p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
     p.add_argument("--force", action="store_true", help="overwrite existing output files")
+    add_rate_and_plausibility_args(p)
     add_quiet(p)
     cli_options.add_solver_args(p)
     p.set_defaults(func=_cmd_retarget)

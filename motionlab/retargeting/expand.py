@@ -13,8 +13,12 @@ with ``output_format="glb"``) plus ``OUT/manifest.csv``, one row per (clip, char
   writes for that pair.
 * **Resumable and safe.** Every BVH is written to a temporary file; the manifest (rewritten
   atomically) records a batch's rows *before* its files are renamed into place. A rerun keeps
-  every row whose file exists and redoes the rest: a kill at any moment loses at most the batch
-  in flight. An output that exists but is not in the manifest is someone else's file and is
+  an output only when its file exists and its row's SHA-256 of the source file
+  (``source_sha256``), of the character (``character_sha256``: the file's bytes, or a preset's
+  factors) and of every option that changes the result (``options_sha256``: the checkpoint's
+  weights, the solver settings, the root rule and the output frame rate) are those of this run;
+  everything else is redone and :attr:`ExpandResult.redone` says why. A kill at any moment loses
+  at most the batch in flight. An output that exists but is not in the manifest is someone else's file and is
   only replaced with ``force=True``. A clip that cannot be read or mapped is recorded as an
   ``error`` row with its message, and the job goes on.
 * **Quality flags.** A row is flagged when its mean foot penetration exceeds
@@ -22,7 +26,11 @@ with ``output_format="glb"``) plus ``OUT/manifest.csv``, one row per (clip, char
   ``skate_ratio`` (default 2) times the source clip's own skating scaled by the root's ground
   ratio ``r_xz`` (a longer-legged character moves its feet faster by that ratio; sliding beyond
   twice that is new sliding the retargeting added). Both rules are set by these principles, not
-  fitted to any clip.
+  fitted to any clip. Every output also goes through the plausibility tests of
+  :mod:`motionlab.retargeting.plausibility` (feet on the floor, hip height, bone lengths); a
+  failed test adds ``implausible_<test>`` to ``flag``.
+* **Frame rate.** Outputs are at each source's frame rate unless ``fps`` is given; the network
+  runs at the checkpoint's, and every resample is listed in :attr:`ExpandResult.resampled`.
 * **Beyond one machine.** ``backend="ray"`` sends the same batches to Ray actors
   (:mod:`motionlab.retargeting.cluster`), each loading the checkpoint once; this process
   still writes every file and the manifest, so both backends give the same outputs.
@@ -33,8 +41,11 @@ Taught in ``notebooks/07_expanding_a_database.ipynb``.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import glob
+import hashlib
 import io
+import json
 import os
 import tempfile
 import time
@@ -45,11 +56,11 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from motionlab.core import bvh, gltf, humanoid, metrics
+from motionlab.core import bvh, gltf, humanoid, metrics, rest_pose
 from motionlab.core.skeleton import Skeleton
 from motionlab.retargeting.batching import Pair, PairResult, batch_frames, plan_batches, quality, solve_pairs
 from motionlab.retargeting.checkpoint import Checkpoint
-from motionlab.retargeting.pipeline import prepare_source
+from motionlab.retargeting.pipeline import at_rate, prepare_source
 from motionlab.retargeting.solver import SolverConfig
 
 __all__ = [
@@ -61,6 +72,7 @@ __all__ = [
     "characters",
     "find_sources",
     "read_manifest",
+    "options_digest",
     "ExpandResult",
     "expand",
 ]
@@ -80,11 +92,14 @@ MANIFEST = "manifest.csv"
 COLUMNS = (
     "clip", "character", "status", "output", "source", "character_file", "frames", "steps", "stop_reason",
     "loss", "angle", "foot", "contact", "penetration_cm", "skating_cm_s", "source_skating_cm_s", "seconds", "batch_size",
-    "flag", "error",
+    "flag", "error", "fps", "source_sha256", "character_sha256", "options_sha256",
 )  # fmt: skip
 """Manifest columns: ``status`` is ``ok`` or ``error``; ``loss``/``angle``/``foot``/``contact`` the
 final (best) L_iter, L_angle, L_foot (metres), L_contact (m/s); ``seconds`` the pair's share of its batch's wall time;
-``flag`` lists the quality thresholds exceeded (``penetration``, ``skating``), empty if none."""
+``flag`` lists the quality thresholds exceeded (``penetration``, ``skating``) and the failed
+plausibility tests (``implausible_foot``, ``_floor``, ``_hips``, ``_bones``), empty if none; ``fps`` the
+output's frame rate; the ``*_sha256`` columns key resumption (module docstring)."""
+_OLD_COLUMNS = COLUMNS[: COLUMNS.index("fps")]  # manifests written before the content keys: all redone
 FORMATS = ("bvh", "glb")
 """Output formats of :func:`expand`: BVH text or binary glTF 2.0 (:mod:`motionlab.core.gltf`)."""
 
@@ -107,12 +122,14 @@ class Character:
     skeleton : Skeleton or None     ``None`` when the file could not be read (``error`` says why)
     origin : str                    the BVH path or ``preset:NAME``
     error : str                     why the character cannot be used ("" if it can)
+    digest : str                    SHA-256 of the file's bytes, or of a preset's factors
     """
 
     name: str
     skeleton: Skeleton | None
     origin: str
     error: str = ""
+    digest: str = ""
 
 
 def _preset(spec: str) -> tuple[str, dict[str, float]]:
@@ -156,14 +173,17 @@ def characters(*specs: str, presets: Iterable[str] = ()) -> list[Character]:
             e[0] = e[1].stem if stems.count(e[1].stem) == 1 else f"{e[1].parent.name}_{e[1].stem}"
     out = []
     for name, p in entries:
+        digest = _sha256(p)
         try:
-            sk = humanoid.to_canonical_skeleton(bvh.load(p).skeleton)
-            out.append(Character(name, sk, str(p)))
+            sk = rest_pose.standing_skeleton(bvh.load(p), f"character file {p}")[0]
+            out.append(Character(name, sk, str(p), digest=digest))
         except _ERRORS as err:
-            out.append(Character(name, None, str(p), _why(err, "character", p)))
+            out.append(Character(name, None, str(p), _why(err, "character", p), digest))
     for spec in presets:
         name, factors = _preset(spec)
-        out.append(Character(name, humanoid.scale_bones(humanoid.canonical_skeleton(), **factors), f"preset:{spec}"))
+        sk = humanoid.scale_bones(humanoid.canonical_skeleton(), **factors)
+        digest = hashlib.sha256(json.dumps(factors, sort_keys=True).encode()).hexdigest()
+        out.append(Character(name, sk, f"preset:{spec}", digest=digest))
     names = [c.name for c in out]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
@@ -171,6 +191,28 @@ def characters(*specs: str, presets: Iterable[str] = ()) -> list[Character]:
     for n in names:
         _check_name(n, "character")
     return out
+
+
+def _sha256(path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def options_digest(checkpoint: Checkpoint, solver: SolverConfig, root_mode: str, fps: float | None) -> str:
+    """SHA-256 of everything besides source and character that changes an output: the checkpoint's
+    weights, normalisation and frame rate, the solver settings, the root rule and the output rate."""
+    h = hashlib.sha256()
+    for name, tensor in sorted(checkpoint.model.state_dict().items()):
+        h.update(name.encode())
+        h.update(tensor.detach().cpu().double().numpy().tobytes())
+    h.update(np.asarray(checkpoint.stats.mean, dtype=np.float64).tobytes())
+    h.update(np.asarray(checkpoint.stats.std, dtype=np.float64).tobytes())
+    settings = {"solver": dataclasses.asdict(solver), "root": root_mode, "fps": fps, "ckpt_fps": checkpoint.fps}
+    h.update(json.dumps(settings, sort_keys=True, default=str).encode())
+    return h.hexdigest()
 
 
 def _why(err: Exception, role: str, path) -> str:
@@ -218,11 +260,11 @@ def read_manifest(out: str | Path) -> list[dict]:
         return []
     with open(path, newline="", encoding="utf-8") as f:
         reader = csv.DictReader(f)
-        if tuple(reader.fieldnames or ()) != COLUMNS:
+        if tuple(reader.fieldnames or ()) not in (COLUMNS, _OLD_COLUMNS):
             raise ValueError(
                 f"{path} is not an expand manifest (columns {reader.fieldnames}, expected {list(COLUMNS)})"
             )
-        return list(reader)
+        return [{k: r.get(k, "") for k in COLUMNS} for r in reader]
 
 
 def _umask_mode() -> int:
@@ -280,6 +322,10 @@ class ExpandResult:
     source_frames : int     source frames (at the checkpoint's rate) solved in this run
     seconds : float         wall time of the run
     batches : int           latent-iteration batches run
+    redone : dict           why outputs that existed were redone: reason -> count (``source changed``,
+                            ``character changed``, ``options changed``, ``file missing``)
+    resampled : list of str   one line per source whose frame rate changed on the way
+    implausible : int       outputs of this run that failed a plausibility test
     """
 
     out: Path
@@ -290,6 +336,9 @@ class ExpandResult:
     source_frames: int = 0
     seconds: float = 0.0
     batches: int = 0
+    redone: dict = field(default_factory=dict)
+    resampled: list = field(default_factory=list)
+    implausible: int = 0
 
     @property
     def throughput(self) -> float:
@@ -311,8 +360,11 @@ class ExpandResult:
                 f"{name:<18} {len(ok):>4} {len(rs) - len(ok):>4} {sum(1 for r in ok if r['flag']):>4} "
                 f"{mean('steps', 6, 1)} {mean('loss', 8, 4)} {mean('penetration_cm', 7, 3)} {mean('skating_cm_s', 10, 2)}"
             )
+        why = ", ".join(f"{n} {reason}" for reason, n in sorted(self.redone.items()))
+        redone = sum(self.redone.values())
         lines.append(
-            f"this run: {self.done} solved, {self.skipped} already done, {self.failed} failed; "
+            f"this run: {self.done} solved ({redone} redone{': ' + why if why else ''}; "
+            f"{self.implausible} implausible), {self.skipped} already done, {self.failed} failed; "
             f"{self.source_frames} source frames in {self.seconds:.1f} s = {self.throughput:.0f} frames/s "
             f"({self.batches} batches); manifest {self.out / MANIFEST}"
         )
@@ -320,15 +372,17 @@ class ExpandResult:
 
 
 # ---------------------------------------------------------------------------- the job
-def _row(pr: PairResult, source: str, char: Character, source_skate: float, limits, suffix: str) -> dict:
+def _row(pr: PairResult, src: _Source, char: Character, limits, suffix: str, out_motion, options: str) -> dict:
     res = pr.result
     h = res.history
     q = quality(res)
     flags = []
     if q["penetration_cm"] > limits[0]:
         flags.append("penetration")
-    if q["skating_cm_s"] > limits[1] * source_skate * res.root_scale[0] and q["skating_cm_s"] > 0:
+    if q["skating_cm_s"] > limits[1] * src.skating * res.root_scale[0] and q["skating_cm_s"] > 0:
         flags.append("skating")
+    flags += [f"implausible_{t}" for t in res.plausibility.failed]
+    source = src.path
     best = int(np.argmin(h["loss"]))
     return {
         "clip": pr.clip,
@@ -337,7 +391,7 @@ def _row(pr: PairResult, source: str, char: Character, source_skate: float, limi
         "output": f"{pr.character}/{pr.clip}{suffix}",
         "source": source,
         "character_file": char.origin,
-        "frames": str(res.motion.num_frames),
+        "frames": str(out_motion.num_frames),
         "steps": str(res.steps),
         "stop_reason": res.stop_reason,
         "loss": _fmt(h["loss"][best]),
@@ -346,12 +400,42 @@ def _row(pr: PairResult, source: str, char: Character, source_skate: float, limi
         "contact": _fmt(h["contact"][best]) if h.get("contact") else "",
         "penetration_cm": _fmt(q["penetration_cm"]),
         "skating_cm_s": _fmt(q["skating_cm_s"]),
-        "source_skating_cm_s": _fmt(source_skate),
+        "source_skating_cm_s": _fmt(src.skating),
         "seconds": _fmt(pr.seconds),
         "batch_size": str(pr.batch_size),
         "flag": "+".join(flags),
         "error": "",
+        "fps": _fmt(out_motion.fps),
+        "source_sha256": src.digest,
+        "character_sha256": char.digest,
+        "options_sha256": options,
     }
+
+
+@dataclass
+class _Source:
+    """What the rows need of a source clip: its path, skating (cm/s), frame rate and SHA-256."""
+
+    path: str
+    skating: float
+    fps: float
+    digest: str
+
+
+def _reuse(old: dict | None, file: Path, expected: tuple[str, str, str], output: str) -> str:
+    """``""`` when the old row's output can be kept, else why it must be redone (``"new"``: no output)."""
+    if old is None or old["status"] != "ok" or old["output"] != output:
+        return "new"
+    if not file.is_file():
+        return "file missing"
+    for key, value, reason in zip(
+        ("source_sha256", "character_sha256", "options_sha256"),
+        expected,
+        ("source changed", "character changed", "options changed"),
+    ):
+        if old.get(key, "") != value:
+            return reason
+    return ""
 
 
 def _error_row(clip: str, character: str, source: str, origin: str, message: str, suffix: str = ".bvh") -> dict:
@@ -391,6 +475,7 @@ def expand(
     on_batch: Callable[[int, list[dict]], None] | None = None,
     threads: int | None = None,
     output_format: str = "bvh",
+    fps: float | None = None,
 ) -> ExpandResult:
     """Retarget every source clip onto every character; see the module docstring.
 
@@ -415,6 +500,8 @@ def expand(
         which prints both); unchanged on a GPU.
     output_format : ``"bvh"`` (default) or ``"glb"`` (glTF 2.0, :func:`motionlab.core.gltf.dumps`):
         the outputs' format and file suffix. A rerun in another format redoes every pair.
+    fps : frame rate of every output (default: each source's own); the network runs at the
+        checkpoint's rate
 
     Returns
     -------
@@ -431,15 +518,49 @@ def expand(
     try:
         return _expand(
             sources, targets, out, checkpoint, solver, root_mode, force, max_frames, backend, address, workers,
-            max_penetration_cm, skate_ratio, progress, on_batch, "." + output_format,
+            max_penetration_cm, skate_ratio, progress, on_batch, "." + output_format, fps,
         )  # fmt: skip
     finally:
         torch.set_num_threads(before)
 
 
+def _plan(clips, targets, out, known, force, suffix, options, result, rows):
+    """Which pairs to solve: a kept output needs its file and unchanged content hashes."""
+    todo: list[tuple[str, Path, Character, str]] = []
+    digests: dict[Path, str] = {}
+    for clip, path in clips:
+        try:
+            digests[path] = digests.get(path) or _sha256(path)
+        except OSError:
+            digests[path] = ""  # unreadable: _load_pairs records the error
+        for c in targets:
+            key, output = (c.name, clip), f"{c.name}/{clip}{suffix}"
+            file = out / output
+            old = known.get(key)
+            why = _reuse(old, file, (digests[path], c.digest, options), output)
+            if not force and not why:
+                rows[key] = old
+                result.skipped += 1
+            elif file.exists() and not force and why == "new":
+                message = f"{file} exists and is not an output of this job; pass --force to replace it"
+                rows[key] = _error_row(clip, c.name, str(path), c.origin, message, suffix)
+                result.failed += 1
+            else:
+                todo.append((clip, path, c, digests[path]))
+                if why != "new" or force and file.exists():
+                    reason = "forced" if force else why
+                    result.redone[reason] = result.redone.get(reason, 0) + 1
+    # rows of the old manifest for pairs outside this run stay while their files exist
+    planned = {(c.name, clip) for clip, _, c, _ in todo}
+    for key, r in known.items():
+        if key not in rows and key not in planned and (r["status"] != "ok" or (out / r["output"]).is_file()):
+            rows[key] = r
+    return todo
+
+
 def _expand(
     sources, targets, out, checkpoint, solver, root_mode, force, max_frames, backend, address, workers,
-    max_penetration_cm, skate_ratio, progress, on_batch, suffix,
+    max_penetration_cm, skate_ratio, progress, on_batch, suffix, fps,
 ) -> ExpandResult:  # fmt: skip
     start = time.perf_counter()
     out = Path(out)
@@ -455,34 +576,15 @@ def _expand(
         _clean_temporaries(out / c.name)
     result = ExpandResult(out)
     rows: dict[tuple[str, str], dict] = {}
-    todo: list[tuple[str, Path, Character]] = []
-    for clip, path in clips:
-        for c in targets:
-            key = (c.name, clip)
-            file = out / c.name / f"{clip}{suffix}"
-            old = known.get(key)
-            ours = old is not None and old["status"] == "ok" and old["output"] == f"{c.name}/{clip}{suffix}"
-            if not force and ours and file.is_file():
-                rows[key] = old
-                result.skipped += 1
-            elif file.exists() and not force and not ours:
-                rows[key] = _error_row(
-                    clip,
-                    c.name,
-                    str(path),
-                    c.origin,
-                    f"{file} exists and is not an output of this job; pass --force to replace it",
-                    suffix,
-                )
-                result.failed += 1
-            else:
-                todo.append((clip, path, c))
-    # rows of the old manifest for pairs outside this run stay while their files exist
-    planned = {(c.name, clip) for clip, _, c in todo}
-    for key, r in known.items():
-        if key not in rows and key not in planned and (r["status"] != "ok" or (out / r["output"]).is_file()):
-            rows[key] = r
+    options = options_digest(checkpoint, solver, root_mode, fps)
+    todo = _plan(clips, targets, out, known, force, suffix, options, result, rows)
     pairs, sources_by_clip = _load_pairs(todo, checkpoint, solver, rows, result, suffix)
+    for src in sources_by_clip.values():
+        rates = (src.fps, checkpoint.fps, fps or src.fps)
+        if max(rates) - min(rates) > 1e-4 * max(rates):
+            result.resampled.append(
+                f"{src.path}: resampled: source {rates[0]:g} fps -> network {rates[1]:g} fps -> output {rates[2]:g} fps"
+            )
     _write_manifest(out, list(rows.values()))
     chars = {c.name: c for c in targets}
     limits = (max_penetration_cm, skate_ratio)
@@ -497,31 +599,7 @@ def _expand(
 
     bar = tqdm(total=len(batches), desc="expand", unit="batch", disable=not progress)
     for index, solved in enumerate(stream):
-        new = []
-        staged = []
-        try:
-            for pr in solved:
-                src_path, src_skate = sources_by_clip[pr.clip]
-                row = _row(pr, src_path, chars[pr.character], src_skate, limits, suffix)
-                file = out / row["output"]
-                file.parent.mkdir(parents=True, exist_ok=True)
-                fd, tmp = tempfile.mkstemp(dir=file.parent, prefix=f".{file.name}.", suffix=".tmp")
-                motion = pr.result.motion
-                data = gltf.dumps(motion) if suffix == gltf.SUFFIX else bvh.dumps(motion).encode("utf-8")
-                with os.fdopen(fd, "wb") as f:
-                    f.write(data)
-                os.chmod(tmp, _MODE)
-                staged.append((tmp, file))
-                new.append(row)
-                rows[(pr.character, pr.clip)] = row
-                result.source_frames += pr.result.motion.num_frames
-            _write_manifest(out, list(rows.values()))  # rows first, then the files: a kill between the
-            for tmp, file in staged:  # two leaves rows without files, which a rerun redoes
-                os.replace(tmp, file)
-        finally:
-            for tmp, _ in staged:
-                if os.path.exists(tmp):
-                    os.unlink(tmp)
+        new = _write_batch(solved, sources_by_clip, chars, limits, suffix, options, fps, out, rows, result)
         result.done += len(new)
         result.batches += 1
         bar.update(1)
@@ -533,15 +611,46 @@ def _expand(
     return result
 
 
+def _write_batch(solved, sources_by_clip, chars, limits, suffix, options, fps, out, rows, result) -> list[dict]:
+    """Rows first (manifest), then the files: a kill between the two leaves rows without files,
+    which a rerun redoes."""
+    new, staged = [], []
+    try:
+        for pr in solved:
+            src = sources_by_clip[pr.clip]
+            motion = at_rate(pr.result, fps or src.fps, src.fps).motion
+            row = _row(pr, src, chars[pr.character], limits, suffix, motion, options)
+            result.implausible += not pr.result.plausibility.ok
+            file = out / row["output"]
+            file.parent.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(dir=file.parent, prefix=f".{file.name}.", suffix=".tmp")
+            data = gltf.dumps(motion) if suffix == gltf.SUFFIX else bvh.dumps(motion).encode("utf-8")
+            with os.fdopen(fd, "wb") as f:
+                f.write(data)
+            os.chmod(tmp, _MODE)
+            staged.append((tmp, file))
+            new.append(row)
+            rows[(pr.character, pr.clip)] = row
+            result.source_frames += pr.result.motion.num_frames
+        _write_manifest(out, list(rows.values()))
+        for tmp, file in staged:
+            os.replace(tmp, file)
+    finally:
+        for tmp, _ in staged:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+    return new
+
+
 def _load_pairs(todo, checkpoint, solver, rows, result, suffix):
     """Read each source once; a clip or character that fails becomes ``error`` rows."""
     pairs: list[Pair] = []
-    sources_by_clip: dict[str, tuple[str, float]] = {}
+    sources_by_clip: dict[str, _Source] = {}
     by_clip: dict[str, list] = {}
-    for clip, path, c in todo:
-        by_clip.setdefault(clip, [path, []])[1].append(c)
+    for clip, path, c, digest in todo:
+        by_clip.setdefault(clip, [path, [], digest])[1].append(c)
     feet = [humanoid.JOINTS.index(f) for f in humanoid.FEET]
-    for clip, (path, chars) in by_clip.items():
+    for clip, (path, chars, digest) in by_clip.items():
         try:
             motion = bvh.load(path)
             prepared = prepare_source(motion, checkpoint, "full", solver)
@@ -551,7 +660,8 @@ def _load_pairs(todo, checkpoint, solver, rows, result, suffix):
                 result.failed += 1
             continue
         pos = prepared.motion.global_positions()
-        sources_by_clip[clip] = (str(path), 100.0 * metrics.foot_skating(pos, feet, prepared.motion.fps))
+        skating = 100.0 * metrics.foot_skating(pos, feet, prepared.motion.fps)
+        sources_by_clip[clip] = _Source(str(path), skating, motion.fps, digest)
         for c in chars:
             if c.skeleton is None:
                 rows[(c.name, clip)] = _error_row(clip, c.name, str(path), c.origin, c.error, suffix)

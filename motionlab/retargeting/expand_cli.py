@@ -10,8 +10,17 @@ Examples::
 from __future__ import annotations
 
 import argparse
+import sys
 
-from motionlab.cli_args import add_quiet, check_output_folder, non_negative, non_negative_int, positive, positive_int
+from motionlab.cli_args import (
+    add_quiet,
+    add_rate_and_plausibility_args,
+    check_output_folder,
+    non_negative,
+    non_negative_int,
+    positive,
+    positive_int,
+)
 from motionlab.retargeting import cli_options
 from motionlab.retargeting.cli_options import ROOT_MODES
 
@@ -54,10 +63,20 @@ def _cmd_expand(args) -> int:
         progress=not args.quiet,
         threads=args.threads or None,
         output_format=args.format,
+        fps=args.fps,
     )
+    for line in job.resampled:  # always shown, also under -q
+        print(line, file=sys.stderr)
     if not args.quiet:
         print(job.summary())
         _print_failures(job)
+    if job.implausible and not args.keep_implausible:
+        print(
+            f"{job.implausible} output(s) failed the plausibility check (flag implausible_* in {job.out / ex.MANIFEST}); "
+            "--keep-implausible accepts them",
+            file=sys.stderr,
+        )
+        return 1
     return 1 if job.failed else 0
 
 
@@ -119,6 +138,7 @@ def register(subparsers) -> None:
     )
     p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
     p.add_argument("--force", action="store_true", help="redo every pair and replace existing outputs")
+    add_rate_and_plausibility_args(p)
     add_quiet(p)
     cli_options.add_solver_args(p)
     p.set_defaults(func=_cmd_expand)

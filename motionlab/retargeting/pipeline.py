@@ -6,9 +6,12 @@
     result = retarget(source_motion, target_skeleton, ckpt)  # method="full" | "network" | "copy"
     bvh.save("out.bvh", result.motion)
 
-Steps: the source is reduced to the 22 canonical joints and resampled to the checkpoint's
-frame rate; the target rig is reduced to its canonical T-pose skeleton
-(:func:`humanoid.to_canonical_skeleton`) — nothing but B's rest offsets is used.
+Steps: the source is reduced to the 22 canonical joints, brought to its canonical standing
+rest pose (:mod:`motionlab.core.rest_pose`) and resampled to the checkpoint's frame rate; the
+target rig is reduced to its canonical standing skeleton (:func:`target_skeleton`: B's rest
+offsets, or a frame of B's motion when its rest pose does not stand). The output is resampled
+back to the source's frame rate unless another is asked for (:func:`at_rate`), and every output
+is checked for plausibility (:mod:`motionlab.retargeting.plausibility`).
 
 **Whole clips, no seams (our choice).** The encoder is fully convolutional and φ is a latent
 per frame, so a clip of any length goes through the network as *one* sequence and the latent
@@ -22,8 +25,9 @@ about the world origin, with one ratio for the ground plane and one for the heig
 * horizontally by ``r_xz`` = B's / A's **leg chain**, the summed bone lengths from the Hips
   down to the toe (Hips→UpLeg→Leg→Foot→ToeBase, :func:`leg_chain`): with the same joint
   angles, a longer leg takes a longer stride, and the hip offset and the foot count too;
-* vertically by ``r_y`` = B's / A's **hip height** (rest height of the Hips above the lowest
-  rest joint, :func:`hip_height`), so a standing pose keeps its feet on the ground;
+* vertically by ``r_y`` = B's / A's **hip height** (height of the Hips above the lowest joint in
+  the canonical standing rest pose, :func:`hip_height`, :mod:`motionlab.core.rest_pose`), so a
+  standing pose keeps its feet on the ground whatever rest pose each studio rigged;
 * the heading (facing direction) of every frame is A's: the network's root rotation, expressed
   in A's heading frame, is turned back by A's heading.
 
@@ -42,15 +46,15 @@ Taught in ``notebooks/03_latent_iteration.ipynb``.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import torch
 
-from motionlab.core import humanoid, preprocess, quat, threads
+from motionlab.core import humanoid, preprocess, quat, rest_pose, threads
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
-from motionlab.retargeting import contacts
+from motionlab.retargeting import contacts, plausibility
 from motionlab.retargeting.checkpoint import Checkpoint
 from motionlab.retargeting.features import ClipFeatures, check_motion, clip_features
 from motionlab.retargeting.solver import SolverConfig, solve
@@ -70,6 +74,7 @@ __all__ = [
     "finish",
     "source_contacts",
     "contact_stride",
+    "at_rate",
     "retarget",
 ]
 
@@ -85,7 +90,8 @@ class RetargetResult:
 
     Attributes
     ----------
-    motion : Motion           on B's canonical 22-joint skeleton, world space, checkpoint fps
+    motion : Motion           on B's canonical 22-joint standing skeleton, world space, at the
+                              checkpoint's fps (:func:`finish`) or the one :func:`at_rate` chose
     positions : ndarray (T, 22, 3)   world joint positions (FK of ``motion``), metres
     method : str              one of :data:`METHODS`
     root_scale : (float, float)  ``(r_xz, r_y)`` that scaled A's root trajectory
@@ -93,6 +99,8 @@ class RetargetResult:
     stop_reason : str         why the solver stopped ("" without iteration)
     steps : int               solver steps
     seconds : float           wall time of the method itself (network + solver), seconds
+    plausibility : Plausibility or None   the output's plausibility tests (:mod:`.plausibility`)
+    resampled : str           how the frame rate changed on the way ("" when it did not)
     """
 
     motion: Motion
@@ -103,10 +111,16 @@ class RetargetResult:
     stop_reason: str = ""
     steps: int = 0
     seconds: float = 0.0
+    plausibility: plausibility.Plausibility | None = None
+    resampled: str = ""
 
 
 def hip_height(skeleton: Skeleton) -> float:
-    """Rest-pose height of the root above the lowest joint (metres) of a canonical skeleton."""
+    """Rest-pose height of the root above the lowest joint (metres) of a canonical skeleton.
+
+    A standing height only for a skeleton in its canonical standing rest pose
+    (:func:`target_skeleton`, :func:`motionlab.core.rest_pose.standing_skeleton`).
+    """
     rest = skeleton.rest_positions()
     return float(rest[0, 1] - rest[:, 1].min())
 
@@ -183,15 +197,19 @@ def source_contacts(source: Motion) -> np.ndarray:
     return contacts.detect_contacts(source.global_positions(), contacts.rest_heights(sk), sk.height(), source.fps)
 
 
-def target_skeleton(target: Skeleton | Motion) -> Skeleton:
-    """B's canonical 22-joint T-pose skeleton from a rig (or a Motion on it).
+def target_skeleton(target: Skeleton | Motion, what: str = "target") -> Skeleton:
+    """B's canonical 22-joint skeleton in its standing rest pose (:func:`rest_pose.standing_skeleton`).
 
-    Raises :class:`humanoid.RigMappingError` naming the joints that cannot be mapped.
+    ``target`` is a rig (Skeleton) or a Motion on it; the motion is used only when the rest
+    offsets do not stand. A canonical skeleton is returned as it is.
+
+    Raises :class:`humanoid.RigMappingError` naming the joints that cannot be mapped and
+    :class:`rest_pose.RestPoseError` (naming ``what``) when no standing pose can be found.
     """
     sk = target.skeleton if isinstance(target, Motion) else target
     if not isinstance(sk, Skeleton):
         raise ValueError(f"expected a target Skeleton or Motion, got {type(target).__name__}")
-    out = humanoid.to_canonical_skeleton(sk)
+    out = rest_pose.standing_skeleton(target, what)[0]
     if out.height() <= 1e-6:
         raise ValueError("the target skeleton has zero height")
     return out
@@ -272,7 +290,7 @@ def prepare_source(
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     check_motion(source, "source motion")
     fps = checkpoint.fps if checkpoint is not None else source.fps
-    src = preprocess.prepare(source, fps)
+    src = preprocess.prepare(source, fps, stand=True)
     check_motion(src, "source motion")
     if method == "copy":
         return PreparedSource(source.name, src)
@@ -318,9 +336,31 @@ def finish(
         local_rot = _to_world(heading_rot, src.features.yaw)
     name = f"{src.name}_on_target" if src.name else "retargeted"
     motion = Motion(pair.target, local_rot, pair.root_pos, src.motion.fps, None, name)
-    return RetargetResult(
-        motion, motion.global_positions(), method, pair.root_scale, history or {}, stop_reason, steps, seconds
-    )
+    positions = motion.global_positions()
+    planted = None if src.planted is None else src.planted[0].cpu().numpy()
+    check = plausibility.check(positions, pair.target, src.motion, planted)
+    return RetargetResult(motion, positions, method, pair.root_scale, history or {}, stop_reason, steps, seconds, check)
+
+
+def _same_rate(a: float, b: float) -> bool:
+    return abs(a - b) <= 1e-4 * max(a, b)
+
+
+def at_rate(result: RetargetResult, fps: float, source_fps: float) -> RetargetResult:
+    """``result`` resampled to ``fps`` (frames per second), with ``resampled`` saying what happened.
+
+    ``source_fps`` is the source file's rate; the text names every rate the clip went through
+    (source, network, output) whenever one differs from another, so callers can always print it.
+    Rates within 1e-4 (relative) are the same. Plausibility stays that of the solved rate.
+    """
+    solved = result.motion.fps
+    if _same_rate(fps, solved) and _same_rate(source_fps, solved):
+        return result
+    note = f"resampled: source {source_fps:g} fps -> network {solved:g} fps -> output {fps:g} fps"
+    if _same_rate(fps, solved):
+        return replace(result, resampled=note)
+    motion = result.motion.resample(fps)
+    return replace(result, motion=motion, positions=motion.global_positions(), resampled=note)
 
 
 def retarget(
@@ -332,6 +372,7 @@ def retarget(
     root_mode: str = "stride",
     progress: bool = False,
     callback=None,
+    fps: float | None = None,
 ) -> RetargetResult:
     """Generate B's version of ``source``.
 
@@ -346,11 +387,19 @@ def retarget(
     root_mode : ``"stride"`` (default), ``"hips"`` or ``"legs"``: how A's root trajectory is scaled
     progress : tqdm bar for the iteration
     callback : passed to :func:`solver.solve` (per-step ``loss``, ``angle``, ``foot``)
+    fps : frame rate of the output (default: the source's); the network runs at the
+        checkpoint's rate and :func:`at_rate` converts
 
     Returns
     -------
     RetargetResult; ``result.motion`` is a proper Motion (local rotations + root positions) on
-    B's canonical skeleton, so bone lengths are exact.
+    B's canonical standing skeleton, so bone lengths are exact; ``result.plausibility`` says
+    whether it passed the plausibility tests, ``result.resampled`` how the rate changed.
+
+    Raises
+    ------
+    ValueError (and its subclasses :class:`humanoid.RigMappingError`,
+    :class:`rest_pose.RestPoseError`) for a source or target that cannot be used.
 
     Notes
     -----
@@ -361,7 +410,7 @@ def retarget(
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     check_motion(source, "source motion")
-    target_skeleton(target)  # a bad target fails before any work
+    target = target_skeleton(target)  # a bad target fails before any work
     if method != "copy" and checkpoint is None:
         from motionlab.retargeting import load_default
 
@@ -391,4 +440,5 @@ def retarget(
             fps=src.motion.fps,
         )
         heading_rot, history, reason, steps = res.local_rot[0], res.history, res.stop_reason, res.steps
-    return finish(pair, heading_rot, method, history, reason, steps, time.perf_counter() - start)
+    result = finish(pair, heading_rot, method, history, reason, steps, time.perf_counter() - start)
+    return at_rate(result, fps or source.fps, source.fps)

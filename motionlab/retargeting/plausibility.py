@@ -1,0 +1,149 @@
+"""Is a retargeted clip physically plausible on its target? Checked on every output.
+
+A retargeted clip of B is **plausible** when, with ``leg`` = B's thigh + shin
+(:func:`motionlab.core.humanoid.leg_length`) and ``hip`` = B's standing hip height
+(:func:`motionlab.retargeting.pipeline.hip_height` of the standing rest pose,
+:mod:`motionlab.core.rest_pose`):
+
+* **feet on the floor** (``foot``): on the frames where A's foot joints are planted
+  (:func:`pipeline.source_contacts`), the median height of B's same joints above their own
+  contact height (rest height above the lowest rest joint, :func:`contacts.rest_heights`), as a
+  fraction of ``leg``, is within :data:`FOOT_TOL` of the same measure of A on A's legs — a
+  tenth of the leg is a few centimetres on a human and still tells a planted foot from a lifted
+  one. The test is against A's own value so that a source recorded a little above its floor
+  (mocap markers, a rig's foot joints off the sole) does not condemn every output: it flags
+  what the retargeting did;
+* **nothing deep under the floor** (``floor``): no joint in any frame lower than
+  :data:`FOOT_TOL` × ``leg`` below ``y = 0`` or below A's own lowest joint (as a fraction of A's
+  leg; a source whose toes dip under its floor passes that on);
+* **hips at a standing height for B's legs** (``hips``): B's median root height as a fraction of
+  ``hip`` differs from A's median root height as a fraction of A's standing hip height by at most
+  :data:`HIP_TOL` (a crouch stays a crouch, a stand a stand, whatever the legs);
+* **B's bone lengths** (``bones``): every bone of every frame within :data:`BONE_TOL` of B's
+  rest length (relative).
+
+The thresholds are fractions of the target's own leg length or standing height, set by these
+principles, never fitted to clips, so they hold for any size or file unit. A clip without
+planted frames skips the foot test.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from motionlab.core import humanoid
+from motionlab.core.motion import Motion
+from motionlab.retargeting import contacts
+
+__all__ = ["FOOT_TOL", "HIP_TOL", "BONE_TOL", "Plausibility", "check"]
+
+FOOT_TOL = 0.10
+"""Foot height in contact frames and depth under the floor allowed, as a fraction of B's leg length."""
+HIP_TOL = 0.20
+"""Allowed difference of the median hip height, as a fraction of the standing hip height (B's vs A's)."""
+BONE_TOL = 0.01
+"""Allowed relative deviation of a bone's length from B's rest length."""
+
+
+@dataclass(frozen=True)
+class Plausibility:
+    """The plausibility measures of one retargeted clip and the tests it failed.
+
+    Attributes
+    ----------
+    foot_height : float     median height of B's planted foot joints above contact height, / leg (nan: no contacts)
+    source_foot_height : float   the same for A, / A's leg
+    lowest : float          lowest joint height over the clip, / leg (negative: under the floor)
+    source_lowest : float   the same for A, / A's leg
+    hip_ratio : float       B's median root height / B's standing hip height
+    source_hip_ratio : float   the same for A on A
+    bone_error : float      largest relative bone-length deviation
+    failed : tuple of str   names of the failed tests: ``foot``, ``floor``, ``hips``, ``bones``
+    """
+
+    foot_height: float
+    source_foot_height: float
+    lowest: float
+    source_lowest: float
+    hip_ratio: float
+    source_hip_ratio: float
+    bone_error: float
+    failed: tuple[str, ...]
+
+    @property
+    def ok(self) -> bool:
+        """True when every test passed."""
+        return not self.failed
+
+    def describe(self) -> str:
+        """One line: the measures and, when some failed, which."""
+        verdict = "plausible" if self.ok else "IMPLAUSIBLE (" + ", ".join(self.failed) + ")"
+        return (
+            f"{verdict}: hip height {self.hip_ratio:.2f} of standing (source {self.source_hip_ratio:.2f}), "
+            f"foot in contact {self.foot_height:+.3f} leg (source {self.source_foot_height:+.3f}), lowest joint {self.lowest:+.3f} leg (source {self.source_lowest:+.3f}), "
+            f"bone lengths within {100 * self.bone_error:.2g} %"
+        )
+
+
+def _hip_ratio(positions: np.ndarray, skeleton) -> float:
+    rest = skeleton.rest_positions()
+    standing = rest[0, 1] - rest[:, 1].min()
+    return float(np.median(positions[:, 0, 1]) / standing) if standing > 0 else float("nan")
+
+
+def _foot_height(positions: np.ndarray, skeleton, planted: np.ndarray) -> float:
+    """Median height of the planted foot joints above their contact height, / leg (nan: none planted)."""
+    if not np.any(planted):
+        return float("nan")
+    heights = positions[:, list(contacts.CONTACT_JOINTS), 1] - contacts.rest_heights(skeleton)[None]
+    return float(np.median(heights[planted]) / humanoid.leg_length(skeleton))
+
+
+def check(positions: np.ndarray, target, source: Motion, planted: np.ndarray | None = None) -> Plausibility:
+    """The plausibility tests of the module docstring.
+
+    Parameters
+    ----------
+    positions : ndarray (T, 22, 3)   B's world joint positions, metres
+    target : Skeleton                B's canonical skeleton in its standing rest pose
+    source : Motion                  A on the canonical 22 joints in its standing rest pose, T frames
+    planted : ndarray (T, 4) of bool, optional   A's planted foot joints (default: detected on ``source``)
+
+    Returns
+    -------
+    Plausibility
+
+    Raises
+    ------
+    ValueError when ``positions`` and ``source`` differ in frames.
+    """
+    positions = np.asarray(positions, dtype=np.float64)
+    if positions.shape[0] != source.num_frames:
+        raise ValueError(f"{positions.shape[0]} retargeted frames but {source.num_frames} source frames")
+    if planted is None:
+        from motionlab.retargeting.pipeline import source_contacts
+
+        planted = source_contacts(source)
+    leg = humanoid.leg_length(target)
+    foot = _foot_height(positions, target, planted)
+    src_pos = source.global_positions()
+    src_foot = _foot_height(src_pos, source.skeleton, planted)
+    lowest = float(positions[..., 1].min() / leg)
+    src_lowest = float(src_pos[..., 1].min() / humanoid.leg_length(source.skeleton))
+    hip, src_hip = _hip_ratio(positions, target), _hip_ratio(src_pos, source.skeleton)
+    bones = np.linalg.norm(positions[:, 1:] - positions[:, humanoid.PARENTS[1:]], axis=-1)
+    rest = target.bone_lengths()[1:]
+    long = rest > 1e-9
+    bone_error = float(np.abs(bones[:, long] / rest[long] - 1.0).max()) if long.any() else 0.0
+    failed = []
+    if not abs(foot - src_foot) <= FOOT_TOL and not np.isnan(foot - src_foot):
+        failed.append("foot")
+    if not lowest >= min(0.0, src_lowest) - FOOT_TOL:
+        failed.append("floor")
+    if not abs(hip - src_hip) <= HIP_TOL:
+        failed.append("hips")
+    if not bone_error <= BONE_TOL:
+        failed.append("bones")
+    return Plausibility(foot, src_foot, lowest, src_lowest, hip, src_hip, bone_error, tuple(failed))

@@ -1,0 +1,108 @@
+"""The canonical standing rest pose (:mod:`motionlab.core.rest_pose`) on synthetic and real rigs."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from motionlab import synthetic
+from motionlab.core import bvh, humanoid, quat, rest_pose
+from motionlab.core.motion import Motion
+from motionlab.core.skeleton import Skeleton
+from motionlab.retargeting import pipeline
+from tests.conftest import require_data
+
+
+def _walk(frames: int = 60) -> Motion:
+    return synthetic.generate("walk", humanoid.canonical_skeleton(), num_frames=frames, fps=60, seed=0)
+
+
+def _repose(motion: Motion, turn: np.ndarray) -> Motion:
+    """The same world motion on rest offsets turned by ``turn`` (22, 4) per joint (a studio's own rest)."""
+    sk, parents = motion.skeleton, humanoid.PARENTS
+    offsets = sk.offsets.copy()
+    offsets[1:] = quat.rotate(turn[parents[1:]], sk.offsets[1:])
+    local = quat.mul(motion.local_rot, quat.conj(turn)[None])
+    local[:, 1:] = quat.mul(turn[None, parents[1:]], local[:, 1:])
+    return Motion(Skeleton(sk.names, parents, offsets), quat.normalize(local), motion.root_pos.copy(), motion.fps)
+
+
+def _lying(motion: Motion) -> Motion:
+    """Every bone along +X at rest, as Bandai Namco's rig: each joint's bones turned to +X."""
+    turn = np.tile([1.0, 0, 0, 0], (22, 1))
+    for c in range(1, 22):
+        turn[humanoid.PARENTS[c]] = quat.between(motion.skeleton.offsets[c], np.array([1.0, 0.0, 0.0]))
+    return _repose(motion, turn)
+
+
+def test_t_pose_rig_is_left_as_it_is():
+    walk = _walk()
+    out, pose = rest_pose.standing(walk)
+    assert out is walk and pose.source == "rest" and pose.straightened == ()
+
+
+def test_lying_rest_stands_from_the_motion_with_world_positions_kept():
+    walk = _walk()
+    lying = _lying(walk)
+    np.testing.assert_allclose(lying.global_positions(), walk.global_positions(), atol=1e-9)
+    assert pipeline.hip_height(lying.skeleton) < 0.1  # the bug: a lying rest has no hip height
+    out, pose = rest_pose.standing(lying)
+    assert pose.source == "motion" and pose.frame >= 0
+    np.testing.assert_allclose(out.global_positions(), walk.global_positions(), atol=1e-9)
+    # legs straight below the hips: the standing hip height is the T-pose's within 3 % (the frame's
+    # pelvis tilt and ankle angle stay)
+    assert pipeline.hip_height(out.skeleton) == pytest.approx(pipeline.hip_height(walk.skeleton), rel=0.03)
+    np.testing.assert_allclose(out.skeleton.bone_lengths(), walk.skeleton.bone_lengths(), atol=1e-9)
+
+
+def test_arms_down_and_spread_legs_are_turned_onto_the_t_pose():
+    walk = _walk()
+    turn = np.tile([1.0, 0, 0, 0], (22, 1))
+    for side, sign in (("Left", 1.0), ("Right", -1.0)):
+        arm = quat.from_axis_angle([0.0, 0.0, 1.0], -sign * np.pi / 2)  # arms hang down
+        turn[humanoid.JOINTS.index(f"{side}Arm")] = arm
+        turn[humanoid.JOINTS.index(f"{side}ForeArm")] = arm
+        turn[humanoid.JOINTS.index(f"{side}Hand")] = arm  # a leaf turns with its bone
+        spread = quat.from_axis_angle([0.0, 0.0, 1.0], sign * np.radians(20))  # an A-stance
+        turn[humanoid.JOINTS.index(f"{side}UpLeg")] = spread
+        turn[humanoid.JOINTS.index(f"{side}Leg")] = spread
+    out, pose = rest_pose.standing(_repose(walk, turn))
+    assert pose.source == "rest"
+    assert {"LeftForeArm", "LeftHand", "LeftLeg", "LeftFoot"} <= set(pose.straightened)
+    np.testing.assert_allclose(out.skeleton.offsets[1:], walk.skeleton.offsets[1:], atol=1e-9)
+    np.testing.assert_allclose(out.global_positions(), walk.global_positions(), atol=1e-9)
+    same = np.abs((out.local_rot * walk.local_rot).sum(-1))  # |cos| of half the angle between them
+    np.testing.assert_allclose(same, 1.0, atol=1e-9)
+
+
+def test_no_standing_pose_is_a_named_error():
+    lying = _lying(_walk(10))
+    crawl = lying.copy(local_rot=np.tile(quat.normalize(lying.local_rot[:1] * 0 + [1.0, 0, 0, 0]), (10, 1, 1)))
+    with pytest.raises(rest_pose.RestPoseError, match=r"crawl.bvh: no standing pose.*(thigh|shin|Hips->Neck)"):
+        rest_pose.standing(crawl, "crawl.bvh")
+    with pytest.raises(rest_pose.RestPoseError, match=r"rig.bvh: the rest offsets are not a standing pose.*no motion"):
+        rest_pose.standing_skeleton(lying.skeleton, "rig.bvh")
+
+
+def test_bandai_namco_stands_like_a_mixamo_character():
+    """The issue's bug: Bandai's rest hip height was 0.065 m; its standing pose gives a human one."""
+    root = require_data("bandai_namco")
+    motion = bvh.load(root / "dataset-1" / "walk" / "dataset-1_walk_normal_001.bvh")
+    sk, pose = rest_pose.standing_skeleton(motion, "bandai")
+    assert pose.source == "motion"
+    leg = humanoid.leg_length(sk)
+    assert 1.0 < pipeline.hip_height(sk) / leg < 1.3  # hips above straight legs plus the foot
+    aj = require_data("mixamo", "Aj", "Running.bvh")
+    r = pipeline.root_scale(pipeline.target_skeleton(bvh.load(aj)), sk)
+    assert 0.8 < r[1] < 1.3  # was 0.063 (and 15.9 the other way)
+
+
+def test_info_says_which_pose_it_used(tmp_path, capsys):
+    from motionlab.cli import main
+
+    bvh.save(tmp_path / "tpose.bvh", _walk(20))
+    bvh.save(tmp_path / "lying.bvh", _lying(_walk(20)))
+    assert main(["info", str(tmp_path / "tpose.bvh")]) == 0
+    assert "rest      standing pose from the rest offsets" in capsys.readouterr().out
+    assert main(["info", str(tmp_path / "lying.bvh")]) == 0
+    assert "standing pose from frame" in capsys.readouterr().out

@@ -1,0 +1,60 @@
+"""The plausibility check on retargeted outputs (:mod:`motionlab.retargeting.plausibility`)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from motionlab import retargeting, synthetic
+from motionlab.core import humanoid
+from motionlab.retargeting import plausibility
+from motionlab.retargeting.pipeline import retarget
+from motionlab.retargeting.solver import SolverConfig
+
+FAST = SolverConfig(max_steps=8)
+
+
+@pytest.fixture(scope="module")
+def walked():
+    ckpt = retargeting.load_default("cpu")
+    clip = synthetic.dataset(1, seed=1, num_frames=40)[0]
+    target = humanoid.scale_bones(humanoid.canonical_skeleton(), legs=1.2)
+    res = retarget(clip, target, ckpt, solver=FAST)
+    from motionlab.retargeting.pipeline import prepare_source
+
+    return res, prepare_source(clip, None, "copy").motion
+
+
+def test_a_good_output_passes(walked):
+    res, src = walked
+    assert res.plausibility.ok, res.plausibility.describe()
+    assert res.plausibility.bone_error < 1e-9
+
+
+def test_lifted_sunk_stretched_outputs_fail(walked):
+    res, src = walked
+    leg = humanoid.leg_length(res.motion.skeleton)
+    up = res.positions + [0.0, 0.5 * leg, 0.0]
+    assert plausibility.check(up, res.motion.skeleton, src).failed == ("foot", "hips")
+    down = res.positions - [0.0, 0.3 * leg, 0.0]
+    assert set(plausibility.check(down, res.motion.skeleton, src).failed) == {"foot", "floor", "hips"}
+    stretched = res.positions.copy()
+    stretched[:, humanoid.JOINTS.index("LeftHand")] *= 1.1
+    assert plausibility.check(stretched, res.motion.skeleton, src).failed == ("bones",)
+
+
+def test_root_rule_that_sinks_short_legs_is_flagged():
+    """Scaling the root by thigh + shin on a very short-legged character puts its feet in the floor."""
+    ckpt = retargeting.load_default("cpu")
+    clip = synthetic.dataset(1, seed=1, num_frames=40)[0]
+    stubby = humanoid.scale_bones(humanoid.canonical_skeleton(), legs=0.4)
+    assert retarget(clip, stubby, ckpt, solver=FAST).plausibility.ok
+    bad = retarget(clip, stubby, ckpt, solver=FAST, root_mode="legs").plausibility
+    assert "foot" in bad.failed and "IMPLAUSIBLE" in bad.describe()
+
+
+def test_frames_must_match(walked):
+    res, src = walked
+    with pytest.raises(ValueError, match="frames"):
+        plausibility.check(res.positions[:-1], res.motion.skeleton, src)
+    assert np.isfinite(res.plausibility.hip_ratio)
