@@ -69,7 +69,7 @@ def rule(enabled: bool):
         threads.SMALL_ROWS = before
 
 
-def sizes(ckpt, lengths=(120, 480, 1920, 7680, 15360), repeats=3) -> None:
+def sizes(ckpt, lengths=(120, 480, 960, 1920), repeats=3) -> None:
     cfg = SolverConfig(max_steps=20, threshold=0.0, patience=0)
     target = synthetic.character_set(1, seed=1)[0]
     print(f"part 1: 20 latent-iteration steps, one clip; torch default threads = {torch.get_num_threads()}")

@@ -33,6 +33,7 @@ from motionlab.core.skeleton import Skeleton
 
 __all__ = [
     "JOINTS",
+    "heading",
     "PARENTS",
     "FEET",
     "PROFILES",
@@ -410,3 +411,20 @@ def canonical_skeleton(height: float = 1.75) -> Skeleton:
         JOINTS.index("RightToeBase"): (0.0, 0.0, 0.07),
     }
     return Skeleton(JOINTS, PARENTS, np.array(offsets) * h, {j: np.array(v) * h for j, v in ends.items()})
+
+
+def heading(global_pos: np.ndarray) -> np.ndarray:
+    """Facing angle about +Y (radians, 0 = facing +Z) of canonical poses (..., 22, 3).
+
+    Forward is ``across × up`` where ``across`` averages the right→left hip and shoulder vectors.
+    """
+    pos = np.asarray(global_pos)
+    if pos.shape[-2:] != (len(JOINTS), 3):
+        raise ValueError(f"expected canonical positions (..., 22, 3), got {pos.shape}")
+    hips, shoulders = (
+        [JOINTS.index(n) for n in ("LeftUpLeg", "RightUpLeg")],
+        [JOINTS.index(n) for n in ("LeftArm", "RightArm")],
+    )
+    across = (pos[..., hips[0], :] - pos[..., hips[1], :]) + (pos[..., shoulders[0], :] - pos[..., shoulders[1], :])
+    forward = np.cross(across, np.array([0.0, 1.0, 0.0]))
+    return np.arctan2(forward[..., 0], forward[..., 2])

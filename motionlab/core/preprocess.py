@@ -39,9 +39,6 @@ __all__ = [
     "NormStats",
 ]
 
-_L_HIP, _R_HIP = humanoid.JOINTS.index("LeftUpLeg"), humanoid.JOINTS.index("RightUpLeg")
-_L_SH, _R_SH = humanoid.JOINTS.index("LeftArm"), humanoid.JOINTS.index("RightArm")
-
 
 def prepare(motion: Motion, fps: float | None = 60.0, profile=None, stand: bool = False) -> Motion:
     """Reduce a motion to the 22-joint humanoid and resample it to ``fps`` (``None``: keep).
@@ -61,17 +58,7 @@ def prepare(motion: Motion, fps: float | None = 60.0, profile=None, stand: bool 
     return out
 
 
-def heading(global_pos: np.ndarray) -> np.ndarray:
-    """Facing angle about +Y (radians, 0 = facing +Z) of canonical poses (..., 22, 3).
-
-    Forward is ``across × up`` where ``across`` averages the right→left hip and shoulder vectors.
-    """
-    pos = np.asarray(global_pos)
-    if pos.shape[-2:] != (len(humanoid.JOINTS), 3):
-        raise ValueError(f"expected canonical positions (..., 22, 3), got {pos.shape}")
-    across = (pos[..., _L_HIP, :] - pos[..., _R_HIP, :]) + (pos[..., _L_SH, :] - pos[..., _R_SH, :])
-    forward = np.cross(across, np.array([0.0, 1.0, 0.0]))
-    return np.arctan2(forward[..., 0], forward[..., 2])
+heading = humanoid.heading  # the facing angle of canonical poses, used throughout this module
 
 
 @dataclass

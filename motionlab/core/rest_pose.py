@@ -172,9 +172,8 @@ def _standing_turn(motion: Motion, what: str) -> tuple[np.ndarray, int, float]:
             f"{TOLERANCE_DEG:g} deg of straight down and Hips->Neck of straight up (most upright: frame {t}, where "
             f"{_WHAT[which[t]]} is {score[t]:.0f} deg off)"
         )
-    from motionlab.core import preprocess
 
-    yaw = preprocess.heading(g_pos[t])
+    yaw = humanoid.heading(g_pos[t])
     return quat.mul(quat.from_yaw(-yaw)[None], g_rot[t]), t, float(score[t])
 
 

@@ -36,7 +36,7 @@ import numpy as np
 
 from motionlab.core import humanoid
 
-__all__ = ["CONTACT_JOINTS", "HEIGHT_TOL", "SPEED_TOL", "MIN_FRAMES", "detect_contacts", "rest_heights"]
+__all__ = ["CONTACT_JOINTS", "HEIGHT_TOL", "SPEED_TOL", "MIN_FRAMES", "detect_contacts", "rest_heights", "of_motion"]
 
 CONTACT_JOINTS: tuple[int, ...] = tuple(humanoid.JOINTS.index(n) for n in humanoid.FEET)
 """LeftFoot, RightFoot, LeftToeBase, RightToeBase: the joints whose contacts are detected."""
@@ -115,3 +115,10 @@ def rest_heights(skeleton) -> np.ndarray:
     """Rest-pose heights (4,) of the contact joints above the skeleton's lowest rest joint, metres."""
     rest = skeleton.rest_positions()
     return rest[list(CONTACT_JOINTS), 1] - rest[:, 1].min()
+
+
+def of_motion(motion) -> np.ndarray:
+    """Planted feet (T, 4) of a motion on the canonical 22-joint humanoid (:func:`detect_contacts`
+    with the skeleton's own rest heights and height)."""
+    sk = motion.skeleton
+    return detect_contacts(motion.global_positions(), rest_heights(sk), sk.height(), motion.fps)

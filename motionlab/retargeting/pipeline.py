@@ -193,8 +193,7 @@ def root_scale(source: Skeleton, target: Skeleton, mode: str = "stride") -> tupl
 
 def source_contacts(source: Motion) -> np.ndarray:
     """A's planted feet (T, 4) for the contact term, from a canonical motion (:mod:`.contacts`)."""
-    sk = source.skeleton
-    return contacts.detect_contacts(source.global_positions(), contacts.rest_heights(sk), sk.height(), source.fps)
+    return contacts.of_motion(source)
 
 
 def target_skeleton(target: Skeleton | Motion, what: str = "target") -> Skeleton:

@@ -123,9 +123,7 @@ def check(positions: np.ndarray, target, source: Motion, planted: np.ndarray | N
     if positions.shape[0] != source.num_frames:
         raise ValueError(f"{positions.shape[0]} retargeted frames but {source.num_frames} source frames")
     if planted is None:
-        from motionlab.retargeting.pipeline import source_contacts
-
-        planted = source_contacts(source)
+        planted = contacts.of_motion(source)
     leg = humanoid.leg_length(target)
     foot = _foot_height(positions, target, planted)
     src_pos = source.global_positions()

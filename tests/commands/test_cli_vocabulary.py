@@ -52,6 +52,7 @@ VOCABULARY = {
     "--device": ("device", "text", "torch device"),
     "--checkpoint": ("checkpoint", "text", "the retargeting network's checkpoint file"),
     "--canonical": ("canonical", "flag", "reduce the rig to the canonical 22 joints"),
+    "--keep-implausible": ("keep_implausible", "flag", "keep outputs that fail the plausibility check"),
     "--characters": ("characters", "text", "target characters given as rigs (expand)"),
     "--num-characters": ("num_characters", "positive_int", "how many synthetic characters (demo)"),
     "--root": ("root", "text", "root trajectory rule of retargeting (stride, hips, legs, contacts)"),
