@@ -1,11 +1,12 @@
 """How many CPU threads torch uses for a piece of work.
 
-torch splits each operation over all cores. For the small tensors of an interactive solve (one
-clip of a few hundred frames) the threads spend more time waiting for each other than
-computing, and when another program keeps the cores busy a waiting thread may not be scheduled
-for a whole time slice: the same solve then takes several times longer. So work below
-:data:`SMALL_ROWS` rows per step runs on one thread; larger work keeps torch's own setting.
-The threshold and the measurements behind it are printed by ``benchmarks/bench_threads.py``.
+torch splits each operation over all cores. On a quiet machine that makes even a small solve
+faster, but when another program keeps the cores busy, each operation waits for its slowest
+thread, and a thread that is not scheduled holds up every step: a one-clip solve then takes
+many times longer. So interactive work, up to :data:`SMALL_ROWS` rows (sequences × frames) per
+step, runs on one thread: it gives up the second thread's gain on a quiet machine to stay fast on
+a busy one. Larger work keeps torch's own setting. ``benchmarks/bench_threads.py`` prints both
+sides of that trade, quiet and under load.
 """
 
 from __future__ import annotations
@@ -18,7 +19,9 @@ import torch
 __all__ = ["SMALL_ROWS", "threads_for", "torch_threads"]
 
 SMALL_ROWS = 8192
-"""Rows (sequences × frames) per step up to which one thread is used."""
+"""Rows (sequences × frames) per step up to which one thread is used: one clip of up to about two
+minutes at 60 fps, the size of interactive work (the proportion sliders, ``retarget`` of a clip,
+the demo)."""
 
 
 def threads_for(rows: int) -> int:

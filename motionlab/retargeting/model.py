@@ -312,8 +312,8 @@ class RetargetNet(nn.Module):
         M, D = phi.shape
 
         def tangent(u: torch.Tensor, length: torch.Tensor, du: torch.Tensor) -> torch.Tensor:
-            # d unit(r) = (du − u ⟨u, du⟩) / ‖r‖ for du (M, J, 4, D); elementwise (tiny batched matmuls are slow)
-            return (du - u[..., :, None] * (u[..., :, None] * du).sum(-2, keepdim=True)) / length[..., None]
+            # d unit(r) = (du − u ⟨u, du⟩) / ‖r‖ for du (M, J, 4, D)
+            return (du - u[..., :, None] * torch.einsum("mjb,mjbd->mjd", u, du)[..., None, :]) / length[..., None]
 
         r = self.f_qlinear(phi).reshape(M, NUM_JOINTS, 4)
         rlen = torch.sqrt((r * r).sum(-1, keepdim=True))
@@ -335,9 +335,9 @@ class RetargetNet(nn.Module):
         left = torch.stack([w, -x, -y, -z, x, w, -z, y, y, z, w, -x, z, -y, x, w], -1).reshape(M, NUM_JOINTS, 4, 4)
         w, x, y, z = p.unbind(-1)
         right = torch.stack([w, -x, -y, -z, x, w, z, -y, y, -z, w, x, z, y, -x, w], -1).reshape(M, NUM_JOINTS, 4, 4)
-        jac = (right[..., None] * jq[..., None, :, :]).sum(-2)
+        jac = torch.einsum("mjab,mjbd->mjad", right, jq)  # R(p) dq for every frame, joint and latent channel
         if jp is not None:
-            jac = jac + (left[..., None] * jp[..., None, :, :]).sum(-2)
+            jac = jac + torch.einsum("mjab,mjbd->mjad", left, jp)  # + L(q) dp
         return tq.mul(q, p), jac.reshape(M, 4 * NUM_JOINTS, D)
 
     def decode(self, phi: torch.Tensor, offsets: torch.Tensor, embedding: torch.Tensor | None = None) -> Decoded:
