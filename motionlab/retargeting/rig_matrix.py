@@ -56,13 +56,13 @@ def family_clips(root: str | Path | None, seconds: float = 3.0) -> dict[str, Mot
 def pair_matrix(clips: dict[str, Motion], checkpoint, solver=None, pairs=None) -> list[dict]:
     """Retarget each clip onto each other family's rig (``pairs``: the ``(source, target)`` to run).
 
-        Returns one dict per pair: ``source``, ``target``, ``ok``, ``failed``, ``root_scale_y`` (the vertical
-    root scale B / A, standing hip heights), ``hip_ratio`` (B's median
-        hip height / B's standing hip height), ``source_hip_ratio``, ``foot_cm`` (median height of
-        planted feet above contact height, cm), ``foot_leg`` (the same / B's leg length),
-        ``source_foot_leg`` (A's, / A's leg length),
-        ``lowest_leg``, ``skating_cm_s`` (B's planted-foot speed on A's contact frames,
-    :func:`metrics.planted_slide`) and ``source_skating_cm_s`` (A's own), ``fps`` (output) and ``source_fps``.
+    Returns one dict per pair: ``source``, ``target``, ``ok``, ``failed``, ``root_scale_y`` (the
+    vertical root scale B / A, standing hip heights), ``hip_ratio`` (B's median hip height / B's
+    standing hip height), ``source_hip_ratio``, ``foot_cm`` (median height of planted feet above
+    contact height, cm), ``foot_leg`` (the same / B's leg length), ``source_foot_leg`` (A's, / A's
+    leg length), ``lowest_leg``, ``skating_cm_s`` (B's planted-foot speed on A's contact frames,
+    :func:`metrics.planted_slide`), ``source_skating_cm_s`` (A's own), ``fps`` (output) and
+    ``source_fps``.
     """
     from motionlab.retargeting.pipeline import retarget, source_contacts
 
