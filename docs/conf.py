@@ -28,7 +28,8 @@ extensions = [
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
     "sphinx-mathjax-offline",  # MathJax served from the site itself: formulas render offline too
-    "sphinx.ext.viewcode",
+    # no sphinx.ext.viewcode: the code is in the repository, and its highlighted copy (8 MB) kept the
+    # site over its 50 MB budget
 ]
 
 # --- sources --------------------------------------------------------------------------------

@@ -146,8 +146,11 @@ def _check_player(browser, rel: str, out: Path, timeout_ms: int = 20_000) -> dic
         page.wait_for_timeout(200)
         stem = Path(rel).stem
         (out / "players").mkdir(parents=True, exist_ok=True)
+        start = time.monotonic()
         first = canvas.screenshot(path=str(out / "players" / f"{stem}_0.png"))
-        page.wait_for_timeout(500)
+        # 0.5 s from the first shot to the second, whatever the first took (a slow screenshot
+        # added to a fixed wait can land a whole loop of a 1-second clip later: the same frame)
+        page.wait_for_timeout(max(0.0, 500.0 - 1000.0 * (time.monotonic() - start)))
         second = canvas.screenshot(path=str(out / "players" / f"{stem}_1.png"))
         result["changed"] = round(_changed_fraction(first, second), 4)
         result["errors"] = errors
