@@ -1,4 +1,4 @@
-"""System C: key-pose-constrained interpolation and gap filling (algorithms.md §C).
+"""System C: key-pose-constrained interpolation and gap filling (Yang, Su, Yan, Li and Liu 2019, key-pose-constrained interpolation of human motion sequences).
 
 Modules, one concept each:
 

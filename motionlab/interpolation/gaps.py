@@ -295,8 +295,8 @@ def moving_slerp(rot_a, trans_a, rot_b, trans_b, curve: str = "linear") -> tuple
     transition frame ``A(m)`` while sequence B runs into its transition frame ``B(n)``, and the
     weight moves from A to B (``α(0) = 0``, ``α(L) = 1``; between them ``α`` from ``curve``). Both
     ends move, so the in-between keeps the motion of the two actions instead of sliding between
-    two frozen poses; when each sequence holds one repeated frame it is plain SLERP. (algorithms.md
-    §C.6 leaves the index directions open; this reading keeps both sequences in forward time.)
+    two frozen poses; when each sequence holds one repeated frame it is plain SLERP. (The paper
+    leaves the index directions open; this reading keeps both sequences in forward time.)
 
     Parameters
     ----------
@@ -547,7 +547,7 @@ def _follow_strides(motion: Motion, a: int, b: int, joint: int, target: np.ndarr
     is wrong near the other end: on ``sessions/walk`` ``walk_normal_001`` cut at frame 20 the root
     missed by 11.0% of its displacement (SLERP with the Hermite root: 2.9%), now 4.1%. Chosen on
     the normal walk takes against the strides' own speed, the swap everywhere and SLERP with the
-    Hermite root where the speed changes (``scripts/compare_stride_root.py``; README)."""
+    Hermite root where the speed changes (``scripts/compare_stride_root.py``; ``docs/results_interpolation.md``)."""
     out = _follow(motion, a, b, joint, target)
     if detect.changes_speed(*side_speeds(motion, a, b, joint)):
         out = smooth_root(out, [a, b], joint=joint)
@@ -589,7 +589,7 @@ def fill(
         tangents are the velocities measured just outside the gap (:func:`smooth_root` with the
         gap's two ends as anchors), so a walking character keeps walking through it at the speed
         it had on both sides; or ``"stride"``, the recorded strides on both sides continued across
-        the gap (turned with the walker's heading) and blended (:mod:`.stride_root`; the Hermite
+        the gap (turned with the walker's heading) and blended (``_stride_root``; the Hermite
         curve where no stride can be read), which keeps the hips' bob and sway. The
         foot-through-floor guard of :func:`smooth_root` applies to both. (The ``"graph"`` method
         always uses the Hermite curve through its key poses.)

@@ -1,6 +1,6 @@
 """Key poses: segment a long recording into action nodes by clustering in PPCA latent space.
 
-The paper (algorithms.md §C.2) projects poses with PPCA and clusters them; each cluster that
+The paper (Yang, Su, Yan, Li and Liu 2019, key-pose-constrained interpolation of human motion sequences) projects poses with PPCA and clusters them; each cluster that
 forms a contiguous stretch of the recording is an *action node* (stand, walk, run, squat …)
 holding a short sequence of key frames ``M_i = [m_0 … m_t]``. Our recipe:
 

@@ -1,6 +1,6 @@
 """SLERP along a gap: the weights α(k), quaternion paths, and Euler interpolation for contrast.
 
-The paper (algorithms.md §C.6) fills ``N`` missing frames between a known frame ``A(m)`` and a
+The paper (Yang, Su, Yan, Li and Liu 2019, key-pose-constrained interpolation of human motion sequences) fills ``N`` missing frames between a known frame ``A(m)`` and a
 known frame ``B(n)`` with
 
 .. math::

@@ -52,7 +52,7 @@ def build_report(graph: MotionGraph) -> dict:
     links)), ``behaviour_links`` (ordered behaviour pairs joined directly: ``source``,
     ``target``, ``via`` → number of links), ``largest_scc`` and ``recorded_frames``
     (whole graph), ``percent``, ``conditions`` (kind → ``count``, ``example``) and ``info``
-    (build times and counts; ``threshold`` in metres RMS, the unit of ``graph-build --threshold``).
+    (build times and counts; ``threshold`` in metres RMS, the unit of ``graph-build --distance-threshold``).
     """
     n = graph.num_frames
     recorded = np.zeros(n, dtype=bool)

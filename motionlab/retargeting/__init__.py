@@ -1,4 +1,4 @@
-"""System A: retargeting by latent-space iteration (paper ``seeds/000_*.txt``).
+"""System A: retargeting by latent-space iteration (Wang, Li, Xie and Jia 2023).
 
 Train a network on ONE character's motion, then generate the motion of a character with other
 proportions by optimising the network's latent code (weights frozen) so that joint directions

@@ -1,7 +1,7 @@
 """Expand a motion database: many clips onto many characters in one batched, resumable job.
 
 The retargeting paper's stated purpose is to *expand motion databases*: one performer's
-library, generated for every new character (``seeds/000_*.txt``, Abstract). :func:`expand` takes
+library, generated for every new character (Wang, Li, Xie and Jia 2023, skeletal motion data generation for humanoid character animation, DOI 10.3969/j.issn.1003-5060.2023.01.006, abstract). :func:`expand` takes
 source clips × target characters and writes ``OUT/<character>/<clip>.bvh`` (or ``.glb``, glTF 2.0,
 with ``output_format="glb"``) plus ``OUT/manifest.csv``, one row per (clip, character)::
 

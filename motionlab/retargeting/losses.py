@@ -34,7 +34,7 @@ even when every joint position is right.
 ``contact_loss`` is *our addition* to the iteration: on the frames where A's foot is planted
 (:mod:`motionlab.retargeting.contacts`), B's foot joint should not move in the world.
 
-Paper: ``seeds/000_*.txt``, eq. (8) (L_recon) and eqs. (15)–(17) (the iteration's losses, §2.2). Taught in ``notebooks/03_latent_iteration.ipynb``.
+Paper: Wang, Li, Xie and Jia 2023, eq. (8) (L_recon) and eqs. (15)–(17) (the iteration's losses, §2.2). Taught in ``notebooks/03_latent_iteration.ipynb``.
 """
 
 from __future__ import annotations

@@ -26,7 +26,7 @@ Design choices the paper leaves open (documented here, shown in notebook 02):
   input features; positions are root-relative. World placement is the job of
   :mod:`motionlab.retargeting.pipeline`.
 
-Paper: "Skeletal motion generation by latent-space iteration" (``seeds/000_*.txt``), §2.2:
+Paper: "Skeletal motion generation by latent-space iteration" (Wang, Li, Xie and Jia 2023, DOI 10.3969/j.issn.1003-5060.2023.01.006), §2.2:
 eqs. (1)–(7) for A's own skeleton (training), eqs. (10)–(14) for a target skeleton.
 Taught in ``notebooks/02_training_autoencoder.ipynb``.
 """
