@@ -99,17 +99,22 @@ def _error(message: str) -> Exception:
     return CLIError(message)
 
 
+def _check_writable(option: str, path: Path, folder: Path) -> None:
+    """Refuse ``path`` when the existing ``folder`` it goes into cannot be written."""
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise _error(
+            f"{option} {path}: cannot write into the folder {folder.resolve()} (permission denied); "
+            "choose a folder you can write to"
+        )
+
+
 def _check_folder(option: str, path: Path, folder: Path) -> None:
     """``folder`` (where ``path`` goes) exists and takes new files."""
     if folder.exists() and not folder.is_dir():
         raise _error(f"{option} {path}: {folder} is a file, not a folder; choose a file name in a folder")
     if not folder.is_dir():
         raise _error(f"{option} {path}: the folder {folder} does not exist; create it or choose another folder")
-    if not os.access(folder, os.W_OK | os.X_OK):
-        raise _error(
-            f"{option} {path}: cannot write into the folder {folder.resolve()} (permission denied); "
-            "choose a folder you can write to"
-        )
+    _check_writable(option, path, folder)
 
 
 def check_outputs(
@@ -175,11 +180,7 @@ def check_output_folder(option: str, given: str | os.PathLike) -> Path:
         folder = folder.parent
     if not folder.is_dir():
         raise _error(f"{option} {path}: {folder} is a file, so the folder cannot be made; choose another folder")
-    if not os.access(folder, os.W_OK | os.X_OK):
-        raise _error(
-            f"{option} {path}: cannot write into the folder {folder.resolve()} (permission denied); "
-            "choose a folder you can write to"
-        )
+    _check_writable(option, path, folder)
     return path
 
 

@@ -30,9 +30,8 @@ FORMAT = "motionlab-retargeting"
 FORMAT_VERSION = 1
 
 DTYPES = {"float64": torch.float64, "float32": torch.float32}
-"""Float types a network computes in, by name. float64 is the default: the latent iteration
-compares losses step by step (its stopping rule), and in float32 the CPU's kernels alone move
-those losses in the third digit; in float64 the same run gives the same steps everywhere."""
+"""Float types a network computes in, by name. float64 is the default, so that the latent
+iteration's losses and stopping step do not depend on the CPU (``docs/reproducibility.md``)."""
 
 
 class CheckpointError(ValueError):

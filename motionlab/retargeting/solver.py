@@ -200,14 +200,11 @@ def step_grid(size: float) -> float:
     """The spacing iterates are rounded to: the power of two just below ``size · 2⁻¹²``.
 
     The latent iteration rounds its start φ₀ to ``step_grid(std(φ₀))`` and the latent offset,
-    after each Adam step, to ``step_grid(lr)`` (``lr`` the group's actual step size): a
-    four-thousandth of a step. Why: the Gauss–Newton start is a damped least-squares solve, which
-    turns a difference in the last bit of its inputs (another CPU's kernels add in another order)
-    into one in the eleventh digit, and Adam, which divides each gradient by its own running size,
-    lets such a difference grow step by step, until after some 50 steps the loss, and with it
-    where the stopping rule stops, differ in the third digit. On the grid, differences that small
-    are rounded away, so the iterates are the same on every CPU
-    (``benchmarks/bench_reproducibility.py`` prints the comparison).
+    after each Adam step, to ``step_grid(lr)`` (``lr`` the group's actual step size). Differences
+    in the last bits of the gradients (another CPU's kernels add in another order) are rounded
+    away instead of growing step by step, so the iterates, and the step at which the stopping rule
+    stops, are the same on every CPU (``docs/reproducibility.md``,
+    ``benchmarks/bench_reproducibility.py``).
     """
     return 2.0 ** math.floor(math.log2(size) - 12)
 
