@@ -223,93 +223,124 @@ def _channels(tok: _Tokens, joint_name: str) -> tuple[str, ...]:
     return tuple(names)
 
 
-def _parse_hierarchy(tok: _Tokens):
-    """Parse ``HIERARCHY`` up to and including the ``Frame Time:`` line."""
-    tok.expect("HIERARCHY", " at the start of the file")
-    first = tok.take()
-    if first is None or first.upper() != "ROOT":
-        raise tok.error(f"expected 'ROOT' after HIERARCHY, found {_show(first)}")
-    names: list[str] = []
-    parents: list[int] = []
-    offsets: list[tuple[float, float, float]] = []
-    channels: list[tuple[str, ...]] = []
-    end_sites: dict[int, tuple[float, float, float]] = {}
-    seen: dict[str, int] = {}
+class _Hierarchy:
+    """The joint tree read so far from a ``HIERARCHY`` block, in file order and file units."""
 
-    def new_joint(keyword: str, parent: int) -> _Joint:
+    def __init__(self, tok: _Tokens) -> None:
+        self.tok = tok
+        self.names: list[str] = []
+        self.parents: list[int] = []
+        self.offsets: list[tuple[float, float, float]] = []
+        self.channels: list[tuple[str, ...]] = []
+        self.end_sites: dict[int, tuple[float, float, float]] = {}
+        self.seen: dict[str, int] = {}  # joint name -> line it was declared on
+
+    def new_joint(self, keyword: str, parent: int) -> _Joint:
+        """Read ``<name> {`` after ``ROOT``/``JOINT`` and add the joint."""
+        tok = self.tok
         line = tok.line
         name = _joint_name(tok, keyword)
-        if name in seen:
-            raise tok.error(f"expected a unique joint name, found {name!r} again (first at line {seen[name]})")
-        seen[name] = line
-        names.append(name)
-        parents.append(parent)
-        offsets.append((0.0, 0.0, 0.0))
-        channels.append(())
+        if name in self.seen:
+            raise tok.error(f"expected a unique joint name, found {name!r} again (first at line {self.seen[name]})")
+        self.seen[name] = line
+        self.names.append(name)
+        self.parents.append(parent)
+        self.offsets.append((0.0, 0.0, 0.0))
+        self.channels.append(())
         tok.expect("{", f" to open joint {name!r}")
-        return _Joint(len(names) - 1, line)
+        return _Joint(len(self.names) - 1, line)
 
-    def offset(what: str) -> tuple[float, float, float]:
-        x, y, z = (tok.number(f"{axis} of the OFFSET of {what}") for axis in "xyz")
+    def offset(self, what: str) -> tuple[float, float, float]:
+        x, y, z = (self.tok.number(f"{axis} of the OFFSET of {what}") for axis in "xyz")
         return x, y, z
 
-    stack: list[_Joint | None] = [new_joint("ROOT", -1)]  # None marks an open End Site block
-    end_site_offset: tuple[float, float, float] | None = None
-    while stack:
-        top = stack[-1]
-        word = tok.take()
+    def end_site_token(self, word: str | None, stack: list, pending):
+        """One token inside ``End Site { OFFSET x y z }``; returns the offset read and not yet closed."""
         key = None if word is None else word.upper()
-        if top is None:  # inside End Site { OFFSET x y z }
-            owner = stack[-2]
-            if key == "OFFSET" and end_site_offset is None:
-                end_site_offset = offset(f"the End Site of joint {names[owner.index]!r}")
-            elif key == "}" and end_site_offset is not None:
-                end_sites[owner.index] = end_site_offset
-                end_site_offset = None
-                stack.pop()
-            else:
-                wanted = "'}' to close the End Site" if end_site_offset is not None else "OFFSET in the End Site"
-                raise tok.error(f"expected {wanted} of joint {names[owner.index]!r}, found {_show(word)}")
-            continue
-        name = names[top.index]
+        owner = stack[-2]
+        if key == "OFFSET" and pending is None:
+            return self.offset(f"the End Site of joint {self.names[owner.index]!r}")
+        if key == "}" and pending is not None:
+            self.end_sites[owner.index] = pending
+            stack.pop()
+            return None
+        wanted = "'}' to close the End Site" if pending is not None else "OFFSET in the End Site"
+        raise self.tok.error(f"expected {wanted} of joint {self.names[owner.index]!r}, found {_show(word)}")
+
+    def joint_token(self, word: str | None, top: _Joint, stack: list) -> None:
+        """One token in the body of joint ``top``: OFFSET, CHANNELS, a child, an End Site or ``}``."""
+        tok = self.tok
+        key = None if word is None else word.upper()
+        name = self.names[top.index]
         if key == "OFFSET" and not top.has_offset and not top.has_children:
-            offsets[top.index] = offset(f"joint {name!r}")
+            self.offsets[top.index] = self.offset(f"joint {name!r}")
             top.has_offset = True
-            continue
-        if key == "CHANNELS" and not top.has_channels and not top.has_children:
-            channels[top.index] = _channels(tok, name)
+        elif key == "CHANNELS" and not top.has_channels and not top.has_children:
+            self.channels[top.index] = _channels(tok, name)
             top.has_channels = True
-            continue
-        if key in ("JOINT", "END", "}") and not top.has_offset:
+        elif key in ("JOINT", "END", "}") and not top.has_offset:
             raise tok.error(f"expected OFFSET for joint {name!r} (opened at line {top.line}), found {_show(word)}")
-        if key == "JOINT":
+        elif key == "JOINT":
             top.has_children = True
-            stack.append(new_joint("JOINT", top.index))
+            stack.append(self.new_joint("JOINT", top.index))
         elif key == "END":
-            site = tok.take()
-            if site is None or site.upper() != "SITE":
-                raise tok.error(f"expected 'Site' after 'End' in joint {name!r}, found {_show(site)}")
-            if top.has_end_site:
-                raise tok.error(f"expected at most one End Site in joint {name!r}, found a second one")
-            top.has_end_site = True
-            top.has_children = True
-            rest = tok.rest_of_line()  # some exporters name End Sites: skip up to '{'
-            tok.skip(rest.index("{") if "{" in rest else len(rest))
-            tok.expect("{", f" to open the End Site of joint {name!r}")
+            self.open_end_site(top, name)
             stack.append(None)
         elif key == "}":
             stack.pop()
         else:
-            if word is not None and (word.lower() in _POSITION or word.lower() in _ROTATION):
-                hint = f" (joint {name!r} declares CHANNELS {len(channels[top.index])}, but more channel names follow)"
-            elif key in ("OFFSET", "CHANNELS"):
-                hint = f" (a second or misplaced {word} in joint {name!r})"
-            elif key == "MOTION" or word is None:
-                hint = f" (unbalanced braces: joint {name!r} opened at line {top.line} is never closed)"
-            else:
-                hint = ""
-            raise tok.error(f"expected JOINT, End Site or '}}' in joint {name!r}, found {_show(word)}{hint}")
+            raise self.unexpected(word, top)
 
+    def open_end_site(self, top: _Joint, name: str) -> None:
+        """Read ``Site [name] {`` after ``End`` in joint ``top``."""
+        tok = self.tok
+        site = tok.take()
+        if site is None or site.upper() != "SITE":
+            raise tok.error(f"expected 'Site' after 'End' in joint {name!r}, found {_show(site)}")
+        if top.has_end_site:
+            raise tok.error(f"expected at most one End Site in joint {name!r}, found a second one")
+        top.has_end_site = True
+        top.has_children = True
+        rest = tok.rest_of_line()  # some exporters name End Sites: skip up to '{'
+        tok.skip(rest.index("{") if "{" in rest else len(rest))
+        tok.expect("{", f" to open the End Site of joint {name!r}")
+
+    def unexpected(self, word: str | None, top: _Joint) -> BVHError:
+        """The error for a token that cannot come next in joint ``top``, with a hint at the likely cause."""
+        key = None if word is None else word.upper()
+        name = self.names[top.index]
+        if word is not None and (word.lower() in _POSITION or word.lower() in _ROTATION):
+            hint = f" (joint {name!r} declares CHANNELS {len(self.channels[top.index])}, but more channel names follow)"
+        elif key in ("OFFSET", "CHANNELS"):
+            hint = f" (a second or misplaced {word} in joint {name!r})"
+        elif key == "MOTION" or word is None:
+            hint = f" (unbalanced braces: joint {name!r} opened at line {top.line} is never closed)"
+        else:
+            hint = ""
+        return self.tok.error(f"expected JOINT, End Site or '}}' in joint {name!r}, found {_show(word)}{hint}")
+
+
+def _parse_joints(tok: _Tokens) -> _Hierarchy:
+    """Parse ``HIERARCHY`` through the ``}`` that closes the root."""
+    tok.expect("HIERARCHY", " at the start of the file")
+    first = tok.take()
+    if first is None or first.upper() != "ROOT":
+        raise tok.error(f"expected 'ROOT' after HIERARCHY, found {_show(first)}")
+    tree = _Hierarchy(tok)
+    stack: list[_Joint | None] = [tree.new_joint("ROOT", -1)]  # None marks an open End Site block
+    end_site_offset: tuple[float, float, float] | None = None
+    while stack:
+        top = stack[-1]
+        word = tok.take()
+        if top is None:
+            end_site_offset = tree.end_site_token(word, stack, end_site_offset)
+        else:
+            tree.joint_token(word, top, stack)
+    return tree
+
+
+def _parse_frames_header(tok: _Tokens) -> tuple[int, int, float]:
+    """Parse ``MOTION``, ``Frames: n`` and ``Frame Time: s``; returns (n, line of Frames:, s)."""
     word = tok.take()
     if word is None or word.upper() != "MOTION":
         if word == "}":
@@ -338,7 +369,14 @@ def _parse_hierarchy(tok: _Tokens):
     ft = float(value) if _NUMBER.fullmatch(value) else math.nan
     if not (math.isfinite(ft) and ft > 0 and math.isfinite(1.0 / ft)):
         raise tok.error(f"expected a positive frame time in seconds after 'Frame Time:', found {_show(value)}")
-    return names, parents, offsets, channels, end_sites, n_frames, frames_line, ft
+    return n_frames, frames_line, ft
+
+
+def _parse_hierarchy(tok: _Tokens):
+    """Parse ``HIERARCHY`` up to and including the ``Frame Time:`` line."""
+    tree = _parse_joints(tok)
+    n_frames, frames_line, ft = _parse_frames_header(tok)
+    return tree.names, tree.parents, tree.offsets, tree.channels, tree.end_sites, n_frames, frames_line, ft
 
 
 # ---------------------------------------------------------------------------------- motion block
@@ -885,33 +923,8 @@ def _fmt(values, precision: int) -> str:
     return " ".join(f"{v:.{precision}f}" for v in _no_negative_zero(values, precision))
 
 
-def dumps(motion: Motion, scale: float | None = None, precision: int = 6) -> str:
-    """BVH text of a motion.
-
-    Parameters
-    ----------
-    motion : Motion
-    scale : float, optional   metres -> file units; default ``1 / DEFAULT_SCALE`` (100, centimetres)
-    precision : int           decimals written for offsets, positions and angles (degrees)
-
-    Returns
-    -------
-    str
-        Joints are written depth-first (children in index order) with ``skeleton.channels``
-        when set, else positions + ``Zrotation Yrotation Xrotation`` for the root (and for
-        non-root joints whose ``local_pos`` moves), ``Zrotation Yrotation Xrotation`` for the
-        others. Every joint gets exactly three rotation channels, as Blender's importer needs:
-        a layout with fewer is completed by the missing axes (zero angles where the original
-        axes expressed the motion). ``Frame Time:`` has the fewest digits that give ``fps`` back
-        exactly.
-
-    Raises
-    ------
-    ValueError
-        No frames (Blender cannot import a 0-frame file), non-finite values, names BVH cannot hold, or a joint whose channel layout cannot
-        express its motion (rotation about an axis it has no channel for, or a translation
-        away from its offset without position channels); the message names the joint.
-    """
+def _check_write_args(motion: Motion, scale, precision) -> tuple[float, int]:
+    """``(scale, precision)`` checked for :func:`dumps`, after checking the motion can be named in BVH."""
     if not isinstance(motion, Motion):
         raise TypeError(f"expected a Motion, got {type(motion).__name__}")
     if motion.num_frames == 0:
@@ -921,25 +934,30 @@ def dumps(motion: Motion, scale: float | None = None, precision: int = 6) -> str
     scale = 1.0 / DEFAULT_SCALE if scale is None else _check_scale(scale)
     if isinstance(precision, bool) or not isinstance(precision, (int, np.integer)) or not 0 <= precision <= 17:
         raise ValueError(f"expected precision as a whole number of decimals from 0 to 17, got {precision!r}")
-    precision = int(precision)
-    skeleton = motion.skeleton
-    names = skeleton.names
-    for name in names:
+    for name in motion.skeleton.names:
         _check_name(name)
+    return scale, int(precision)
+
+
+def _finite_channels(motion: Motion) -> tuple[np.ndarray, np.ndarray]:
+    """Normalised local rotations (T, J, 4) and translations (T, J, 3); raises on a non-finite value."""
     local_rot = motion.local_rot
     translations = motion.translations()
     for label, array in (("local_rot", local_rot), ("positions", translations)):
         bad = np.argwhere(~np.isfinite(array))
         if bad.size:
             t, j = int(bad[0, 0]), int(bad[0, 1])
-            raise ValueError(f"cannot write BVH: {label} of joint {names[j]!r} at frame {t} is not finite")
-    local_rot = quat.normalize(local_rot, "local_rot")
-    # a length difference below half the last printed digit is invisible in the file
-    pos_tol = 0.5 * 10.0**-precision / scale
-    layouts = _check_layout(skeleton, translations, pos_tol)
-    n_frames = motion.num_frames
-    rest = skeleton.offsets
-    columns: list[np.ndarray] = []
+            raise ValueError(
+                f"cannot write BVH: {label} of joint {motion.skeleton.names[j]!r} at frame {t} is not finite"
+            )
+    return quat.normalize(local_rot, "local_rot"), translations
+
+
+def _rotation_angles(local_rot: np.ndarray, layouts, names, precision: int) -> dict[int, np.ndarray]:
+    """Each joint's rotation-channel angles (T, k) in degrees, in its layout's order.
+
+    Joints sharing an axis order are split together; raises if a joint rotates outside its channels.
+    """
     groups: dict[str, list[int]] = {}
     for j, layout in enumerate(layouts):
         axes = "".join(_ROTATION[c.lower()] for c in layout if c.lower() in _ROTATION)
@@ -961,6 +979,16 @@ def dumps(motion: Motion, scale: float | None = None, precision: int = 6) -> str
         degrees[degrees <= -180.0 + 0.5 * 10.0**-precision] += 360.0
         for n, j in enumerate(joints):
             angles[j] = degrees[:, n]
+    return angles
+
+
+def _channel_columns(translations, angles, layouts, skeleton: Skeleton, scale: float, pos_tol: float) -> list:
+    """One (T,) column per channel, in joint-index order, positions in file units.
+
+    Raises if a joint's translation leaves its offset along an axis it has no position channel for.
+    """
+    names, rest = skeleton.names, skeleton.offsets
+    columns: list[np.ndarray] = []
     for j, layout in enumerate(layouts):
         keys = [c.lower() for c in layout]
         for axis in range(3):
@@ -979,7 +1007,12 @@ def dumps(motion: Motion, scale: float | None = None, precision: int = 6) -> str
             else:
                 columns.append(angles[j][:, rot_index])
                 rot_index += 1
+    return columns
 
+
+def _hierarchy_lines(skeleton: Skeleton, layouts, scale: float, precision: int) -> tuple[list[str], list[int]]:
+    """The ``HIERARCHY`` block's lines, and the depth-first joint order it lists (children by index)."""
+    names = skeleton.names
     lines = ["HIERARCHY"]
     children: list[list[int]] = [[] for _ in names]
     for j in range(1, len(names)):
@@ -1007,20 +1040,62 @@ def dumps(motion: Motion, scale: float | None = None, precision: int = 6) -> str
         ]
         stack.append((~j, depth))
         stack.extend((c, depth + 1) for c in reversed(children[j]))
-    lines += ["MOTION", f"Frames: {n_frames}", f"Frame Time: {_format_frame_time(motion.fps)}"]
+    return lines, order
 
-    # columns were built in joint-index order; the file lists joints depth-first
-    starts = np.cumsum([0] + [len(layouts[j]) for j in range(len(names))])
+
+def _frame_lines(columns, layouts, order: list[int], n_frames: int, precision: int) -> str:
+    """The frame rows: ``columns`` (joint-index order) permuted to the file's depth-first ``order``."""
+    starts = np.cumsum([0] + [len(layout) for layout in layouts])
     perm = [c for j in order for c in range(starts[j], starts[j + 1])]
     data = np.stack([columns[c] for c in perm], axis=1) if perm else np.zeros((n_frames, 0))
     data = _no_negative_zero(data, precision)
-    header = "\n".join(lines) + "\n"
     if n_frames == 0:
-        return header
+        return ""
     if data.shape[1] == 0:
-        return header + "\n" * n_frames
+        return "\n" * n_frames
     row = " ".join([f"%.{precision}f"] * data.shape[1])
-    return header + ("\n".join([row] * n_frames) % tuple(data.ravel().tolist())) + "\n"
+    return ("\n".join([row] * n_frames) % tuple(data.ravel().tolist())) + "\n"
+
+
+def dumps(motion: Motion, scale: float | None = None, precision: int = 6) -> str:
+    """BVH text of a motion.
+
+    Parameters
+    ----------
+    motion : Motion
+    scale : float, optional   metres -> file units; default ``1 / DEFAULT_SCALE`` (100, centimetres)
+    precision : int           decimals written for offsets, positions and angles (degrees)
+
+    Returns
+    -------
+    str
+        Joints are written depth-first (children in index order) with ``skeleton.channels``
+        when set, else positions + ``Zrotation Yrotation Xrotation`` for the root (and for
+        non-root joints whose ``local_pos`` moves), ``Zrotation Yrotation Xrotation`` for the
+        others. Every joint gets exactly three rotation channels, as Blender's importer needs:
+        a layout with fewer is completed by the missing axes (zero angles where the original
+        axes expressed the motion). ``Frame Time:`` has the fewest digits that give ``fps`` back
+        exactly.
+
+    Raises
+    ------
+    ValueError
+        No frames (Blender cannot import a 0-frame file), non-finite values, names BVH cannot hold, or a joint whose channel layout cannot
+        express its motion (rotation about an axis it has no channel for, or a translation
+        away from its offset without position channels); the message names the joint.
+    """
+    scale, precision = _check_write_args(motion, scale, precision)
+    skeleton = motion.skeleton
+    local_rot, translations = _finite_channels(motion)
+    # a length difference below half the last printed digit is invisible in the file
+    pos_tol = 0.5 * 10.0**-precision / scale
+    layouts = _check_layout(skeleton, translations, pos_tol)
+    angles = _rotation_angles(local_rot, layouts, skeleton.names, precision)
+    columns = _channel_columns(translations, angles, layouts, skeleton, scale, pos_tol)
+    lines, order = _hierarchy_lines(skeleton, layouts, scale, precision)
+    lines += ["MOTION", f"Frames: {motion.num_frames}", f"Frame Time: {_format_frame_time(motion.fps)}"]
+    header = "\n".join(lines) + "\n"
+    return header + _frame_lines(columns, layouts, order, motion.num_frames, precision)
 
 
 def save(
