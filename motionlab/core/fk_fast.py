@@ -240,6 +240,115 @@ def _check_chunk(chunk: int) -> int:
     return chunk
 
 
+def _check_fast_args(local_rot, local_pos, parents, root_pos, chunk) -> tuple[tuple[int, ...], int, torch.Size]:
+    """Checked ``(parents, chunk, batch)`` for :func:`fk_positions_fast`; ``batch`` is the broadcast leading shape."""
+    if not isinstance(local_rot, torch.Tensor) or not isinstance(local_pos, torch.Tensor):
+        raise ValueError(
+            f"expected torch tensors, got {type(local_rot).__name__} and {type(local_pos).__name__} "
+            "(use fk_positions_fast_np for NumPy arrays)"
+        )
+    if local_rot.ndim < 2 or local_rot.shape[-1] != 4:
+        raise ValueError(f"expected local_rot of shape (..., J, 4), got {tuple(local_rot.shape)}")
+    num_joints = local_rot.shape[-2]
+    if local_pos.ndim < 2 or local_pos.shape[-2:] != (num_joints, 3):
+        raise ValueError(f"expected local_pos of shape (..., {num_joints}, 3), got {tuple(local_pos.shape)}")
+    if root_pos is not None and (root_pos.ndim < 1 or root_pos.shape[-1] != 3):
+        raise ValueError(f"expected root_pos of shape (..., 3), got {tuple(root_pos.shape)}")
+    parents = _check_parents(parents, num_joints)
+    chunk = _check_chunk(chunk)
+    try:
+        batch = torch.broadcast_shapes(
+            local_rot.shape[:-2], local_pos.shape[:-2], *(() if root_pos is None else (root_pos.shape[:-1],))
+        )
+    except RuntimeError:
+        raise ValueError(
+            f"leading shapes do not broadcast: local_rot {tuple(local_rot.shape)}, local_pos {tuple(local_pos.shape)}"
+            + ("" if root_pos is None else f", root_pos {tuple(root_pos.shape)}")
+        ) from None
+    return parents, chunk, batch
+
+
+def _reference_fk(local_rot, local_pos, parents, root_pos, batch, out):
+    """:func:`fk_torch.fk_positions` with ``root_pos`` applied (gradients, other devices and dtypes)."""
+    if root_pos is not None:
+        local_pos = local_pos.expand(batch + (local_rot.shape[-2], 3)).clone()
+        local_pos[..., 0, :] = root_pos
+    result = fk_torch.fk_positions(local_rot, local_pos, parents)
+    if out is not None:
+        out.copy_(result)
+        return out
+    return result
+
+
+def _flat_inputs(local_rot, local_pos, root_pos, batch, n: int):
+    """Inputs flattened to ``n`` frames: ``(rot (n, J, 4), pos, offsets (J, 3), shared)``.
+
+    ``shared``: one set of offsets for all frames, and ``pos`` is only the root (n, 3);
+    otherwise ``pos`` is every joint's (n, J, 3) and ``offsets`` are zeros.
+    """
+    num_joints, dtype = local_rot.shape[-2], local_rot.dtype
+    rot = local_rot.expand(batch + (num_joints, 4)).reshape(n, num_joints, 4)
+    shared = math.prod(local_pos.shape[:-2]) == 1
+    if shared:  # one set of offsets for all frames; per-frame data is only the root
+        offsets = local_pos.reshape(num_joints, 3).to(dtype).contiguous()
+        if root_pos is None:
+            root = offsets[0].expand(n, 3)
+        else:
+            root = root_pos.to(dtype).expand(batch + (3,)).reshape(n, 3)
+        pos = root.contiguous() if root_pos is not None else root
+    else:
+        full = local_pos.to(dtype).expand(batch + (num_joints, 3))
+        if root_pos is not None:
+            full = full.clone()
+            full[..., 0, :] = root_pos
+        pos = full.reshape(n, num_joints, 3)
+        offsets = torch.zeros(num_joints, 3, dtype=dtype)
+    return rot, pos, offsets, shared
+
+
+def _result_buffer(out, batch, n: int, num_joints: int, dtype) -> torch.Tensor:
+    """The (n, J, 3) tensor to write into: a view of ``out`` (checked), or a new one."""
+    if out is None:
+        # NumPy allocates big buffers on transparent huge pages, which saves one page fault per
+        # 4 KiB on first touch; torch does so only with THP_MEM_ALLOC_ENABLE=1.
+        return torch.from_numpy(np.empty((n, num_joints, 3), dtype=_NUMPY_DTYPE[dtype]))
+    if tuple(out.shape) != tuple(batch) + (num_joints, 3) or out.dtype != dtype or not out.is_contiguous():
+        raise ValueError(
+            f"expected out as a contiguous {dtype} tensor of shape {tuple(batch) + (num_joints, 3)}, "
+            f"got {out.dtype} {tuple(out.shape)}"
+        )
+    return out.view(n, num_joints, 3)
+
+
+def _compiled_chunks(kernel, key, rot, pos, offsets, result, chunk: int) -> int:
+    """Run the compiled kernel over whole chunks, then the tail padded with identity rotations.
+
+    Returns how many frames were done (fewer than all if the kernel failed part way).
+    """
+    n, num_joints, dtype = rot.shape[0], rot.shape[1], rot.dtype
+    done = 0
+    full_chunks = n // chunk * chunk
+    for start in range(0, full_chunks, chunk):
+        stop = start + chunk
+        if not _run_chunk(
+            kernel, key, rot[start:stop].contiguous(), pos[start:stop].contiguous(), offsets, result[start:stop]
+        ):
+            break
+        done = stop
+    if done == full_chunks < n:  # the tail, padded to a whole chunk with identity rotations
+        rest = n - full_chunks
+        rot_c = torch.zeros((chunk, num_joints, 4), dtype=dtype)
+        rot_c[:, :, 0] = 1.0
+        rot_c[:rest] = rot[full_chunks:]
+        pos_c = torch.zeros((chunk,) + tuple(pos.shape[1:]), dtype=dtype)
+        pos_c[:rest] = pos[full_chunks:]
+        tail = torch.empty((chunk, num_joints, 3), dtype=dtype)
+        if _run_chunk(kernel, key, rot_c, pos_c, offsets, tail):
+            result[full_chunks:] = tail[:rest]
+            done = n
+    return done
+
+
 def fk_positions_fast(
     local_rot: torch.Tensor,
     local_pos: torch.Tensor,
@@ -276,100 +385,24 @@ def fk_positions_fast(
     Forward only. When gradients are needed, on non-CPU devices and for dtypes other than
     float32/float64, the call falls through to :func:`motionlab.core.fk_torch.fk_positions`.
     """
-    if not isinstance(local_rot, torch.Tensor) or not isinstance(local_pos, torch.Tensor):
-        raise ValueError(
-            f"expected torch tensors, got {type(local_rot).__name__} and {type(local_pos).__name__} "
-            "(use fk_positions_fast_np for NumPy arrays)"
-        )
-    if local_rot.ndim < 2 or local_rot.shape[-1] != 4:
-        raise ValueError(f"expected local_rot of shape (..., J, 4), got {tuple(local_rot.shape)}")
-    num_joints = local_rot.shape[-2]
-    if local_pos.ndim < 2 or local_pos.shape[-2:] != (num_joints, 3):
-        raise ValueError(f"expected local_pos of shape (..., {num_joints}, 3), got {tuple(local_pos.shape)}")
-    if root_pos is not None and (root_pos.ndim < 1 or root_pos.shape[-1] != 3):
-        raise ValueError(f"expected root_pos of shape (..., 3), got {tuple(root_pos.shape)}")
-    parents = _check_parents(parents, num_joints)
-    chunk = _check_chunk(chunk)
-    try:
-        batch = torch.broadcast_shapes(
-            local_rot.shape[:-2], local_pos.shape[:-2], *(() if root_pos is None else (root_pos.shape[:-1],))
-        )
-    except RuntimeError:
-        raise ValueError(
-            f"leading shapes do not broadcast: local_rot {tuple(local_rot.shape)}, local_pos {tuple(local_pos.shape)}"
-            + ("" if root_pos is None else f", root_pos {tuple(root_pos.shape)}")
-        ) from None
-    dtype = local_rot.dtype
-
+    parents, chunk, batch = _check_fast_args(local_rot, local_pos, parents, root_pos, chunk)
+    num_joints, dtype = local_rot.shape[-2], local_rot.dtype
     needs_grad = torch.is_grad_enabled() and any(
         t is not None and t.requires_grad for t in (local_rot, local_pos, root_pos)
     )
     if needs_grad or local_rot.device.type != "cpu" or dtype not in _FAST_DTYPES:
-        if root_pos is not None:
-            local_pos = local_pos.expand(batch + (num_joints, 3)).clone()
-            local_pos[..., 0, :] = root_pos
-        result = fk_torch.fk_positions(local_rot, local_pos, parents)
-        if out is not None:
-            out.copy_(result)
-            return out
-        return result
+        return _reference_fk(local_rot, local_pos, parents, root_pos, batch, out)
 
     n = math.prod(batch)
-    rot = local_rot.expand(batch + (num_joints, 4)).reshape(n, num_joints, 4)
-    shared = math.prod(local_pos.shape[:-2]) == 1
-    if shared:  # one set of offsets for all frames; per-frame data is only the root
-        offsets = local_pos.reshape(num_joints, 3).to(dtype).contiguous()
-        if root_pos is None:
-            root = offsets[0].expand(n, 3)
-        else:
-            root = root_pos.to(dtype).expand(batch + (3,)).reshape(n, 3)
-        pos = root.contiguous() if root_pos is not None else root
-    else:
-        full = local_pos.to(dtype).expand(batch + (num_joints, 3))
-        if root_pos is not None:
-            full = full.clone()
-            full[..., 0, :] = root_pos
-        pos = full.reshape(n, num_joints, 3)
-        offsets = torch.zeros(num_joints, 3, dtype=dtype)
-
-    if out is None:
-        # NumPy allocates big buffers on transparent huge pages, which saves one page fault per
-        # 4 KiB on first touch; torch does so only with THP_MEM_ALLOC_ENABLE=1.
-        result = torch.from_numpy(np.empty((n, num_joints, 3), dtype=_NUMPY_DTYPE[dtype]))
-    else:
-        if tuple(out.shape) != tuple(batch) + (num_joints, 3) or out.dtype != dtype or not out.is_contiguous():
-            raise ValueError(
-                f"expected out as a contiguous {dtype} tensor of shape {tuple(batch) + (num_joints, 3)}, "
-                f"got {out.dtype} {tuple(out.shape)}"
-            )
-        result = out.view(n, num_joints, 3)
+    rot, pos, offsets, shared = _flat_inputs(local_rot, local_pos, root_pos, batch, n)
+    result = _result_buffer(out, batch, n, num_joints, dtype)
     if n == 0:
         return result.view(batch + (num_joints, 3)) if out is None else out
 
     kernel = _get_kernel(parents, shared, dtype, chunk, compile)
     key = _key(parents, shared, dtype, chunk)
-    done = 0
     with torch.no_grad():
-        if kernel is not None:
-            full_chunks = n // chunk * chunk
-            for start in range(0, full_chunks, chunk):
-                stop = start + chunk
-                if not _run_chunk(
-                    kernel, key, rot[start:stop].contiguous(), pos[start:stop].contiguous(), offsets, result[start:stop]
-                ):
-                    break
-                done = stop
-            if done == full_chunks < n:  # the tail, padded to a whole chunk with identity rotations
-                rest = n - full_chunks
-                rot_c = torch.zeros((chunk, num_joints, 4), dtype=dtype)
-                rot_c[:, :, 0] = 1.0
-                rot_c[:rest] = rot[full_chunks:]
-                pos_c = torch.zeros((chunk,) + tuple(pos.shape[1:]), dtype=dtype)
-                pos_c[:rest] = pos[full_chunks:]
-                tail = torch.empty((chunk, num_joints, 3), dtype=dtype)
-                if _run_chunk(kernel, key, rot_c, pos_c, offsets, tail):
-                    result[full_chunks:] = tail[:rest]
-                    done = n
+        done = _compiled_chunks(kernel, key, rot, pos, offsets, result, chunk) if kernel is not None else 0
         for start in range(done, n, EAGER_CHUNK):  # eager fallback (compile off or failed)
             stop = min(start + EAGER_CHUNK, n)
             _eager_chunk(parents, shared, rot[start:stop], pos[start:stop], offsets, result[start:stop])
