@@ -176,6 +176,132 @@ def _ground(v2: np.ndarray) -> np.ndarray:
     return np.stack([v2[..., 0], np.zeros(v2.shape[:-1]), v2[..., 1]], axis=-1)
 
 
+@dataclass
+class _Drive:
+    """Per-frame quantities (N,) that several stages of :func:`pose` read; angles in radians."""
+
+    P: dict[str, np.ndarray]  # blended style parameters
+    heading: np.ndarray
+    phase: np.ndarray
+    gait: np.ndarray  # weight of stepping locomotion
+    stand: np.ndarray  # 1 - gait
+    cycle: np.ndarray  # 2π phase
+    midstance: np.ndarray  # 2π (phase - duty / 2)
+    fwd2: np.ndarray  # (N, 2) ground-plane forward
+    left2: np.ndarray  # (N, 2) ground-plane left
+    lean: np.ndarray
+    twist: np.ndarray  # pelvis yaw about the heading
+
+
+def _drive(tl: Timeline, heading: np.ndarray, phase: np.ndarray, extra: dict[str, np.ndarray]) -> _Drive:
+    P = tl.params
+    gait = tl.gait
+    cycle = 2.0 * np.pi * phase
+    return _Drive(
+        P=P,
+        heading=heading,
+        phase=phase,
+        gait=gait,
+        stand=1.0 - gait,
+        cycle=cycle,
+        midstance=2.0 * np.pi * (phase - 0.5 * P["duty"]),
+        fwd2=np.stack([np.sin(heading), np.cos(heading)], axis=-1),
+        left2=np.stack([np.cos(heading), -np.sin(heading)], axis=-1),
+        lean=P["lean"] + extra["lean"],
+        twist=-P["hip_twist"] * np.cos(cycle),
+    )
+
+
+def _pelvis_position(geo, tl, d: _Drive, q_pelvis, base, feet, extra, noise) -> tuple[np.ndarray, list[np.ndarray]]:
+    """Root positions (N, 3) and the hips relative to the root [(N, 3), (N, 3)] (see the module's step 1)."""
+    P, leg, gait, stand = d.P, geo.leg, d.gait, d.stand
+    feet_mid = 0.5 * (feet[0].ankle[:, [0, 2]] + feet[1].ankle[:, [0, 2]])
+    shift = P["sway"] * leg * (gait * np.cos(d.midstance) + stand * noise["sway"])
+    xz = gait[:, None] * base + stand[:, None] * feet_mid
+    xz = xz + shift[:, None] * d.left2 - extra["back"][:, None] * d.fwd2
+    y = (
+        geo.stand_height(P["step_width"])
+        - P["crouch"] * leg
+        + P["bounce"] * leg * np.cos(2.0 * d.midstance)
+        + extra["dy"]
+        + 0.004 * leg * stand * noise["breath"]
+    )
+    hips_rel = [quat.rotate(q_pelvis, geo.hip[f]) for f in (0, 1)]
+    limits = []
+    for f in (0, 1):
+        ankle = feet[f].ankle
+        d2 = np.sum((xz + hips_rel[f][:, [0, 2]] - ankle[:, [0, 2]]) ** 2, axis=-1)
+        reach = _reach(feet[f]) * (geo.thigh[f] + geo.shin[f])
+        limits.append(ankle[:, 1] + np.sqrt(np.maximum(reach**2 - d2, 0.0)) - hips_rel[f][:, 1])
+    limit = np.minimum(*limits)
+    # a jump already plans its own ballistic path; elsewhere meet a falling limit in good time
+    jumping = np.zeros(len(d.heading))
+    for jump in tl.jumps:
+        inside = ease_track(tl.time, [jump.crouch - 0.15, jump.crouch, jump.recover, jump.recover + 0.15], [0, 1, 1, 0])
+        jumping = np.maximum(jumping, inside)
+    y = _softmin(y, jumping * limit + (1.0 - jumping) * _smooth_floor(limit, tl.fps))
+    return np.stack([xz[:, 0], y, xz[:, 1]], axis=-1), hips_rel
+
+
+def _pose_legs(local, geo, d: _Drive, q_pelvis, root, hips_rel, feet) -> None:
+    """Hip, knee, ankle and toe rotations into ``local`` by two-bone IK onto the foot tracks."""
+    off = geo.offsets
+    pelvis_fwd = quat.rotate(quat.from_yaw(d.heading + d.twist), _Z)
+    for f, side in enumerate(_SIDES):
+        track = feet[f]
+        hip = root + hips_rel[f]
+        foot_fwd = quat.rotate(quat.from_yaw(track.yaw), _Z)
+        pole = foot_fwd + pelvis_fwd + 0.1 * _SIGN[f] * _ground(d.left2)
+        # a swinging foot out of reach is followed softly (no knee snap); planted ones exactly
+        soft = np.where(track.swing >= 0.0, _SOFT_KNEE * (1.0 - track.swing) * (geo.thigh[f] + geo.shin[f]), 0.0)
+        knee, ankle = ik.two_bone(hip, track.ankle, geo.thigh[f], geo.shin[f], pole, soft)
+        g_thigh = ik.aim(off[_j(f"{side}Leg")], _Z, knee - hip, pole)
+        g_shin = ik.aim(off[_j(f"{side}Foot")], _Z, ankle - knee, pole)
+        g_foot = quat.mul(quat.from_yaw(track.yaw), _rx(track.pitch))
+        local[:, _j(f"{side}UpLeg")] = quat.mul(quat.conj(q_pelvis), g_thigh)
+        local[:, _j(f"{side}Leg")] = quat.mul(quat.conj(g_thigh), g_shin)
+        local[:, _j(f"{side}Foot")] = quat.mul(quat.conj(g_shin), g_foot)
+        local[:, _j(f"{side}ToeBase")] = _rx(track.toe_bend)
+
+
+def _pose_spine_and_head(local, d: _Drive, q_pelvis, noise) -> np.ndarray:
+    """Spine, neck and head rotations into ``local``; returns the chest's world rotation (N, 4)."""
+    chest_yaw = d.heading + 0.7 * d.P["hip_twist"] * np.cos(d.cycle)
+    q_chest = quat.mul(quat.from_yaw(chest_yaw), _rx(d.lean))
+    bend = quat.mul(quat.conj(q_pelvis), q_chest)
+    for name, weight in (("Spine", 0.3), ("Spine1", 0.35), ("Spine2", 0.35)):
+        local[:, _j(name)] = _fraction(bend, weight)
+    look_pitch = 0.08 + 0.3 * np.maximum(d.lean - 0.1, 0.0)
+    q_head = quat.mul(quat.from_yaw(d.heading + 0.3 * d.stand * noise["look"]), _rx(look_pitch))
+    nod = quat.mul(quat.conj(q_chest), q_head)
+    local[:, _j("Neck")] = _fraction(nod, 0.5)
+    local[:, _j("Head")] = _fraction(nod, 0.5)
+    return q_chest
+
+
+def _pose_arms(local, geo, d: _Drive, q_chest, extra, noise) -> None:
+    """Clavicle, shoulder and elbow rotations into ``local``: a swing against the legs, elbows bent."""
+    P, off = d.P, geo.offsets
+    swing = P["arm_swing"] * (1.0 + 0.1 * noise["arm"]) * np.cos(2.0 * np.pi * (d.phase - 0.03))
+    idle_arm = 0.04 * d.stand * noise["sway"]
+    for f, side in enumerate(_SIDES):
+        theta = -_SIGN[f] * swing + extra["arm"] + idle_arm
+        elbow = np.maximum(P["elbow"] + extra["elbow"] + 0.3 * np.maximum(theta, 0.0), 0.03)
+        clavicle = _rz(_SIGN[f] * 0.25 * np.maximum(theta - 1.2, 0.0))
+        g_shoulder = quat.mul(q_chest, clavicle)
+        q_arm = quat.mul(_rx(-theta), _rz(_SIGN[f] * P["arm_out"]))
+        upper = quat.rotate(q_arm, -_Y)
+        bend_dir = quat.rotate(q_arm, _Z)
+        c, s = np.cos(elbow)[:, None], np.sin(elbow)[:, None]
+        fore = c * upper + s * bend_dir
+        fore_bend = -s * upper + c * bend_dir
+        g_arm = ik.aim(off[_j(f"{side}ForeArm")], _Z, quat.rotate(q_chest, upper), quat.rotate(q_chest, bend_dir))
+        g_fore = ik.aim(off[_j(f"{side}Hand")], _Z, quat.rotate(q_chest, fore), quat.rotate(q_chest, fore_bend))
+        local[:, _j(f"{side}Shoulder")] = clavicle
+        local[:, _j(f"{side}Arm")] = quat.mul(quat.conj(g_shoulder), g_arm)
+        local[:, _j(f"{side}ForeArm")] = quat.mul(quat.conj(g_arm), g_fore)
+
+
 def pose(
     geo: Geometry,
     tl: Timeline,
@@ -200,101 +326,13 @@ def pose(
     noise : dict of (N,) curves       slow random signals in [-1, 1]: ``sway``, ``look``,
                                       ``arm``, ``breath``
     """
-    P = tl.params
-    leg = geo.leg
-    gait = tl.gait
-    stand = 1.0 - gait
-    cycle = 2.0 * np.pi * phase
-    midstance = 2.0 * np.pi * (phase - 0.5 * P["duty"])
-    fwd2 = np.stack([np.sin(heading), np.cos(heading)], axis=-1)
-    left2 = np.stack([np.cos(heading), -np.sin(heading)], axis=-1)
-    n = len(heading)
-
-    # ---------------------------------------------------------------- pelvis orientation
-    lean = P["lean"] + extra["lean"]
-    twist = -P["hip_twist"] * np.cos(cycle)
-    roll = 0.4 * P["hip_twist"] * np.cos(midstance)
-    q_pelvis = quat.mul(quat.mul(quat.from_yaw(heading + twist), _rx(0.35 * lean)), _rz(roll))
-
-    # ---------------------------------------------------------------- pelvis position
-    feet_mid = 0.5 * (feet[0].ankle[:, [0, 2]] + feet[1].ankle[:, [0, 2]])
-    shift = P["sway"] * leg * (gait * np.cos(midstance) + stand * noise["sway"])
-    xz = gait[:, None] * base + stand[:, None] * feet_mid
-    xz = xz + shift[:, None] * left2 - extra["back"][:, None] * fwd2
-    y = (
-        geo.stand_height(P["step_width"])
-        - P["crouch"] * leg
-        + P["bounce"] * leg * np.cos(2.0 * midstance)
-        + extra["dy"]
-        + 0.004 * leg * stand * noise["breath"]
-    )
-    hips_rel = [quat.rotate(q_pelvis, geo.hip[f]) for f in (0, 1)]
-    limits = []
-    for f in (0, 1):
-        ankle = feet[f].ankle
-        d2 = np.sum((xz + hips_rel[f][:, [0, 2]] - ankle[:, [0, 2]]) ** 2, axis=-1)
-        reach = _reach(feet[f]) * (geo.thigh[f] + geo.shin[f])
-        limits.append(ankle[:, 1] + np.sqrt(np.maximum(reach**2 - d2, 0.0)) - hips_rel[f][:, 1])
-    limit = np.minimum(*limits)
-    # a jump already plans its own ballistic path; elsewhere meet a falling limit in good time
-    jumping = np.zeros(n)
-    for jump in tl.jumps:
-        inside = ease_track(tl.time, [jump.crouch - 0.15, jump.crouch, jump.recover, jump.recover + 0.15], [0, 1, 1, 0])
-        jumping = np.maximum(jumping, inside)
-    y = _softmin(y, jumping * limit + (1.0 - jumping) * _smooth_floor(limit, tl.fps))
-    root = np.stack([xz[:, 0], y, xz[:, 1]], axis=-1)
-
-    local = np.tile(quat.IDENTITY, (n, len(JOINTS), 1))
+    d = _drive(tl, heading, phase, extra)
+    roll = 0.4 * d.P["hip_twist"] * np.cos(d.midstance)
+    q_pelvis = quat.mul(quat.mul(quat.from_yaw(heading + d.twist), _rx(0.35 * d.lean)), _rz(roll))
+    root, hips_rel = _pelvis_position(geo, tl, d, q_pelvis, base, feet, extra, noise)
+    local = np.tile(quat.IDENTITY, (len(heading), len(JOINTS), 1))
     local[:, 0] = q_pelvis
-    off = geo.offsets
-
-    # ---------------------------------------------------------------- legs
-    pelvis_fwd = quat.rotate(quat.from_yaw(heading + twist), _Z)
-    for f, side in enumerate(_SIDES):
-        track = feet[f]
-        hip = root + hips_rel[f]
-        foot_fwd = quat.rotate(quat.from_yaw(track.yaw), _Z)
-        pole = foot_fwd + pelvis_fwd + 0.1 * _SIGN[f] * _ground(left2)
-        # a swinging foot out of reach is followed softly (no knee snap); planted ones exactly
-        soft = np.where(track.swing >= 0.0, _SOFT_KNEE * (1.0 - track.swing) * (geo.thigh[f] + geo.shin[f]), 0.0)
-        knee, ankle = ik.two_bone(hip, track.ankle, geo.thigh[f], geo.shin[f], pole, soft)
-        g_thigh = ik.aim(off[_j(f"{side}Leg")], _Z, knee - hip, pole)
-        g_shin = ik.aim(off[_j(f"{side}Foot")], _Z, ankle - knee, pole)
-        g_foot = quat.mul(quat.from_yaw(track.yaw), _rx(track.pitch))
-        local[:, _j(f"{side}UpLeg")] = quat.mul(quat.conj(q_pelvis), g_thigh)
-        local[:, _j(f"{side}Leg")] = quat.mul(quat.conj(g_thigh), g_shin)
-        local[:, _j(f"{side}Foot")] = quat.mul(quat.conj(g_shin), g_foot)
-        local[:, _j(f"{side}ToeBase")] = _rx(track.toe_bend)
-
-    # ---------------------------------------------------------------- spine and head
-    chest_yaw = heading + 0.7 * P["hip_twist"] * np.cos(cycle)
-    q_chest = quat.mul(quat.from_yaw(chest_yaw), _rx(lean))
-    bend = quat.mul(quat.conj(q_pelvis), q_chest)
-    for name, weight in (("Spine", 0.3), ("Spine1", 0.35), ("Spine2", 0.35)):
-        local[:, _j(name)] = _fraction(bend, weight)
-    look_pitch = 0.08 + 0.3 * np.maximum(lean - 0.1, 0.0)
-    q_head = quat.mul(quat.from_yaw(heading + 0.3 * stand * noise["look"]), _rx(look_pitch))
-    nod = quat.mul(quat.conj(q_chest), q_head)
-    local[:, _j("Neck")] = _fraction(nod, 0.5)
-    local[:, _j("Head")] = _fraction(nod, 0.5)
-
-    # ---------------------------------------------------------------- arms
-    swing = P["arm_swing"] * (1.0 + 0.1 * noise["arm"]) * np.cos(2.0 * np.pi * (phase - 0.03))
-    idle_arm = 0.04 * stand * noise["sway"]
-    for f, side in enumerate(_SIDES):
-        theta = -_SIGN[f] * swing + extra["arm"] + idle_arm
-        elbow = np.maximum(P["elbow"] + extra["elbow"] + 0.3 * np.maximum(theta, 0.0), 0.03)
-        clavicle = _rz(_SIGN[f] * 0.25 * np.maximum(theta - 1.2, 0.0))
-        g_shoulder = quat.mul(q_chest, clavicle)
-        q_arm = quat.mul(_rx(-theta), _rz(_SIGN[f] * P["arm_out"]))
-        upper = quat.rotate(q_arm, -_Y)
-        bend_dir = quat.rotate(q_arm, _Z)
-        c, s = np.cos(elbow)[:, None], np.sin(elbow)[:, None]
-        fore = c * upper + s * bend_dir
-        fore_bend = -s * upper + c * bend_dir
-        g_arm = ik.aim(off[_j(f"{side}ForeArm")], _Z, quat.rotate(q_chest, upper), quat.rotate(q_chest, bend_dir))
-        g_fore = ik.aim(off[_j(f"{side}Hand")], _Z, quat.rotate(q_chest, fore), quat.rotate(q_chest, fore_bend))
-        local[:, _j(f"{side}Shoulder")] = clavicle
-        local[:, _j(f"{side}Arm")] = quat.mul(quat.conj(g_shoulder), g_arm)
-        local[:, _j(f"{side}ForeArm")] = quat.mul(quat.conj(g_arm), g_fore)
+    _pose_legs(local, geo, d, q_pelvis, root, hips_rel, feet)
+    q_chest = _pose_spine_and_head(local, d, q_pelvis, noise)
+    _pose_arms(local, geo, d, q_chest, extra, noise)
     return local, root

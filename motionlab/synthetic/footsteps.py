@@ -43,6 +43,7 @@ JUMP_TOE_LAND = 0.35  # rad: toes first on landing
 _SWING_PEAK = 0.75  # exponent < 1 moves the swing's highest point earlier
 _MOVING = 0.05  # gait weight below which the character is standing
 _SETTLE_SWING = 0.3  # s: swing time of a settling step
+_SIDES = (1.0, -1.0)  # sideways sign of each foot: left foot on +X
 
 
 @dataclass
@@ -112,6 +113,103 @@ def foot_pose(ankle_flat, yaw, pitch, toe, heel) -> np.ndarray:
     return ankle_flat + quat.rotate(q_yaw, pivot - quat.rotate(q_pitch, pivot))
 
 
+@dataclass
+class _Planner:
+    """What :func:`plan` reads while it places steps: the timeline, the character and the path (N frames)."""
+
+    tl: Timeline
+    geo: object  # body.Geometry
+    heading: np.ndarray  # (N,) radians
+    base: np.ndarray  # (N, 2) metres; shifted in place after each jump
+
+    def stand_spot(self, f: int, when: float) -> tuple[np.ndarray, float]:
+        """Where foot ``f`` stands (x, z) and its yaw, beside the path at time ``when``."""
+        t, base, tl = self.tl.time, self.base, self.tl
+        psi = float(np.interp(when, t, self.heading))
+        _, left = _yaw_dirs(psi)
+        xz = np.array([np.interp(when, t, base[:, 0]), np.interp(when, t, base[:, 1])])
+        xz = xz + left * _SIDES[f] * 0.5 * tl.at("step_width", when) * self.geo.hip_width
+        return xz, psi + _SIDES[f] * float(tl.at("toe_out", when))
+
+    def ankle3(self, f: int, xz: np.ndarray) -> np.ndarray:
+        return np.array([xz[0], self.geo.ankle_height[f], xz[1]])
+
+    def events(self, phase: np.ndarray) -> list[tuple[float, int, int]]:
+        """``(time, kind, index)`` in time order: kind 0 a gait-clock step of foot ``index``,
+        1 jump ``index``'s take-off, 2 a settling step (index 0 the first, 1 the second)."""
+        t, tl = self.tl.time, self.tl
+        events: list[tuple[float, int, int]] = []
+        for f in (0, 1):
+            offset = 0.5 * f
+            levels = np.arange(np.ceil(phase[0] - offset), np.floor(phase[-1] - offset) + 1) + offset
+            events += [(float(x), 0, f) for x in np.interp(levels, phase, t)]
+        events += [(j.takeoff, 1, k) for k, j in enumerate(tl.jumps)]
+        gait = tl.gait
+        # coming to a stop: two quick settling steps, the farther foot first (decided when they happen)
+        stops = np.flatnonzero((gait[:-1] >= _MOVING) & (gait[1:] < _MOVING)) + 1
+        for k in stops:
+            events += [(t[k] + _SETTLE_SWING, 2, 0), (t[k] + 2.0 * _SETTLE_SWING, 2, 1)]
+        events.sort()
+        return events
+
+    def lift_time(self, cur: Plant, when: float, swing: float) -> float:
+        """When the foot planted as ``cur`` lifts for a step landing at ``when``.
+
+        No earlier than the foot has stood a moment and no action holds it down; a shorter
+        swing is fine (a swing shorter than ``_MIN_SWING`` is skipped by the caller).
+        """
+        t, leg = self.tl.time, self.geo.leg
+        lift = min(when - swing, _falls_behind(cur, t, self.base, self.heading, _MAX_BEHIND * leg))
+        lift = max(lift, max(cur.land, cur.flat) + _MIN_STANCE)
+        for a, b in self.tl.locks:
+            if a < when and b > lift:
+                lift = max(lift, b)
+        return lift
+
+    def landing(self, f: int, when: float, cycle: float, duty: float, noise: np.ndarray) -> tuple[np.ndarray, float]:
+        """Where (x, z) and with which yaw foot ``f`` lands at ``when``: a little before mid-stance, varied by ``noise``."""
+        t, tl, geo, base = self.tl.time, self.tl, self.geo, self.base
+        g = float(np.interp(when, t, tl.gait))
+        xz, yaw = self.stand_spot(f, when + _UNDER_BODY * duty * cycle)
+        fwd, left = _yaw_dirs(yaw - _SIDES[f] * float(tl.at("toe_out", when)))
+        step = float(tl.at("stride", when)) * geo.leg
+        xz = xz + g * (0.03 * step * noise[0] * fwd + 0.04 * geo.hip_width * noise[1] * left)
+        yaw = yaw + g * 0.03 * noise[2]
+        # never reach farther ahead of the body than a leg can (the mid-stance guess assumes
+        # the current cadence, which a transition may change)
+        base_now = np.array([np.interp(when, t, base[:, 0]), np.interp(when, t, base[:, 1])])
+        ahead = float(np.dot(xz - base_now, fwd))
+        return xz - fwd * max(ahead - _MAX_AHEAD * geo.leg, 0.0), yaw
+
+    def step(self, plants: list[list[Plant]], when: float, kind: int, idx: int, noise: np.ndarray) -> None:
+        """Take the step of a kind-0 or kind-2 event (see :meth:`events`), unless it is too short or not needed."""
+        tl, leg = self.tl, self.geo.leg
+        f = idx
+        if kind == 2:  # settling step: the foot farther from its spot goes first
+            away = [np.linalg.norm(self.stand_spot(k, when)[0] - plants[k][-1].ankle[[0, 2]]) for k in (0, 1)]
+            f = int(np.argmax(away)) if idx == 0 else int(np.argmin(away))
+        cur = plants[f][-1]
+        cycle = 2.0 / float(tl.at("cadence", when))
+        duty = float(tl.at("duty", when))
+        swing = _SETTLE_SWING if kind == 2 else max((1.0 - duty) * cycle, 0.2)
+        lift = self.lift_time(cur, when, swing)
+        if when - lift < _MIN_SWING:
+            return
+        g = float(np.interp(when, tl.time, tl.gait))
+        xz, yaw = self.landing(f, when, cycle, duty, noise)
+        dist = float(np.linalg.norm(xz - cur.ankle[[0, 2]]))
+        if g < _MOVING and dist < _SETTLE * leg:
+            return
+        scale = float(np.clip(dist / (0.8 * leg), 0.25, 1.0))
+        cur.lift = lift
+        cur.heel = max(lift - float(np.clip(0.35 * (lift - cur.flat), 0.04, 0.3)), cur.flat)
+        cur.p_off = float(tl.at("toe_off", when)) * scale
+        p_land = float(tl.at("heel_strike", when)) * scale
+        roll = min(0.12, 0.25 * duty * cycle) if p_land != 0.0 else 0.0
+        height = float(tl.at("foot_lift", when)) * leg * float(np.clip(0.3 + dist / (0.6 * leg), 0.3, 1.0))
+        plants[f].append(Plant(when, when + roll, _FAR, _FAR, self.ankle3(f, xz), yaw, p_land, 0.0, height))
+
+
 def plan(tl: Timeline, geo, heading: np.ndarray, phase: np.ndarray, base: np.ndarray, rng: np.random.Generator):
     """Place every footstep of the clip.
 
@@ -129,84 +227,18 @@ def plan(tl: Timeline, geo, heading: np.ndarray, phase: np.ndarray, base: np.nda
     plants : [left plants, right plants], each a list of :class:`Plant` in time order
     base : ndarray (N, 2)         the path, shifted after each jump to where it landed
     """
-    t = tl.time
-    base = base.copy()
-    leg = geo.leg
-    sides = (1.0, -1.0)  # left foot on +X
-
-    def stand_spot(f: int, when: float) -> tuple[np.ndarray, float]:
-        psi = float(np.interp(when, t, heading))
-        _, left = _yaw_dirs(psi)
-        xz = np.array([np.interp(when, t, base[:, 0]), np.interp(when, t, base[:, 1])])
-        xz = xz + left * sides[f] * 0.5 * tl.at("step_width", when) * geo.hip_width
-        return xz, psi + sides[f] * float(tl.at("toe_out", when))
-
-    def ankle3(f: int, xz: np.ndarray) -> np.ndarray:
-        return np.array([xz[0], geo.ankle_height[f], xz[1]])
-
+    planner = _Planner(tl, geo, heading, base.copy())
     plants: list[list[Plant]] = []
     for f in (0, 1):
-        xz, yaw = stand_spot(f, t[0])
-        plants.append([Plant(-_FAR, -_FAR, _FAR, _FAR, ankle3(f, xz), yaw)])
-
-    events: list[tuple[float, int, int]] = []
-    for f in (0, 1):
-        offset = 0.5 * f
-        levels = np.arange(np.ceil(phase[0] - offset), np.floor(phase[-1] - offset) + 1) + offset
-        events += [(float(x), 0, f) for x in np.interp(levels, phase, t)]
-    events += [(j.takeoff, 1, k) for k, j in enumerate(tl.jumps)]
-    gait = tl.gait
-    # coming to a stop: two quick settling steps, the farther foot first (decided when they happen)
-    stops = np.flatnonzero((gait[:-1] >= _MOVING) & (gait[1:] < _MOVING)) + 1
-    for k in stops:
-        events += [(t[k] + _SETTLE_SWING, 2, 0), (t[k] + 2.0 * _SETTLE_SWING, 2, 1)]
-    events.sort()
-
-    for when, kind, idx in events:
+        xz, yaw = planner.stand_spot(f, tl.time[0])
+        plants.append([Plant(-_FAR, -_FAR, _FAR, _FAR, planner.ankle3(f, xz), yaw)])
+    for when, kind, idx in planner.events(phase):
         if kind == 1:
-            _jump(tl.jumps[idx], tl, geo, plants, base, heading, ankle3)
+            _jump(tl.jumps[idx], tl, geo, plants, planner.base, heading, planner.ankle3)
             continue
         noise = rng.standard_normal(3)  # drawn for every event, so one skip shifts nothing
-        f = idx
-        if kind == 2:  # settling step: the foot farther from its spot goes first
-            away = [np.linalg.norm(stand_spot(k, when)[0] - plants[k][-1].ankle[[0, 2]]) for k in (0, 1)]
-            f = int(np.argmax(away)) if idx == 0 else int(np.argmin(away))
-        cur = plants[f][-1]
-        cycle = 2.0 / float(tl.at("cadence", when))
-        duty = float(tl.at("duty", when))
-        swing = _SETTLE_SWING if kind == 2 else max((1.0 - duty) * cycle, 0.2)
-        # lift no earlier than the foot has stood a moment and no action holds it down; a
-        # shorter swing is fine, a swing shorter than _MIN_SWING is skipped
-        lift = min(when - swing, _falls_behind(cur, t, base, heading, _MAX_BEHIND * leg))
-        lift = max(lift, max(cur.land, cur.flat) + _MIN_STANCE)
-        for a, b in tl.locks:
-            if a < when and b > lift:
-                lift = max(lift, b)
-        if when - lift < _MIN_SWING:
-            continue
-        g = float(np.interp(when, t, gait))
-        xz, yaw = stand_spot(f, when + _UNDER_BODY * duty * cycle)
-        fwd, left = _yaw_dirs(yaw - sides[f] * float(tl.at("toe_out", when)))
-        step = float(tl.at("stride", when)) * leg
-        xz = xz + g * (0.03 * step * noise[0] * fwd + 0.04 * geo.hip_width * noise[1] * left)
-        yaw = yaw + g * 0.03 * noise[2]
-        # never reach farther ahead of the body than a leg can (the mid-stance guess assumes
-        # the current cadence, which a transition may change)
-        base_now = np.array([np.interp(when, t, base[:, 0]), np.interp(when, t, base[:, 1])])
-        ahead = float(np.dot(xz - base_now, fwd))
-        xz = xz - fwd * max(ahead - _MAX_AHEAD * leg, 0.0)
-        dist = float(np.linalg.norm(xz - cur.ankle[[0, 2]]))
-        if g < _MOVING and dist < _SETTLE * leg:
-            continue
-        scale = float(np.clip(dist / (0.8 * leg), 0.25, 1.0))
-        cur.lift = lift
-        cur.heel = max(lift - float(np.clip(0.35 * (lift - cur.flat), 0.04, 0.3)), cur.flat)
-        cur.p_off = float(tl.at("toe_off", when)) * scale
-        p_land = float(tl.at("heel_strike", when)) * scale
-        roll = min(0.12, 0.25 * duty * cycle) if p_land != 0.0 else 0.0
-        height = float(tl.at("foot_lift", when)) * leg * float(np.clip(0.3 + dist / (0.6 * leg), 0.3, 1.0))
-        plants[f].append(Plant(when, when + roll, _FAR, _FAR, ankle3(f, xz), yaw, p_land, 0.0, height))
-    return plants, base
+        planner.step(plants, when, kind, idx, noise)
+    return plants, planner.base
 
 
 def _falls_behind(plant: Plant, t: np.ndarray, base: np.ndarray, heading: np.ndarray, limit: float) -> float:

@@ -202,6 +202,86 @@ def _squats(style: Style, start: float, end_limit: float, leg: float) -> list[Sq
     return out
 
 
+def _fade_halves(segments, durations: np.ndarray, blend: float, fps: float) -> list[float]:
+    """Half-width (seconds) of the cross-fade at the start of each segment (0 for the first).
+
+    Never more than 45 % of either neighbour; starting or stopping (gait <-> standing) takes
+    twice as long as other changes.
+    """
+    moving = [b in ("walk", "run") for b, _, _ in segments]
+    return [0.0] + [
+        max(
+            min(
+                0.5 * blend * (2.0 if moving[i - 1] != moving[i] else 1.0), 0.45 * durations[i - 1], 0.45 * durations[i]
+            ),
+            0.5 / fps,
+        )
+        for i in range(1, len(segments))
+    ]
+
+
+def _schedule_actions(segments, bounds: np.ndarray, half: list[float], pad_after: float, leg: float):
+    """``(jumps, squats, locks)`` of the jump and squat segments.
+
+    An action that cannot fit its segment (even squeezed) pushes the later segments back in
+    ``bounds`` (modified in place), so that nothing starts moving before a jump has landed or a
+    squat is up.
+    """
+    moving = [b in ("walk", "run") for b, _, _ in segments]
+    jumps, squats, locks = [], [], []
+    last = len(segments) - 1
+    for i, (behaviour, _, style) in enumerate(segments):
+        if behaviour not in ("jump", "squat") or bounds[i] > bounds[-1] + pad_after:
+            continue
+        start = bounds[i] + (half[i] if i > 0 else _FIRST_ACTION_DELAY)
+        if i > 0 and moving[i - 1]:
+            start += _SETTLE_BEFORE[behaviour]
+        end_limit = bounds[i + 1] - (half[i + 1] if i < last else 0.0)
+        if behaviour == "jump":
+            new_jumps = _jumps(style, start, end_limit, leg)
+            jumps += new_jumps
+            # settling steps may finish during the first part of the counter-movement
+            new_locks = [(j.bottom - 0.3 * (j.bottom - j.crouch), j.absorb) for j in new_jumps]
+        else:
+            new_squats = _squats(style, start, end_limit, leg)
+            squats += new_squats
+            new_locks = [(q.start, q.end) for q in new_squats]
+        locks += new_locks
+        overrun = new_locks[-1][1] - end_limit
+        if i < last and overrun > 0:
+            bounds[i + 1 : last + 1] += overrun
+    return jumps, squats, locks
+
+
+def _segment_weights(time: np.ndarray, bounds: np.ndarray, half: list[float], count: int) -> np.ndarray:
+    """Weight (N, count) of each segment: smoothstep fades that sum to 1 on every frame."""
+
+    def up(i: int) -> np.ndarray:  # 0 → 1 around the start of segment i
+        if i == 0:
+            return np.ones_like(time)
+        if i == count:
+            return np.zeros_like(time)
+        return smoothstep((time - bounds[i] + half[i]) / (2.0 * half[i]))
+
+    return np.stack([up(i) - up(i + 1) for i in range(count)], axis=-1)
+
+
+def _hold_gait_fields(params: dict, segments, seg_w: np.ndarray, gait: np.ndarray) -> None:
+    """Re-blend the stepping fields of ``params`` in place.
+
+    The stepping knobs of a gait keep their values while the gait fades out (a runner stops
+    with quick, ever shorter steps, not with slow walking ones): average them over the
+    locomotion segments only, and over the standing ones once no gait is left. The travel
+    and swing amplitudes belong to the gait alone and fade out with it.
+    """
+    moving_mask = np.array([b in ("walk", "run") for b, _, _ in segments])
+    for name in _GAIT_FIELDS + _GAIT_ONLY:
+        values = np.array([getattr(st, name) for _, _, st in segments])
+        walking = seg_w[:, moving_mask] @ values[moving_mask] / np.maximum(gait, 1e-12)
+        standing = seg_w[:, ~moving_mask] @ values[~moving_mask] / np.maximum(1.0 - gait, 1e-12)
+        params[name] = np.where(gait > 1e-3, walking, standing) if name in _GAIT_FIELDS else gait * walking
+
+
 def build(
     segments: list[tuple[str, int, Style]],
     leg: float,
@@ -226,53 +306,10 @@ def build(
     n_before = int(np.ceil(pad_before * fps))
     n_after = int(np.ceil(pad_after * fps))
     time = (np.arange(n_before + total + n_after) - n_before) / fps
-    durations = frames / fps
-    # half-width of each boundary's cross-fade, never more than 45 % of either neighbour;
-    # starting or stopping (gait <-> standing) takes twice as long as other changes
-    moving = [b in ("walk", "run") for b, _, _ in segments]
-    half = [0.0] + [
-        max(
-            min(
-                0.5 * blend * (2.0 if moving[i - 1] != moving[i] else 1.0), 0.45 * durations[i - 1], 0.45 * durations[i]
-            ),
-            0.5 / fps,
-        )
-        for i in range(1, len(segments))
-    ]
+    half = _fade_halves(segments, frames / fps, blend, fps)
+    jumps, squats, locks = _schedule_actions(segments, bounds, half, pad_after, leg)
 
-    # schedule the actions; one that cannot fit its segment (even squeezed) pushes the later
-    # segments back, so that nothing starts moving before a jump has landed or a squat is up
-    jumps, squats, locks = [], [], []
-    last = len(segments) - 1
-    for i, (behaviour, _, style) in enumerate(segments):
-        if behaviour not in ("jump", "squat") or bounds[i] > bounds[-1] + pad_after:
-            continue
-        start = bounds[i] + (half[i] if i > 0 else _FIRST_ACTION_DELAY)
-        if i > 0 and moving[i - 1]:
-            start += _SETTLE_BEFORE[behaviour]
-        end_limit = bounds[i + 1] - (half[i + 1] if i < last else 0.0)
-        if behaviour == "jump":
-            new_jumps = _jumps(style, start, end_limit, leg)
-            jumps += new_jumps
-            # settling steps may finish during the first part of the counter-movement
-            new_locks = [(j.bottom - 0.3 * (j.bottom - j.crouch), j.absorb) for j in new_jumps]
-        else:
-            new_squats = _squats(style, start, end_limit, leg)
-            squats += new_squats
-            new_locks = [(q.start, q.end) for q in new_squats]
-        locks += new_locks
-        overrun = new_locks[-1][1] - end_limit
-        if i < last and overrun > 0:
-            bounds[i + 1 : last + 1] += overrun
-
-    def up(i: int) -> np.ndarray:  # 0 → 1 around the start of segment i
-        if i == 0:
-            return np.ones_like(time)
-        if i == len(segments):
-            return np.zeros_like(time)
-        return smoothstep((time - bounds[i] + half[i]) / (2.0 * half[i]))
-
-    seg_w = np.stack([up(i) - up(i + 1) for i in range(len(segments))], axis=-1)
+    seg_w = _segment_weights(time, bounds, half, len(segments))
     weights = np.zeros((len(time), len(BEHAVIOURS)))
     params = {name: np.zeros_like(time) for name in FIELDS}
     segs = []
@@ -282,17 +319,6 @@ def build(
         for name in FIELDS:
             params[name] += w * getattr(style, name)
         segs.append(Segment(behaviour, float(bounds[i]), float(max(bounds[i + 1], bounds[i])), style))
-
-    # the stepping knobs of a gait keep their values while the gait fades out (a runner stops
-    # with quick, ever shorter steps, not with slow walking ones): average them over the
-    # locomotion segments only, and over the standing ones once no gait is left. The travel
-    # and swing amplitudes belong to the gait alone and fade out with it.
     gait = weights[:, BEHAVIOURS.index("walk")] + weights[:, BEHAVIOURS.index("run")]
-    moving_mask = np.array(moving)
-    for name in _GAIT_FIELDS + _GAIT_ONLY:
-        values = np.array([getattr(st, name) for _, _, st in segments])
-        walking = seg_w[:, moving_mask] @ values[moving_mask] / np.maximum(gait, 1e-12)
-        standing = seg_w[:, ~moving_mask] @ values[~moving_mask] / np.maximum(1.0 - gait, 1e-12)
-        params[name] = np.where(gait > 1e-3, walking, standing) if name in _GAIT_FIELDS else gait * walking
-
+    _hold_gait_fields(params, segments, seg_w, gait)
     return Timeline(time, n_before, total, float(fps), weights, params, segs, jumps, squats, locks)
