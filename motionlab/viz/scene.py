@@ -216,10 +216,6 @@ class SkeletonActor:
         if unknown:
             raise ValueError(f"unknown trail(s) {sorted(unknown)}; expected 'root' and/or 'feet'")
         pv = backend.import_pyvista()
-        from vtkmodules.vtkCommonDataModel import vtkDataObject
-        from vtkmodules.vtkFiltersCore import vtkGlyph3D, vtkTubeFilter
-        from vtkmodules.vtkFiltersSources import vtkSphereSource
-
         self.plotter = plotter
         self.color = _rgb(color)
         self.offset = np.asarray(offset, dtype=np.float64).reshape(3)
@@ -235,6 +231,18 @@ class SkeletonActor:
         self._bone_points = pv.PolyData()
         self._joint_points = pv.PolyData()
         self._build_geometry()
+        self._build_filters()
+        self._add_actors()
+        self._add_trails()
+        self.frame = -1
+        self.set_frame(0)
+
+    def _build_filters(self) -> None:
+        """The VTK filters: tubes along the bone segments, sphere glyphs at the joints."""
+        from vtkmodules.vtkCommonDataModel import vtkDataObject
+        from vtkmodules.vtkFiltersCore import vtkGlyph3D, vtkTubeFilter
+        from vtkmodules.vtkFiltersSources import vtkSphereSource
+
         self._tube = vtkTubeFilter()
         self._tube.SetInputData(self._bone_points)
         self._tube.SetRadius(0.011 * self.size)
@@ -255,37 +263,40 @@ class SkeletonActor:
         self._glyph.SetInputArrayToProcess(0, 0, 0, points, "value" if self._value_mode else "rgb")
         self._glyph.SetInputArrayToProcess(1, 0, 0, points, "scale")
 
+    def _add_actors(self) -> None:
+        """Bone and joint actors in the plotter (and a colour bar when joints show values)."""
+        plotter = self.plotter
         self.bone_actor = _add_pipeline(plotter, self._tube, color=self.color)
-        if self._value_mode:
-            low, high = self._value_range()
-            self.joint_actor = _add_pipeline(plotter, self._glyph, scalars="value", cmap=cmap, clim=(low, high))
-            plotter.add_scalar_bar(
-                value_title,
-                mapper=self.joint_actor.GetMapper(),
-                n_labels=3,
-                fmt="%.2f",
-                vertical=True,
-                color="#333333",
-                position_x=0.86,
-                position_y=0.08,
-                width=0.07,
-                height=0.45,
-                title_font_size=12,
-                label_font_size=11,
-            )
-        else:
+        if not self._value_mode:
             self.joint_actor = _add_pipeline(plotter, self._glyph, scalars="rgb")
-        # trails
+            return
+        low, high = self._value_range()
+        self.joint_actor = _add_pipeline(plotter, self._glyph, scalars="value", cmap=self._cmap, clim=(low, high))
+        plotter.add_scalar_bar(
+            self._value_title,
+            mapper=self.joint_actor.GetMapper(),
+            n_labels=3,
+            fmt="%.2f",
+            vertical=True,
+            color="#333333",
+            position_x=0.86,
+            position_y=0.08,
+            width=0.07,
+            height=0.45,
+            title_font_size=12,
+            label_font_size=11,
+        )
+
+    def _add_trails(self) -> None:
+        """One line mesh per requested trail, in a light tint of the bone colour."""
         self._trail_meshes: dict[str, object] = {}
         tint = 0.45 * self.color + 0.55
         for kind in self.trails:
             if self._paths[kind].size == 0:  # e.g. feet trails on a rig without feet
                 continue
             mesh = self._trail_polydata(self._paths[kind])
-            plotter.add_mesh(mesh, color=tint, line_width=3, lighting=False, reset_camera=False)
+            self.plotter.add_mesh(mesh, color=tint, line_width=3, lighting=False, reset_camera=False)
             self._trail_meshes[kind] = mesh
-        self.frame = -1
-        self.set_frame(0)
 
     # -------------------------------------------------------------- data
     def _build_geometry(self) -> None:
@@ -413,6 +424,30 @@ class SkeletonActor:
             mesh.points = shown.reshape(-1, 3)
 
 
+def _scene_args(motions, camera, colors, offsets, labels, joint_values, window_size):
+    """:class:`Scene`'s arguments checked: the per-motion ones as lists of K (defaults filled in), and
+    ``(width, height)``; raises ``ValueError`` on a wrong count, camera or size."""
+    motions = [motions] if isinstance(motions, Motion) else list(motions)
+    if not motions or not all(isinstance(m, Motion) for m in motions):
+        raise ValueError(f"expected a Motion or a non-empty sequence of Motions, got {motions!r:.80}")
+    if camera not in ("frame", "follow"):
+        raise ValueError(f"camera must be 'frame' or 'follow', got {camera!r}")
+    K = len(motions)
+    colors = list(colors) if colors is not None else [PALETTE[k % len(PALETTE)] for k in range(K)]
+    offsets = np.zeros((K, 3)) if offsets is None else np.asarray(offsets, dtype=np.float64)
+    labels = list(labels) if labels is not None else [m.name or None for m in motions]
+    joint_values = list(joint_values) if joint_values is not None else [None] * K
+    for what, seq in (("colors", colors), ("labels", labels), ("joint_values", joint_values)):
+        if len(seq) != K:
+            raise ValueError(f"expected {K} {what} (one per motion), got {len(seq)}")
+    if offsets.shape != (K, 3):
+        raise ValueError(f"expected offsets of shape ({K}, 3), got {offsets.shape}")
+    width, height = (int(v) for v in window_size)
+    if width < 16 or height < 16:
+        raise ValueError(f"window_size must be at least 16 x 16 pixels, got {window_size}")
+    return motions, colors, offsets, labels, joint_values, (width, height)
+
+
 # ---------------------------------------------------------------------------- the scene
 class Scene:
     """Several characters, a ground grid and a camera, on one timeline.
@@ -459,34 +494,10 @@ class Scene:
         anti_aliasing: bool | None = None,
         plotter=None,
     ) -> None:
-        motions = [motions] if isinstance(motions, Motion) else list(motions)
-        if not motions or not all(isinstance(m, Motion) for m in motions):
-            raise ValueError(f"expected a Motion or a non-empty sequence of Motions, got {motions!r:.80}")
-        if camera not in ("frame", "follow"):
-            raise ValueError(f"camera must be 'frame' or 'follow', got {camera!r}")
-        K = len(motions)
-        colors = list(colors) if colors is not None else [PALETTE[k % len(PALETTE)] for k in range(K)]
-        offsets = np.zeros((K, 3)) if offsets is None else np.asarray(offsets, dtype=np.float64)
-        labels = list(labels) if labels is not None else [m.name or None for m in motions]
-        joint_values = list(joint_values) if joint_values is not None else [None] * K
-        for what, seq in (("colors", colors), ("labels", labels), ("joint_values", joint_values)):
-            if len(seq) != K:
-                raise ValueError(f"expected {K} {what} (one per motion), got {len(seq)}")
-        if offsets.shape != (K, 3):
-            raise ValueError(f"expected offsets of shape ({K}, 3), got {offsets.shape}")
-        width, height = (int(v) for v in window_size)
-        if width < 16 or height < 16:
-            raise ValueError(f"window_size must be at least 16 x 16 pixels, got {window_size}")
-
-        pv = backend.import_pyvista()
-        self.off_screen = backend.resolve_off_screen(off_screen)
-        self.plotter = (
-            plotter if plotter is not None else pv.Plotter(off_screen=self.off_screen, window_size=(width, height))
+        motions, colors, offsets, labels, joint_values, (width, height) = _scene_args(
+            motions, camera, colors, offsets, labels, joint_values, window_size
         )
-        self.plotter.set_background(BACKGROUND)
-        if plotter is None:
-            smooth = (not self.off_screen) if anti_aliasing is None else bool(anti_aliasing)
-            self.plotter.ren_win.SetMultiSamples(4 if smooth else 0)
+        self._open_plotter(plotter, off_screen, (width, height), anti_aliasing)
         self.camera_mode = camera
         self.fps = motions[0].fps
         self.actors: list[SkeletonActor] = []
@@ -508,7 +519,25 @@ class Scene:
             )
         self.num_frames = max(int(np.floor(a.motion.duration * self.fps + 1e-6)) + 1 for a in self.actors)
         self._ground_mesh = self._add_ground() if ground else None
-        # text: frame/time on top, then one coloured legend line per labelled character
+        self._add_text_rows(height, show_time)
+        self._setup_camera()
+        self.frame = -1
+        self.set_frame(0, render=False)
+
+    def _open_plotter(self, plotter, off_screen, window_size: tuple[int, int], anti_aliasing) -> None:
+        """Use ``plotter``, or open a new one (multisampling per ``anti_aliasing``); set the background."""
+        pv = backend.import_pyvista()
+        self.off_screen = backend.resolve_off_screen(off_screen)
+        self.plotter = (
+            plotter if plotter is not None else pv.Plotter(off_screen=self.off_screen, window_size=window_size)
+        )
+        self.plotter.set_background(BACKGROUND)
+        if plotter is None:
+            smooth = (not self.off_screen) if anti_aliasing is None else bool(anti_aliasing)
+            self.plotter.ren_win.SetMultiSamples(4 if smooth else 0)
+
+    def _add_text_rows(self, height: int, show_time: bool) -> None:
+        """Frame/time on top, then one coloured legend line per labelled character."""
         font = max(6, round(height / 44))
         line = 2.0 * font / height  # viewport units
         rows = [("", "#444444")] if show_time else []
@@ -522,9 +551,6 @@ class Scene:
             texts.append(actor)
         # a plain text actor: pyvista's corner annotation re-fits its font every frame (slow)
         self._time_text = texts[0] if show_time else None
-        self._setup_camera()
-        self.frame = -1
-        self.set_frame(0, render=False)
 
     # -------------------------------------------------------------- geometry of the whole clip
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
