@@ -1105,11 +1105,7 @@ def save(
     precision: int = 6,
     overwrite: bool = False,
 ) -> Path:
-    """Write a motion as a BVH file (see :func:`dumps` for the layout).
-
-    The text is built in memory and written to a temporary file in the same folder that then
-    replaces ``path`` in one step (:func:`motionlab.core.files.atomic_write`), so a failure never
-    leaves a partial file, and temporary files of killed earlier writes are removed.
+    """Write a motion as a BVH file (see :func:`dumps` for the layout) and return ``Path(path)``.
 
     Parameters
     ----------
@@ -1119,18 +1115,10 @@ def save(
     precision : int           decimals written
     overwrite : bool          replace an existing file (default: refuse)
 
-    Returns
-    -------
-    Path   the path written
-
-    Raises
-    ------
-    FileExistsError
-        ``path`` exists and ``overwrite`` is False.
-    OSError
-        ``path`` is a folder, or its folder is missing or not writable (checked before writing).
-    ValueError
-        The motion cannot be written (see :func:`dumps`).
+    The text is built first and written through :func:`motionlab.core.files.atomic_write`,
+    which raises for ``path`` as :func:`~motionlab.core.files.check_output` says (a folder, an
+    existing file without ``overwrite``, a missing or read-only folder) and never leaves a
+    partial file. ``ValueError`` when the motion cannot be written (see :func:`dumps`).
     """
     text = dumps(motion, scale=scale, precision=precision)
     return files.atomic_write(path, lambda f: f.write(text), overwrite=overwrite, what="BVH file")

@@ -16,6 +16,7 @@ a running writer's file is never touched.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import tempfile
@@ -111,19 +112,26 @@ def atomic_write_all(outputs: list[tuple], overwrite: bool = False) -> list[Path
     of a system failure.
     """
     checked = [(check_output(path, overwrite, what), write, binary, what) for path, write, binary, what in outputs]
-    temps: list[tuple[str, Path]] = []
-    try:
+    temps: list[str] = []
+    with _removed_on_error(temps):
         for path, write, binary, what in checked:
             remove_stale(path)
-            temps.append((_write_temporary(path, write, binary, what), path))
-        for tmp, path in temps:
+            temps.append(_write_temporary(path, write, binary, what))
+        for tmp, (path, *_) in zip(temps, checked, strict=True):
             os.replace(tmp, path)
+    return [path for path, *_ in checked]
+
+
+@contextlib.contextmanager
+def _removed_on_error(temps: list[str]):
+    """On any error (also ``KeyboardInterrupt``) inside the block, remove the files in ``temps`` and re-raise."""
+    try:
+        yield
     except BaseException:
-        for tmp, _ in temps:
+        for tmp in temps:
             if os.path.exists(tmp):
                 os.unlink(tmp)
         raise
-    return [path for _, path in temps]
 
 
 def _write_temporary(path: Path, write: Callable, binary: bool, what: str) -> str:
@@ -138,7 +146,7 @@ def _write_temporary(path: Path, write: Callable, binary: bool, what: str) -> st
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.{os.getpid()}.", suffix=TMP_SUFFIX)
     except OSError as e:  # the folder refuses new files: say which output, not the temporary name
         raise type(e)(f"cannot write the {what} {path}: {(e.strerror or str(e)).lower()}") from None
-    try:
+    with _removed_on_error([tmp]):
         if binary:
             with os.fdopen(fd, "wb") as f:
                 write(f)
@@ -146,10 +154,6 @@ def _write_temporary(path: Path, write: Callable, binary: bool, what: str) -> st
             with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
                 write(f)
         os.chmod(tmp, mode)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
     return tmp
 
 
@@ -172,10 +176,6 @@ def atomic_write(
     path = check_output(path, overwrite, what)
     remove_stale(path)
     tmp = _write_temporary(path, write, binary, what)
-    try:
+    with _removed_on_error([tmp]):
         os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
     return path

@@ -272,30 +272,19 @@ def dumps(motion: Motion) -> bytes:
 
 
 def save(path: str | os.PathLike, motion: Motion, overwrite: bool = False) -> Path:
-    """Write a motion as a ``.glb`` file (see :func:`dumps`), atomically.
-
-    The whole file is built in memory first, then written to a temporary file beside ``path``
-    that replaces it in one step (:func:`motionlab.core.files.atomic_write`): a failure never
-    leaves a partial file, and nothing is written when the motion is refused.
+    """Write a motion as a ``.glb`` file (see :func:`dumps`) and return ``Path(path)``.
 
     Parameters
     ----------
-    path : str or PathLike   the destination; must end in ``.glb``
+    path : str or PathLike   the destination, ending in ``.glb``
     motion : Motion
     overwrite : bool         replace an existing file (default: refuse)
 
-    Returns
-    -------
-    Path   the path written
-
-    Raises
-    ------
-    ValueError
-        ``path`` does not end in ``.glb``, or the motion cannot be written (see :func:`dumps`).
-    FileExistsError
-        ``path`` exists and ``overwrite`` is False.
-    OSError
-        ``path`` is a folder, or its folder is missing or not writable (checked before writing).
+    ``path`` must end in ``.glb`` (else ``ValueError``) and is checked by
+    :func:`motionlab.core.files.check_output` before the motion is converted, so nothing is
+    written when either is refused; the bytes then go through
+    :func:`~motionlab.core.files.atomic_write`. ``ValueError`` when the motion cannot be
+    written (see :func:`dumps`).
     """
     path = Path(path)
     if path.suffix.lower() != SUFFIX:

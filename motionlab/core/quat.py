@@ -53,23 +53,23 @@ _EPS_NORM = 1e-12
 _SLERP_NLERP_BELOW = 1e-6  # radians: below this half-angle slerp falls back to nlerp
 
 
+def _as_float_last(x, size: int, expected: str) -> np.ndarray:
+    """``x`` as an array of floats (float64 unless already floating) whose last axis has ``size`` entries."""
+    x = np.asarray(x)
+    if x.ndim == 0 or x.shape[-1] != size:
+        raise ValueError(f"expected {expected}, got shape {x.shape}")
+    if not np.issubdtype(x.dtype, np.floating):
+        x = x.astype(np.float64)
+    return x
+
+
 def check(q, name: str = "q") -> np.ndarray:
     """Return ``q`` as a float array after checking its last axis has 4 components."""
-    q = np.asarray(q)
-    if q.ndim == 0 or q.shape[-1] != 4:
-        raise ValueError(f"expected {name} as (..., 4) quaternions (w, x, y, z), got shape {q.shape}")
-    if not np.issubdtype(q.dtype, np.floating):
-        q = q.astype(np.float64)
-    return q
+    return _as_float_last(q, 4, f"{name} as (..., 4) quaternions (w, x, y, z)")
 
 
 def _check_vec(v, name: str = "v") -> np.ndarray:
-    v = np.asarray(v)
-    if v.ndim == 0 or v.shape[-1] != 3:
-        raise ValueError(f"expected {name} as (..., 3) vectors, got shape {v.shape}")
-    if not np.issubdtype(v.dtype, np.floating):
-        v = v.astype(np.float64)
-    return v
+    return _as_float_last(v, 3, f"{name} as (..., 3) vectors")
 
 
 def mul(a, b) -> np.ndarray:

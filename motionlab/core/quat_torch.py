@@ -145,6 +145,7 @@ def to_matrix(q: torch.Tensor) -> torch.Tensor:
     ).reshape(q.shape[:-1] + (3, 3))
 
 
+# Intended twin of quat.from_matrix (§2: torch twins keep the algorithm; tests/core/test_quat_torch.py pins them equal).
 def from_matrix(m: torch.Tensor) -> torch.Tensor:
     """Unit quaternions (w >= 0) of (..., 3, 3) rotation matrices."""
     if m.ndim < 2 or tuple(m.shape[-2:]) != (3, 3):

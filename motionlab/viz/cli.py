@@ -139,6 +139,7 @@ def _movie_length(out: Path, motion, stride: int | None) -> tuple[int, float]:
 
 def register(subparsers) -> None:
     """Add ``view`` to the ``motionlab`` command."""
+    # the same argparse shape as every subcommand's register(); the words are view's own
     p = subparsers.add_parser(
         "view",
         help="play a BVH file in 3D, or write it to an MP4/GIF movie",

@@ -162,6 +162,7 @@ def _legend(data: dict) -> str:
     return "".join(items)
 
 
+# Intended twin: the same first parameters as player_data, which it wraps.
 def player_html(
     motions: Motion | Sequence[Motion],
     colors: Sequence[str] | None = None,
