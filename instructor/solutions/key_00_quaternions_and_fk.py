@@ -1,26 +1,29 @@
-"""Instructor's key for notebook 00 (quaternions and forward kinematics)."""
+"""Instructor's key for notebook 00 (quaternions and forward kinematics).
+
+Exercises 1 and 2 are experiments: the key reruns the notebook's cell with the changed parameter
+and returns the number a student reads off and types (as printed).
+"""
 
 import numpy as np
 
 from motionlab.core import fk, quat
 
 
-def my_conj(q):
-    """Exercise 1: the conjugate (w, -x, -y, -z) of quaternions (..., 4)."""
-    q = np.asarray(q, dtype=float)
-    return q * np.array([1.0, -1.0, -1.0, -1.0])
+def my_nlerp_turn_experiment():
+    """Exercise 1: section 4's cell with a 90° turn; nlerp's fastest / slowest step, as printed."""
+    q0 = quat.IDENTITY
+    q1 = quat.from_axis_angle([0, 1, 0], np.radians(90))
+    t = np.linspace(0, 1, 50)
+    nlerp = quat.normalize((1 - t)[:, None] * q0 + t[:, None] * q1)
+    steps = np.diff(np.degrees(quat.angle_between(q0, nlerp)))
+    return round(float(steps.max() / steps.min()), 2)
 
 
-def my_slerp(q0, q1, t):
-    """Exercise 2: spherical linear interpolation of two unit quaternions (4,), short arc."""
-    q0, q1 = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
-    d = float(np.dot(q0, q1))
-    if d < 0:  # q1 and -q1 are the same rotation: take the shorter arc
-        q1, d = -q1, -d
-    omega = np.arccos(min(d, 1.0))
-    if omega < 1e-9:  # the same rotation: nothing to interpolate
-        return q0.copy()
-    return (np.sin((1 - t) * omega) * q0 + np.sin(t * omega) * q1) / np.sin(omega)
+def my_euler_order_experiment():
+    """Exercise 2: degrees between (30°, −20°, 45°) read as 'zxy' and as 'xyz'."""
+    angles = np.radians([30.0, -20.0, 45.0])
+    gap = quat.angle_between(quat.from_euler(angles, "zxy"), quat.from_euler(angles, "xyz"))
+    return round(float(np.degrees(gap)), 1)
 
 
 def left_hand_height_with_arm_raised(skeleton):

@@ -2,16 +2,20 @@
 
 import numpy as np
 
-from motionlab.core import humanoid
+from motionlab.core import humanoid, preprocess
 
 
-def my_heading(pose):
-    """Exercise 1: facing angle (radians, 0 = +z) of one canonical pose (22, 3)."""
-    p = np.asarray(pose, dtype=float)
+def my_hips_heading_experiment(world):
+    """Exercise 1 (experiment): largest |ψ_hips − ψ| over the clip's frames, degrees, one decimal.
+
+    ``world``: the clip's canonical joint positions (T, 22, 3), as in section 3.
+    """
     ix = humanoid.JOINTS.index
-    across = (p[ix("LeftUpLeg")] - p[ix("RightUpLeg")]) + (p[ix("LeftArm")] - p[ix("RightArm")])
+    across = world[:, ix("LeftUpLeg")] - world[:, ix("RightUpLeg")]  # the hips only
     forward = np.cross(across, [0.0, 1.0, 0.0])
-    return float(np.arctan2(forward[0], forward[2]))
+    psi_hips = np.arctan2(forward[:, 0], forward[:, 2])
+    gap = np.angle(np.exp(1j * (psi_hips - preprocess.heading(world))))  # wrapped to (−π, π]
+    return round(float(np.degrees(np.abs(gap).max())), 1)
 
 
 def my_window_count(num_frames, window=120, stride=30):

@@ -2,14 +2,16 @@
 
 import numpy as np
 
+from motionlab.core import humanoid
+from motionlab.viz import compare, proportions
 
-def my_pose_error(motion, reference):
-    """Exercise 1: per-frame mean joint distance (T,), metres, after removing each root."""
-    a = motion.global_positions()
-    b = reference.global_positions()
-    a = a - a[:, :1]
-    b = b - b[:, :1]
-    return np.linalg.norm(a - b, axis=-1).mean(axis=1)
+
+def my_shorter_legs_experiment(walk):
+    """Exercise 1 (experiment): section 4's comparison with legs × 0.8; mean pose error, m, as printed."""
+    short_legs = humanoid.scale_bones(walk.skeleton, legs=0.8)
+    copied = proportions.copy_rotation_solver(walk)(short_legs)
+    err = compare.joint_errors(copied, walk, relative_to_root=True)
+    return round(float(np.nanmean(err)), 3)
 
 
 def my_joint_speed(motion):

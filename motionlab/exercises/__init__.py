@@ -14,22 +14,24 @@ notebook:
 
 Put the check last in its cell: the returned :class:`Result` displays as its message::
 
-    def my_conj(q):
+    def my_window_count(num_frames, window=120, stride=30):
         ...
-    exercises.conj.check(my_conj)          # ✓ my_conj is right on 3 cases
+    exercises.window_count.check(my_window_count)   # ✓ my_window_count is right on 7 case(s)
 
 The named exercises, by notebook (each module holds its exercises' cases, references and
 typical mistakes):
 
-* :mod:`~motionlab.exercises.basics`: 00 ``conj``, ``slerp``, ``hand_height``; 01 ``heading``,
-  ``window_count``; 04 ``pose_error``, ``joint_speed``;
+* :mod:`~motionlab.exercises.basics`: 00 ``hand_height``; 01 ``window_count``; 04 ``joint_speed``;
 * :mod:`~motionlab.exercises.retargeting`: 02 ``recon_loss``, ``combine``, ``rotations``;
   03 ``foot_loss``, ``root_scale``, ``angle_loss``;
 * :mod:`~motionlab.exercises.motion_graphs`: 05 ``local_minima``, ``distance_matrix``;
 * :mod:`~motionlab.exercises.interpolation`: 06 ``ease``, ``sigma2``, ``jumps``.
 
 Experiments (:class:`Question`: change a parameter, run the experiment, type the number it gives;
-the check reruns it on the notebook's own inputs): 03 ``foot_weight`` (λ_foot in the paper's
+the check reruns it on the notebook's own inputs): 00 ``nlerp_turn`` (SLERP against nlerp on a
+smaller turn), ``euler_order`` (the same angles in another channel order); 01 ``hips_heading``
+(the heading from the hips alone); 04 ``shorter_legs`` (copying rotations onto shorter legs);
+03 ``foot_weight`` (λ_foot in the paper's
 set-up), 06 ``held_out_q`` (q by likelihood on truly held-out frames), 05
 ``vanishing_threshold`` (the graph threshold at which a style leaves the pruned standard graph).
 
@@ -41,7 +43,7 @@ answers and an alternative correct answer. :func:`check` is the same machinery f
 
 from __future__ import annotations
 
-from .basics import conj, hand_height, heading, joint_speed, pose_error, slerp, window_count
+from .basics import euler_order, hand_height, hips_heading, joint_speed, nlerp_turn, shorter_legs, window_count
 from .core import Exercise, Mistake, Question, Result, check
 from .interpolation import ease, held_out_q, jumps, sigma2
 from .motion_graphs import distance_matrix, local_minima, vanishing_threshold
@@ -53,12 +55,8 @@ __all__ = [
     "Question",
     "Result",
     "check",
-    "conj",
-    "slerp",
     "hand_height",
-    "heading",
     "window_count",
-    "pose_error",
     "joint_speed",
     "recon_loss",
     "combine",
@@ -71,6 +69,10 @@ __all__ = [
     "ease",
     "sigma2",
     "jumps",
+    "nlerp_turn",
+    "euler_order",
+    "hips_heading",
+    "shorter_legs",
     "foot_weight",
     "held_out_q",
     "vanishing_threshold",
@@ -79,12 +81,8 @@ __all__ = [
 ]
 
 EXERCISES: dict[str, Exercise] = {
-    "conj": conj,
-    "slerp": slerp,
     "hand_height": hand_height,
-    "heading": heading,
     "window_count": window_count,
-    "pose_error": pose_error,
     "joint_speed": joint_speed,
     "recon_loss": recon_loss,
     "combine": combine,
@@ -104,6 +102,10 @@ EXERCISES: dict[str, Exercise] = {
 """
 
 EXPERIMENTS: dict[str, Question] = {
+    "nlerp_turn": nlerp_turn,
+    "euler_order": euler_order,
+    "hips_heading": hips_heading,
+    "shorter_legs": shorter_legs,
     "foot_weight": foot_weight,
     "held_out_q": held_out_q,
     "vanishing_threshold": vanishing_threshold,

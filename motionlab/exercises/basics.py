@@ -2,108 +2,86 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from .core import Exercise, Mistake
+from .core import Exercise, Mistake, Question
 
-__all__ = ["conj", "slerp", "hand_height", "heading", "window_count", "pose_error", "joint_speed"]
+__all__ = [
+    "nlerp_turn",
+    "euler_order",
+    "hand_height",
+    "hips_heading",
+    "window_count",
+    "shorter_legs",
+    "joint_speed",
+]
 
 
 # --------------------------------------------------------------------------- notebook 00
-def _quat_cases():
-    rng = np.random.default_rng(100)
+def _nlerp_speed_ratio(turn_degrees: float, steps: int = 50, radians_typed: bool = False) -> float:
+    """Fastest / slowest step of nlerp from the identity to a turn about y (section 4's experiment)."""
     from motionlab.core import quat
 
-    unit = quat.normalize(rng.normal(size=(5, 4)))
-    not_unit = rng.normal(size=(2, 3, 4)) * 2.0  # conj is defined for any quaternion
-    return [(unit,), (quat.IDENTITY.copy(),), (not_unit,)]
+    angle = turn_degrees if radians_typed else np.radians(turn_degrees)  # the mistake passes 90 as radians
+    q0, q1 = quat.IDENTITY, quat.from_axis_angle([0, 1, 0], angle)
+    t = np.linspace(0, 1, steps)
+    nlerp = quat.normalize((1 - t)[:, None] * q0 + t[:, None] * q1)
+    step = np.diff(np.degrees(quat.angle_between(q0, nlerp)))
+    return float(step.max() / step.min())
 
 
-def _conj_ref(q):
-    from motionlab.core import quat
-
-    return quat.conj(q)
-
-
-conj = Exercise(
-    "00 · exercise 1 (conjugate)",
-    _conj_ref,
-    _quat_cases,
+nlerp_turn = Question(
+    "00 · exercise 1 (experiment: nlerp on a smaller turn)",
+    lambda: _nlerp_speed_ratio(90.0),
+    atol=0.006,  # the ratio as printed, with two decimals
     mistakes=[
         Mistake(
-            lambda q: -np.asarray(q),
-            "you changed the sign of all four components. That is the same rotation as q, "
-            "not its conjugate: which part of (w, x, y, z) keeps its sign?",
+            lambda: _nlerp_speed_ratio(170.0),
+            "that is the 170° turn of the page; change the angle to 90° and run the cell again.",
         ),
-        Mistake(lambda q: np.asarray(q), "your function returns q unchanged."),
         Mistake(
-            lambda q: _conj_ref(q) / np.sum(np.asarray(q) ** 2, axis=-1, keepdims=True),
-            "you divided by |q|²: that is the inverse q⁻¹. It equals the conjugate only for unit "
-            "quaternions, and case 3 is not a unit quaternion.",
+            lambda: _nlerp_speed_ratio(90.0, radians_typed=True),
+            "quat.from_axis_angle takes radians: 90 radians is not a quarter turn (use np.radians(90)).",
+        ),
+        Mistake(lambda: 1.0, "1.00 is slerp's ratio (constant speed); the question asks about nlerp."),
+        Mistake(
+            lambda: 1.0 / _nlerp_speed_ratio(90.0),
+            "that is slowest / fastest; the cell prints fastest / slowest (a number above 1).",
         ),
     ],
 )
+"""Notebook 00, section 4: nlerp's fastest/slowest step ratio for a 90° turn (50 steps)."""
+
+_EULER_ANGLES = (30.0, -20.0, 45.0)  # degrees, section 3's angles
 
 
-def _slerp_cases():
-    rng = np.random.default_rng(101)
+def _order_gap(order: str = "xyz", degrees: bool = True, typed_degrees: bool = False) -> float:
+    """Angle between section 3's rotation read as ``zxy`` and the same numbers read as ``order``."""
     from motionlab.core import quat
 
-    cases = []
-    for k in range(6):
-        q0, q1 = quat.normalize(rng.normal(size=4)), quat.normalize(rng.normal(size=4))
-        if k % 2 == 0 and np.dot(q0, q1) > 0:  # half of the pairs need the short-arc flip
-            q1 = -q1
-        if k % 2 == 1 and np.dot(q0, q1) < 0:
-            q1 = -q1
-        for t in (0.0, 0.25, 0.5, 1.0):
-            cases.append((q0, q1, t))
-    return cases
+    angles = np.array(_EULER_ANGLES) if typed_degrees else np.radians(_EULER_ANGLES)
+    gap = float(quat.angle_between(quat.from_euler(angles, "zxy"), quat.from_euler(angles, order)))
+    return float(np.degrees(gap)) if degrees else gap
 
 
-def _slerp_ref(q0, q1, t):
-    from motionlab.core import quat
-
-    return quat.slerp(q0, q1, t)
-
-
-def _slerp_long_arc(q0, q1, t):
-    om = math.acos(float(np.clip(np.dot(q0, q1), -1.0, 1.0)))
-    if om < 1e-9:
-        return np.asarray(q0, dtype=float)
-    return (math.sin((1 - t) * om) * np.asarray(q0) + math.sin(t * om) * np.asarray(q1)) / math.sin(om)
-
-
-def _nlerp(q0, q1, t):
-    q1 = np.asarray(q1) if np.dot(q0, q1) >= 0 else -np.asarray(q1)
-    q = (1 - t) * np.asarray(q0) + t * q1
-    return q / np.linalg.norm(q)
-
-
-slerp = Exercise(
-    "00 · exercise 2 (slerp)",
-    _slerp_ref,
-    _slerp_cases,
-    sign_free=True,
+euler_order = Question(
+    "00 · exercise 2 (experiment: the same angles in another channel order)",
+    _order_gap,
+    atol=0.06,  # an answer typed with one decimal passes
     mistakes=[
+        Mistake(lambda: _order_gap(degrees=False), "that is in radians; the question asks for degrees."),
         Mistake(
-            _slerp_long_arc,
-            "right when q0·q1 > 0, wrong otherwise: q1 and -q1 are the same rotation, and "
-            "slerp must take the shorter of the two arcs between q0 and ±q1.",
+            lambda: _order_gap(typed_degrees=True),
+            "quat.from_euler takes radians: pass np.radians([30, -20, 45]), as section 3 does.",
         ),
+        Mistake(lambda: 0.0, "you compared 'zxy' with itself: build the second rotation with order 'xyz'."),
         Mistake(
-            _nlerp,
-            "right at t = 0, 0.5 and 1 only: normalising a straight-line blend follows the arc "
-            "but not at constant angular speed. Weight q0 and q1 by sines of the angle.",
-        ),
-        Mistake(
-            lambda q0, q1, t: _slerp_ref(q0, q1, 1 - t),
-            "at t = 0 the answer must be q0 and at t = 1 it must be q1: yours is the other way round.",
+            lambda: _order_gap("zyx"),
+            "that is the order 'zyx'; the question asks for 'xyz'.",
         ),
     ],
 )
+"""Notebook 00, section 3: degrees between (30°, −20°, 45°) read as ``zxy`` and as ``xyz``."""
 
 
 def _hand_height_ref(skeleton):
@@ -163,68 +141,48 @@ hand_height = Exercise(
 
 
 # --------------------------------------------------------------------------- notebook 01
-def _heading_cases():
-    from motionlab import synthetic
-    from motionlab.core import humanoid, quat
+def _heading_gap(world, across: str = "hips", reduce: str = "max", degrees: bool = True, flip: bool = False) -> float:
+    """Largest (or mean) |ψ_across − ψ| over the frames of ``world`` (T, 22, 3), wrapped to ±180°.
 
-    walk = synthetic.generate("walk", humanoid.canonical_skeleton(), num_frames=40, fps=30, seed=3)
-    pos = walk.global_positions()
-    cases = []
-    for k, yaw in enumerate(np.radians([0, 40, 100, 170, -135, -60])):  # every quadrant, both signs
-        q = quat.from_axis_angle([0, 1, 0], yaw)
-        cases.append((quat.rotate(q, pos[5 * k]),))
-    return cases
+    ``across``: ``"hips"`` (LeftUpLeg − RightUpLeg) or ``"shoulders"`` (LeftArm − RightArm);
+    ψ is :func:`motionlab.core.preprocess.heading` (hips and shoulders together).
+    """
+    from motionlab.core import humanoid, preprocess
 
-
-def _heading_ref(pose):
-    from motionlab.core import preprocess
-
-    return preprocess.heading(pose)
-
-
-def _heading_variant(mode: str):
-    def wrong(pose):
-        from motionlab.core import humanoid
-
-        p = np.asarray(pose)
-        ix = humanoid.JOINTS.index
-        hips = p[ix("LeftUpLeg")] - p[ix("RightUpLeg")]
-        shoulders = p[ix("LeftArm")] - p[ix("RightArm")]
-        across = hips if mode == "hips only" else hips + shoulders
-        up = np.array([0.0, 1.0, 0.0])
-        f = np.cross(up, across) if mode == "up x across" else np.cross(across, up)
-        if mode == "atan2(z, x)":
-            return np.arctan2(f[2], f[0])
-        if mode == "degrees":
-            return np.degrees(np.arctan2(f[0], f[2]))
-        return np.arctan2(f[0], f[2])
-
-    return wrong
+    p = np.asarray(world, dtype=np.float64)
+    ix = humanoid.JOINTS.index
+    left, right = ("LeftUpLeg", "RightUpLeg") if across == "hips" else ("LeftArm", "RightArm")
+    vector = p[..., ix(left), :] - p[..., ix(right), :]
+    up = np.array([0.0, 1.0, 0.0])
+    forward = np.cross(up, vector) if flip else np.cross(vector, up)
+    psi = np.arctan2(forward[..., 0], forward[..., 2])
+    gap = np.abs((psi - preprocess.heading(p) + np.pi) % (2 * np.pi) - np.pi)
+    value = float(gap.max() if reduce == "max" else gap.mean())
+    return float(np.degrees(value)) if degrees else value
 
 
-heading = Exercise(
-    "01 · exercise 1 (heading)",
-    _heading_ref,
-    _heading_cases,
-    period=2 * np.pi,
-    atol=1e-6,
+hips_heading = Question(
+    "01 · exercise 1 (experiment: the heading from the hips alone)",
+    _heading_gap,
+    atol=0.06,  # an answer typed with one decimal passes
+    rtol=0.002,
     mistakes=[
+        Mistake(lambda w: _heading_gap(w, degrees=False), "that is in radians; the question asks for degrees."),
         Mistake(
-            _heading_variant("up x across"),
-            "off by half a turn: the cross product is not commutative. With the right-hand rule, "
-            "which order of `across` and `up` points to the character's front?",
+            lambda w: _heading_gap(w, "shoulders"),
+            "that is the shoulders' heading; the experiment keeps the hips (LeftUpLeg − RightUpLeg) only.",
         ),
         Mistake(
-            _heading_variant("atan2(z, x)"),
-            "check the order of atan2's arguments: ψ = 0 means facing +z, and ψ grows from +z towards +x.",
+            lambda w: _heading_gap(w, reduce="mean"),
+            "that is the mean over the frames; the question asks for the largest difference.",
         ),
-        Mistake(_heading_variant("degrees"), "return radians, not degrees."),
         Mistake(
-            _heading_variant("hips only"),
-            "close but not equal: `across` uses the shoulders as well as the hips.",
+            lambda w: _heading_gap(w, flip=True),
+            "off by about half a turn: forward = across × up, in that order (the cross product is not commutative).",
         ),
     ],
 )
+"""Notebook 01, section 3: the largest gap (degrees) between the hips-only heading and ψ on the clip."""
 
 
 def _window_count_ref(num_frames, window=120, stride=30):
@@ -261,62 +219,33 @@ window_count = Exercise(
 
 
 # --------------------------------------------------------------------------- notebook 04
-def _pose_cases():
-    from motionlab import synthetic
-    from motionlab.core import humanoid, quat
+def _copied_error(walk, legs: float = 0.8, relative_to_root: bool = True) -> float:
+    """Mean pose error (m) of ``walk`` copied by local rotations onto its skeleton with legs × ``legs``."""
+    from motionlab.core import humanoid
+    from motionlab.viz import compare, proportions
 
-    skeleton = humanoid.canonical_skeleton()
-    walk = synthetic.generate("walk", skeleton, num_frames=30, fps=30.0, seed=0)
-    other = synthetic.generate("run", skeleton, num_frames=30, fps=30.0, seed=1)
-    turned = walk.copy(local_rot=quat.mul(quat.from_axis_angle([0, 1, 0], 0.3), walk.local_rot))
-    return [(other, walk), (walk, walk), (turned, walk)]
+    copied = proportions.copy_rotation_solver(walk)(humanoid.scale_bones(walk.skeleton, legs=legs))
+    return float(np.nanmean(compare.joint_errors(copied, walk, relative_to_root=relative_to_root)))
 
 
-def _pose_error_ref(motion, reference):
-    from motionlab.viz import compare
-
-    return compare.joint_errors(motion, reference, relative_to_root=True).mean(axis=1)
-
-
-def _pose_error_variant(mode: str):
-    def wrong(motion, reference):
-        a, b = motion.global_positions(), reference.global_positions()
-        if mode != "no root":
-            a, b = a - a[:, :1], b - b[:, :1]
-        d = np.linalg.norm(a - b, axis=-1)
-        if mode == "squared":
-            return (d**2).mean(axis=1)
-        if mode == "over frames":
-            return d.mean(axis=0)
-        if mode == "components":
-            return np.abs(a - b).mean(axis=(1, 2))
-        return d.mean(axis=1)
-
-    return wrong
-
-
-pose_error = Exercise(
-    "04 · exercise 1 (pose error)",
-    _pose_error_ref,
-    _pose_cases,
+shorter_legs = Question(
+    "04 · exercise 1 (experiment: copying onto shorter legs)",
+    _copied_error,
+    atol=0.0006,  # an answer typed with three decimals passes
+    rtol=0.005,
     mistakes=[
         Mistake(
-            _pose_error_variant("no root"),
-            "the two motions are compared as poses: subtract each motion's own root position from "
-            "its joints first (frame by frame).",
-        ),
-        Mistake(_pose_error_variant("squared"), "average the distances, not the squared distances."),
-        Mistake(
-            _pose_error_variant("over frames"),
-            "the result has one value per frame, shape (T,): which axis holds the joints?",
+            lambda walk: _copied_error(walk, 1.25),
+            "that is the page's character with legs × 1.25; make the legs × 0.8 and run the cell again.",
         ),
         Mistake(
-            _pose_error_variant("components"),
-            "the error of a joint is the length of the difference vector (a norm over x, y, z), "
-            "not the mean of its coordinates' differences.",
+            lambda walk: _copied_error(walk, relative_to_root=False),
+            "that error includes where the root is; keep relative_to_root=True to compare the poses only.",
         ),
+        Mistake(lambda walk: 100 * _copied_error(walk), "that is in centimetres; the cell prints metres."),
     ],
 )
+"""Notebook 04, section 4: mean pose error (m) of the walk copied onto legs × 0.8."""
 
 
 def _speed_cases():
