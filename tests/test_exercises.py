@@ -488,19 +488,12 @@ def style_takes():
     ]
 
 
-EXPERIMENT_NAMES = [
-    "nlerp_turn",
-    "euler_order",
-    "hips_heading",
-    "shorter_legs",
-    "foot_weight",
-    "held_out_q",
-    "vanishing_threshold",
-]
+EXPERIMENT_NAMES = {"nlerp_turn", "euler_order", "hips_heading", "shorter_legs"}  # notebooks 00, 01, 04
+EXPERIMENT_NAMES |= {"foot_weight", "held_out_q", "vanishing_threshold"}  # notebooks 03, 05, 06
 
 
 def test_every_experiment_is_listed():
-    assert set(exercises.EXPERIMENTS) == set(EXPERIMENT_NAMES)
+    assert set(exercises.EXPERIMENTS) == EXPERIMENT_NAMES
 
 
 def test_every_experiment_is_checked_in_a_notebook():
@@ -509,7 +502,7 @@ def test_every_experiment_is_checked_in_a_notebook():
         assert f"exercises.{name}.check(" in notebooks, f"{name} is checked nowhere"
 
 
-@pytest.mark.parametrize("name", EXPERIMENT_NAMES)
+@pytest.mark.parametrize("name", sorted(EXPERIMENT_NAMES))
 def test_an_unanswered_experiment_says_so(name):
     result = exercises.EXPERIMENTS[name].check(..., None)
     assert not result.passed and not result.attempted and "not answered yet" in result.message
