@@ -14,15 +14,15 @@ time waiting on memory and on Python. This module changes three things:
    the joint loop of one chunk into a single vectorised C++ function. The tree is baked in,
    and only global quaternions that some child needs are computed.
 
-The first call for a new skeleton (parents), dtype, chunk size or torch thread count compiles.
-That takes about 20-60 s on two cores, or a few seconds when inductor's on-disk cache already
-holds the kernel; :func:`warmup` does it ahead of time. If ``torch.compile`` is missing or
+The first call for a new skeleton (parents), dtype, chunk size or torch thread count compiles,
+which is slow (much faster when inductor's on-disk cache already holds the kernel);
+:func:`warmup` does it ahead of time and returns how long it took. If ``torch.compile`` is missing or
 fails, a warning is issued once and the same blocked algorithm runs eagerly. That fallback is
 slower, but it gives the same result.
 
 Threads: the kernel splits each chunk between torch's threads, with a few OpenMP barriers per
 chunk. When other processes keep the cores busy, a spinning thread at a barrier can wait a
-whole scheduler time slice for a descheduled one, which makes it 10-50x slower. On a shared
+whole scheduler time slice for a descheduled one, which makes it many times slower. On a shared
 machine, set ``OMP_WAIT_POLICY=PASSIVE`` before starting Python, or call
 ``torch.set_num_threads(1)``.
 
@@ -67,7 +67,7 @@ BLOCK = 16
 DEFAULT_CHUNK = 8192
 """Frames per compiled call. For 22 joints in float32 a chunk's working set is about 1.8 KB
 per frame (15 MB), which stays in the last-level cache; a bigger chunk also pays the per-call
-overhead (about 0.1 ms) and the thread barriers fewer times."""
+overhead and the thread barriers fewer times."""
 
 EAGER_CHUNK = 65536
 """Frames per step of the eager fallback, long enough to amortise per-operation overhead."""

@@ -470,7 +470,7 @@ class Scene:
         (:func:`motionlab.viz.backend.resolve_off_screen`)
     show_time : print the frame number and time in a corner
     anti_aliasing : smooth edges with 4x multisampling; None: only when rendering on screen
-        (off-screen rendering is usually software OpenGL, where it costs 3-4x the render time)
+        (off-screen rendering is usually software OpenGL, where it multiplies the render time)
     plotter : draw into this existing pyvista Plotter instead of a new one
     """
 
