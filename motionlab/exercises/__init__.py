@@ -25,13 +25,14 @@ typical mistakes):
   ``window_count``; 04 ``pose_error``, ``joint_speed``;
 * :mod:`~motionlab.exercises.retargeting`: 02 ``recon_loss``, ``combine``, ``rotations``;
   03 ``foot_loss``, ``root_scale``, ``angle_loss``;
-* :mod:`~motionlab.exercises.motion_graphs`: 05 ``local_minima``, ``distance_matrix``;
+* :mod:`~motionlab.exercises.motion_graphs`: 05 ``local_minima``;
 * :mod:`~motionlab.exercises.interpolation`: 06 ``ease``, ``sigma2``, ``jumps``.
 
 Experiments (:class:`Question`: change a parameter, run the experiment, type the number it gives;
 the check reruns it on the notebook's own inputs): 03 ``foot_weight`` (λ_foot in the paper's
-set-up), 06 ``held_out_q`` (q by likelihood on truly held-out frames), 05
-``vanishing_threshold`` (the graph threshold at which a style leaves the pruned standard graph).
+set-up), 06 ``held_out_q`` (q by likelihood on truly held-out frames), 05 ``style_change``
+(the ``dwell`` at which a style change lasts a gait cycle) and ``vanishing_threshold`` (the graph
+threshold at which a style leaves the pruned standard graph).
 
 Their reference solutions, as a student would write them, are in ``instructor/solutions/`` (the
 instructor's key, outside the students' ``notebooks/`` folder), and ``tests/test_exercises.py`` runs every check against the key, typical wrong
@@ -44,7 +45,7 @@ from __future__ import annotations
 from .basics import conj, hand_height, heading, joint_speed, pose_error, slerp, window_count
 from .core import Exercise, Mistake, Question, Result, check
 from .interpolation import ease, held_out_q, jumps, sigma2
-from .motion_graphs import distance_matrix, local_minima, vanishing_threshold
+from .motion_graphs import local_minima, style_change, vanishing_threshold
 from .retargeting import angle_loss, combine, foot_loss, foot_weight, recon_loss, root_scale, rotations
 
 __all__ = [
@@ -67,13 +68,13 @@ __all__ = [
     "root_scale",
     "angle_loss",
     "local_minima",
-    "distance_matrix",
     "ease",
     "sigma2",
     "jumps",
     "foot_weight",
     "held_out_q",
     "vanishing_threshold",
+    "style_change",
     "EXERCISES",
     "EXPERIMENTS",
 ]
@@ -93,7 +94,6 @@ EXERCISES: dict[str, Exercise] = {
     "root_scale": root_scale,
     "angle_loss": angle_loss,
     "local_minima": local_minima,
-    "distance_matrix": distance_matrix,
     "ease": ease,
     "sigma2": sigma2,
     "jumps": jumps,
@@ -107,6 +107,7 @@ EXPERIMENTS: dict[str, Question] = {
     "foot_weight": foot_weight,
     "held_out_q": held_out_q,
     "vanishing_threshold": vanishing_threshold,
+    "style_change": style_change,
 }
 """Every experiment exercise (a :class:`Question`: change a parameter, run, report a number).
 

@@ -51,6 +51,9 @@ __all__ = [
     "RequestTooLong",
     "TOLERANCE",
     "MAX_FRAMES",
+    "PoolWalker",
+    "pool_walker",
+    "walk_to_exit",
 ]
 
 MAX_FRAMES = 100_000
@@ -159,7 +162,7 @@ def _check_total(segs: list[Segment]) -> None:
 
 # ---------------------------------------------------------------------------- in-pool walks
 @dataclass
-class _Clip:
+class PoolWalker:
     """The walkable frames of one style's takes (a *pool*: a run of clips stored side by side).
 
     Frames are pool-local (``0 … length-1`` from the pool's first frame). ``step[f]``: f → f+1
@@ -199,7 +202,7 @@ class _Clip:
         return np.concatenate([f, self.loop_src[m]]), np.concatenate([f + 1, self.loop_dst[m]])
 
 
-def _pool_walker(graph: MotionGraph, clips: list[int], index: int = 0) -> _Clip:
+def _pool_walker(graph: MotionGraph, clips: list[int], index: int = 0) -> PoolWalker:
     """Walker over the consecutive clips ``clips`` (one style's takes)."""
     first, last = graph.clips[clips[0]], graph.clips[clips[-1]]
     st, sp = first.start, last.stop
@@ -219,18 +222,33 @@ def _pool_walker(graph: MotionGraph, clips: list[int], index: int = 0) -> _Clip:
     # the SPARSE_JUMPS cheapest jumps into every frame (ties: the nearer source first)
     order = np.lexsort((src, graph.cost[m], dst))
     few = order[np.arange(order.size) - np.searchsorted(dst[order], dst[order]) < SPARSE_JUMPS]
-    return _Clip(
+    return PoolWalker(
         index, sp - st, step, src, dst, last_src, last_dst, np.asarray(clips, dtype=np.int64), offsets,
         graph.alive[st:sp].copy(), (src[few], dst[few]),
     )  # fmt: skip
 
 
-def _clip_walker(graph: MotionGraph, c: int) -> _Clip:
+def pool_walker(graph: MotionGraph, behaviour: str, style: str) -> PoolWalker:
+    """The walker over one style's pool of a structured graph (its takes, from the structure table).
+
+    Raises
+    ------
+    SearchError when the graph has no structure table or no such behaviour or style.
+    """
+    cells = graph.table.get("behaviours") if graph.table else None
+    if not cells:
+        raise SearchError("this graph has no structure table (a standard graph?)")
+    if behaviour not in cells or style not in cells[behaviour]:
+        raise SearchError(f"no style {behaviour}/{style} in the graph")
+    return _pool_walker(graph, [t["clip"] for t in cells[behaviour][style]["takes"]])
+
+
+def _clip_walker(graph: MotionGraph, c: int) -> PoolWalker:
     """Walker over one clip (the standard graph's search)."""
     return _pool_walker(graph, [c], c)
 
 
-def _distances(cw: _Clip, start: int, targets: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def _distances(cw: PoolWalker, start: int, targets: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Breadth-first search from ``start``: fewest moves to every frame (-1: unreachable) and
     the parent of each reached frame. Stops early once every frame of ``targets`` is reached.
 
@@ -255,7 +273,7 @@ def _distances(cw: _Clip, start: int, targets: np.ndarray | None = None) -> tupl
     return dist, parent
 
 
-def _path(cw: _Clip, start: int, targets, name: str) -> tuple[list[int], int]:
+def _path(cw: PoolWalker, start: int, targets, name: str) -> tuple[list[int], int]:
     """Frames of a shortest walk from ``start`` to the nearest of ``targets`` (the ``r``-th).
 
     The *loop guard*: when the search has seen every frame reachable from ``start`` without
@@ -276,7 +294,7 @@ def _path(cw: _Clip, start: int, targets, name: str) -> tuple[list[int], int]:
     return frames[::-1], r
 
 
-def _runs(cw: _Clip | int, frames: list[int]) -> list[tuple[int, int, int]]:
+def _runs(cw: PoolWalker | int, frames: list[int]) -> list[tuple[int, int, int]]:
     """Pool-local frames -> ``(clip, first, last)`` pieces in clip frames."""
     out = []
     a = prev = frames[0]
@@ -302,7 +320,7 @@ SPARSE_JUMPS = 2
 takes holds dozens of jumps per frame, and the recursion's cost grows with them."""
 
 
-def _reach(cw: _Clip, start: int, steps: int, jumps: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+def _reach(cw: PoolWalker, start: int, steps: int, jumps: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """(steps, L) int16: fewest jumps of a walk of ``c + 1`` frames from ``start`` that ends at
     each frame (``_NEVER`` where no walk of that length ends there).
 
@@ -354,7 +372,7 @@ def _reach_few(out: np.ndarray, step_ok: np.ndarray, layers: list) -> np.ndarray
 
 
 def _backtrack(
-    cw: _Clip, reach: np.ndarray, c: int, x: int, jumps: tuple[np.ndarray, np.ndarray] | None = None
+    cw: PoolWalker, reach: np.ndarray, c: int, x: int, jumps: tuple[np.ndarray, np.ndarray] | None = None
 ) -> list[int]:
     """Frames of a walk with the fewest jumps reaching ``x`` after ``c + 1`` frames
     (reverse-engineered from ``reach``, see :func:`_reach`); each jump is a blend in the
@@ -384,7 +402,7 @@ def _deltas(n: int):
 
 
 def _walk(
-    cw: _Clip, start: int, need: list[int], exits: list[int], name: str = "clip"
+    cw: PoolWalker, start: int, need: list[int], exits: list[int], name: str = "clip"
 ) -> tuple[list[tuple[int, int, int]], int, int]:
     """A walk from ``start`` of about ``need[r]`` frames ending at ``exits[r]`` (``-1``: any frame).
 
@@ -462,10 +480,24 @@ everywhere, and the walk with the fewest frames can jump on every frame; each ju
 many per jump."""
 
 
-def _quick_exit(cw: _Clip, start: int, exits: list[int], name: str) -> tuple[list[tuple[int, int, int]], int, int]:
-    """The cheapest walk to an exit: frames plus :data:`JUMP_FRAMES` per jump, over the cheapest
-    jump into each frame; the shortest walk (a breadth-first search with the loop guard) when
-    nothing cheaper is found."""
+def walk_to_exit(
+    cw: PoolWalker, start: int, exits: list[int], name: str = "pool"
+) -> tuple[list[tuple[int, int, int]], int, int]:
+    """The cheapest walk through a pool from ``start`` to one of ``exits`` (pool-local frames).
+
+    Cost: frames plus :data:`JUMP_FRAMES` per jump, over the cheapest jumps into each frame; the
+    shortest walk (a breadth-first search) when nothing cheaper is found.
+
+    Returns
+    -------
+    pieces : list of ``(clip, first, last)``; r : index of the exit reached; frames : frames played
+
+    Raises
+    ------
+    SearchError (the *loop guard*) when every frame reachable from ``start`` has been visited
+    without meeting an exit. Paper B stops a search at the second pass of a clip's last
+    self-loop point instead; a pool of many takes has no single last self-loop point.
+    """
     frames, r = _path(cw, start, exits, name)
     jumps = sum(b != a + 1 for a, b in zip(frames[:-1], frames[1:]))
     rows = len(frames) + JUMP_FRAMES * jumps  # no longer walk can cost less
@@ -479,7 +511,7 @@ def _quick_exit(cw: _Clip, start: int, exits: list[int], name: str) -> tuple[lis
     return _runs(cw, frames), r, len(frames)
 
 
-def _next(cw: _Clip, f: int) -> int:
+def _next(cw: PoolWalker, f: int) -> int:
     """A frame that may follow ``f`` (the next frame, or a jump)."""
     a, b = cw.succ(np.array([f]))
     if b.size == 0:
@@ -494,13 +526,13 @@ class _Planner:
             raise SearchError("this graph has no structure table (a standard graph?); use search_standard")
         self.g = graph
         self.entries = graph.table["behaviours"]
-        self.walkers: dict[int, _Clip] = {}
+        self.walkers: dict[int, PoolWalker] = {}
         self.links: dict[tuple[str, str], list[dict]] = {}
         self.memo: dict = {}
         for link in graph.table["links"]:
             self.links.setdefault(tuple(link["from"]), []).append(link)
 
-    def walker(self, key: tuple[str, str]) -> _Clip:
+    def walker(self, key: tuple[str, str]) -> PoolWalker:
         if key not in self.walkers:
             cell = self.entries[key[0]][key[1]]
             self.walkers[key] = _pool_walker(self.g, [t["clip"] for t in cell["takes"]])
@@ -580,7 +612,7 @@ class _Planner:
             cw = self.walker(key)
             routes = link["routes"]
             exits = [r["exit"] for r in routes]
-            p, r, n = _quick_exit(cw, enter, exits, f"{key[0]}/{key[1]}")
+            p, r, n = walk_to_exit(cw, enter, exits, f"{key[0]}/{key[1]}")
             route = routes[r]
             pieces.extend(p)
             pieces.extend(tuple(x) for x in route["pieces"])

@@ -54,12 +54,12 @@ def test_loop_guard():
     import numpy as np
 
     # frames 0..9, one jump back 9 -> 4: from frame 5 the frames 0..3 can never be reached
-    cw = search._Clip(0, 10, np.array([True] * 9 + [False]), np.array([9]), np.array([4]), 9, 4)
+    cw = search.PoolWalker(0, 10, np.array([True] * 9 + [False]), np.array([9]), np.array([4]), 9, 4)
     with pytest.raises(search.SearchError, match="loop guard"):
-        search._quick_exit(cw, 5, [2], "clip")
-    pieces, r, n = search._quick_exit(cw, 5, [2, 7], "clip")
+        search.walk_to_exit(cw, 5, [2], "clip")
+    pieces, r, n = search.walk_to_exit(cw, 5, [2, 7], "clip")
     assert pieces == [(0, 5, 7)] and n == 3 and r == 1
-    pieces, r, n = search._quick_exit(cw, 8, [5], "clip")  # the way round through the jump
+    pieces, r, n = search.walk_to_exit(cw, 8, [5], "clip")  # the way round through the jump
     assert pieces == [(0, 8, 9), (0, 4, 5)] and n == 4
 
 
@@ -113,7 +113,7 @@ def test_walk_takes_the_fewest_jumps():
 
     # two takes of 10 frames side by side (no step 9 -> 10); jumps 5->12, 3->15, 8->11, 2->3
     step = np.array([True] * 9 + [False] + [True] * 9 + [False])
-    cw = search._Clip(0, 20, step, np.array([5, 3, 8, 2]), np.array([12, 15, 11, 3]), -1, -1)
+    cw = search.PoolWalker(0, 20, step, np.array([5, 3, 8, 2]), np.array([12, 15, 11, 3]), -1, -1)
     pieces, _, n = search._walk(cw, 0, [15], [-1])
     assert n == 15 and pieces == [(0, 0, 8), (0, 11, 16)]  # one jump; 0..5 -> 12..19 is a frame short
     reach = search._reach(cw, 0, 15)
@@ -147,7 +147,7 @@ def test_reach_with_few_jumps_per_frame_matches_the_recursion():
     rank = np.arange(40) - np.searchsorted(dst[order], dst[order])
     few = order[rank < search.SPARSE_JUMPS]
     assert rank.max() >= search.SPARSE_JUMPS  # the full set takes the grouped path
-    cw = search._Clip(0, n, step, src, dst, -1, -1)
+    cw = search.PoolWalker(0, n, step, src, dst, -1, -1)
     for s, d in ((src[few], dst[few]), (src, dst)):
         got = search._reach(cw, 2, 25, (s, d))
         np.testing.assert_array_equal(got, _reach_by_hand(step, s, d, 2, 25))
