@@ -84,18 +84,26 @@ class SearchResult:
     """A path and how well it meets the request.
 
     ``pieces``: list of ``(clip, first, last)`` (clip-local frames, inclusive); ``achieved``:
-    frames given to each segment; ``requested``: the request's counts; ``transitions``: index in
-    the output of the first frame after each jump (for smoothness metrics).
+    frames given to each segment (its own style's frames and the recorded route out of it);
+    ``requested``: the request's counts; ``passing``: frames after each segment spent in other
+    styles on the way to the next one (empty: none), so that ``sum(achieved) + sum(passing)`` is
+    the path's length; ``transitions``: index in the output of the first frame after each jump
+    (for smoothness metrics).
     """
 
     pieces: list[tuple[int, int, int]]
     requested: list[int]
     achieved: list[int]
     segments: list[Segment] = field(default_factory=list)
+    passing: list[int] = field(default_factory=list)
 
     @property
     def num_frames(self) -> int:
         return int(sum(b - a + 1 for _, a, b in self.pieces))
+
+    def pieces_per_second(self, fps: float) -> float:
+        """Pieces of the path (each after the first begins with a jump) per second at ``fps`` frames/s."""
+        return len(self.pieces) * float(fps) / max(self.num_frames, 1)
 
     @property
     def errors(self) -> list[int]:
@@ -111,8 +119,10 @@ class SearchResult:
 
     def report(self) -> str:
         lines = []
-        for s, a in zip(self.segments, self.achieved):
+        for k, (s, a) in enumerate(zip(self.segments, self.achieved)):
             lines.append(f"{s.behaviour}:{s.style}: requested {s.frames}, got {a} ({a - s.frames:+d})")
+            if k < len(self.passing) and self.passing[k]:
+                lines.append(f"  then {self.passing[k]} frames through other styles on the way")
         return "\n".join(lines)
 
 
@@ -402,10 +412,13 @@ def _deltas(n: int):
 
 
 def _walk(
-    cw: PoolWalker, start: int, need: list[int], exits: list[int], name: str = "clip"
+    cw: PoolWalker, start: int, need: list[int], exits: list[int], name: str = "clip", slack: int = 0
 ) -> tuple[list[tuple[int, int, int]], int, int]:
     """A walk from ``start`` of about ``need[r]`` frames ending at ``exits[r]`` (``-1``: any frame).
 
+    Of the walks within ``slack`` frames of an option's length, the cheapest wins: each jump
+    costs :data:`JUMP_FRAMES` frames (it is a blend), each frame off the request one; when there
+    is none, the walk nearest the requested length.
     Returns pieces, the chosen option ``r`` and the frames played.
     """
     pieces: list[tuple[int, int, int]] = []
@@ -432,10 +445,10 @@ def _walk(
     # first the cheapest jump into each frame and just the rows an exact length needs (a pool of
     # many takes holds dozens of jumps per frame, and the recursion's cost grows with them);
     # when that gives no walk of exactly the requested length, every jump and the full width
-    short = min(steps, int(need_c.max()) + 2)
-    for rows, jumps, widest in ((short, cw.sparse, 0), (steps, None, steps)):
+    short = min(steps, int(need_c.max()) + slack + 2)
+    for rows, jumps, widest in ((short, cw.sparse, slack), (steps, None, steps)):
         reach = _reach(cw, start, rows, jumps)
-        best = _choose(reach, need_c, ex, rows, widest)
+        best = _choose(reach, need_c, ex, rows, widest, slack)
         if best is not None:
             break
     if best is None:
@@ -446,31 +459,41 @@ def _walk(
     return pieces, r, played + c + 1
 
 
-def _choose(reach: np.ndarray, need_c: np.ndarray, ex: np.ndarray, steps: int, widest: int):
-    """``(option, row, exit frame)`` of the walk nearest the requested length (``None``: none
-    within ``widest`` rows of it): an option's exit frame, or (``-1``) any frame, the one with
-    the fewest jumps."""
-    best = None
-    for delta in _deltas(widest + 1):
-        c = need_c + delta
-        ok = np.flatnonzero((c >= 0) & (c < steps))
-        if ok.size == 0:
+def _choose(reach: np.ndarray, need_c: np.ndarray, ex: np.ndarray, steps: int, widest: int, slack: int = 0):
+    """``(option, row, exit frame)``: of the walks within ``slack`` rows of an option's requested
+    row, the cheapest, at :data:`JUMP_FRAMES` per jump plus one per frame off the request (the
+    nearer length on ties); when there is none, the walk nearest the requested length (``None``:
+    none within ``widest`` rows of it)."""
+    best, best_key = None, None
+    for order, delta in enumerate(_deltas(widest + 1)):
+        if best is not None and (abs(delta) > slack or abs(delta) >= best_key[0]):
+            break
+        found = _fewest_jumps(reach, need_c + delta, ex, steps)
+        if found is None:
             continue
-        anywhere = ok[ex[ok] < 0]
-        for r in anywhere:
-            row = reach[c[r]]
-            if row.min() < _NEVER:  # any frame may end it: the one reached with the fewest jumps
-                best = (int(r), int(c[r]), int(np.argmin(row)))
-                break
-        if best is not None:
-            break
-        fixed = ok[ex[ok] >= 0]
-        jumps = reach[c[fixed], ex[fixed]]
-        if jumps.min(initial=_NEVER) < _NEVER:
-            r = int(fixed[np.argmin(jumps)])  # of the exits met, the one with the fewest jumps
-            best = (r, int(c[r]), int(ex[r]))
-            break
+        key = (JUMP_FRAMES * found[3] + abs(delta), order)
+        if best is None or key < best_key:
+            best, best_key = found[:3], key
     return best
+
+
+def _fewest_jumps(reach: np.ndarray, c: np.ndarray, ex: np.ndarray, steps: int):
+    """``(option, row, frame, jumps)`` of the walk with the fewest jumps ending in row ``c[r]``
+    at option ``r``'s exit frame (or, ``-1``, at any frame); ``None`` when there is none."""
+    ok = np.flatnonzero((c >= 0) & (c < steps))
+    found = None
+    for r in ok[ex[ok] < 0]:
+        row = reach[c[r]]
+        j = int(row.min())
+        if j < _NEVER and (found is None or j < found[3]):
+            found = (int(r), int(c[r]), int(np.argmin(row)), j)
+    fixed = ok[ex[ok] >= 0]
+    if fixed.size:
+        jumps = reach[c[fixed], ex[fixed]]
+        k = int(np.argmin(jumps))
+        if jumps[k] < _NEVER and (found is None or int(jumps[k]) < found[3]):
+            found = (int(fixed[k]), int(c[fixed[k]]), int(ex[fixed[k]]), int(jumps[k]))
+    return found
 
 
 JUMP_FRAMES = 8
@@ -644,6 +667,7 @@ def search(graph: MotionGraph, request, progress: bool = False) -> SearchResult:
     plans = [planner.hops(a, b) if a != b else [] for a, b in zip(keys[:-1], keys[1:])]
     pieces: list[tuple[int, int, int]] = []
     achieved: list[int] = []
+    passing = [0] * len(segs)
     enter = planner.walker(keys[0]).first_alive()
     bar = None
     if progress:
@@ -655,8 +679,9 @@ def search(graph: MotionGraph, request, progress: bool = False) -> SearchResult:
             bar.update(seg.frames)
         cw = planner.walker(keys[k])
         name = f"{seg.behaviour}/{seg.style}"
+        slack = max(2, int(TOLERANCE * seg.frames))
         if k == len(segs) - 1 or not plans[k]:
-            p, _, n = _walk(cw, enter, [seg.frames], [-1], name)
+            p, _, n = _walk(cw, enter, [seg.frames], [-1], name, slack)
             pieces.extend(p)
             achieved.append(n)
             if k < len(segs) - 1:  # the same style again: continue from a frame that follows
@@ -664,16 +689,18 @@ def search(graph: MotionGraph, request, progress: bool = False) -> SearchResult:
                 local = int(cw.offsets[np.flatnonzero(cw.clips == c_last)[0]]) + f_last
                 enter = _next(cw, local)
             continue
-        options, spent, exits = planner.options(plans[k])
-        p, r, n = _walk(cw, enter, np.maximum(seg.frames - spent, 1).tolist(), exits, name)
+        options, _, exits = planner.options(plans[k])
+        own = np.array([seg.frames - o[0]["frames"] for o in options])  # the route out counts here
+        p, r, n = _walk(cw, enter, np.maximum(own, 1).tolist(), exits, name, slack)
         route, more, more_frames, enter = options[r]
         pieces.extend(p)
         pieces.extend(tuple(x) for x in route["pieces"])
         pieces.extend(more)
-        achieved.append(n + route["frames"] + more_frames)
+        achieved.append(n + route["frames"])
+        passing[k] = more_frames
     if bar is not None:
         bar.close()
-    return SearchResult(_merge(pieces), [s.frames for s in segs], achieved, segs)
+    return SearchResult(_merge(pieces), [s.frames for s in segs], achieved, segs, passing)
 
 
 def _segments(request) -> list[Segment]:
