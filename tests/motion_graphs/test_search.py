@@ -151,3 +151,30 @@ def test_reach_with_few_jumps_per_frame_matches_the_recursion():
     for s, d in ((src[few], dst[few]), (src, dst)):
         got = search._reach(cw, 2, 25, (s, d))
         np.testing.assert_array_equal(got, _reach_by_hand(step, s, d, 2, 25))
+
+
+def test_frames_through_other_styles_are_reported_apart(sgraph):
+    r = search.search(sgraph, REQUEST)
+    # walk/happy -> run/normal passes through other styles (no recorded clip leaves walk/happy)
+    assert len(r.passing) == len(r.requested) and sum(r.passing) > 0
+    assert r.num_frames == sum(r.achieved) + sum(r.passing)
+    k = next(k for k, p in enumerate(r.passing) if p)
+    assert f"then {r.passing[k]} frames through other styles" in r.report()
+    assert r.pieces_per_second(sgraph.fps) == pytest.approx(len(r.pieces) * sgraph.fps / r.num_frames)
+
+
+def test_fewest_jumps_within_the_tolerance():
+    # frames 0..9, one jump back 9 -> 0: 12 frames from frame 0 need the jump, 10 frames do not
+    cw = search.PoolWalker(0, 10, np.array([True] * 9 + [False]), np.array([9]), np.array([0]), 9, 0)
+    pieces, _, n = search._walk(cw, 0, [12], [-1], slack=0)
+    assert n == 12 and len(pieces) == 2
+    pieces, _, n = search._walk(cw, 0, [12], [-1], slack=2)  # 2 frames short costs less than a jump
+    assert n == 10 and pieces == [(0, 0, 9)]
+
+
+def test_pool_walker_of_a_style(sgraph):
+    cell = sgraph.table["behaviours"]["walk"]["normal"]
+    cw = search.pool_walker(sgraph, "walk", "normal")
+    assert cw.length == cell["frames"] and cw.alive.sum() == cell["alive"]
+    with pytest.raises(search.SearchError, match="walk/sneaky"):
+        search.pool_walker(sgraph, "walk", "sneaky")
