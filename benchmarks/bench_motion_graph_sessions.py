@@ -38,7 +38,7 @@ import time
 import numpy as np
 
 from motionlab import data
-from motionlab.motion_graphs import clips, distance, report, search, segments, structured
+from motionlab.motion_graphs import cli, clips, distance, report, search, segments, structured
 
 GRID = (0.015, 0.02, 0.025, 0.03, 0.04, 0.05)
 """Thresholds tried, metres RMS."""
@@ -218,6 +218,7 @@ def session(folder) -> int:
         print("no threshold of the grid meets the goals on the pick half")
         return 1
     print(f"chosen threshold (smallest meeting the goals on the pick half): {chosen} m")
+    print(f"graph-build's default threshold (motion_graphs.cli.DISTANCE_THRESHOLD): {cli.DISTANCE_THRESHOLD} m")
     for name, ms in (("check", check), ("all", motions)):
         t0 = time.perf_counter()
         g = structured.build_structured(ms, distance.threshold_from(chosen))

@@ -439,6 +439,10 @@ def _walk(
             pieces.extend(_runs(cw, list(range(cw.last_dst, cw.last_src + 1))) * reps)
             played += reps * cw.cycle
             start = cw.last_dst
+    if len(need) == 1 and ex[0] < 0 and _straight(cw, start, need[0] - played):
+        # a walk along the take with no jump at all: nothing costs less
+        pieces.extend(_runs(cw, list(range(start, start + need[0] - played))))
+        return pieces, 0, need[0]
     steps = max(n - played for n in need) + max(cw.cycle, 2)
     steps = max(steps, 2)
     need_c = np.array(need) - played - 1
@@ -457,6 +461,11 @@ def _walk(
     frames = _backtrack(cw, reach, c, x, jumps)
     pieces.extend(_runs(cw, frames))
     return pieces, r, played + c + 1
+
+
+def _straight(cw: PoolWalker, start: int, frames: int) -> bool:
+    """True when ``frames`` frames from ``start`` follow one another inside one take."""
+    return frames >= 1 and start + frames <= cw.length and bool(cw.step[start : start + frames - 1].all())
 
 
 def _choose(reach: np.ndarray, need_c: np.ndarray, ex: np.ndarray, steps: int, widest: int, slack: int = 0):
