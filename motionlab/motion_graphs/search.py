@@ -3,9 +3,10 @@ r"""Searching a motion graph for a requested sequence of behaviours.
 A request is a list of segments ``(behaviour, style, frames)``: "300 frames of an angry walk,
 then 200 frames of a normal run". The answer is a *path*: runs of frames
 ``(clip, first, last)`` joined by the graph's edges, and for every segment the number of
-frames it got. A segment runs from its first frame in its clip up to the first frame of the
-next segment's clip, so the frames of a transition count towards the segment it leaves and the
-segment lengths add up to the path length.
+frames it got: the frames of its own style and of the recorded route out of it (an
+interpolation space or a transition clip), so a transition counts towards the segment it
+leaves. Frames spent in other styles on the way to the next segment (a style passed through
+because no route joins the two directly) are counted apart (:attr:`SearchResult.passing`).
 
 **Structured graph** (paper B). The structure table gives each segment's style pool (its
 takes, side by side) and the recorded routes out of it, so the search never explores the whole
@@ -16,12 +17,15 @@ reachability recursion over frame counts,
 .. math:: R_{c+1} = \operatorname{shift}(R_c) \,\lor\, \operatorname{jumps}(R_c), \qquad R_0 = \{e\},
 
 (``R_c``: frames where a walk of ``c + 1`` frames can be) run once per segment. The exit whose
-route length ``r`` satisfies ``c + 1 + r = n`` wins (exactly, or else the closest). Long
+route length ``r`` satisfies ``c + 1 + r = n`` wins; of the walks within :data:`TOLERANCE`, the
+one that costs least at :data:`JUMP_FRAMES` frames per jump and one per frame off the request
+(each jump is a blend in the synthesised motion). Long
 segments first take the shortest way to the pool's main cycle (its longest jump back inside
 one take) and repeat it, so the recursion stays short: the *iterative choice of self-loop and
 transition points*. Pools crossed on the way to the next segment are passed by the shortest walk
-to an exit (a breadth-first search); the **loop guard** stops it with an error once every frame
-it can reach has been visited. A request may ask for at most :data:`MAX_FRAMES` frames.
+to an exit (:func:`walk_to_exit`); the **loop guard** stops it with an error once every frame
+it can reach has been visited (paper B stops at the second pass of a clip's last self-loop
+point; a pool of many takes has none). A request may ask for at most :data:`MAX_FRAMES` frames.
 
 **Standard graph** (for comparison). Dijkstra's shortest path (in frames) on the compressed
 graph from the current frame to any frame of the requested clip, then the same in-clip
@@ -62,8 +66,8 @@ motion is held in memory and written as one BVH file; longer requests are refuse
 limit, rather than running for minutes and filling the disk."""
 
 TOLERANCE = 0.05
-"""Documented accuracy: a reachable segment length is met exactly when the clip's loops allow,
-and otherwise within ``max(2 frames, 5%)`` — checked by the tests."""
+"""Documented accuracy: every reachable segment gets its requested length within
+``max(2 frames, 5%)``; inside that band the walk with the fewest jumps wins (checked by the tests)."""
 
 
 class SearchError(GraphError):
@@ -338,15 +342,16 @@ def _reach(cw: PoolWalker, start: int, steps: int, jumps: tuple[np.ndarray, np.n
     ``J[c+1, d] = min over jumps s → d of J[c, s] + 1``; the jump part is one
     ``np.minimum.reduceat`` over the jumps sorted by destination, so each row is vectorised.
     """
-    out = np.full((max(steps, 1), cw.length), _NEVER, dtype=np.int16)
-    out[0, start] = 0
     step_ok = cw.step[:-1]
     src, dst = (cw.loop_src, cw.loop_dst) if jumps is None else jumps
     order = np.argsort(dst, kind="stable")
     src, dst = src[order], dst[order]
     rank = np.arange(dst.size) - np.searchsorted(dst, dst)  # k-th jump into its frame
     if rank.size == 0 or rank.max() < SPARSE_JUMPS:
-        return _reach_few(out, step_ok, [(src[rank == k], dst[rank == k]) for k in range(SPARSE_JUMPS)])
+        layers = [(src[rank == k], dst[rank == k]) for k in range(SPARSE_JUMPS)]
+        return _reach_few(max(steps, 1), cw.length, start, step_ok, layers)
+    out = np.full((max(steps, 1), cw.length), _NEVER, dtype=np.int16)
+    out[0, start] = 0
     if dst.size:
         heads = np.flatnonzero(np.concatenate([[True], dst[1:] != dst[:-1]]))
         targets = dst[heads]
@@ -360,25 +365,30 @@ def _reach(cw: PoolWalker, start: int, steps: int, jumps: tuple[np.ndarray, np.n
     return out
 
 
-def _reach_few(out: np.ndarray, step_ok: np.ndarray, layers: list) -> np.ndarray:
+def _reach_few(steps: int, n: int, start: int, step_ok: np.ndarray, layers: list) -> np.ndarray:
     """:func:`_reach` when few jumps enter each frame: ``layers[k]`` holds the k-th jump into
-    each frame (at most one per frame), so a row is one gather per layer, with no grouping."""
-    n = out.shape[1]
+    each frame (at most one per frame), so a row is one gather per layer, with no grouping.
+
+    Returns a (steps, n) view of an array with one more column, always ``_NEVER``: the frame a
+    missing jump comes from."""
+    out = np.full((steps, n + 1), _NEVER, dtype=np.int16)
+    out[0, start] = 0
     src_of = []
     for src, dst in layers:
         s = np.full(n, n)  # the jump into each frame, n (a frame that is never reached) if none
         s[dst] = src
         src_of.append(s)
-    prev_x = np.full(n + 1, _NEVER, dtype=np.int16)
-    for c in range(1, out.shape[0]):
-        prev_x[:n] = out[c - 1]
-        cur = out[c]
-        np.copyto(cur[1:], prev_x[: n - 1], where=step_ok)  # the row starts all _NEVER
-        for s in src_of:
-            via = prev_x[s]
-            np.add(via, 1, out=via, where=via < _NEVER)
-            np.minimum(cur, via, out=cur)
-    return out
+    via, other = np.empty(n, dtype=np.int16), np.empty(n, dtype=np.int16)
+    for c in range(1, steps):
+        prev, cur = out[c - 1], out[c]
+        np.copyto(cur[1:n], prev[: n - 1], where=step_ok)  # the row starts all _NEVER
+        np.take(prev, src_of[0], out=via)
+        for s in src_of[1:]:
+            np.minimum(via, np.take(prev, s, out=other), out=via)
+        np.minimum(via, _NEVER - 1, out=via)  # a jump from nowhere stays _NEVER after the + 1
+        via += 1
+        np.minimum(cur[:n], via, out=cur[:n])
+    return out[:, :n]
 
 
 def _backtrack(
@@ -529,7 +539,10 @@ def walk_to_exit(
     SearchError (the *loop guard*) when every frame reachable from ``start`` has been visited
     without meeting an exit. Paper B stops a search at the second pass of a clip's last
     self-loop point instead; a pool of many takes has no single last self-loop point.
+    ValueError when ``start`` or an exit lies outside the pool, or ``exits`` is empty.
     """
+    if not exits or not all(0 <= int(x) < cw.length for x in [start, *exits]):
+        raise ValueError(f"expected a start and at least one exit in 0..{cw.length - 1}, got {start} and {exits}")
     frames, r = _path(cw, start, exits, name)
     jumps = sum(b != a + 1 for a, b in zip(frames[:-1], frames[1:]))
     rows = len(frames) + JUMP_FRAMES * jumps  # no longer walk can cost less
