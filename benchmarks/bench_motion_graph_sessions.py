@@ -38,7 +38,7 @@ import time
 import numpy as np
 
 from motionlab import data
-from motionlab.motion_graphs import clips, distance, report, search, segments, structured
+from motionlab.motion_graphs import cli, clips, distance, report, search, segments, structured
 
 GRID = (0.015, 0.02, 0.025, 0.03, 0.04, 0.05)
 """Thresholds tried, metres RMS."""
@@ -165,7 +165,8 @@ def session_line(name: str, rms: float, seconds: float, e: dict) -> str:
     shares = "  ".join(
         f"{b} {v['percent']:.1f}% {v['reachable_pairs']}/{v['style_pairs']}" for b, v in sorted(beh.items())
     )
-    req = "request " + ("/".join(map(str, e["request"].achieved)) if e["request"] else "fails")
+    r = e["request"]
+    req = f"request {'/'.join(map(str, r.achieved))} (+{sum(r.passing)} passing)" if r else "request fails"
     return f"{name:<6} {rms:.3f} m  build {seconds:5.1f} s  {shares}  {req}  {'meets goals' if e['meets'] else 'misses goals'}"
 
 
@@ -217,6 +218,7 @@ def session(folder) -> int:
         print("no threshold of the grid meets the goals on the pick half")
         return 1
     print(f"chosen threshold (smallest meeting the goals on the pick half): {chosen} m")
+    print(f"graph-build's default threshold (motion_graphs.cli.DISTANCE_THRESHOLD): {cli.DISTANCE_THRESHOLD} m")
     for name, ms in (("check", check), ("all", motions)):
         t0 = time.perf_counter()
         g = structured.build_structured(ms, distance.threshold_from(chosen))
@@ -224,8 +226,13 @@ def session(folder) -> int:
         print(session_line(name, chosen, time.perf_counter() - t0, e))
     print(report.format_report(e["report"]))
     if e["request"] is not None:
+        r = e["request"]
         print(f"request {REQUEST}:")
-        print(e["request"].report())
+        print(r.report())
+        print(
+            f"path: {r.num_frames} frames in {len(r.pieces)} pieces, "
+            f"{r.pieces_per_second(g.fps):.2f} pieces per second ({r.num_frames / len(r.pieces):.1f} frames per piece)"
+        )
     else:
         print(f"request {REQUEST} fails: {e['error']}")
     ms_req, _ = timed(g, REQUEST) if e["request"] is not None else (float("nan"), None)

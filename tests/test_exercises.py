@@ -48,7 +48,6 @@ SOLUTIONS = {
     "root_scale": K03.my_root_scale,
     "angle_loss": K03.my_angle_loss,
     "local_minima": K05.my_local_minima,
-    "distance_matrix": K05.my_distance_matrix,
     "ease": K06.my_ease,
     "sigma2": K06.my_sigma2,
     "jumps": K06.my_jumps,
@@ -188,16 +187,6 @@ def _minima_roll(m):
     return out
 
 
-def _distance_without_turn(pos_a, pos_b):
-    from motionlab.motion_graphs import distance
-
-    fa, fb = distance.cloud_features(pos_a), distance.cloud_features(pos_b)
-    w2 = np.concatenate([fa.weights, fa.weights])
-    a = (fa.centred * w2) @ fb.centred.T
-    y = (fa.height * fa.weights) @ fb.height.T
-    return np.maximum(fa.self_term[:, None] + fb.self_term[None, :] - 2 * y - 2 * a, 0)
-
-
 def _sigma2_np_cov(X, q):
     lam = np.sort(np.linalg.eigvalsh(np.cov(X.T)))[::-1]
     return lam[q:].mean()
@@ -250,7 +239,6 @@ WRONG = [
     ("local_minima", _minima_strict, "<="),
     ("local_minima", _minima_four, "diagonal"),
     ("local_minima", _minima_roll, "np.roll"),
-    ("distance_matrix", _distance_without_turn, "square-root term"),
     ("ease", lambda n: np.arange(1, n + 1) / (n + 1), "linear weights"),
     ("ease", lambda n: 0.5 * (1 - np.cos(np.pi * np.arange(1, n + 1) / n)), "N + 1"),
     ("sigma2", _sigma2_np_cov, "N − 1"),
@@ -360,23 +348,6 @@ def _minima_loop(m):
     return out
 
 
-def _distance_by_alignment(pos_a, pos_b):
-    """Another way: the optimal turn and shift of every pair, then the weighted squared distance."""
-    from motionlab.core import quat
-    from motionlab.motion_graphs import distance
-
-    fa, fb = distance.cloud_features(pos_a), distance.cloud_features(pos_b)
-    h = distance.DEFAULT_WINDOW // 2
-    clouds = [
-        p[np.clip(np.arange(len(p))[:, None] + np.arange(-h, h + 1), 0, len(p) - 1)].reshape(len(p), -1, 3)
-        for p in (pos_a, pos_b)
-    ]
-    i, j = np.meshgrid(np.arange(len(pos_a)), np.arange(len(pos_b)), indexing="ij")
-    theta, shift = distance.alignment(fa, fb, i, j)
-    moved = quat.rotate(quat.from_yaw(theta)[..., None, :], clouds[1][j]) + shift[..., None, :]
-    return np.sum(fa.weights * np.sum((clouds[0][i] - moved) ** 2, axis=-1), axis=-1)
-
-
 def _ease_sin(num):
     return np.sin(np.pi * np.arange(1, num + 1) / (2 * (num + 1))) ** 2  # ½(1 − cos 2x) = sin² x
 
@@ -404,7 +375,6 @@ ALTERNATIVES = [
     ("root_scale", _root_from_rest_positions),
     ("angle_loss", _angle_by_stack),
     ("local_minima", _minima_loop),
-    ("distance_matrix", _distance_by_alignment),
     ("ease", _ease_sin),
     ("sigma2", _sigma2_svd),
     ("jumps", _jumps_loop),
@@ -489,7 +459,7 @@ def style_takes():
 
 
 EXPERIMENT_NAMES = {"nlerp_turn", "euler_order", "hips_heading", "shorter_legs"}  # notebooks 00, 01, 04
-EXPERIMENT_NAMES |= {"foot_weight", "held_out_q", "vanishing_threshold"}  # notebooks 03, 05, 06
+EXPERIMENT_NAMES |= {"foot_weight", "held_out_q", "vanishing_threshold", "style_change"}  # notebooks 03, 05, 06
 
 
 def test_every_experiment_is_listed():
@@ -696,3 +666,20 @@ def test_shorter_legs_experiment():
         result = q.check(value, walk)
         assert not result.passed and result.attempted and phrase in result.hint, (phrase, result.message)
     assert not q.check(answer * 1.5, walk).passed
+
+
+def test_style_change_experiment(style_takes):
+    q = exercises.style_change
+    request = [("walk", "normal", 150), ("walk", "happy", 150), ("walk", "sad", 150)]
+    answer = K05.my_style_change(style_takes, request)
+    assert answer in exercises.motion_graphs.DWELLS
+    assert q.check(answer, style_takes, request).passed
+    assert q.check(float(answer), style_takes, request).passed
+    frames = exercises.motion_graphs.style_change_frames(style_takes, request, answer)
+    assert frames >= exercises.motion_graphs.gait_cycle_frames(style_takes, "normal")
+    if frames != answer:
+        result = q.check(frames, style_takes, request)
+        assert not result.passed and "dwell" in result.hint
+    result = q.check(None, style_takes, request)
+    assert not result.passed and not result.attempted and "not answered yet" in result.message
+    assert not q.check(answer + 100, style_takes, request).passed

@@ -18,10 +18,6 @@ LIMIT = 80
 MARK = "# long-function:"
 
 ALLOWED = {
-    "motion_graphs/structured.py::build_structured",
-    "motion_graphs/structured.py::_bridge_routes",
-    "motion_graphs/synthesis.py::synthesize",
-    "motion_graphs/report.py::build_report",
     "retargeting/solver.py::_iterate",
     "retargeting/cli.py::register",
     "retargeting/cli.py::_cmd_evaluate",

@@ -18,18 +18,23 @@ def my_local_minima(matrix):
     return mask
 
 
-def my_distance_matrix(pos_a, pos_b):
-    """Exercise 2: D = S_A + S_B − 2Y − 2√(a² + b²) for every frame pair, (Ta, Tb) m²."""
-    fa, fb = distance.cloud_features(pos_a), distance.cloud_features(pos_b)
-    n = fa.height.shape[1]
-    w = fa.weights
-    xa, za = fa.centred[:, :n], fa.centred[:, n:]
-    xb, zb = fb.centred[:, :n], fb.centred[:, n:]
-    a = (xa * w) @ xb.T + (za * w) @ zb.T
-    b = (xa * w) @ zb.T - (za * w) @ xb.T
-    y = (fa.height * w) @ fb.height.T
-    d = fa.self_term[:, None] + fb.self_term[None, :] - 2 * y - 2 * np.sqrt(a**2 + b**2)
-    return np.maximum(d, 0.0)  # rounding can leave tiny negative values
+DWELLS = (2, 4, 6, 8, 10, 12)  # as in the notebook (exercises.motion_graphs.DWELLS)
+
+
+def my_style_change(motions, request):
+    """Exercise 2: the smallest dwell at which the first style change lasts one gait cycle."""
+    from motionlab.motion_graphs import cycles, search, structured
+
+    style = request[0][1]
+    cycle = np.median(np.concatenate([cycles.segment_cycles(m).lengths() for m in motions if f"_{style}_" in m.name]))
+    for dwell in DWELLS:
+        g = structured.build_structured(motions, distance.threshold_from(0.03), dwell=dwell)
+        kinds = [(g.clips[c].kind, b - a + 1) for c, a, b in search.search(g, request).pieces]
+        first = next(k for k, (kind, _) in enumerate(kinds) if kind == "intermediate")
+        end = next((k for k in range(first, len(kinds)) if kinds[k][0] != "intermediate"), len(kinds))
+        if sum(n for _, n in kinds[first:end]) >= cycle:
+            return dwell
+    return 0
 
 
 THRESHOLDS_CM = (3, 4, 5, 6, 8, 10)  # as in the notebook (exercises.THRESHOLDS_CM)

@@ -24,16 +24,16 @@ typical mistakes):
 * :mod:`~motionlab.exercises.basics`: 00 ``hand_height``; 01 ``window_count``; 04 ``joint_speed``;
 * :mod:`~motionlab.exercises.retargeting`: 02 ``recon_loss``, ``combine``, ``rotations``;
   03 ``foot_loss``, ``root_scale``, ``angle_loss``;
-* :mod:`~motionlab.exercises.motion_graphs`: 05 ``local_minima``, ``distance_matrix``;
+* :mod:`~motionlab.exercises.motion_graphs`: 05 ``local_minima``;
 * :mod:`~motionlab.exercises.interpolation`: 06 ``ease``, ``sigma2``, ``jumps``.
 
 Experiments (:class:`Question`: change a parameter, run the experiment, type the number it gives;
 the check reruns it on the notebook's own inputs): 00 ``nlerp_turn`` (SLERP against nlerp on a
 smaller turn), ``euler_order`` (the same angles in another channel order); 01 ``hips_heading``
 (the heading from the hips alone); 04 ``shorter_legs`` (copying rotations onto shorter legs);
-03 ``foot_weight`` (λ_foot in the paper's
-set-up), 06 ``held_out_q`` (q by likelihood on truly held-out frames), 05
-``vanishing_threshold`` (the graph threshold at which a style leaves the pruned standard graph).
+03 ``foot_weight`` (λ_foot in the paper's set-up); 05 ``style_change`` (the ``dwell`` at which a
+style change lasts a gait cycle) and ``vanishing_threshold`` (the graph threshold at which a style
+leaves the pruned standard graph); 06 ``held_out_q`` (q by likelihood on truly held-out frames).
 
 Their reference solutions, as a student would write them, are in ``instructor/solutions/`` (the
 instructor's key, outside the students' ``notebooks/`` folder), and ``tests/test_exercises.py`` runs every check against the key, typical wrong
@@ -46,7 +46,7 @@ from __future__ import annotations
 from .basics import euler_order, hand_height, hips_heading, joint_speed, nlerp_turn, shorter_legs, window_count
 from .core import Exercise, Mistake, Question, Result, check
 from .interpolation import ease, held_out_q, jumps, sigma2
-from .motion_graphs import distance_matrix, local_minima, vanishing_threshold
+from .motion_graphs import local_minima, style_change, vanishing_threshold
 from .retargeting import angle_loss, combine, foot_loss, foot_weight, recon_loss, root_scale, rotations
 
 __all__ = [
@@ -65,7 +65,6 @@ __all__ = [
     "root_scale",
     "angle_loss",
     "local_minima",
-    "distance_matrix",
     "ease",
     "sigma2",
     "jumps",
@@ -76,6 +75,7 @@ __all__ = [
     "foot_weight",
     "held_out_q",
     "vanishing_threshold",
+    "style_change",
     "EXERCISES",
     "EXPERIMENTS",
 ]
@@ -91,7 +91,6 @@ EXERCISES: dict[str, Exercise] = {
     "root_scale": root_scale,
     "angle_loss": angle_loss,
     "local_minima": local_minima,
-    "distance_matrix": distance_matrix,
     "ease": ease,
     "sigma2": sigma2,
     "jumps": jumps,
@@ -109,6 +108,7 @@ EXPERIMENTS: dict[str, Question] = {
     "foot_weight": foot_weight,
     "held_out_q": held_out_q,
     "vanishing_threshold": vanishing_threshold,
+    "style_change": style_change,
 }
 """Every experiment exercise (a :class:`Question`: change a parameter, run, report a number).
 

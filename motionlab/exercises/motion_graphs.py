@@ -1,4 +1,5 @@
-"""Exercises of notebook 05 (motion graphs): transition candidates and Kovar's frame distance."""
+"""Exercises of notebook 05 (motion graphs): transition candidates, how long a style change lasts,
+and the threshold at which a style leaves the standard graph."""
 
 from __future__ import annotations
 
@@ -6,7 +7,16 @@ import numpy as np
 
 from .core import Exercise, Mistake, Question
 
-__all__ = ["local_minima", "distance_matrix", "vanishing_threshold", "style_frames_kept", "THRESHOLDS_CM"]
+__all__ = [
+    "local_minima",
+    "style_change",
+    "style_change_frames",
+    "gait_cycle_frames",
+    "DWELLS",
+    "vanishing_threshold",
+    "style_frames_kept",
+    "THRESHOLDS_CM",
+]
 
 
 # --------------------------------------------------------------------------- exercise 1
@@ -79,82 +89,96 @@ local_minima = Exercise(
 )
 
 
-# --------------------------------------------------------------------------- exercise 2
-def _distance_cases():
-    from motionlab import synthetic
-    from motionlab.core import quat
+# --------------------------------------------------------------------------- exercise 2 (experiment)
+DWELLS = (2, 4, 6, 8, 10, 12)
+"""The values of ``dwell`` (fewest frames a route spends in each intermediate motion,
+:func:`structured.build_structured`) exercise 2 moves through."""
 
-    walk = synthetic.generate("walk", None, 60, 30.0, seed=1).global_positions()
-    other = synthetic.generate("walk", None, 60, 30.0, seed=2).global_positions()
-    turned = quat.rotate(quat.from_yaw(1.2), walk) + np.array([0.7, 0.0, -1.5])  # same motion elsewhere
-    return [(walk[:30], other[:40]), (walk[10:35], turned[:20]), (other[5:12], other[20:31])]
+_CHANGE: dict = {}
 
 
-def _distance_ref(pos_a, pos_b):
-    from motionlab.motion_graphs import distance
+def style_change_frames(motions, request, dwell: int) -> int:
+    """Frames the path of ``request`` spends in intermediate motions during its first style change.
 
-    return distance.distance_matrix(pos_a, pos_b)
+    The structured graph of ``motions`` at 3 cm RMS (:func:`distance.threshold_from`) with the
+    given ``dwell`` is searched for ``request`` (list of ``(behaviour, style, frames)``); the
+    first run of pieces in intermediate motions is counted (0 when the path has none).
+    """
+    from motionlab.motion_graphs import distance, search, structured
 
-
-def _distance_variant(mode: str):
-    def wrong(pos_a, pos_b):
-        from motionlab.motion_graphs import distance
-
-        fa, fb = distance.cloud_features(pos_a), distance.cloud_features(pos_b)
-        n = fa.height.shape[1]
-        w = fa.weights
-        ax, az, bx, bz = fa.centred[:, :n], fa.centred[:, n:], fb.centred[:, :n], fb.centred[:, n:]
-        a = (ax * w) @ bx.T + (az * w) @ bz.T
-        b = (ax * w) @ bz.T - (az * w) @ bx.T
-        y = (fa.height * w) @ fb.height.T
-        s = fa.self_term[:, None] + fb.self_term[None, :]
-        if mode == "no turn":
-            d = s - 2 * y - 2 * a
-        elif mode == "no sqrt":
-            d = s - 2 * y - 2 * (a * a + b * b)
-        elif mode == "no y":
-            d = s - 2 * np.sqrt(a * a + b * b)
-        else:  # "plus": the cross terms added
-            d = s + 2 * y + 2 * np.sqrt(a * a + b * b)
-        return np.maximum(d, 0.0)
-
-    return wrong
+    key = (tuple(id(m) for m in motions), tuple(map(tuple, request)), int(dwell))
+    if key not in _CHANGE:
+        g = structured.build_structured(motions, distance.threshold_from(0.03), dwell=int(dwell))
+        frames, started = 0, False
+        for c, a, b in search.search(g, request).pieces:
+            inside = g.clips[c].kind == "intermediate"
+            if started and not inside:
+                break
+            if inside:
+                started, frames = True, frames + b - a + 1
+        _CHANGE[key] = frames
+    return _CHANGE[key]
 
 
-def _distance_no_clamp(pos_a, pos_b):  # rounding can leave -1e-17 where D is 0: both are accepted
-    from motionlab.motion_graphs import distance
+def gait_cycle_frames(motions, style: str) -> float:
+    """Median length (frames) of the whole gait cycles (:func:`cycles.segment_cycles`) of the
+    takes named ``*_<style>_*``."""
+    from motionlab.motion_graphs import cycles
 
-    fa, fb = distance.cloud_features(pos_a), distance.cloud_features(pos_b)
-    n = fa.height.shape[1]
-    w2 = np.concatenate([fa.weights, fa.weights])
-    a = (fa.centred * w2) @ fb.centred.T
-    b = (fa.centred * w2) @ np.concatenate([fb.centred[:, n:], -fb.centred[:, :n]], axis=1).T
-    y = (fa.height * fa.weights) @ fb.height.T
-    return fa.self_term[:, None] + fb.self_term[None, :] - 2 * y - 2 * np.sqrt(a * a + b * b)
+    lengths = [cycles.segment_cycles(m).lengths() for m in motions if f"_{style}_" in f"_{m.name}_"]
+    return float(np.median(np.concatenate(lengths)))
 
 
-distance_matrix = Exercise(
-    "05 · exercise 2 (closed-form distance)",
-    _distance_ref,
-    _distance_cases,
-    # the package rounds points to distance.GRID (≈ 3.8 µm) so that its sums are exact: an answer
-    # computed from the raw positions may differ by 2·√D·e + e² (e = 2·√3·GRID), a few 1e-6 m² here
-    atol=2e-5,
-    accept=[_distance_no_clamp],
+def _first_lasting(motions, request, frames_of=style_change_frames) -> float:
+    """The smallest dwell of :data:`DWELLS` whose first style change lasts at least one gait cycle
+    of the request's first style (0: none does)."""
+    cycle = gait_cycle_frames(motions, request[0][1])
+    for d in DWELLS:
+        if frames_of(motions, request, d) >= cycle:
+            return float(d)
+    return 0.0
+
+
+def _frames_at_answer(motions, request) -> float:
+    d = _first_lasting(motions, request)
+    return float(style_change_frames(motions, request, int(d))) if d else -1.0
+
+
+def _by_lower_bound(motions, request) -> float:
+    cycle = gait_cycle_frames(motions, request[0][1])
+    return float(next((d for d in DWELLS if 4 * d >= cycle), 0))
+
+
+def _both_changes(motions, request) -> float:
+    """Counting every intermediate frame of the path (all style changes together)."""
+    from motionlab.motion_graphs import distance, search, structured
+
+    cycle = gait_cycle_frames(motions, request[0][1])
+    for d in DWELLS:
+        g = structured.build_structured(motions, distance.threshold_from(0.03), dwell=d)
+        r = search.search(g, request)
+        if sum(b - a + 1 for c, a, b in r.pieces if g.clips[c].kind == "intermediate") >= cycle:
+            return float(d)
+    return 0.0
+
+
+style_change = Question(
+    "05 · exercise 2 (experiment: how long a style change lasts)",
+    _first_lasting,
     mistakes=[
         Mistake(
-            _distance_variant("no turn"),
-            "right only where the two clouds face the same way: the minimum over the turn θ of "
-            "a cos θ + b sin θ is what gives the square-root term.",
-        ),
-        Mistake(_distance_variant("no sqrt"), "the last term is 2 √(a² + b²): the square root is missing."),
-        Mistake(
-            _distance_variant("no y"),
-            "the heights are not turned or shifted, but they still differ: the −2Y term is missing.",
+            _frames_at_answer,
+            "that is a number of frames in the blends; the question asks for the dwell that gives them.",
         ),
         Mistake(
-            _distance_variant("plus"),
-            "D is a squared distance, ‖p − p'‖² = ‖p‖² + ‖p'‖² − 2 p·p': the cross terms are subtracted.",
+            _by_lower_bound,
+            "that is where 4 × dwell reaches a gait cycle, a lower bound; measure the path the search "
+            "returns, whose route may stay longer than dwell in a blend.",
+        ),
+        Mistake(
+            _both_changes,
+            "that counts the frames in the blends of every style change of the path; count only the "
+            "first change, from the first style into the second.",
         ),
     ],
 )

@@ -27,14 +27,37 @@ import numpy as np
 
 from motionlab.core.motion import Motion
 
-__all__ = ["Cycles", "contacts", "strikes", "cycles_from_ankles", "segment_cycles", "FOOT_JOINTS"]
+__all__ = ["Cycles", "Spans", "contacts", "strikes", "cycles_from_ankles", "segment_cycles", "FOOT_JOINTS"]
 
 FOOT_JOINTS = ("LeftFoot", "RightFoot")
 """Ankle joints of the canonical humanoid whose contacts define the cycles."""
 
 
+class Spans:
+    """Whole pieces of a take (gait cycles or action segments), held as ``bounds``: int array,
+    shape (K, 2), ``[first, stop)`` frames of each piece."""
+
+    bounds: np.ndarray
+
+    @property
+    def count(self) -> int:
+        """Number of whole pieces."""
+        return int(self.bounds.shape[0])
+
+    @property
+    def span(self) -> tuple[int, int]:
+        """``[first, stop)`` of the whole pieces together (``(0, 0)`` when there is none)."""
+        if self.count == 0:
+            return (0, 0)
+        return int(self.bounds[0, 0]), int(self.bounds[-1, 1])
+
+    def lengths(self) -> np.ndarray:
+        """(K,) frames per piece."""
+        return self.bounds[:, 1] - self.bounds[:, 0]
+
+
 @dataclass(frozen=True)
-class Cycles:
+class Cycles(Spans):
     """Gait cycles of one clip.
 
     Attributes
@@ -42,28 +65,14 @@ class Cycles:
     left, right : int arrays, strike frames of the left and right foot (ascending)
     bounds : int array, shape (C, 2), ``[first, stop)`` frames of each whole cycle (C may be 0)
     num_frames : frames of the clip
+
+    ``count``, ``span`` and ``lengths()`` of the whole cycles come from :class:`Spans`.
     """
 
     left: np.ndarray
     right: np.ndarray
     bounds: np.ndarray
     num_frames: int
-
-    @property
-    def count(self) -> int:
-        """Number of whole cycles."""
-        return int(self.bounds.shape[0])
-
-    @property
-    def span(self) -> tuple[int, int]:
-        """``[first, stop)`` of the whole cycles together (``(0, 0)`` when there is none)."""
-        if self.count == 0:
-            return (0, 0)
-        return int(self.bounds[0, 0]), int(self.bounds[-1, 1])
-
-    def lengths(self) -> np.ndarray:
-        """(C,) frames per cycle."""
-        return self.bounds[:, 1] - self.bounds[:, 0]
 
 
 def contacts(pos, fps: float, feet=(0, 1), height: float = 0.06, speed: float = 0.6) -> np.ndarray:

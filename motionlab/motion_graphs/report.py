@@ -73,29 +73,8 @@ def build_report(graph: MotionGraph) -> dict:
         comp = graph.largest_component(behaviour_frames[b])
         takes_b = np.zeros(n, dtype=bool)
         for (bb, s), ks in sorted(style_clips.items()):
-            if bb != b:
-                continue
-            mine = np.zeros(n, dtype=bool)
-            for k in ks:
-                mine[graph.clips[k].start : graph.clips[k].stop] = True
-            takes_b |= mine
-            frames = int(mine.sum())
-            inside = int((comp & mine).sum())
-            cell = cells.get(b, {}).get(s, {})
-            cycles = sum(int(t.get("cycles", 0)) for t in cell.get("takes", []))
-            rows.append(
-                dict(
-                    behaviour=b,
-                    style=s,
-                    takes=len(ks),
-                    frames=frames,
-                    cycles=cycles,
-                    transitions=int(np.sum(live & mine[graph.src])),
-                    in_largest=inside,
-                    in_largest_percent=_pct(inside, frames),
-                    pruned=int((mine & ~graph.alive).sum()),
-                )
-            )
+            if bb == b:
+                rows.append(_style_row(graph, b, s, ks, comp, live, cells.get(b, {}).get(s, {}), takes_b))
         total = int(takes_b.sum())
         got = int((comp & takes_b).sum())
         behaviours[b] = dict(frames=total, largest_scc=got, percent=_pct(got, total), **_kind(cells.get(b, {})))
@@ -119,6 +98,27 @@ def build_report(graph: MotionGraph) -> dict:
         percent=_pct(got, total),
         conditions=conditions,
         info=info,
+    )
+
+
+def _style_row(graph: MotionGraph, b: str, s: str, ks: list[int], comp, live, cell: dict, takes_b) -> dict:
+    """One report row: the takes ``ks`` of style ``s`` against the behaviour's largest component
+    ``comp`` (frame mask); marks their frames in ``takes_b``."""
+    mine = np.zeros(graph.num_frames, dtype=bool)
+    for k in ks:
+        mine[graph.clips[k].start : graph.clips[k].stop] = True
+    takes_b |= mine
+    frames, inside = int(mine.sum()), int((comp & mine).sum())
+    return dict(
+        behaviour=b,
+        style=s,
+        takes=len(ks),
+        frames=frames,
+        cycles=sum(int(t.get("cycles", 0)) for t in cell.get("takes", [])),
+        transitions=int(np.sum(live & mine[graph.src])),
+        in_largest=inside,
+        in_largest_percent=_pct(inside, frames),
+        pruned=int((mine & ~graph.alive).sum()),
     )
 
 

@@ -3,9 +3,10 @@ r"""Searching a motion graph for a requested sequence of behaviours.
 A request is a list of segments ``(behaviour, style, frames)``: "300 frames of an angry walk,
 then 200 frames of a normal run". The answer is a *path*: runs of frames
 ``(clip, first, last)`` joined by the graph's edges, and for every segment the number of
-frames it got. A segment runs from its first frame in its clip up to the first frame of the
-next segment's clip, so the frames of a transition count towards the segment it leaves and the
-segment lengths add up to the path length.
+frames it got: the frames of its own style and of the recorded route out of it (an
+interpolation space or a transition clip), so a transition counts towards the segment it
+leaves. Frames spent in other styles on the way to the next segment (a style passed through
+because no route joins the two directly) are counted apart (:attr:`SearchResult.passing`).
 
 **Structured graph** (paper B). The structure table gives each segment's style pool (its
 takes, side by side) and the recorded routes out of it, so the search never explores the whole
@@ -16,12 +17,15 @@ reachability recursion over frame counts,
 .. math:: R_{c+1} = \operatorname{shift}(R_c) \,\lor\, \operatorname{jumps}(R_c), \qquad R_0 = \{e\},
 
 (``R_c``: frames where a walk of ``c + 1`` frames can be) run once per segment. The exit whose
-route length ``r`` satisfies ``c + 1 + r = n`` wins (exactly, or else the closest). Long
+route length ``r`` satisfies ``c + 1 + r = n`` wins; of the walks within :data:`TOLERANCE`, the
+one that costs least at :data:`JUMP_FRAMES` frames per jump and one per frame off the request
+(each jump is a blend in the synthesised motion). Long
 segments first take the shortest way to the pool's main cycle (its longest jump back inside
 one take) and repeat it, so the recursion stays short: the *iterative choice of self-loop and
 transition points*. Pools crossed on the way to the next segment are passed by the shortest walk
-to an exit (a breadth-first search); the **loop guard** stops it with an error once every frame
-it can reach has been visited. A request may ask for at most :data:`MAX_FRAMES` frames.
+to an exit (:func:`walk_to_exit`); the **loop guard** stops it with an error once every frame
+it can reach has been visited (paper B stops at the second pass of a clip's last self-loop
+point; a pool of many takes has none). A request may ask for at most :data:`MAX_FRAMES` frames.
 
 **Standard graph** (for comparison). Dijkstra's shortest path (in frames) on the compressed
 graph from the current frame to any frame of the requested clip, then the same in-clip
@@ -51,6 +55,9 @@ __all__ = [
     "RequestTooLong",
     "TOLERANCE",
     "MAX_FRAMES",
+    "PoolWalker",
+    "pool_walker",
+    "walk_to_exit",
 ]
 
 MAX_FRAMES = 100_000
@@ -59,8 +66,8 @@ motion is held in memory and written as one BVH file; longer requests are refuse
 limit, rather than running for minutes and filling the disk."""
 
 TOLERANCE = 0.05
-"""Documented accuracy: a reachable segment length is met exactly when the clip's loops allow,
-and otherwise within ``max(2 frames, 5%)`` — checked by the tests."""
+"""Documented accuracy: every reachable segment gets its requested length within
+``max(2 frames, 5%)``; inside that band the walk with the fewest jumps wins (checked by the tests)."""
 
 
 class SearchError(GraphError):
@@ -81,18 +88,26 @@ class SearchResult:
     """A path and how well it meets the request.
 
     ``pieces``: list of ``(clip, first, last)`` (clip-local frames, inclusive); ``achieved``:
-    frames given to each segment; ``requested``: the request's counts; ``transitions``: index in
-    the output of the first frame after each jump (for smoothness metrics).
+    frames given to each segment (its own style's frames and the recorded route out of it);
+    ``requested``: the request's counts; ``passing``: frames after each segment spent in other
+    styles on the way to the next one (empty: none), so that ``sum(achieved) + sum(passing)`` is
+    the path's length; ``transitions``: index in the output of the first frame after each jump
+    (for smoothness metrics).
     """
 
     pieces: list[tuple[int, int, int]]
     requested: list[int]
     achieved: list[int]
     segments: list[Segment] = field(default_factory=list)
+    passing: list[int] = field(default_factory=list)
 
     @property
     def num_frames(self) -> int:
         return int(sum(b - a + 1 for _, a, b in self.pieces))
+
+    def pieces_per_second(self, fps: float) -> float:
+        """Pieces of the path (each after the first begins with a jump) per second at ``fps`` frames/s."""
+        return len(self.pieces) * float(fps) / max(self.num_frames, 1)
 
     @property
     def errors(self) -> list[int]:
@@ -108,8 +123,10 @@ class SearchResult:
 
     def report(self) -> str:
         lines = []
-        for s, a in zip(self.segments, self.achieved):
+        for k, (s, a) in enumerate(zip(self.segments, self.achieved)):
             lines.append(f"{s.behaviour}:{s.style}: requested {s.frames}, got {a} ({a - s.frames:+d})")
+            if k < len(self.passing) and self.passing[k]:
+                lines.append(f"  then {self.passing[k]} frames through other styles on the way")
         return "\n".join(lines)
 
 
@@ -159,7 +176,7 @@ def _check_total(segs: list[Segment]) -> None:
 
 # ---------------------------------------------------------------------------- in-pool walks
 @dataclass
-class _Clip:
+class PoolWalker:
     """The walkable frames of one style's takes (a *pool*: a run of clips stored side by side).
 
     Frames are pool-local (``0 … length-1`` from the pool's first frame). ``step[f]``: f → f+1
@@ -199,7 +216,7 @@ class _Clip:
         return np.concatenate([f, self.loop_src[m]]), np.concatenate([f + 1, self.loop_dst[m]])
 
 
-def _pool_walker(graph: MotionGraph, clips: list[int], index: int = 0) -> _Clip:
+def _pool_walker(graph: MotionGraph, clips: list[int], index: int = 0) -> PoolWalker:
     """Walker over the consecutive clips ``clips`` (one style's takes)."""
     first, last = graph.clips[clips[0]], graph.clips[clips[-1]]
     st, sp = first.start, last.stop
@@ -219,18 +236,33 @@ def _pool_walker(graph: MotionGraph, clips: list[int], index: int = 0) -> _Clip:
     # the SPARSE_JUMPS cheapest jumps into every frame (ties: the nearer source first)
     order = np.lexsort((src, graph.cost[m], dst))
     few = order[np.arange(order.size) - np.searchsorted(dst[order], dst[order]) < SPARSE_JUMPS]
-    return _Clip(
+    return PoolWalker(
         index, sp - st, step, src, dst, last_src, last_dst, np.asarray(clips, dtype=np.int64), offsets,
         graph.alive[st:sp].copy(), (src[few], dst[few]),
     )  # fmt: skip
 
 
-def _clip_walker(graph: MotionGraph, c: int) -> _Clip:
+def pool_walker(graph: MotionGraph, behaviour: str, style: str) -> PoolWalker:
+    """The walker over one style's pool of a structured graph (its takes, from the structure table).
+
+    Raises
+    ------
+    SearchError when the graph has no structure table or no such behaviour or style.
+    """
+    cells = graph.table.get("behaviours") if graph.table else None
+    if not cells:
+        raise SearchError("this graph has no structure table (a standard graph?)")
+    if behaviour not in cells or style not in cells[behaviour]:
+        raise SearchError(f"no style {behaviour}/{style} in the graph")
+    return _pool_walker(graph, [t["clip"] for t in cells[behaviour][style]["takes"]])
+
+
+def _clip_walker(graph: MotionGraph, c: int) -> PoolWalker:
     """Walker over one clip (the standard graph's search)."""
     return _pool_walker(graph, [c], c)
 
 
-def _distances(cw: _Clip, start: int, targets: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def _distances(cw: PoolWalker, start: int, targets: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Breadth-first search from ``start``: fewest moves to every frame (-1: unreachable) and
     the parent of each reached frame. Stops early once every frame of ``targets`` is reached.
 
@@ -255,7 +287,7 @@ def _distances(cw: _Clip, start: int, targets: np.ndarray | None = None) -> tupl
     return dist, parent
 
 
-def _path(cw: _Clip, start: int, targets, name: str) -> tuple[list[int], int]:
+def _path(cw: PoolWalker, start: int, targets, name: str) -> tuple[list[int], int]:
     """Frames of a shortest walk from ``start`` to the nearest of ``targets`` (the ``r``-th).
 
     The *loop guard*: when the search has seen every frame reachable from ``start`` without
@@ -276,7 +308,7 @@ def _path(cw: _Clip, start: int, targets, name: str) -> tuple[list[int], int]:
     return frames[::-1], r
 
 
-def _runs(cw: _Clip | int, frames: list[int]) -> list[tuple[int, int, int]]:
+def _runs(cw: PoolWalker | int, frames: list[int]) -> list[tuple[int, int, int]]:
     """Pool-local frames -> ``(clip, first, last)`` pieces in clip frames."""
     out = []
     a = prev = frames[0]
@@ -302,7 +334,7 @@ SPARSE_JUMPS = 2
 takes holds dozens of jumps per frame, and the recursion's cost grows with them."""
 
 
-def _reach(cw: _Clip, start: int, steps: int, jumps: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+def _reach(cw: PoolWalker, start: int, steps: int, jumps: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """(steps, L) int16: fewest jumps of a walk of ``c + 1`` frames from ``start`` that ends at
     each frame (``_NEVER`` where no walk of that length ends there).
 
@@ -310,15 +342,16 @@ def _reach(cw: _Clip, start: int, steps: int, jumps: tuple[np.ndarray, np.ndarra
     ``J[c+1, d] = min over jumps s → d of J[c, s] + 1``; the jump part is one
     ``np.minimum.reduceat`` over the jumps sorted by destination, so each row is vectorised.
     """
-    out = np.full((max(steps, 1), cw.length), _NEVER, dtype=np.int16)
-    out[0, start] = 0
     step_ok = cw.step[:-1]
     src, dst = (cw.loop_src, cw.loop_dst) if jumps is None else jumps
     order = np.argsort(dst, kind="stable")
     src, dst = src[order], dst[order]
     rank = np.arange(dst.size) - np.searchsorted(dst, dst)  # k-th jump into its frame
     if rank.size == 0 or rank.max() < SPARSE_JUMPS:
-        return _reach_few(out, step_ok, [(src[rank == k], dst[rank == k]) for k in range(SPARSE_JUMPS)])
+        layers = [(src[rank == k], dst[rank == k]) for k in range(SPARSE_JUMPS)]
+        return _reach_few(max(steps, 1), cw.length, start, step_ok, layers)
+    out = np.full((max(steps, 1), cw.length), _NEVER, dtype=np.int16)
+    out[0, start] = 0
     if dst.size:
         heads = np.flatnonzero(np.concatenate([[True], dst[1:] != dst[:-1]]))
         targets = dst[heads]
@@ -332,29 +365,34 @@ def _reach(cw: _Clip, start: int, steps: int, jumps: tuple[np.ndarray, np.ndarra
     return out
 
 
-def _reach_few(out: np.ndarray, step_ok: np.ndarray, layers: list) -> np.ndarray:
+def _reach_few(steps: int, n: int, start: int, step_ok: np.ndarray, layers: list) -> np.ndarray:
     """:func:`_reach` when few jumps enter each frame: ``layers[k]`` holds the k-th jump into
-    each frame (at most one per frame), so a row is one gather per layer, with no grouping."""
-    n = out.shape[1]
+    each frame (at most one per frame), so a row is one gather per layer, with no grouping.
+
+    Returns a (steps, n) view of an array with one more column, always ``_NEVER``: the frame a
+    missing jump comes from."""
+    out = np.full((steps, n + 1), _NEVER, dtype=np.int16)
+    out[0, start] = 0
     src_of = []
     for src, dst in layers:
         s = np.full(n, n)  # the jump into each frame, n (a frame that is never reached) if none
         s[dst] = src
         src_of.append(s)
-    prev_x = np.full(n + 1, _NEVER, dtype=np.int16)
-    for c in range(1, out.shape[0]):
-        prev_x[:n] = out[c - 1]
-        cur = out[c]
-        np.copyto(cur[1:], prev_x[: n - 1], where=step_ok)  # the row starts all _NEVER
-        for s in src_of:
-            via = prev_x[s]
-            np.add(via, 1, out=via, where=via < _NEVER)
-            np.minimum(cur, via, out=cur)
-    return out
+    via, other = np.empty(n, dtype=np.int16), np.empty(n, dtype=np.int16)
+    for c in range(1, steps):
+        prev, cur = out[c - 1], out[c]
+        np.copyto(cur[1:n], prev[: n - 1], where=step_ok)  # the row starts all _NEVER
+        np.take(prev, src_of[0], out=via)
+        for s in src_of[1:]:
+            np.minimum(via, np.take(prev, s, out=other), out=via)
+        np.minimum(via, _NEVER - 1, out=via)  # a jump from nowhere stays _NEVER after the + 1
+        via += 1
+        np.minimum(cur[:n], via, out=cur[:n])
+    return out[:, :n]
 
 
 def _backtrack(
-    cw: _Clip, reach: np.ndarray, c: int, x: int, jumps: tuple[np.ndarray, np.ndarray] | None = None
+    cw: PoolWalker, reach: np.ndarray, c: int, x: int, jumps: tuple[np.ndarray, np.ndarray] | None = None
 ) -> list[int]:
     """Frames of a walk with the fewest jumps reaching ``x`` after ``c + 1`` frames
     (reverse-engineered from ``reach``, see :func:`_reach`); each jump is a blend in the
@@ -384,10 +422,13 @@ def _deltas(n: int):
 
 
 def _walk(
-    cw: _Clip, start: int, need: list[int], exits: list[int], name: str = "clip"
+    cw: PoolWalker, start: int, need: list[int], exits: list[int], name: str = "clip", slack: int = 0
 ) -> tuple[list[tuple[int, int, int]], int, int]:
     """A walk from ``start`` of about ``need[r]`` frames ending at ``exits[r]`` (``-1``: any frame).
 
+    Of the walks within ``slack`` frames of an option's length, the cheapest wins: each jump
+    costs :data:`JUMP_FRAMES` frames (it is a blend), each frame off the request one; when there
+    is none, the walk nearest the requested length.
     Returns pieces, the chosen option ``r`` and the frames played.
     """
     pieces: list[tuple[int, int, int]] = []
@@ -408,16 +449,20 @@ def _walk(
             pieces.extend(_runs(cw, list(range(cw.last_dst, cw.last_src + 1))) * reps)
             played += reps * cw.cycle
             start = cw.last_dst
+    if len(need) == 1 and ex[0] < 0 and _straight(cw, start, need[0] - played):
+        # a walk along the take with no jump at all: nothing costs less
+        pieces.extend(_runs(cw, list(range(start, start + need[0] - played))))
+        return pieces, 0, need[0]
     steps = max(n - played for n in need) + max(cw.cycle, 2)
     steps = max(steps, 2)
     need_c = np.array(need) - played - 1
     # first the cheapest jump into each frame and just the rows an exact length needs (a pool of
     # many takes holds dozens of jumps per frame, and the recursion's cost grows with them);
     # when that gives no walk of exactly the requested length, every jump and the full width
-    short = min(steps, int(need_c.max()) + 2)
-    for rows, jumps, widest in ((short, cw.sparse, 0), (steps, None, steps)):
+    short = min(steps, int(need_c.max()) + slack + 2)
+    for rows, jumps, widest in ((short, cw.sparse, slack), (steps, None, steps)):
         reach = _reach(cw, start, rows, jumps)
-        best = _choose(reach, need_c, ex, rows, widest)
+        best = _choose(reach, need_c, ex, rows, widest, slack)
         if best is not None:
             break
     if best is None:
@@ -428,31 +473,46 @@ def _walk(
     return pieces, r, played + c + 1
 
 
-def _choose(reach: np.ndarray, need_c: np.ndarray, ex: np.ndarray, steps: int, widest: int):
-    """``(option, row, exit frame)`` of the walk nearest the requested length (``None``: none
-    within ``widest`` rows of it): an option's exit frame, or (``-1``) any frame, the one with
-    the fewest jumps."""
-    best = None
-    for delta in _deltas(widest + 1):
-        c = need_c + delta
-        ok = np.flatnonzero((c >= 0) & (c < steps))
-        if ok.size == 0:
+def _straight(cw: PoolWalker, start: int, frames: int) -> bool:
+    """True when ``frames`` frames from ``start`` follow one another inside one take."""
+    return frames >= 1 and start + frames <= cw.length and bool(cw.step[start : start + frames - 1].all())
+
+
+def _choose(reach: np.ndarray, need_c: np.ndarray, ex: np.ndarray, steps: int, widest: int, slack: int = 0):
+    """``(option, row, exit frame)``: of the walks within ``slack`` rows of an option's requested
+    row, the cheapest, at :data:`JUMP_FRAMES` per jump plus one per frame off the request (the
+    nearer length on ties); when there is none, the walk nearest the requested length (``None``:
+    none within ``widest`` rows of it)."""
+    best, best_key = None, None
+    for order, delta in enumerate(_deltas(widest + 1)):
+        if best is not None and (abs(delta) > slack or abs(delta) >= best_key[0]):
+            break
+        found = _fewest_jumps(reach, need_c + delta, ex, steps)
+        if found is None:
             continue
-        anywhere = ok[ex[ok] < 0]
-        for r in anywhere:
-            row = reach[c[r]]
-            if row.min() < _NEVER:  # any frame may end it: the one reached with the fewest jumps
-                best = (int(r), int(c[r]), int(np.argmin(row)))
-                break
-        if best is not None:
-            break
-        fixed = ok[ex[ok] >= 0]
-        jumps = reach[c[fixed], ex[fixed]]
-        if jumps.min(initial=_NEVER) < _NEVER:
-            r = int(fixed[np.argmin(jumps)])  # of the exits met, the one with the fewest jumps
-            best = (r, int(c[r]), int(ex[r]))
-            break
+        key = (JUMP_FRAMES * found[3] + abs(delta), order)
+        if best is None or key < best_key:
+            best, best_key = found[:3], key
     return best
+
+
+def _fewest_jumps(reach: np.ndarray, c: np.ndarray, ex: np.ndarray, steps: int):
+    """``(option, row, frame, jumps)`` of the walk with the fewest jumps ending in row ``c[r]``
+    at option ``r``'s exit frame (or, ``-1``, at any frame); ``None`` when there is none."""
+    ok = np.flatnonzero((c >= 0) & (c < steps))
+    found = None
+    for r in ok[ex[ok] < 0]:
+        row = reach[c[r]]
+        j = int(row.min())
+        if j < _NEVER and (found is None or j < found[3]):
+            found = (int(r), int(c[r]), int(np.argmin(row)), j)
+    fixed = ok[ex[ok] >= 0]
+    if fixed.size:
+        jumps = reach[c[fixed], ex[fixed]]
+        k = int(np.argmin(jumps))
+        if jumps[k] < _NEVER and (found is None or int(jumps[k]) < found[3]):
+            found = (int(fixed[k]), int(c[fixed[k]]), int(ex[fixed[k]]), int(jumps[k]))
+    return found
 
 
 JUMP_FRAMES = 8
@@ -462,10 +522,27 @@ everywhere, and the walk with the fewest frames can jump on every frame; each ju
 many per jump."""
 
 
-def _quick_exit(cw: _Clip, start: int, exits: list[int], name: str) -> tuple[list[tuple[int, int, int]], int, int]:
-    """The cheapest walk to an exit: frames plus :data:`JUMP_FRAMES` per jump, over the cheapest
-    jump into each frame; the shortest walk (a breadth-first search with the loop guard) when
-    nothing cheaper is found."""
+def walk_to_exit(
+    cw: PoolWalker, start: int, exits: list[int], name: str = "pool"
+) -> tuple[list[tuple[int, int, int]], int, int]:
+    """The cheapest walk through a pool from ``start`` to one of ``exits`` (pool-local frames).
+
+    Cost: frames plus :data:`JUMP_FRAMES` per jump, over the cheapest jumps into each frame; the
+    shortest walk (a breadth-first search) when nothing cheaper is found.
+
+    Returns
+    -------
+    pieces : list of ``(clip, first, last)``; r : index of the exit reached; frames : frames played
+
+    Raises
+    ------
+    SearchError (the *loop guard*) when every frame reachable from ``start`` has been visited
+    without meeting an exit. Paper B stops a search at the second pass of a clip's last
+    self-loop point instead; a pool of many takes has no single last self-loop point.
+    ValueError when ``start`` or an exit lies outside the pool, or ``exits`` is empty.
+    """
+    if not exits or not all(0 <= int(x) < cw.length for x in [start, *exits]):
+        raise ValueError(f"expected a start and at least one exit in 0..{cw.length - 1}, got {start} and {exits}")
     frames, r = _path(cw, start, exits, name)
     jumps = sum(b != a + 1 for a, b in zip(frames[:-1], frames[1:]))
     rows = len(frames) + JUMP_FRAMES * jumps  # no longer walk can cost less
@@ -479,7 +556,7 @@ def _quick_exit(cw: _Clip, start: int, exits: list[int], name: str) -> tuple[lis
     return _runs(cw, frames), r, len(frames)
 
 
-def _next(cw: _Clip, f: int) -> int:
+def _next(cw: PoolWalker, f: int) -> int:
     """A frame that may follow ``f`` (the next frame, or a jump)."""
     a, b = cw.succ(np.array([f]))
     if b.size == 0:
@@ -494,13 +571,13 @@ class _Planner:
             raise SearchError("this graph has no structure table (a standard graph?); use search_standard")
         self.g = graph
         self.entries = graph.table["behaviours"]
-        self.walkers: dict[int, _Clip] = {}
+        self.walkers: dict[int, PoolWalker] = {}
         self.links: dict[tuple[str, str], list[dict]] = {}
         self.memo: dict = {}
         for link in graph.table["links"]:
             self.links.setdefault(tuple(link["from"]), []).append(link)
 
-    def walker(self, key: tuple[str, str]) -> _Clip:
+    def walker(self, key: tuple[str, str]) -> PoolWalker:
         if key not in self.walkers:
             cell = self.entries[key[0]][key[1]]
             self.walkers[key] = _pool_walker(self.g, [t["clip"] for t in cell["takes"]])
@@ -580,7 +657,7 @@ class _Planner:
             cw = self.walker(key)
             routes = link["routes"]
             exits = [r["exit"] for r in routes]
-            p, r, n = _quick_exit(cw, enter, exits, f"{key[0]}/{key[1]}")
+            p, r, n = walk_to_exit(cw, enter, exits, f"{key[0]}/{key[1]}")
             route = routes[r]
             pieces.extend(p)
             pieces.extend(tuple(x) for x in route["pieces"])
@@ -612,6 +689,7 @@ def search(graph: MotionGraph, request, progress: bool = False) -> SearchResult:
     plans = [planner.hops(a, b) if a != b else [] for a, b in zip(keys[:-1], keys[1:])]
     pieces: list[tuple[int, int, int]] = []
     achieved: list[int] = []
+    passing = [0] * len(segs)
     enter = planner.walker(keys[0]).first_alive()
     bar = None
     if progress:
@@ -623,8 +701,9 @@ def search(graph: MotionGraph, request, progress: bool = False) -> SearchResult:
             bar.update(seg.frames)
         cw = planner.walker(keys[k])
         name = f"{seg.behaviour}/{seg.style}"
+        slack = max(2, int(TOLERANCE * seg.frames))
         if k == len(segs) - 1 or not plans[k]:
-            p, _, n = _walk(cw, enter, [seg.frames], [-1], name)
+            p, _, n = _walk(cw, enter, [seg.frames], [-1], name, slack)
             pieces.extend(p)
             achieved.append(n)
             if k < len(segs) - 1:  # the same style again: continue from a frame that follows
@@ -632,16 +711,18 @@ def search(graph: MotionGraph, request, progress: bool = False) -> SearchResult:
                 local = int(cw.offsets[np.flatnonzero(cw.clips == c_last)[0]]) + f_last
                 enter = _next(cw, local)
             continue
-        options, spent, exits = planner.options(plans[k])
-        p, r, n = _walk(cw, enter, np.maximum(seg.frames - spent, 1).tolist(), exits, name)
+        options, _, exits = planner.options(plans[k])
+        own = np.array([seg.frames - o[0]["frames"] for o in options])  # the route out counts here
+        p, r, n = _walk(cw, enter, np.maximum(own, 1).tolist(), exits, name, slack)
         route, more, more_frames, enter = options[r]
         pieces.extend(p)
         pieces.extend(tuple(x) for x in route["pieces"])
         pieces.extend(more)
-        achieved.append(n + route["frames"] + more_frames)
+        achieved.append(n + route["frames"])
+        passing[k] = more_frames
     if bar is not None:
         bar.close()
-    return SearchResult(_merge(pieces), [s.frames for s in segs], achieved, segs)
+    return SearchResult(_merge(pieces), [s.frames for s in segs], achieved, segs, passing)
 
 
 def _segments(request) -> list[Segment]:

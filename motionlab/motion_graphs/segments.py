@@ -82,7 +82,7 @@ LEG_JOINTS = (("LeftLeg", "LeftFoot"), ("RightLeg", "RightFoot"))
 
 
 @dataclass(frozen=True)
-class Segments:
+class Segments(_cycles.Spans):
     """What a take is and where it may be cut.
 
     Attributes
@@ -95,6 +95,8 @@ class Segments:
     both_planted : share of the frames with both feet planted, in [0, 1]
     ports : bool array, shape (T,), frames where links to other styles and behaviours may
         begin or end (an action's boundary stances; a gait's start, stop and double support)
+
+    ``count``, ``span`` and ``lengths()`` of the whole segments come from :class:`.cycles.Spans`.
     """
 
     kind: str
@@ -103,18 +105,6 @@ class Segments:
     num_frames: int
     both_planted: float
     ports: np.ndarray
-
-    @property
-    def count(self) -> int:
-        """Number of whole segments."""
-        return int(self.bounds.shape[0])
-
-    @property
-    def span(self) -> tuple[int, int]:
-        """``[first, stop)`` of the whole segments together (``(0, 0)`` when there is none)."""
-        if self.count == 0:
-            return (0, 0)
-        return int(self.bounds[0, 0]), int(self.bounds[-1, 1])
 
     def stance_frames(self) -> np.ndarray:
         """(T,) bool: frames inside a stance phase."""

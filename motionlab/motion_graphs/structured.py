@@ -57,9 +57,12 @@ Taught in ``notebooks/05_motion_graphs.ipynb``.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import time
 from collections.abc import Mapping, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -71,6 +74,8 @@ from motionlab.motion_graphs import segments as _segments
 from motionlab.motion_graphs import stance_links as _stance_links
 from motionlab.motion_graphs.graph import EDGE_KINDS, ClipInfo, GraphError, MotionGraph, check_motions, pair_edges
 from motionlab.motion_graphs.naming import ClipLabel, label_name, parse_name
+
+Key = tuple[str, str]
 
 __all__ = ["build_structured", "build_wcmg", "structure_rows", "STYLE_PAIRS"]
 
@@ -143,6 +148,422 @@ def _best_only(i, j, cost):
     return i[k : k + 1], j[k : k + 1], cost[k : k + 1]
 
 
+@dataclass
+class _Options:
+    """The build's settings (see :func:`build_structured`), resolved to numbers."""
+
+    threshold: float
+    window: int
+    min_loop: int
+    weights: tuple[float, ...]
+    style_pairs: str
+    reference_style: str
+    force: bool
+    dwell: int
+    neighbours: int
+    rep_cycles: int
+    progress: bool
+
+
+@dataclass
+class _Arranged:
+    """The clips in graph order: each style's takes side by side (by take), transition clips last.
+
+    ``order[n]``: input index of graph clip ``n``; ``pools``: key → graph clip indices of its
+    takes; ``transitions``: graph clip indices of the transition clips."""
+
+    motions: list[Motion]
+    labels: list[ClipLabel]
+    order: list[int]
+    pools: dict[Key, list[int]]
+    transitions: list[int]
+
+
+def _arrange(motions: Sequence[Motion], labels: Sequence[ClipLabel]) -> _Arranged:
+    pools_in: dict[Key, list[int]] = {}
+    for k, lab in enumerate(labels):
+        if lab.kind == "basic":
+            pools_in.setdefault(lab.key, []).append(k)
+    for key in pools_in:
+        pools_in[key].sort(key=lambda k: (labels[k].take or "", k))
+    order = [k for key in sorted(pools_in) for k in pools_in[key]]
+    order += [k for k, lab in enumerate(labels) if lab.kind == "transition"]
+    where = {k: n for n, k in enumerate(order)}  # input index -> graph clip index
+    return _Arranged(
+        [motions[k] for k in order],
+        [labels[k] for k in order],
+        order,
+        {key: [where[k] for k in ks] for key, ks in pools_in.items()},
+        [where[k] for k, lab in enumerate(labels) if lab.kind == "transition"],
+    )
+
+
+@dataclass
+class _Cuts:
+    """Per take its gait cycles and segments (``None`` where they cannot be cut), the cuts that
+    represent it (segments of an action, cycles of a gait) and each style's representative take."""
+
+    cyc: dict
+    seg: dict
+    cuts: dict
+    rep: dict[Key, int]
+    take_frames: list[int]
+
+    def rep_span(self, key: Key, n: int) -> tuple[int, int]:
+        """``n`` whole cycles (or segments) from the middle of the representative take (all of it without)."""
+        cy = self.cuts[self.rep[key]]
+        if cy is None or cy.count == 0:
+            return (0, self.take_frames[self.rep[key]])
+        n = min(n, cy.count)
+        mid = (cy.count - n) // 2
+        return int(cy.bounds[mid, 0]), int(cy.bounds[mid + n - 1, 1])
+
+    def rep_count(self, key: Key, rep_cycles: int) -> int:
+        cy = self.cuts[self.rep[key]]
+        return rep_cycles if cy is None or cy.count == 0 else min(rep_cycles, cy.count)
+
+
+def _cut_takes(arr: _Arranged, notes: _Notes, progress: bool) -> _Cuts:
+    """Stage 1: cycles and segments of every take, and the representative take of every style."""
+    cyc, seg, cuts = {}, {}, {}
+    for _key, ks in _progress(sorted(arr.pools.items()), "cycles", enabled=progress):
+        for c in ks:
+            try:
+                cyc[c] = _cycles.segment_cycles(arr.motions[c])
+                seg[c] = _segments.segment_take(arr.motions[c])
+            except ValueError:
+                cyc[c] = seg[c] = None
+            # a gait is cut into whole cycles, a standing action into segments between stances
+            cuts[c] = seg[c] if seg[c] is not None and seg[c].kind == "action" else cyc[c]
+    rep: dict[Key, int] = {}
+    for key, ks in arr.pools.items():
+        # the take with the most whole cycles or segments (ties: the first take) represents the style
+        rep[key] = max(ks, key=lambda c: (cuts[c].count if cuts[c] is not None else -1, -c))
+        if cuts[rep[key]] is None or cuts[rep[key]].count == 0:
+            notes.add("no whole cycle", f"{arr.motions[rep[key]].name}: the whole take represents its style")
+    return _Cuts(cyc, seg, cuts, rep, [m.num_frames for m in arr.motions])
+
+
+def _interpolation_spaces(arr: _Arranged, cuts: _Cuts, opt: _Options) -> tuple[list[Motion], list[ClipInfo], list]:
+    """Stage 2: intermediate motions between representative cycles of styles of one behaviour.
+
+    Returns the intermediate motions, their clip infos and the spaces
+    ``(behaviour, s1, s2, [graph clip indices of the intermediates])``."""
+    by_behaviour: dict[str, list[str]] = {}
+    for b, s in arr.pools:
+        by_behaviour.setdefault(b, []).append(s)
+    extra: list[Motion] = []
+    extra_infos: list[ClipInfo] = []
+    spaces = []
+    pairs_todo = []
+    for b, styles in sorted(by_behaviour.items()):
+        lengths = {s: arr.motions[cuts.rep[(b, s)]].num_frames for s in styles}
+        pairs_todo += [(b, s1, s2) for s1, s2 in _style_pairs(styles, opt.style_pairs, opt.reference_style, lengths, 0)]
+    for b, s1, s2 in _progress(pairs_todo, "interpolation spaces", enabled=opt.progress):
+        # the same number of whole cycles of both styles, so registration pairs cycle with cycle
+        n = min(cuts.rep_count((b, s1), opt.rep_cycles), cuts.rep_count((b, s2), opt.rep_cycles))
+        cut = []
+        for key in ((b, s1), (b, s2)):
+            f0, f1 = cuts.rep_span(key, n)
+            m = arr.motions[cuts.rep[key]][f0:f1]
+            pos = m.global_positions()
+            cut.append((m, pos, _registration.root_track(m, pos)))
+        (m1, p1, r1), (m2, p2, r2) = cut
+        # the registration must cover (nearly) both spans: 90% of the longer one
+        reg = _registration.dtw(_distance.distance_matrix(p1, p2, opt.window), int(0.9 * max(len(p1), len(p2))))
+        ids = []
+        for w in opt.weights:
+            mid = _registration.blend(m1, m2, reg, w, name=f"{b}_{s1}~{s2}@{w:g}", tracks=(r1, r2))
+            if mid.num_frames < 3:
+                continue
+            ids.append(len(arr.motions) + len(extra))
+            extra.append(mid)
+            extra_infos.append(ClipInfo(mid.name, "intermediate", b, f"{s1}~{s2}@{w:g}", b, s2))
+        spaces.append((b, s1, s2, ids))
+    return extra, extra_infos, spaces
+
+
+class _Compare:
+    """Transition candidates between clips of one graph (:func:`distance.candidates`), with the
+    clips' point-cloud features cached and the cells compared counted."""
+
+    def __init__(self, graph: MotionGraph, threshold: float, window: int):
+        self.graph, self.threshold, self.window = graph, threshold, window
+        self.cache: dict[int, _distance.CloudFeatures] = {}
+        self.comparisons = 0
+
+    def feats(self, c: int) -> _distance.CloudFeatures:
+        if c not in self.cache:
+            g, info = self.graph, self.graph.clips[c]
+            st, sp = info.start, info.stop
+            m = Motion(g.skeleton, g.local_rot[st:sp], g.root_pos[st:sp], g.fps, None, info.name)
+            self.cache[c] = _distance.cloud_features(m.global_positions(), self.window)
+        return self.cache[c]
+
+    def __call__(self, x: int, y: int | None, rows=None, cols=None, thr=None, min_gap=0):
+        """Candidates ``(i, j, cost)`` of clip ``x`` (``rows``) against clip ``y`` (``cols``; ``None``:
+        against itself), below ``thr`` (default: the graph threshold)."""
+        fa, fb = self.feats(x), (None if y is None else self.feats(y))
+        r = rows or slice(0, len(fa))
+        cl = cols or slice(0, len(fb if fb is not None else fa))
+        self.comparisons += (r.stop - r.start) * (cl.stop - cl.start)
+        thr = self.threshold if thr is None else thr
+        return _distance.candidates(fa, fb, thr, self.window, min_gap, r, cl)
+
+
+def _link_takes(graph: MotionGraph, cmp: _Compare, arr: _Arranged, cuts: _Cuts, opt: _Options, notes: _Notes):
+    """Stage 3: within each style, every take with itself, its neighbouring takes and (port to
+    port) every other take; then the style keeps its largest strongly connected part.
+
+    Returns the ports of every pool (:func:`.stance_links.port_features`, after pruning)."""
+    clips = graph.clips
+    ports: dict = {}
+    port_masks = {
+        c: (s.ports if s is not None else np.zeros(clips[c].num_frames, dtype=bool)) for c, s in cuts.seg.items()
+    }
+    for key, ks in _progress(sorted(arr.pools.items()), "takes", enabled=opt.progress):
+        found = {"loop": [], "transition": []}  # (src, dst, cost) global, added at once
+        for c in ks:
+            i, j, cost = cmp(c, None, min_gap=opt.min_loop)
+            ok = j + 1 < clips[c].num_frames
+            found["loop"].append((clips[c].start + i[ok], clips[c].start + j[ok] + 1, cost[ok]))
+        for x, y in _ring_pairs(len(ks), opt.neighbours):
+            a, z = ks[x], ks[y]
+            i, j, cost = cmp(a, z)
+            src, dst, which = pair_edges(i, j, clips[a].start, clips[z].start, clips[z].num_frames,
+                                         clips[a].num_frames, False)  # fmt: skip
+            found["transition"].append((src, dst, cost[which]))
+        # takes connect stance to stance: every take's ports with every other take's
+        found["transition"].append(
+            _stance_links.link_within(graph, _stance_links.port_features(graph, ks, port_masks, cmp.feats),
+                                      opt.threshold, opt.min_loop, opt.window)
+        )  # fmt: skip
+        for kind, parts in found.items():
+            if parts:
+                graph.add_edges(*(np.concatenate(p) for p in zip(*parts)), kind)
+        for c in ks:
+            if c != cuts.rep[key]:
+                cmp.cache.pop(c, None)
+        _prune_pool(graph, cmp, ks, opt, notes)
+        ports[key] = _stance_links.port_features(graph, ks, port_masks, cmp.feats)
+    graph.drop_dead_edges()
+    return ports
+
+
+def _prune_pool(graph: MotionGraph, cmp: _Compare, ks: list[int], opt: _Options, notes: _Notes) -> None:
+    """Keep the largest strongly connected part of one style's takes (with ``force``, a style
+    with no cycle under the threshold first gets its best jump back inside a take)."""
+    clips = graph.clips
+    st, sp = clips[ks[0]].start, clips[ks[-1]].stop
+    mask = np.zeros(graph.num_frames, dtype=bool)
+    mask[st:sp] = True
+    keep = graph.largest_component(mask)
+    if not keep[st:sp].any() and opt.force:
+        best = None
+        for c in ks:
+            i, j, cost = cmp(c, None, thr=np.inf, min_gap=opt.min_loop)
+            ok = (j < i) & (j + 1 < clips[c].num_frames)
+            if ok.any():
+                k = int(np.argmin(np.where(ok, cost, np.inf)))
+                if best is None or cost[k] < best[2]:
+                    best = (clips[c].start + int(i[k]), clips[c].start + int(j[k]) + 1, float(cost[k]), c)
+        if best is not None:
+            graph.add_edges([best[0]], [best[1]], [best[2]], "loop")
+            notes.add("forced", f"{clips[best[3]].name}: no loop under the threshold, best jump back used")
+            keep = graph.largest_component(mask)
+    graph.alive[st:sp] = keep[st:sp]
+    for c in ks:
+        if not graph.alive[clips[c].start : clips[c].stop].any():
+            notes.add("take pruned", f"{clips[c].name}: no transition under the threshold joins it to its style")
+
+
+def _structure_table(graph: MotionGraph, arr: _Arranged, cuts: _Cuts, opt: _Options) -> dict:
+    """Stage 4: the structure table's cells (behaviour → style → takes, spans and counts)."""
+    clips = graph.clips
+    loop_kind = EDGE_KINDS.index("loop")
+    table: dict = {"behaviours": {}, "links": []}
+    for (b, s), ks in sorted(arr.pools.items()):
+        st, sp = clips[ks[0]].start, clips[ks[-1]].stop
+        live = graph.alive[graph.src] & graph.alive[graph.dst]
+        inside = live & (graph.src >= st) & (graph.src < sp) & (graph.dst >= st) & (graph.dst < sp)
+        takes = [_take_row(graph, c, st, cuts) for c in ks]
+        kinds = [t["kind"] for t in takes if t["kind"] is not None]
+        table["behaviours"].setdefault(b, {})[s] = {
+            "kind": max(sorted(set(kinds)), key=kinds.count) if kinds else None,
+            "start": st,
+            "frames": sp - st,
+            "alive": int(graph.alive[st:sp].sum()),
+            "takes": takes,
+            "representative": cuts.rep[(b, s)],
+            "representative_cycles": list(cuts.rep_span((b, s), opt.rep_cycles)),
+            "transitions": int(inside.sum()),
+            "loops": int((inside & (graph.kind == loop_kind)).sum()),
+            "synthetic": bool(any(clips[c].synthetic for c in ks)),
+        }
+    return table
+
+
+def _take_row(graph: MotionGraph, c: int, st: int, cuts: _Cuts) -> dict:
+    ci, cy, sg = graph.clips[c], cuts.cyc[c], cuts.seg[c]
+    return {
+        "clip": c,
+        "name": ci.name,
+        "take": ci.take,
+        "offset": ci.start - st,
+        "frames": ci.num_frames,
+        "alive": int(graph.alive[ci.start : ci.stop].sum()),
+        "cycles": 0 if cy is None else cy.count,
+        "cycle_span": [0, 0] if cy is None else list(cy.span),
+        "kind": None if sg is None else sg.kind,
+        "segments": 0 if sg is None else sg.count,
+        "stances": 0 if sg is None else int(sg.stances.shape[0]),
+    }
+
+
+def _neighbour_edges(graph: MotionGraph, cmp: _Compare, x: int, y: int, force: bool, notes: _Notes):
+    """Candidates between two neighbours of an interpolation space whose both ends are alive (with
+    ``force`` and none under the threshold: the best pair above it)."""
+    cx, cy = graph.clips[x], graph.clips[y]
+
+    def alive_pairs(thr=None):
+        i, j, cost = cmp(x, y, thr=thr)
+        ok = graph.alive[cx.start + i] & graph.alive[cy.start + j]
+        return i[ok], j[ok], cost[ok]
+
+    i, j, cost = alive_pairs()
+    if i.size == 0 and force:
+        i, j, cost = alive_pairs(np.inf)
+        if i.size:
+            i, j, cost = _best_only(i, j, cost)
+            notes.add("forced", f"{cx.name} -> {cy.name}: best pair above threshold")
+    return i, j, cost
+
+
+def _link_styles(graph, cmp, spaces, cuts, pool_start, opt: _Options, notes: _Notes, table: dict, on_route) -> None:
+    """Stage 5: transitions between neighbours S1–M1–…–M4–S2 of every interpolation space; the
+    valid paths through it become routes of the table, in both directions."""
+    clips = graph.clips
+    for b, s1, s2, ids in _progress(spaces, "style links", enabled=opt.progress):
+        if not ids:
+            notes.add("missing link", f"{b}: {s1} <-> {s2} (no intermediate motion)")
+            continue
+        chain = [cuts.rep[(b, s1)], *ids, cuts.rep[(b, s2)]]
+        fwd, bwd = [], []  # per neighbour pair: (src, dst, cost) global
+        for x, y in zip(chain[:-1], chain[1:]):
+            cx, cy_ = clips[x], clips[y]
+            i, j, cost = _neighbour_edges(graph, cmp, x, y, opt.force, notes)
+            ok = (j + 1 < cy_.num_frames) & graph.alive[np.minimum(cy_.start + j + 1, cy_.stop - 1)]
+            fwd.append((cx.start + i[ok], cy_.start + j[ok] + 1, cost[ok]))
+            ok = (i + 1 < cx.num_frames) & graph.alive[np.minimum(cx.start + i + 1, cx.stop - 1)]
+            bwd.append((cy_.start + j[ok], cx.start + i[ok] + 1, cost[ok]))
+        for direction, edges, seq in (("forward", fwd, chain), ("backward", list(reversed(bwd)), chain[::-1])):
+            sa, sz = (s1, s2) if direction == "forward" else (s2, s1)
+            routes, kept = _bridge_routes(graph, seq, edges, opt.dwell, pool_start((b, sa)), pool_start((b, sz)))
+            for src, dst, cost in kept:
+                graph.add_edges(src, dst, cost, "bridge")
+            for r in routes:
+                for clip, f0, f1 in r["pieces"]:
+                    st = clips[clip].start
+                    on_route[st + f0 : st + f1 + 1] = True
+            if routes:
+                table["links"].append({"from": [b, sa], "to": [b, sz], "via": "interpolation", "routes": routes})
+            else:
+                notes.add("missing link", f"{b}: {sa} -> {sz} ({direction}: no valid path through the space)")
+
+
+def _clip_ends(graph, cmp, k: int, pool: list[int], p0: int, entries: bool, thr=None):
+    """Candidates between transition clip ``k`` and the takes ``pool`` of one endpoint style.
+
+    ``entries``: take frames into the first half of ``k``, as (pool-local exit frame, clip frame
+    entered, cost); else the second half of ``k`` into the takes, as (clip frame left, pool-local
+    frame entered, cost)."""
+    c = graph.clips[k]
+    half = c.num_frames // 2
+    parts = []
+    for a in pool:
+        ca = graph.clips[a]
+        if entries:
+            i, j, cost = cmp(a, k, cols=slice(0, half), thr=thr)
+            ok = graph.alive[ca.start + i]
+            parts.append((ca.start + i[ok] - p0, j[ok] + 1, cost[ok]))
+        else:
+            i, j, cost = cmp(k, a, rows=slice(half, c.num_frames), cols=slice(0, ca.num_frames - 1), thr=thr)
+            ok = graph.alive[ca.start + j + 1]
+            parts.append((i[ok], ca.start + j[ok] + 1 - p0, cost[ok]))
+    return tuple(np.concatenate(x) for x in zip(*parts))
+
+
+def _link_transition_clips(graph, cmp, arr: _Arranged, pool_start, opt: _Options, notes: _Notes, table, on_route):
+    """Stage 6: each recorded transition clip compared with the takes of its two endpoint styles
+    only; entries into its first half, exits from its second half (paper B §3.2)."""
+    clips = graph.clips
+    clip_edges: list[tuple[int, int, float]] = []
+    for k in _progress(arr.transitions, "transition clips", enabled=opt.progress):
+        c, lab = clips[k], arr.labels[k]
+        if lab.key not in arr.pools or lab.to_key not in arr.pools:
+            missing = lab.key if lab.key not in arr.pools else lab.to_key
+            notes.add("unused transition clip", f"{c.name}: no basic clip {missing[0]}_{missing[1]}")
+            graph.alive[c.start : c.stop] = False
+            continue
+        p0, p1 = pool_start(lab.key), pool_start(lab.to_key)
+        ends, forced = [], False
+        for entries, key, p in ((True, lab.key, p0), (False, lab.to_key, p1)):
+            e = _clip_ends(graph, cmp, k, arr.pools[key], p, entries)
+            if opt.force and e[0].size == 0:
+                e, forced = _best_only(*_clip_ends(graph, cmp, k, arr.pools[key], p, entries, np.inf)), True
+            ends.append(e)
+        (ei, ej, ec), (xi, xj, xc) = ends
+        if ei.size == 0 or xi.size == 0:
+            notes.add("unused transition clip", f"{c.name}: no entry or exit frames")
+            graph.alive[c.start : c.stop] = False
+            continue
+        if forced:
+            notes.add("forced", f"{c.name}: entry or exit above threshold")
+        routes = _clip_routes(k, c.start, (ei, ej, ec), (xi, xj, xc), p0, p1, clip_edges, on_route)
+        if not routes:
+            notes.add("unused transition clip", f"{c.name}: every entry lies after the last exit")
+            continue
+        link = {"from": list(lab.key), "to": list(lab.to_key), "via": f"transition clip {c.name}", "clip": k}
+        table["links"].append({**link, "routes": routes, "forced": forced})
+    if clip_edges:
+        src, dst, cost = (np.array(x) for x in zip(*clip_edges))
+        graph.add_edges(src, dst, cost, "clip")
+
+
+def _clip_routes(k: int, start: int, ent, ext, p0: int, p1: int, clip_edges: list, on_route) -> list[dict]:
+    """Routes through transition clip ``k`` (first frame ``start``): each entry to the first exit
+    at or after it; appends the entry and exit edges and marks the frames played."""
+    ei, ej, ec = ent
+    srt = np.argsort(ext[0], kind="stable")
+    xi, xj, xc = (x[srt] for x in ext)
+    routes = []
+    for ii, first, cc in zip(ei.tolist(), ej.tolist(), ec.tolist()):
+        e = int(np.searchsorted(xi, first))  # first exit at or after the entry frame
+        if e >= xi.size:
+            continue
+        last = int(xi[e])
+        routes.append({"exit": ii, "enter": int(xj[e]), "pieces": [[k, first, last]], "frames": last - first + 1,
+                       "cost": float(max(cc, xc[e]))})  # fmt: skip
+        clip_edges.append((p0 + ii, start + first, cc))
+        clip_edges.append((start + last, p1 + int(xj[e]), float(xc[e])))
+        on_route[start + first : start + last + 1] = True
+    routes.sort(key=lambda r: r["cost"])
+    return routes
+
+
+def _link_stances(graph: MotionGraph, arr: _Arranged, table: dict, ports: dict, pool_start, opt: _Options) -> int:
+    """Stage 7: stance links (:mod:`.stance_links`) between pools no recorded clip joins.
+    Returns the cells compared."""
+    recorded = {(link["from"][0], link["to"][0]) for link in table["links"] if link["via"] != "interpolation"}
+    kinds = {(b, s): cell["kind"] for b, cells in table["behaviours"].items() for s, cell in cells.items()}
+    pairs = _stance_links.pool_pairs(list(arr.pools), recorded, kinds)
+    links, (src, dst, cost), n_cmp = _stance_links.link_pools(graph, pairs, ports, pool_start, opt.threshold,
+                                                              opt.window)  # fmt: skip
+    graph.add_edges(src, dst, cost, "transition")
+    table["links"].extend(links)
+    return n_cmp
+
+
 def build_structured(
     motions: Sequence[Motion],
     threshold: float,
@@ -170,11 +591,10 @@ def build_structured(
     threshold : largest frame distance of a transition, m² (:func:`distance.threshold_from`)
     name_map : ``{clip name: label text}`` or a callable, see :func:`.naming.parse_name`
     labels : one :class:`ClipLabel` per clip, instead of parsing names
-    window : frames per point cloud
-    min_loop : shortest jump back within one take, frames (default: half a second)
+    window : frames per point cloud; min_loop : shortest jump back within one take, frames (default: 0.5 s)
     weights : blend weights of the intermediate motions
-    style_pairs : ``"hub"``, ``"chain"``, ``"all"`` or ``"none"`` (which styles get an interpolation space)
-    reference_style : the hub style
+    style_pairs : ``"hub"`` (with ``reference_style``), ``"chain"``, ``"all"`` or ``"none"``: which
+        styles get an interpolation space
     force : accept the best local minimum when nothing passes the threshold inside an
         interpolation space or a transition clip (counted as ``forced``)
     synthetic : per clip, True if it is a synthetic stand-in (shown in tables)
@@ -186,394 +606,86 @@ def build_structured(
     Returns
     -------
     MotionGraph with ``table`` (structure table and links) and ``info`` (timings, counts,
-    ``conditions``). Clips are stored style by style, each style's takes side by side (their
-    order in the graph is not the input order).
+    ``conditions``); clips stored style by style, each style's takes side by side.
+
+    Raises
+    ------
+    GraphError when the clips do not share one skeleton and fps, or ``labels`` does not match them.
     """
     t0 = time.perf_counter()
-    skeleton, fps = check_motions(motions)
+    _, fps = check_motions(motions)
     labels = list(labels) if labels is not None else [parse_name(m.name, name_map) for m in motions]
     if len(labels) != len(motions):
         raise GraphError(f"got {len(labels)} labels for {len(motions)} clips")
-    synthetic = list(synthetic) if synthetic is not None else [False] * len(motions)
-    min_loop = int(round(fps / 2)) if min_loop is None else int(min_loop)
-    dwell = max(1, int(round(fps / 5)) if dwell is None else int(dwell))
-    notes = _Notes()
-
-    # ---- pools: the takes of each (behaviour, style), stored side by side
-    pools_in: dict[tuple[str, str], list[int]] = {}
-    for k, lab in enumerate(labels):
-        if lab.kind == "basic":
-            pools_in.setdefault(lab.key, []).append(k)
-    for key in pools_in:
-        pools_in[key].sort(key=lambda k: (labels[k].take or "", k))
-    order = [k for key in sorted(pools_in) for k in pools_in[key]]
-    order += [k for k, lab in enumerate(labels) if lab.kind == "transition"]
-    where = {k: n for n, k in enumerate(order)}  # input index -> graph clip index
-    pools = {key: [where[k] for k in ks] for key, ks in pools_in.items()}
-    transitions = [where[k] for k, lab in enumerate(labels) if lab.kind == "transition"]
-    glabels = [labels[k] for k in order]
-    gmotions = [motions[k] for k in order]
-    take_frames = [m.num_frames for m in gmotions]
-
-    # ---- cycles and representative cycles of every style
-    t_cyc = time.perf_counter()
-    cyc, seg, cuts = {}, {}, {}
-    for _key, ks in _progress(sorted(pools.items()), "cycles", enabled=progress):
-        for c in ks:
-            try:
-                cyc[c] = _cycles.segment_cycles(gmotions[c])
-                seg[c] = _segments.segment_take(gmotions[c])
-            except ValueError:
-                cyc[c] = seg[c] = None
-            # a gait is cut into whole cycles, a standing action into segments between stances
-            cuts[c] = seg[c] if seg[c] is not None and seg[c].kind == "action" else cyc[c]
-    rep: dict[tuple[str, str], int] = {}
-    for key, ks in pools.items():
-        # the take with the most whole cycles or segments (ties: the first take) represents the style
-        rep[key] = max(ks, key=lambda c: (cuts[c].count if cuts[c] is not None else -1, -c))
-        if cuts[rep[key]] is None or cuts[rep[key]].count == 0:
-            notes.add("no whole cycle", f"{gmotions[rep[key]].name}: the whole take represents its style")
-
-    def rep_span(key, n: int) -> tuple[int, int]:
-        """``n`` whole cycles (or segments) from the middle of the representative take (all of it without)."""
-        cy = cuts[rep[key]]
-        if cy is None or cy.count == 0:
-            return (0, take_frames[rep[key]])
-        n = min(n, cy.count)
-        mid = (cy.count - n) // 2
-        return int(cy.bounds[mid, 0]), int(cy.bounds[mid + n - 1, 1])
-
-    def rep_count(key) -> int:
-        cy = cuts[rep[key]]
-        return rep_cycles if cy is None or cy.count == 0 else min(rep_cycles, cy.count)
-
-    t_cyc = time.perf_counter() - t_cyc
-
-    # ---- interpolation spaces between representative cycles of styles of one behaviour
-    t_reg = time.perf_counter()
-    by_behaviour: dict[str, list[str]] = {}
-    for b, s in pools:
-        by_behaviour.setdefault(b, []).append(s)
-    extra: list[Motion] = []
-    extra_infos: list[ClipInfo] = []
-    spaces = []  # (behaviour, s1, s2, [intermediate clip indices])
-    n_input = len(gmotions)
-    pairs_todo = []
-    for b, styles in sorted(by_behaviour.items()):
-        lengths = {s: gmotions[rep[(b, s)]].num_frames for s in styles}
-        pairs_todo += [(b, s1, s2) for s1, s2 in _style_pairs(styles, style_pairs, reference_style, lengths, 0)]
-    for b, s1, s2 in _progress(pairs_todo, "interpolation spaces", enabled=progress):
-        # the same number of whole cycles of both styles, so registration pairs cycle with cycle
-        n = min(rep_count((b, s1)), rep_count((b, s2)))
-        cut = []
-        for key in ((b, s1), (b, s2)):
-            f0, f1 = rep_span(key, n)
-            m = gmotions[rep[key]][f0:f1]
-            pos = m.global_positions()
-            cut.append((m, pos, _registration.root_track(m, pos)))
-        (m1, p1, r1), (m2, p2, r2) = cut
-        # the registration must cover (nearly) both spans: 90% of the longer one
-        reg = _registration.dtw(_distance.distance_matrix(p1, p2, window), int(0.9 * max(len(p1), len(p2))))
-        ids = []
-        for w in weights:
-            mid = _registration.blend(m1, m2, reg, w, name=f"{b}_{s1}~{s2}@{w:g}", tracks=(r1, r2))
-            if mid.num_frames < 3:
-                continue
-            ids.append(n_input + len(extra))
-            extra.append(mid)
-            extra_infos.append(ClipInfo(mid.name, "intermediate", b, f"{s1}~{s2}@{w:g}", b, s2))
-        spaces.append((b, s1, s2, ids))
-    t_reg = time.perf_counter() - t_reg
-
-    infos = [
-        ClipInfo(m.name or label_name(lab), lab.kind, lab.behaviour, lab.style, lab.to_behaviour, lab.to_style,
-                 synthetic=bool(synthetic[k]), take=lab.take)
-        for k, m, lab in zip(order, gmotions, glabels)
-    ]  # fmt: skip
-    graph = MotionGraph.from_motions(gmotions + extra, infos + extra_infos)
-    del gmotions
-    clips = graph.clips
-    comparisons = 0
-    feats_cache: dict[int, _distance.CloudFeatures] = {}
-
-    def feats(c: int) -> _distance.CloudFeatures:
-        if c not in feats_cache:
-            st, sp = clips[c].start, clips[c].stop
-            m = Motion(graph.skeleton, graph.local_rot[st:sp], graph.root_pos[st:sp], graph.fps, None, clips[c].name)
-            feats_cache[c] = _distance.cloud_features(m.global_positions(), window)
-        return feats_cache[c]
-
-    def cands(x, y, rows=None, cols=None, thr=None, min_gap=0):
-        nonlocal comparisons
-        fa, fb = feats(x), (None if y is None else feats(y))
-        r = rows or slice(0, len(fa))
-        cl = cols or slice(0, len(fb if fb is not None else fa))
-        comparisons += (r.stop - r.start) * (cl.stop - cl.start)
-        return _distance.candidates(fa, fb, threshold if thr is None else thr, window, min_gap, r, cl)
-
-    # ---- within each style: every take with itself and its neighbouring takes
-    t_pool = time.perf_counter()
-    table: dict = {"behaviours": {}, "links": []}
-    loop_kind = EDGE_KINDS.index("loop")
-    ports: dict = {}
-    port_masks = {c: (s.ports if s is not None else np.zeros(clips[c].num_frames, dtype=bool)) for c, s in seg.items()}
-    for key, ks in _progress(sorted(pools.items()), "takes", enabled=progress):
-        found = {"loop": [], "transition": []}  # (src, dst, cost) global, added at once
-        for c in ks:
-            i, j, cost = cands(c, None, min_gap=min_loop)
-            ok = j + 1 < clips[c].num_frames
-            found["loop"].append((clips[c].start + i[ok], clips[c].start + j[ok] + 1, cost[ok]))
-        for x, y in _ring_pairs(len(ks), neighbours):
-            a, z = ks[x], ks[y]
-            i, j, cost = cands(a, z)
-            src, dst, which = pair_edges(i, j, clips[a].start, clips[z].start, clips[z].num_frames,
-                                         clips[a].num_frames, False)  # fmt: skip
-            found["transition"].append((src, dst, cost[which]))
-        # takes connect stance to stance: every take's ports with every other take's
-        found["transition"].append(
-            _stance_links.link_within(graph, _stance_links.port_features(graph, ks, port_masks, feats), threshold,
-                                      min_loop, window)
-        )  # fmt: skip
-        for kind, parts in found.items():
-            if parts:
-                graph.add_edges(*(np.concatenate(p) for p in zip(*parts)), kind)
-        for c in ks:
-            if c != rep[key]:
-                feats_cache.pop(c, None)
-        # pruning: keep the largest strongly connected part of the style's takes
-        st, sp = clips[ks[0]].start, clips[ks[-1]].stop
-        mask = np.zeros(graph.num_frames, dtype=bool)
-        mask[st:sp] = True
-        keep = graph.largest_component(mask)
-        if not keep[st:sp].any() and force:
-            # no cycle under the threshold: the best jump back inside a take (a forced loop)
-            best = None
-            for c in ks:
-                i, j, cost = cands(c, None, thr=np.inf, min_gap=min_loop)
-                ok = (j < i) & (j + 1 < clips[c].num_frames)
-                if ok.any():
-                    k = int(np.argmin(np.where(ok, cost, np.inf)))
-                    if best is None or cost[k] < best[2]:
-                        best = (clips[c].start + int(i[k]), clips[c].start + int(j[k]) + 1, float(cost[k]), c)
-            if best is not None:
-                graph.add_edges([best[0]], [best[1]], [best[2]], "loop")
-                notes.add("forced", f"{clips[best[3]].name}: no loop under the threshold, best jump back used")
-                keep = graph.largest_component(mask)
-        graph.alive[st:sp] = keep[st:sp]
-        for c in ks:
-            if not graph.alive[clips[c].start : clips[c].stop].any():
-                notes.add("take pruned", f"{clips[c].name}: no transition under the threshold joins it to its style")
-        ports[key] = _stance_links.port_features(graph, ks, port_masks, feats)
-    graph.drop_dead_edges()
-    t_pool = time.perf_counter() - t_pool
-
-    def pool_start(key) -> int:
-        return clips[pools[key][0]].start
-
-    for (b, s), ks in sorted(pools.items()):
-        st, sp = clips[ks[0]].start, clips[ks[-1]].stop
-        live = graph.alive[graph.src] & graph.alive[graph.dst]
-        inside = live & (graph.src >= st) & (graph.src < sp) & (graph.dst >= st) & (graph.dst < sp)
-        takes = []
-        for c in ks:
-            ci, cy = clips[c], cyc[c]
-            takes.append(
-                {
-                    "clip": c,
-                    "name": ci.name,
-                    "take": ci.take,
-                    "offset": ci.start - st,
-                    "frames": ci.num_frames,
-                    "alive": int(graph.alive[ci.start : ci.stop].sum()),
-                    "cycles": 0 if cy is None else cy.count,
-                    "cycle_span": [0, 0] if cy is None else list(cy.span),
-                    "kind": None if seg[c] is None else seg[c].kind,
-                    "segments": 0 if seg[c] is None else seg[c].count,
-                    "stances": 0 if seg[c] is None else int(seg[c].stances.shape[0]),
-                }
-            )
-        kinds = [t["kind"] for t in takes if t["kind"] is not None]
-        table["behaviours"].setdefault(b, {})[s] = {
-            "kind": max(sorted(set(kinds)), key=kinds.count) if kinds else None,
-            "start": st,
-            "frames": sp - st,
-            "alive": int(graph.alive[st:sp].sum()),
-            "takes": takes,
-            "representative": rep[(b, s)],
-            "representative_cycles": list(rep_span((b, s), rep_cycles)),
-            "transitions": int(inside.sum()),
-            "loops": int((inside & (graph.kind == loop_kind)).sum()),
-            "synthetic": bool(any(clips[c].synthetic for c in ks)),
-        }
-
-    # ---- interpolation spaces: neighbours only, validity, recorded routes in both directions
-    t_links = time.perf_counter()
+    opt = _Options(float(threshold), window, int(round(fps / 2)) if min_loop is None else int(min_loop),
+                   tuple(weights), style_pairs, reference_style, force,
+                   max(1, int(round(fps / 5)) if dwell is None else int(dwell)), neighbours, rep_cycles, progress)  # fmt: skip
+    notes, seconds = _Notes(), {}
+    arr = _arrange(motions, labels)
+    with _timer(seconds, "cycles_seconds"):
+        cuts = _cut_takes(arr, notes, progress)
+    with _timer(seconds, "registration_seconds"):
+        extra, extra_infos, spaces = _interpolation_spaces(arr, cuts, opt)
+    graph = MotionGraph.from_motions(arr.motions + extra, _clip_infos(arr, synthetic) + extra_infos)
+    arr.motions = []  # the graph holds the frames now
+    cmp = _Compare(graph, opt.threshold, window)
+    pool_start = functools.partial(_pool_start, graph, arr)
+    with _timer(seconds, "takes_seconds"):
+        ports = _link_takes(graph, cmp, arr, cuts, opt, notes)
+    table = _structure_table(graph, arr, cuts, opt)
     on_route = np.zeros(graph.num_frames, dtype=bool)
-    for b, s1, s2, ids in _progress(spaces, "style links", enabled=progress):
-        k1, k2 = rep[(b, s1)], rep[(b, s2)]
-        if not ids:
-            notes.add("missing link", f"{b}: {s1} <-> {s2} (no intermediate motion)")
-            continue
-        chain = [k1, *ids, k2]
-        fwd, bwd = [], []  # per neighbour pair: (src, dst, cost) global
-        for x, y in zip(chain[:-1], chain[1:]):
-            cx, cy_ = clips[x], clips[y]
-            i, j, cost = cands(x, y)
-            # both ends must be alive frames of the (pruned) style takes
-            ok = graph.alive[cx.start + i] & graph.alive[cy_.start + j]
-            i, j, cost = i[ok], j[ok], cost[ok]
-            if i.size == 0 and force:
-                i, j, cost = cands(x, y, thr=np.inf)
-                ok = graph.alive[cx.start + i] & graph.alive[cy_.start + j]
-                i, j, cost = i[ok], j[ok], cost[ok]
-                if i.size:
-                    i, j, cost = _best_only(i, j, cost)
-                    notes.add("forced", f"{cx.name} -> {cy_.name}: best pair above threshold")
-            ok = (j + 1 < cy_.num_frames) & graph.alive[np.minimum(cy_.start + j + 1, cy_.stop - 1)]
-            fwd.append((cx.start + i[ok], cy_.start + j[ok] + 1, cost[ok]))
-            ok = (i + 1 < cx.num_frames) & graph.alive[np.minimum(cx.start + i + 1, cx.stop - 1)]
-            bwd.append((cy_.start + j[ok], cx.start + i[ok] + 1, cost[ok]))
-        for direction, edges, seq in (("forward", fwd, chain), ("backward", list(reversed(bwd)), chain[::-1])):
-            sa, sz = (s1, s2) if direction == "forward" else (s2, s1)
-            routes, kept = _bridge_routes(graph, seq, edges, dwell, pool_start((b, sa)), pool_start((b, sz)))
-            for src, dst, cost in kept:
-                graph.add_edges(src, dst, cost, "bridge")
-            for r in routes:
-                for clip, f0, f1 in r["pieces"]:
-                    st = clips[clip].start
-                    on_route[st + f0 : st + f1 + 1] = True
-            if routes:
-                table["links"].append({"from": [b, sa], "to": [b, sz], "via": "interpolation", "routes": routes})
-            else:
-                notes.add("missing link", f"{b}: {sa} -> {sz} ({direction}: no valid path through the space)")
+    with _timer(seconds, "links_seconds"):
+        _link_styles(graph, cmp, spaces, cuts, pool_start, opt, notes, table, on_route)
+        _link_transition_clips(graph, cmp, arr, pool_start, opt, notes, table, on_route)
+    with _timer(seconds, "stance_seconds"):
+        cmp.comparisons += _link_stances(graph, arr, table, ports, pool_start, opt)
+    _finish(graph, table, on_route)
+    graph.info = _info(opt, cmp.comparisons, len(motions), seconds, len(extra), notes)
+    graph.info["build_seconds"] = time.perf_counter() - t0
+    return graph
 
-    # ---- transition clips: compared with the takes of their two endpoint styles only
-    clip_edges: list[tuple[int, int, float]] = []
-    for k in _progress(transitions, "transition clips", enabled=progress):
-        c, lab = clips[k], glabels[k]
-        if lab.key not in pools or lab.to_key not in pools:
-            missing = lab.key if lab.key not in pools else lab.to_key
-            notes.add("unused transition clip", f"{c.name}: no basic clip {missing[0]}_{missing[1]}")
-            graph.alive[c.start : c.stop] = False
-            continue
-        half = c.num_frames // 2
-        forced = False
-        ent = []  # (pool-local exit frame, transition frame entered, cost)
-        for a in pools[lab.key]:
-            i, j, cost = cands(a, k, cols=slice(0, half))
-            ok = graph.alive[clips[a].start + i]
-            ent.append((clips[a].start + i[ok] - pool_start(lab.key), j[ok] + 1, cost[ok]))
-        ei, ej, ec = (np.concatenate(x) for x in zip(*ent))
-        ext = []  # (transition frame left, pool-local target frame entered, cost)
-        for z in pools[lab.to_key]:
-            cz = clips[z]
-            i, j, cost = cands(k, z, rows=slice(half, c.num_frames), cols=slice(0, cz.num_frames - 1))
-            ok = graph.alive[cz.start + j + 1]
-            ext.append((i[ok], cz.start + j[ok] + 1 - pool_start(lab.to_key), cost[ok]))
-        xi, xj, xc = (np.concatenate(x) for x in zip(*ext))
-        if force and ei.size == 0:
-            ent = []
-            for a in pools[lab.key]:
-                i, j, cost = cands(a, k, cols=slice(0, half), thr=np.inf)
-                ok = graph.alive[clips[a].start + i]
-                ent.append((clips[a].start + i[ok] - pool_start(lab.key), j[ok] + 1, cost[ok]))
-            ei, ej, ec = _best_only(*(np.concatenate(x) for x in zip(*ent)))
-            forced = True
-        if force and xi.size == 0:
-            ext = []
-            for z in pools[lab.to_key]:
-                cz = clips[z]
-                i, j, cost = cands(k, z, rows=slice(half, c.num_frames), cols=slice(0, cz.num_frames - 1), thr=np.inf)
-                ok = graph.alive[cz.start + j + 1]
-                ext.append((i[ok], cz.start + j[ok] + 1 - pool_start(lab.to_key), cost[ok]))
-            xi, xj, xc = _best_only(*(np.concatenate(x) for x in zip(*ext)))
-            forced = True
-        if ei.size == 0 or xi.size == 0:
-            notes.add("unused transition clip", f"{c.name}: no entry or exit frames")
-            graph.alive[c.start : c.stop] = False
-            continue
-        if forced:
-            notes.add("forced", f"{c.name}: entry or exit above threshold")
-        srt = np.argsort(xi, kind="stable")
-        xi, xj, xc = xi[srt], xj[srt], xc[srt]
-        p0, p1 = pool_start(lab.key), pool_start(lab.to_key)
-        routes = []
-        for ii, first, cc in zip(ei.tolist(), ej.tolist(), ec.tolist()):
-            e = int(np.searchsorted(xi, first))  # first exit at or after the entry frame
-            if e >= xi.size:
-                continue
-            routes.append(
-                {
-                    "exit": ii,
-                    "enter": int(xj[e]),
-                    "pieces": [[k, first, int(xi[e])]],
-                    "frames": int(xi[e]) - first + 1,
-                    "cost": float(max(cc, xc[e])),
-                }
-            )
-            clip_edges.append((p0 + ii, c.start + first, cc))
-            clip_edges.append((c.start + int(xi[e]), p1 + int(xj[e]), float(xc[e])))
-            on_route[c.start + first : c.start + int(xi[e]) + 1] = True
-        if not routes:
-            notes.add("unused transition clip", f"{c.name}: every entry lies after the last exit")
-            continue
-        routes.sort(key=lambda r: r["cost"])
-        table["links"].append(
-            {
-                "from": list(lab.key),
-                "to": list(lab.to_key),
-                "via": f"transition clip {c.name}",
-                "clip": k,
-                "routes": routes,
-                "forced": forced,
-            }
-        )
-    if clip_edges:
-        src, dst, cost = (np.array(x) for x in zip(*clip_edges))
-        graph.add_edges(src, dst, cost, "clip")
-    t_links = time.perf_counter() - t_links
 
-    # ---- stance links: Kovar transitions between the ports of styles and behaviours
-    t_stance = time.perf_counter()
-    recorded = {(link["from"][0], link["to"][0]) for link in table["links"] if link["via"] != "interpolation"}
-    kinds = {(b, s): cell["kind"] for b, cells in table["behaviours"].items() for s, cell in cells.items()}
-    pairs = _stance_links.pool_pairs(list(pools), recorded, kinds)
-    links, (src, dst, cost), n_cmp = _stance_links.link_pools(graph, pairs, ports, pool_start, threshold, window)
-    comparisons += n_cmp
-    graph.add_edges(src, dst, cost, "transition")
-    table["links"].extend(links)
-    del ports
-    t_stance = time.perf_counter() - t_stance
+def _info(opt: _Options, comparisons: int, n_input: int, seconds: dict, n_extra: int, notes: _Notes) -> dict:
+    """The build's ``info``: settings, counts, stage seconds and conditions."""
+    return dict(
+        kind="structured", threshold=opt.threshold, window=opt.window, min_loop=opt.min_loop, dwell=opt.dwell,
+        style_pairs=opt.style_pairs, weights=list(opt.weights), neighbours=opt.neighbours,
+        rep_cycles=opt.rep_cycles, comparisons=comparisons, input_clips=n_input, **seconds,
+        intermediates=n_extra, conditions=notes.lines,
+    )  # fmt: skip
 
-    # ---- intermediate and transition frames live only on recorded routes
-    for c in clips:
+
+def _clip_infos(arr: _Arranged, synthetic: Sequence[bool] | None) -> list[ClipInfo]:
+    """One :class:`ClipInfo` per clip in graph order (``synthetic``: per input clip, or ``None``)."""
+    return [
+        ClipInfo(m.name or label_name(lab), lab.kind, lab.behaviour, lab.style, lab.to_behaviour, lab.to_style,
+                 synthetic=bool(synthetic[k]) if synthetic is not None else False, take=lab.take)
+        for k, m, lab in zip(arr.order, arr.motions, arr.labels)
+    ]  # fmt: skip
+
+
+def _pool_start(graph: MotionGraph, arr: _Arranged, key: Key) -> int:
+    """Global index of the first frame of style ``key``'s pool (route frames count from it)."""
+    return graph.clips[arr.pools[key][0]].start
+
+
+def _finish(graph: MotionGraph, table: dict, on_route: np.ndarray) -> None:
+    """Intermediate and transition frames live only on recorded routes; dead and repeated edges go."""
+    for c in graph.clips:
         if c.kind in ("intermediate", "transition"):
             graph.alive[c.start : c.stop] &= on_route[c.start : c.stop]
     graph.drop_dead_edges()
     _dedupe(graph)
     graph.table = table
-    graph.info = dict(
-        kind="structured",
-        threshold=float(threshold),
-        window=window,
-        min_loop=min_loop,
-        dwell=dwell,
-        style_pairs=style_pairs,
-        weights=list(weights),
-        neighbours=neighbours,
-        rep_cycles=rep_cycles,
-        comparisons=comparisons,
-        input_clips=len(motions),
-        cycles_seconds=t_cyc,
-        registration_seconds=t_reg,
-        takes_seconds=t_pool,
-        links_seconds=t_links,
-        stance_seconds=t_stance,
-        intermediates=len(extra),
-        conditions=notes.lines,
-        build_seconds=time.perf_counter() - t0,
-    )
-    return graph
+
+
+@contextmanager
+def _timer(seconds: dict, key: str):
+    t = time.perf_counter()
+    try:
+        yield
+    finally:
+        seconds[key] = time.perf_counter() - t
 
 
 def _dedupe(graph: MotionGraph) -> None:
@@ -587,36 +699,52 @@ def _dedupe(graph: MotionGraph) -> None:
 def _bridge_routes(
     graph: MotionGraph, order: list[int], edges: list, dwell: int = 1, s0: int | None = None, t0: int | None = None
 ):
-    """Valid paths through one direction of an interpolation space.
+    """Valid paths through one direction of an interpolation space (paper B §3.3).
 
     ``order``: clip indices source, M…, target; ``edges[k]``: (src, dst, cost) global arrays from
-    ``order[k]`` to ``order[k+1]``. For every frame of an intermediate clip the fewest frames
-    to reach the target (``inf`` if it cannot) are computed back to front:
+    ``order[k]`` to ``order[k+1]``; ``s0``, ``t0``: global frames that route exits and entries
+    count from (default: the first frames of the source and target clips).
+
+    Returns the routes (best first) and, per ``edges[k]``, the edges kept: those whose
+    destination can reach the target (the paper's "remove the first edge of an invalid path").
+    """
+    costs, choice, kept = _bridge_costs(graph, order, edges, dwell)
+    # entries from the source clip
+    src, dst, cost = edges[0]
+    first_mid = order[1]
+    ok = np.isfinite(costs[first_mid][dst - graph.clips[first_mid].start])
+    kept[0] = (src[ok], dst[ok], cost[ok])
+    s0 = graph.clips[order[0]].start if s0 is None else s0  # exits count from here (the style's first take)
+    t0 = graph.clips[order[-1]].start if t0 is None else t0
+    routes = [_trace_route(graph, order, edges, choice, int(e), s0, t0) for e in np.flatnonzero(ok)]
+    routes.sort(key=lambda r: r["cost"])  # best first: the search keeps the first of equals
+    return routes, kept
+
+
+def _bridge_costs(graph: MotionGraph, order: list[int], edges: list, dwell: int):
+    """For every frame of each intermediate clip the fewest frames to reach the target (``inf``
+    if it cannot), computed back to front:
 
     ``cost[f] = min_{f' >= f} (f' - f + 1 + after[f'])``, a reverse running minimum, where
     ``after[f']`` is 0 for an exit into the target and ``cost_next[g]`` for a link to the next
     intermediate frame ``g``; exits count only ``dwell`` frames or more after entering, so a
-    route never rushes through the space. Links whose destination cannot reach the target are dropped; an
-    entry from the source survives only if its destination can (the paper's "remove the first
-    edge of an invalid path").
+    route never rushes through the space.
+
+    Returns ``costs`` and ``choice`` (per intermediate clip: the exit frame taken from each frame
+    and the edge used at each exit frame), and the edges kept between intermediates.
     """
     n_mid = len(order) - 2
     costs: dict[int, np.ndarray] = {}
     choice: dict[int, tuple[np.ndarray, np.ndarray]] = {}
     kept = [None] * len(edges)
     for pos in range(n_mid, 0, -1):
-        clip = order[pos]
-        c = graph.clips[clip]
-        n = c.num_frames
+        clip, nxt = order[pos], order[pos + 1]
+        n = graph.clips[clip].num_frames
         src, dst, cost = edges[pos]
-        nxt = order[pos + 1]
-        if pos == n_mid:
-            after = np.zeros(src.size)
-        else:
-            after = costs[nxt][dst - graph.clips[nxt].start]
+        after = np.zeros(src.size) if pos == n_mid else costs[nxt][dst - graph.clips[nxt].start]
         ok = np.isfinite(after)
         kept[pos] = (src[ok], dst[ok], cost[ok])
-        local = src[ok] - c.start
+        local = src[ok] - graph.clips[clip].start
         best_exit = np.full(n, np.inf)
         best_edge = np.full(n, -1, dtype=np.int64)
         for e in np.argsort(after[ok] + 1.0, kind="stable")[::-1]:  # cheapest written last
@@ -634,42 +762,31 @@ def _bridge_routes(
         later = np.minimum(later, n - 1)
         costs[clip] = np.where(inside, run[later] - f, np.inf)
         choice[clip] = (exit_at[later], best_edge)
-    # entries from the source clip
+    return costs, choice, kept
+
+
+def _trace_route(graph: MotionGraph, order: list[int], edges: list, choice: dict, e: int, s0: int, t0: int) -> dict:
+    """The route that enters the space through entry edge ``e`` (of ``edges[0]``)."""
     src, dst, cost = edges[0]
-    first_mid = order[1]
-    reach = costs[first_mid][dst - graph.clips[first_mid].start]
-    ok = np.isfinite(reach)
-    kept[0] = (src[ok], dst[ok], cost[ok])
-    routes = []
-    s0 = graph.clips[order[0]].start if s0 is None else s0  # exits count from here (the style's first take)
-    t0 = graph.clips[order[-1]].start if t0 is None else t0
-    for e in np.flatnonzero(ok):
-        pieces, worst = [], float(cost[e])
-        g = int(dst[e])
-        pos = 1
-        while pos <= n_mid:
-            clip = order[pos]
-            c = graph.clips[clip]
-            f = g - c.start
-            exit_at, best_edge = choice[clip]
-            x = int(exit_at[f])
-            pieces.append([clip, f, x])
-            ed = int(best_edge[x])
-            s_, d_, c_ = edges[pos]
-            worst = max(worst, float(c_[ed]))
-            g = int(d_[ed])
-            pos += 1
-        routes.append(
-            {
-                "exit": int(src[e]) - s0,
-                "enter": g - t0,
-                "pieces": pieces,
-                "frames": int(sum(p[2] - p[1] + 1 for p in pieces)),
-                "cost": worst,
-            }
-        )
-    routes.sort(key=lambda r: r["cost"])  # best first: the search keeps the first of equals
-    return routes, kept
+    pieces, worst = [], float(cost[e])
+    g = int(dst[e])
+    for pos in range(1, len(order) - 1):
+        clip = order[pos]
+        f = g - graph.clips[clip].start
+        exit_at, best_edge = choice[clip]
+        x = int(exit_at[f])
+        pieces.append([clip, f, x])
+        ed = int(best_edge[x])
+        _, d_, c_ = edges[pos]
+        worst = max(worst, float(c_[ed]))
+        g = int(d_[ed])
+    return {
+        "exit": int(src[e]) - s0,
+        "enter": g - t0,
+        "pieces": pieces,
+        "frames": int(sum(p[2] - p[1] + 1 for p in pieces)),
+        "cost": worst,
+    }
 
 
 def structure_rows(graph: MotionGraph) -> list[dict]:

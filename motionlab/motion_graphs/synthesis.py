@@ -115,38 +115,13 @@ def synthesize(
         else:
             anchor = info.start + a - 1 if a > 0 else info.start + a
             contiguous = prev_global is not None and prev_global + 1 == info.start + a
-            a_rot, a_pos = _frames_pose(graph, np.array([anchor]))
-            yaw_prev = _heading_of(graph, prev_end_rot[None], prev_end_pos[None])[0]
-            yaw_anchor = _heading_of(graph, a_rot, a_pos)[0]
-            dyaw = float(yaw_prev - yaw_anchor)
-            q = quat.from_yaw(np.array(dyaw))
-            shift = prev_end_pos - quat.rotate(q, a_pos[0])
-            shift[1] = 0.0
-            if align == "foot" and stance:
-                # move the anchor pose so its lowest foot joint lands on the previous pose's
-                prev_pose = _positions(graph, prev_end_rot[None], prev_end_pos[None])[0]
-                placed = _positions(graph, *_place(a_rot, a_pos, dyaw, shift))[0]
-                foot = stance[int(np.argmin(prev_pose[stance, 1]))]
-                shift = shift + (prev_pose[foot] - placed[foot]) * np.array([1.0, 0.0, 1.0])
+            dyaw, shift, yaw_prev = _placement(
+                graph, anchor, prev_end_rot, prev_end_pos, stance if align == "foot" else []
+            )
             rot, pos = _place(rot, pos, dyaw, shift)
             if blend > 0 and not contiguous:
                 k = min(blend, len(idx))
-                # what the previous clip would have played next, placed like the previous run
-                pc = int(graph.clip_of(prev_global))
-                pinfo = graph.clips[pc]
-                cont = np.clip(np.arange(prev_global + 1, prev_global + 1 + k), pinfo.start, pinfo.stop - 1)
-                c_rot, c_pos = _frames_pose(graph, cont)
-                p_rot, p_pos = _frames_pose(graph, np.array([prev_global]))
-                # map source frames of the previous clip onto the output through its last frame
-                yaw_src = _heading_of(graph, p_rot, p_pos)[0]
-                c_rot, c_pos = _place(c_rot, c_pos, float(yaw_prev - yaw_src), np.zeros(3))
-                p_pos_placed = quat.rotate(quat.from_yaw(np.array(float(yaw_prev - yaw_src))), p_pos[0])
-                c_pos = c_pos + (prev_end_pos - p_pos_placed) * np.array([1.0, 0.0, 1.0])
-                alpha = _smooth((np.arange(k) + 1.0) / (k + 1.0))
-                rot = rot.copy()
-                pos = pos.copy()
-                rot[:k] = quat.slerp(c_rot, rot[:k], np.broadcast_to(alpha[:, None], rot[:k].shape[:2]))
-                pos[:k] = c_pos * (1 - alpha[:, None]) + pos[:k] * alpha[:, None]
+                rot, pos = _cross_fade(graph, rot, pos, prev_global, prev_end_pos, yaw_prev, k)
                 windows.append((out_len, k))
             rots.append(rot)
             poss.append(pos)
@@ -159,6 +134,45 @@ def synthesize(
     if fix_feet and windows and humanoid.is_canonical(graph.skeleton):
         motion = _fix_feet(motion, windows)
     return motion
+
+
+def _placement(graph: MotionGraph, anchor: int, prev_rot: np.ndarray, prev_pos: np.ndarray, stance: list[int]):
+    """Turn about the vertical (rad) and ground shift (3,) that put global frame ``anchor`` where
+    the previous run ends (pose ``prev_rot`` (J, 4), root ``prev_pos`` (3,)); with ``stance`` foot
+    joints, the shift lands the anchor's foot under the previous pose's lowest foot instead of
+    its root. Also returns the previous pose's heading (rad)."""
+    a_rot, a_pos = _frames_pose(graph, np.array([anchor]))
+    yaw_prev = _heading_of(graph, prev_rot[None], prev_pos[None])[0]
+    dyaw = float(yaw_prev - _heading_of(graph, a_rot, a_pos)[0])
+    shift = prev_pos - quat.rotate(quat.from_yaw(np.array(dyaw)), a_pos[0])
+    shift[1] = 0.0
+    if stance:
+        # move the anchor pose so its lowest foot joint lands on the previous pose's
+        prev_pose = _positions(graph, prev_rot[None], prev_pos[None])[0]
+        placed = _positions(graph, *_place(a_rot, a_pos, dyaw, shift))[0]
+        foot = stance[int(np.argmin(prev_pose[stance, 1]))]
+        shift = shift + (prev_pose[foot] - placed[foot]) * np.array([1.0, 0.0, 1.0])
+    return dyaw, shift, yaw_prev
+
+
+def _cross_fade(graph: MotionGraph, rot, pos, prev_global: int, prev_end_pos, yaw_prev: float, k: int):
+    """The first ``k`` frames of a placed run (``rot`` (n, J, 4), ``pos`` (n, 3)) cross-faded from
+    what the previous clip would have played after global frame ``prev_global``, placed like the
+    previous run; new arrays."""
+    pinfo = graph.clips[int(graph.clip_of(prev_global))]
+    cont = np.clip(np.arange(prev_global + 1, prev_global + 1 + k), pinfo.start, pinfo.stop - 1)
+    c_rot, c_pos = _frames_pose(graph, cont)
+    p_rot, p_pos = _frames_pose(graph, np.array([prev_global]))
+    # map source frames of the previous clip onto the output through its last frame
+    yaw_src = _heading_of(graph, p_rot, p_pos)[0]
+    c_rot, c_pos = _place(c_rot, c_pos, float(yaw_prev - yaw_src), np.zeros(3))
+    p_pos_placed = quat.rotate(quat.from_yaw(np.array(float(yaw_prev - yaw_src))), p_pos[0])
+    c_pos = c_pos + (prev_end_pos - p_pos_placed) * np.array([1.0, 0.0, 1.0])
+    alpha = _smooth((np.arange(k) + 1.0) / (k + 1.0))
+    rot, pos = rot.copy(), pos.copy()
+    rot[:k] = quat.slerp(c_rot, rot[:k], np.broadcast_to(alpha[:, None], rot[:k].shape[:2]))
+    pos[:k] = c_pos * (1 - alpha[:, None]) + pos[:k] * alpha[:, None]
+    return rot, pos
 
 
 def _fix_feet(motion: Motion, windows: list[tuple[int, int]]) -> Motion:

@@ -19,7 +19,7 @@ def _within(result):
 def test_request_is_met_along_edges(sgraph):
     r = search.search(sgraph, REQUEST)
     sgraph.check_path(r.pieces)
-    assert r.num_frames == sum(r.achieved)
+    assert r.num_frames == sum(r.achieved) + sum(r.passing)
     _within(r)
     assert [s.behaviour for s in r.segments] == ["walk", "walk", "run", "walk", "walk"]
 
@@ -54,12 +54,12 @@ def test_loop_guard():
     import numpy as np
 
     # frames 0..9, one jump back 9 -> 4: from frame 5 the frames 0..3 can never be reached
-    cw = search._Clip(0, 10, np.array([True] * 9 + [False]), np.array([9]), np.array([4]), 9, 4)
+    cw = search.PoolWalker(0, 10, np.array([True] * 9 + [False]), np.array([9]), np.array([4]), 9, 4)
     with pytest.raises(search.SearchError, match="loop guard"):
-        search._quick_exit(cw, 5, [2], "clip")
-    pieces, r, n = search._quick_exit(cw, 5, [2, 7], "clip")
+        search.walk_to_exit(cw, 5, [2], "clip")
+    pieces, r, n = search.walk_to_exit(cw, 5, [2, 7], "clip")
     assert pieces == [(0, 5, 7)] and n == 3 and r == 1
-    pieces, r, n = search._quick_exit(cw, 8, [5], "clip")  # the way round through the jump
+    pieces, r, n = search.walk_to_exit(cw, 8, [5], "clip")  # the way round through the jump
     assert pieces == [(0, 8, 9), (0, 4, 5)] and n == 4
 
 
@@ -70,7 +70,7 @@ def test_standard_search_follows_edges(library):
     req = [(b, s, 60) for b, s in sorted(present)][:2]
     r = search.search_standard(g, req)
     g.check_path(r.pieces)
-    assert r.num_frames == sum(r.achieved)
+    assert r.num_frames == sum(r.achieved) + sum(r.passing)
 
 
 def test_search_crosses_three_styles():
@@ -113,7 +113,7 @@ def test_walk_takes_the_fewest_jumps():
 
     # two takes of 10 frames side by side (no step 9 -> 10); jumps 5->12, 3->15, 8->11, 2->3
     step = np.array([True] * 9 + [False] + [True] * 9 + [False])
-    cw = search._Clip(0, 20, step, np.array([5, 3, 8, 2]), np.array([12, 15, 11, 3]), -1, -1)
+    cw = search.PoolWalker(0, 20, step, np.array([5, 3, 8, 2]), np.array([12, 15, 11, 3]), -1, -1)
     pieces, _, n = search._walk(cw, 0, [15], [-1])
     assert n == 15 and pieces == [(0, 0, 8), (0, 11, 16)]  # one jump; 0..5 -> 12..19 is a frame short
     reach = search._reach(cw, 0, 15)
@@ -147,7 +147,34 @@ def test_reach_with_few_jumps_per_frame_matches_the_recursion():
     rank = np.arange(40) - np.searchsorted(dst[order], dst[order])
     few = order[rank < search.SPARSE_JUMPS]
     assert rank.max() >= search.SPARSE_JUMPS  # the full set takes the grouped path
-    cw = search._Clip(0, n, step, src, dst, -1, -1)
+    cw = search.PoolWalker(0, n, step, src, dst, -1, -1)
     for s, d in ((src[few], dst[few]), (src, dst)):
         got = search._reach(cw, 2, 25, (s, d))
         np.testing.assert_array_equal(got, _reach_by_hand(step, s, d, 2, 25))
+
+
+def test_frames_through_other_styles_are_reported_apart(sgraph):
+    r = search.search(sgraph, REQUEST)
+    # walk/happy -> run/normal passes through other styles (no recorded clip leaves walk/happy)
+    assert len(r.passing) == len(r.requested) and sum(r.passing) > 0
+    assert r.num_frames == sum(r.achieved) + sum(r.passing)
+    k = next(k for k, p in enumerate(r.passing) if p)
+    assert f"then {r.passing[k]} frames through other styles" in r.report()
+    assert r.pieces_per_second(sgraph.fps) == pytest.approx(len(r.pieces) * sgraph.fps / r.num_frames)
+
+
+def test_fewest_jumps_within_the_tolerance():
+    # frames 0..9, one jump back 9 -> 0: 12 frames from frame 0 need the jump, 10 frames do not
+    cw = search.PoolWalker(0, 10, np.array([True] * 9 + [False]), np.array([9]), np.array([0]), 9, 0)
+    pieces, _, n = search._walk(cw, 0, [12], [-1], slack=0)
+    assert n == 12 and len(pieces) == 2
+    pieces, _, n = search._walk(cw, 0, [12], [-1], slack=2)  # 2 frames short costs less than a jump
+    assert n == 10 and pieces == [(0, 0, 9)]
+
+
+def test_pool_walker_of_a_style(sgraph):
+    cell = sgraph.table["behaviours"]["walk"]["normal"]
+    cw = search.pool_walker(sgraph, "walk", "normal")
+    assert cw.length == cell["frames"] and cw.alive.sum() == cell["alive"]
+    with pytest.raises(search.SearchError, match="walk/sneaky"):
+        search.pool_walker(sgraph, "walk", "sneaky")
