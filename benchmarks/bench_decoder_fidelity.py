@@ -1,4 +1,4 @@
-"""Why does the network alone reconstruct Aj's held-back clips to 3.5 cm and not 2? Measured.
+"""Why does the network alone not reconstruct Aj's held-back clips to 2 cm (issue 30)? Measured.
 
     MOTIONLAB_DATA=/path/to/shared/data python benchmarks/bench_decoder_fidelity.py
     python benchmarks/bench_decoder_fidelity.py --checkpoint /tmp/motionlab_Aj.pt --half-steps 1500
