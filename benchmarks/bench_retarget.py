@@ -2,7 +2,7 @@
 
 Goals (2-core CPU): training on Aj's clips to a stable loss in <= 10 minutes; the latent solver
 <= 1 s median per 120-frame window; on Aj's 10 held-back ``retarget_gt`` clips (never trained
-on) a reconstruction error <= 1 cm and the iteration within 1° of A's upper-body rotations.
+on) a reconstruction error <= 2 cm (issue 30) and the iteration within 1° of A's upper-body rotations.
 
 Printed, in order: training; decoder fidelity (reconstruction by the network alone, and the
 upper-body rotation error of the encoder's latent, of the Gauss–Newton start and after the
@@ -111,7 +111,7 @@ def _fidelity(ckpt, args):
     print(
         f"  reconstruction by the network alone (encoder -> decoder -> FK on A): mean joint error {100 * err.mean():.2f} cm "
         f"(upper body {100 * err[:, UPPER].mean():.2f}, legs {100 * np.delete(err, [0] + UPPER, axis=1).mean():.2f}); "
-        f"goal <= 1 cm: {'met' if 100 * err.mean() <= 1 else 'MISSED'}"
+        f"goal <= 2 cm: {'met' if 100 * err.mean() <= 2 else 'MISSED'}"
     )
     print(
         f"  upper-body local rotations vs A, median: encoder's latent {np.median(np.concatenate(enc_deg)):.2f} deg, "

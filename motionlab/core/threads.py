@@ -7,6 +7,11 @@ many times longer. So interactive work, up to :data:`SMALL_ROWS` rows (sequences
 step, runs on one thread: it gives up the second thread's gain on a quiet machine to stay fast on
 a busy one. Larger work keeps torch's own setting. ``benchmarks/bench_threads.py`` prints both
 sides of that trade, quiet and under load.
+
+A batch job over many clips (``motionlab expand``) runs on one thread on the CPU whatever its
+size (:func:`batch_threads`): it runs long and unattended, so a machine that turns busy while it
+runs costs the most there; on a quiet machine it gives up the second thread's gain
+(``benchmarks/bench_expand.py`` prints both; docs/performance.md).
 """
 
 from __future__ import annotations
@@ -16,7 +21,7 @@ from collections.abc import Iterator
 
 import torch
 
-__all__ = ["SMALL_ROWS", "threads_for", "torch_threads"]
+__all__ = ["SMALL_ROWS", "batch_threads", "threads_for", "torch_threads"]
 
 SMALL_ROWS = 8192
 """Rows (sequences × frames) per step up to which one thread is used: one clip of up to about two
@@ -29,6 +34,16 @@ def threads_for(rows: int) -> int:
     if rows < 0:
         raise ValueError(f"rows must be >= 0, got {rows}")
     return 1 if rows <= SMALL_ROWS else torch.get_num_threads()
+
+
+def batch_threads(device: str | torch.device, requested: int | None = None) -> int:
+    """Threads for a batch job over many clips on ``device``: ``requested`` when given (>= 1),
+    else 1 on the CPU and torch's setting on other devices (module docstring)."""
+    if requested is not None:
+        if requested < 1:
+            raise ValueError(f"requested must be >= 1 thread, got {requested}")
+        return requested
+    return 1 if torch.device(device).type == "cpu" else torch.get_num_threads()
 
 
 @contextlib.contextmanager

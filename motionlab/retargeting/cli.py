@@ -173,19 +173,65 @@ def _fold_path(path: Path, k: int, folds: int) -> Path:
     return path if folds == 1 else path.with_name(f"{path.stem}_fold{k + 1}of{folds}{path.suffix}")
 
 
-def _cmd_evaluate(args) -> int:
-    from motionlab import data as mdata
+def _animations(args, folder: Path) -> list[str]:
+    """The animations ``evaluate`` runs: --animations, every shared one (--all-animations) or the default 10."""
+    from motionlab.retargeting.evaluate import DEFAULT_ANIMATIONS, shared_animations
+
+    if args.animations:
+        return list(args.animations)
+    if args.all_animations:
+        try:
+            return shared_animations(folder, args.source, args.targets)
+        except (FileNotFoundError, ValueError) as e:
+            raise _error(str(e)) from None
+    return list(DEFAULT_ANIMATIONS)
+
+
+def _fold_checkpoint(args, folder: Path, fpath: Path, left_out: list[str]):
+    """The network of one fold: loaded from ``fpath``, or trained on the source's clips but ``left_out`` and saved there."""
     from motionlab.core import bvh
     from motionlab.retargeting import checkpoint as ck
-    from motionlab.retargeting.evaluate import (
-        DEFAULT_ANIMATIONS,
-        Evaluation,
-        evaluate,
-        rows_with_root,
-        shared_animations,
-        training_clips,
-    )
+    from motionlab.retargeting.evaluate import training_clips
     from motionlab.retargeting.train import TrainConfig, train
+
+    if fpath.is_file() and not args.retrain:
+        ckpt = cli_options.load_checkpoint(str(fpath), args.device)
+        if not args.quiet:
+            print(f"using checkpoint {fpath}")
+        return ckpt
+    try:
+        clips = training_clips(folder, args.source, left_out)
+    except FileNotFoundError as e:
+        raise _error(str(e)) from None
+    if not args.quiet:
+        print(f"training on {len(clips)} clips of {args.source} (none of the {len(left_out)} evaluated) -> {fpath}")
+    ckpt, _ = train(
+        [bvh.load(p) for p in clips],
+        TrainConfig(steps=args.train_steps, seed=args.seed, device=args.device),
+        progress=not args.quiet,
+    )
+    ck.save(fpath, ckpt)
+    return ckpt
+
+
+def _write_csv(args, result) -> None:
+    import csv
+
+    from motionlab.core import files
+
+    def write(f):
+        w = csv.DictWriter(f, fieldnames=list(result.records[0]), lineterminator="\n")
+        w.writeheader()
+        w.writerows(result.records)
+
+    files.atomic_write(args.csv, write, overwrite=args.force, what="--csv file")
+    if not args.quiet:
+        print(f"wrote {args.csv}")
+
+
+def _cmd_evaluate(args) -> int:
+    from motionlab import data as mdata
+    from motionlab.retargeting.evaluate import Evaluation, evaluate, rows_with_root
 
     folder = Path(args.data) if args.data else mdata.data_root() / "mixamo"
     check_outputs([("--csv", args.csv)], args.force)  # refuse before hours of work, not after
@@ -194,15 +240,7 @@ def _cmd_evaluate(args) -> int:
     if args.folds < 1:
         raise _error(f"--folds must be >= 1, got {args.folds}")
     path = Path(args.checkpoint) if args.checkpoint else Path(tempfile.gettempdir()) / f"motionlab_{args.source}.pt"
-    if args.animations:
-        animations = list(args.animations)
-    elif args.all_animations:
-        try:
-            animations = shared_animations(folder, args.source, args.targets)
-        except (FileNotFoundError, ValueError) as e:
-            raise _error(str(e)) from None
-    else:
-        animations = list(DEFAULT_ANIMATIONS)
+    animations = _animations(args, folder)
     if args.folds > len(animations):
         raise _error(f"--folds {args.folds} is more than the {len(animations)} animations evaluated")
     # leave animations out: fold k is evaluated by a network trained without the fold's animations
@@ -212,23 +250,7 @@ def _cmd_evaluate(args) -> int:
     check_outputs(trained, force=True, inputs=[("--csv", args.csv)])  # a checkpoint to train is written later
     result = Evaluation(rows=[])
     for fold, fpath in zip(folds, fold_paths):
-        if fpath.is_file() and not args.retrain:
-            ckpt = cli_options.load_checkpoint(str(fpath), args.device)
-            if not args.quiet:
-                print(f"using checkpoint {fpath}")
-        else:
-            try:
-                clips = training_clips(folder, args.source, fold if args.folds > 1 else animations)
-            except FileNotFoundError as e:
-                raise _error(str(e)) from None
-            if not args.quiet:
-                print(f"training on {len(clips)} clips of {args.source} (none of the {len(fold)} evaluated) -> {fpath}")
-            ckpt, _ = train(
-                [bvh.load(p) for p in clips],
-                TrainConfig(steps=args.train_steps, seed=args.seed, device=args.device),
-                progress=not args.quiet,
-            )
-            ck.save(fpath, ckpt)
+        ckpt = _fold_checkpoint(args, folder, fpath, fold if args.folds > 1 else animations)
         part = evaluate(
             folder,
             ckpt,
@@ -250,18 +272,7 @@ def _cmd_evaluate(args) -> int:
     print()
     print(result.breakdown("pose_mse_h2"))
     if args.csv:
-        import csv
-
-        from motionlab.core import files
-
-        def write(f):
-            w = csv.DictWriter(f, fieldnames=list(result.records[0]), lineterminator="\n")
-            w.writeheader()
-            w.writerows(result.records)
-
-        files.atomic_write(args.csv, write, overwrite=args.force, what="--csv file")
-        if not args.quiet:
-            print(f"wrote {args.csv}")
+        _write_csv(args, result)
     return 0
 
 
@@ -270,6 +281,12 @@ def register(subparsers) -> None:
     from motionlab.retargeting import expand_cli
 
     expand_cli.register(subparsers)
+    _add_retarget(subparsers)
+    _add_train(subparsers)
+    _add_evaluate(subparsers)
+
+
+def _add_retarget(subparsers) -> None:
     p = subparsers.add_parser(
         "retarget",
         help="retarget a BVH clip onto another character (latent iteration)",
@@ -308,6 +325,8 @@ def register(subparsers) -> None:
     cli_options.add_solver_args(p)
     p.set_defaults(func=_cmd_retarget)
 
+
+def _add_train(subparsers) -> None:
     p = subparsers.add_parser(
         "train",
         help="train the retargeting network on one character",
@@ -336,6 +355,8 @@ def register(subparsers) -> None:
     add_quiet(p)
     p.set_defaults(func=_cmd_train)
 
+
+def _add_evaluate(subparsers) -> None:
     p = subparsers.add_parser(
         "evaluate",
         help="reproduce Table 1 (retargeting vs real clips) on a <Character>/<Animation>.bvh folder",

@@ -268,17 +268,7 @@ def evaluate(
     solver : latent iteration settings for the "full" rows
     """
     folder = Path(folder)
-    if not (folder / source).is_dir():
-        raise FileNotFoundError(f"source character folder {folder / source} not found")
-    for t in targets:
-        if not (folder / t).is_dir():
-            raise FileNotFoundError(f"target character folder {folder / t} not found")
-    if animations is None:
-        animations = shared_animations(folder, source, targets)
-    if not animations:
-        raise ValueError(f"no animation shared by {source} and {list(targets)} in {folder}")
-    if checkpoint is None and any(r[1] != "copy" for r in rows):
-        raise ValueError("a checkpoint is needed for the network rows")
+    animations = _check_inputs(folder, checkpoint, source, targets, animations, rows)
     result = Evaluation(rows=[r[0] for r in rows])
     sources, planted = {}, {}
     pairs = [(t, a) for t in targets for a in animations]
@@ -301,38 +291,59 @@ def evaluate(
             {"target": target, "animation": anim, **_gt_metrics(gt_pos, fps, height, planted[anim])}
         )
         for row in rows:
-            label, method, root_mode = row[:3]
-            options = dict(row[3]) if len(row) > 3 else {}
-            correction = options.pop("correction", True)
-            cfg = dataclasses.replace(solver or SolverConfig(), **options)
-            model = checkpoint.model if checkpoint is not None else None
-            if model is not None:
-                model.use_correction = correction
-            try:
-                out = retarget(sources[anim], gt_rig.skeleton, checkpoint, method, cfg, root_mode)
-            finally:
-                if model is not None:
-                    model.use_correction = True
-            pos = out.positions
-            n = min(len(pos), len(gt_pos))
-            if len(pos) != len(gt_pos):
-                warnings.warn(
-                    f"{target}/{anim}: {len(pos)} generated vs {len(gt_pos)} real frames; comparing {n}", stacklevel=2
-                )
-            p, g = pos[:n], gt_pos[:n]
-            rel_p, rel_g = p - p[:, :1], g - g[:, :1]
-            rec = {
-                "row": label,
-                "target": target,
-                "animation": anim,
-                "mse": metrics.mse(p, g) * _CM**2,
-                "mse_h2": metrics.mse(p, g, height=height),
-                "pose_mse_h2": metrics.mse(rel_p, rel_g, height=height),
-                "mpjpe": metrics.mpjpe(p, g) * _CM,
-                **_gt_metrics(p, fps, height, planted[anim]),
-                "time": out.seconds,
-                "steps": out.steps,
-                "stop_reason": out.stop_reason,
-            }
-            result.records.append(rec)
+            out = _run_row(row, sources[anim], gt_rig.skeleton, checkpoint, solver)
+            rec = _record(out, gt_pos, fps, height, planted[anim], f"{target}/{anim}")
+            result.records.append({"row": row[0], "target": target, "animation": anim, **rec})
     return result
+
+
+def _check_inputs(folder: Path, checkpoint, source, targets, animations, rows) -> list[str]:
+    """The animations to evaluate; raises when a character folder, the animations or a needed checkpoint is missing."""
+    if not (folder / source).is_dir():
+        raise FileNotFoundError(f"source character folder {folder / source} not found")
+    for t in targets:
+        if not (folder / t).is_dir():
+            raise FileNotFoundError(f"target character folder {folder / t} not found")
+    if animations is None:
+        animations = shared_animations(folder, source, targets)
+    if not animations:
+        raise ValueError(f"no animation shared by {source} and {list(targets)} in {folder}")
+    if checkpoint is None and any(r[1] != "copy" for r in rows):
+        raise ValueError("a checkpoint is needed for the network rows")
+    return list(animations)
+
+
+def _run_row(row: tuple, source, target, checkpoint: Checkpoint | None, solver: SolverConfig | None):
+    """One row's method on one pair (:func:`retarget`), q_Δ switched off for the call where the row asks."""
+    _, method, root_mode = row[:3]
+    options = dict(row[3]) if len(row) > 3 else {}
+    correction = options.pop("correction", True)
+    cfg = dataclasses.replace(solver or SolverConfig(), **options)
+    model = checkpoint.model if checkpoint is not None else None
+    if model is not None:
+        model.use_correction = correction
+    try:
+        return retarget(source, target, checkpoint, method, cfg, root_mode)
+    finally:
+        if model is not None:
+            model.use_correction = True
+
+
+def _record(out, gt_pos: np.ndarray, fps: float, height: float, planted: np.ndarray, name: str) -> dict:
+    """Every metric of one retargeted clip against the real one (the first frames both have)."""
+    pos = out.positions
+    n = min(len(pos), len(gt_pos))
+    if len(pos) != len(gt_pos):
+        warnings.warn(f"{name}: {len(pos)} generated vs {len(gt_pos)} real frames; comparing {n}", stacklevel=3)
+    p, g = pos[:n], gt_pos[:n]
+    rel_p, rel_g = p - p[:, :1], g - g[:, :1]
+    return {
+        "mse": metrics.mse(p, g) * _CM**2,
+        "mse_h2": metrics.mse(p, g, height=height),
+        "pose_mse_h2": metrics.mse(rel_p, rel_g, height=height),
+        "mpjpe": metrics.mpjpe(p, g) * _CM,
+        **_gt_metrics(p, fps, height, planted),
+        "time": out.seconds,
+        "steps": out.steps,
+        "stop_reason": out.stop_reason,
+    }

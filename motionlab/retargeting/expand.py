@@ -54,10 +54,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import torch
 
 from motionlab.core import bvh, gltf, humanoid, metrics, rest_pose
 from motionlab.core.skeleton import Skeleton
+from motionlab.core.threads import batch_threads, torch_threads
 from motionlab.retargeting.batching import Pair, PairResult, batch_frames, plan_batches, quality, solve_pairs
 from motionlab.retargeting.checkpoint import Checkpoint
 from motionlab.retargeting.pipeline import at_rate, prepare_source
@@ -494,10 +494,8 @@ def expand(
     progress : tqdm bar over batches
     on_batch : called as ``on_batch(batch_index, rows)`` after each batch is on disk (tests use it
         to interrupt a run)
-    threads : torch CPU threads during the job (restored afterwards). Default: 1 on the CPU — a
-        step's tensors are small, and on the shared 2-core CPU one thread ran the same batches
-        many times faster than two (17x in the README's run of ``benchmarks/bench_expand.py``,
-        which prints both); unchanged on a GPU.
+    threads : torch CPU threads during the job (restored afterwards); default
+        :func:`motionlab.core.threads.batch_threads`: 1 on the CPU, unchanged on a GPU.
     output_format : ``"bvh"`` (default) or ``"glb"`` (glTF 2.0, :func:`motionlab.core.gltf.dumps`):
         the outputs' format and file suffix. A rerun in another format redoes every pair.
     fps : frame rate of every output (default: each source's own); the network runs at the
@@ -511,17 +509,11 @@ def expand(
         raise ValueError(f"backend must be 'local' or 'ray', got {backend!r}")
     if output_format not in FORMATS:
         raise ValueError(f"output_format must be one of {FORMATS}, got {output_format!r}")
-    before = torch.get_num_threads()
-    if threads is None:
-        threads = 1 if checkpoint.device.type == "cpu" else before
-    torch.set_num_threads(threads)
-    try:
+    with torch_threads(batch_threads(checkpoint.device, threads)):
         return _expand(
             sources, targets, out, checkpoint, solver, root_mode, force, max_frames, backend, address, workers,
             max_penetration_cm, skate_ratio, progress, on_batch, "." + output_format, fps,
         )  # fmt: skip
-    finally:
-        torch.set_num_threads(before)
 
 
 def _plan(clips, targets, out, known, force, suffix, options, result, rows):

@@ -34,11 +34,11 @@ about the world origin, with one ratio for the ground plane and one for the heig
 ``root_mode="contacts"`` replaces the ground-plane ratio by the one that keeps A's planted feet
 still on B's legs (:func:`contact_stride`; the leg chain when the clip has no steps).
 ``root_mode="hips"`` scales all three axes by the hip height and ``"legs"`` by thigh + shin
-(:func:`humanoid.leg_length`, the plain baseline of the data notes). On the shared Mixamo data
-the stride ratio matches Mixamo's own horizontal root scaling best of five leg measures, in
-every leave-one-character-out split (``benchmarks/bench_root.py``); the hip height matches
-its vertical one best. All three methods (copy-rotation, network without iteration, full
-method) use the same root trajectory, so the comparison is on poses.
+(:func:`humanoid.leg_length`, the plain baseline of the data notes). The default is the rule
+closest to Mixamo's own root paths; how it was chosen and how it holds with each character left
+out is on the results page, docs/results_retargeting.md (``benchmarks/bench_root.py``,
+``benchmarks/bench_root_loco.py``). All three methods (copy-rotation, network without
+iteration, full method) use the same root trajectory, so the comparison is on poses.
 
 Taught in ``notebooks/03_latent_iteration.ipynb``.
 """

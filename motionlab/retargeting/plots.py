@@ -49,6 +49,40 @@ def _axes(ax, figsize):
 
 
 # ----------------------------------------------------------------------------- architecture
+class _Diagram:
+    """Boxes, arrows and shape labels of :func:`draw_architecture` on one Axes."""
+
+    W, H = 2.0, 0.85
+
+    def __init__(self, ax):
+        self.ax = ax
+
+    def box(self, x, y, text, color, w=W):
+        from matplotlib.patches import FancyBboxPatch
+
+        H = self.H
+        self.ax.add_patch(
+            FancyBboxPatch(
+                (x - w / 2, y - H / 2), w, H, boxstyle="round,pad=0.04", fc=color, ec="0.25", lw=1.2, zorder=2
+            )
+        )
+        self.ax.text(x, y, text, ha="center", va="center", fontsize=10, zorder=3)
+
+    def arrow(self, a, b, rad=0.0):
+        from matplotlib.patches import FancyArrowPatch
+
+        self.ax.add_patch(
+            FancyArrowPatch(
+                a, b, arrowstyle="-|>", mutation_scale=13, lw=1.2, color="0.3",
+                connectionstyle=f"arc3,rad={rad}", zorder=1, shrinkA=0, shrinkB=0,
+            )
+        )  # fmt: skip
+
+    def label(self, x, y, text, ha="center"):
+        self.ax.text(x, y, text, ha=ha, va="center", fontsize=8.5, color="0.1", zorder=4,
+                     bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.9})  # fmt: skip
+
+
 def draw_architecture(config=None, frames: int = 120, ax=None):
     """Block diagram of :class:`~motionlab.retargeting.model.RetargetNet` with the shape of every tensor.
 
@@ -62,8 +96,6 @@ def draw_architecture(config=None, frames: int = 120, ax=None):
     -------
     the Axes
     """
-    from matplotlib.patches import FancyArrowPatch, FancyBboxPatch
-
     from motionlab.retargeting.model import FEATURE_DIM, NUM_JOINTS, ModelConfig
 
     cfg = config or ModelConfig()
@@ -72,27 +104,9 @@ def draw_architecture(config=None, frames: int = 120, ax=None):
     ax.set_xlim(-0.15, 15.35)
     ax.set_ylim(-0.55, 4.6)
     ax.axis("off")
-    W, H = 2.0, 0.85
-
-    def box(x, y, text, color, w=W):
-        ax.add_patch(
-            FancyBboxPatch(
-                (x - w / 2, y - H / 2), w, H, boxstyle="round,pad=0.04", fc=color, ec="0.25", lw=1.2, zorder=2
-            )
-        )
-        ax.text(x, y, text, ha="center", va="center", fontsize=10, zorder=3)
-
-    def arrow(a, b, rad=0.0):
-        ax.add_patch(
-            FancyArrowPatch(
-                a, b, arrowstyle="-|>", mutation_scale=13, lw=1.2, color="0.3",
-                connectionstyle=f"arc3,rad={rad}", zorder=1, shrinkA=0, shrinkB=0,
-            )
-        )  # fmt: skip
-
-    def label(x, y, text, ha="center"):
-        ax.text(x, y, text, ha=ha, va="center", fontsize=8.5, color="0.1", zorder=4,
-                bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.9})  # fmt: skip
+    W, H = _Diagram.W, _Diagram.H
+    d = _Diagram(ax)
+    box, arrow, label = d.box, d.arrow, d.label
 
     net, data, op = "#cfe2f3", "#f4f4f4", "#fde9c9"
     top, mid, bot = 3.9, 2.35, 0.8

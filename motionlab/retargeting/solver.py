@@ -61,6 +61,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -512,163 +513,264 @@ def solve_many(
         return _iterate(model, x, source, offsets, root_height, cfg, [1] * x.shape[0], None, progress, contact)
 
 
+@contextmanager
+def _frozen(model: RetargetNet):
+    """The network in eval mode with gradients off for its weights; both restored on exit."""
+    was_training = model.training
+    flags = [p.requires_grad for p in model.parameters()]
+    model.eval()
+    for p in model.parameters():
+        p.requires_grad_(False)
+    try:
+        yield
+    finally:
+        for p, f in zip(model.parameters(), flags):
+            p.requires_grad_(f)
+        model.train(was_training)
+
+
+@dataclass
+class _Problem:
+    """The fixed inputs of one batched latent iteration, on the network's device and float type.
+
+    ``bounds`` (groups + 1,): row ranges of the groups; ``group_of_row`` (N,): each row's group;
+    ``contact``: ``(root_world, yaw, planted, fps)`` of :func:`_contact_inputs`, or None.
+    """
+
+    model: RetargetNet
+    src: torch.Tensor
+    offsets: torch.Tensor
+    root_height: torch.Tensor
+    contact: tuple | None
+    sizes: list
+    bounds: np.ndarray
+    group_of_row: torch.Tensor
+    cfg: SolverConfig
+
+    @property
+    def per_row_offsets(self) -> bool:
+        return self.offsets.ndim == 3
+
+
+def _problem(model, x, source, offsets, root_height, cfg, sizes, contact) -> tuple[_Problem, torch.Tensor]:
+    """Move every input onto the network's device (``x`` and ``source`` in ``x``'s float type)."""
+    device = next(model.parameters()).device
+    x, src = x.to(device), source.to(device=device, dtype=x.dtype)
+    offsets = torch.as_tensor(offsets, dtype=x.dtype, device=device)
+    root_height = root_height.to(device=device, dtype=x.dtype)
+    group_of_row = torch.as_tensor(np.repeat(np.arange(len(sizes)), sizes), device=device)
+    if contact is not None:
+        contact = tuple(t.to(device) for t in contact)
+    bounds = np.cumsum([0] + list(sizes))
+    return _Problem(model, src, offsets, root_height, contact, list(sizes), bounds, group_of_row, cfg), x
+
+
+def _start(p: _Problem, x: torch.Tensor):
+    """φ₀ (N, T, D) (the encoder's, then the Gauss–Newton start where ``cfg`` asks for it), the
+    skeleton embedding and the temporal smoother of the steps; one row at a time, so that a row's
+    numbers do not depend on the batch."""
+    model, cfg, offsets = p.model, p.cfg, p.offsets
+    with torch.no_grad():
+        phi0 = torch.cat([model.encode(x[i : i + 1]) for i in range(x.shape[0])])
+        embedding = (
+            model.skeleton_embedding(offsets)
+            if offsets.ndim == 2
+            else torch.cat([model.skeleton_embedding(o) for o in offsets])
+        )
+    smooth = _smoother(cfg.smooth_sigma, phi0.shape[-1], x.dtype, x.device)
+    if cfg.init == "project" or (cfg.init == "auto" and cfg.theta == "rotations"):
+        steps_filter = smooth if cfg.smooth_projection else None
+        with torch.no_grad():
+            phi0 = torch.cat(
+                [
+                    project_latent(
+                        model,
+                        phi0[i : i + 1],
+                        p.src[i : i + 1],
+                        offsets[i] if p.per_row_offsets else offsets,
+                        cfg.project_iters,
+                        smooth=steps_filter,
+                        exact_rounds=cfg.project_exact,
+                    )
+                    for i in range(x.shape[0])
+                ]
+            )
+    return phi0, embedding, smooth
+
+
+@dataclass
+class _Steps:
+    """Each group's latent offset δ (its rows of φ = φ₀ + smooth(δ)), step grid, and the Adam over them."""
+
+    deltas: list
+    grids: list
+    opt: torch.optim.Adam
+
+
+def _steps(phi0: torch.Tensor, bounds: np.ndarray, lr: float) -> _Steps:
+    """Per group: Adam's step size ``lr · std(φ₀)``, its grid (:func:`step_grid`); φ₀ put on the grid in place."""
+    deltas, param_groups, grids = [], [], []
+    for g in range(len(bounds) - 1):
+        part = phi0[bounds[g] : bounds[g + 1]]
+        scale = max(float(part.std()) if part.numel() > 1 else 1.0, 1e-6)
+        with torch.no_grad():  # the start on the grid too (see step_grid)
+            part.copy_(torch.round(part / step_grid(scale)) * step_grid(scale))
+        deltas.append(torch.zeros_like(part, requires_grad=True))
+        param_groups.append({"params": [deltas[-1]], "lr": lr * scale})
+        grids.append(step_grid(param_groups[-1]["lr"]))
+    return _Steps(deltas, grids, torch.optim.Adam(param_groups))
+
+
+def _losses(p: _Problem, phi0, embedding, smooth, steps: _Steps, active: list):
+    """Decode the active groups' latents; ``(out, phi, group_loss (active,), values)`` where
+    ``values[k]`` is ``[L_iter, L_angle, L_foot, L_contact]`` of active group k (means over its rows)."""
+    groups, bounds, device, dtype = len(p.sizes), p.bounds, phi0.device, phi0.dtype
+    everyone = len(active) == groups
+    rows = None if everyone else torch.cat([torch.arange(bounds[g], bounds[g + 1]) for g in active]).to(device)
+    delta = steps.deltas[0] if groups == 1 else torch.cat([steps.deltas[g] for g in active])
+    phi = (phi0 if everyone else phi0[rows]) + smooth(delta)
+    if p.per_row_offsets and not everyone:
+        out = p.model.decode(phi, p.offsets[rows], embedding[rows])
+    else:
+        out = p.model.decode(phi, p.offsets, embedding)
+    s, h = (p.src, p.root_height) if everyone else (p.src[rows], p.root_height[rows])
+    extra = {}
+    if p.contact is not None:
+        extra = dict(
+            zip(("root_world", "yaw", "planted", "fps"), p.contact if everyone else [c[rows] for c in p.contact])
+        )
+    loss, angle, foot, touch = sequence_losses(s, out, h, p.cfg, **extra)  # (rows,): each sequence on its own
+    owner = p.group_of_row if everyone else p.group_of_row[rows]
+    which = owner if everyone else torch.searchsorted(torch.as_tensor(active, device=device), owner)
+    count = torch.zeros(len(active), dtype=dtype, device=device).index_add_(0, which, torch.ones_like(loss))
+    parts = [
+        torch.zeros(len(active), dtype=dtype, device=device).index_add_(0, which, v) / count
+        for v in (loss, angle, foot, touch)
+    ]
+    return out, phi, parts[0], torch.stack([q.detach() for q in parts], 1).tolist()
+
+
+@dataclass
+class _Track:
+    """Per group: the loss history, the plateau rule's state, the stop reason and the best iterate
+    (rows ``bounds[g]:bounds[g + 1]`` of ``best_rot``, ``best_pos``, ``best_phi``)."""
+
+    histories: list
+    best: list
+    since_best: list
+    reasons: list
+    best_value: list
+    best_step: list
+    steps: list
+    best_rot: torch.Tensor
+    best_pos: torch.Tensor
+    best_phi: torch.Tensor
+
+    @classmethod
+    def new(cls, phi0: torch.Tensor, groups: int) -> _Track:
+        shape = phi0.shape[:2]
+        return cls(
+            [{"loss": [], "angle": [], "foot": [], "contact": []} for _ in range(groups)],
+            [float("inf")] * groups,  # best loss that counted as an improvement (plateau rule)
+            [0] * groups,
+            ["max_steps"] * groups,
+            [float("inf")] * groups,
+            [0] * groups,
+            [0] * groups,
+            torch.empty(shape + (22, 4), dtype=phi0.dtype, device=phi0.device),
+            torch.empty(shape + (22, 3), dtype=phi0.dtype, device=phi0.device),
+            torch.empty_like(phi0),
+        )
+
+    def record(self, p: _Problem, active: list, values: list, out, phi, callback) -> list[int]:
+        """Log one evaluation of the active groups, keep their best iterates; the indices into
+        ``active`` of the groups that stop here."""
+        cfg, stopped, row = p.cfg, [], 0
+        for k, g in enumerate(active):
+            value, a_value, f_value, c_value = values[k]
+            n = p.sizes[g]
+            for key, v in zip(("loss", "angle", "foot", "contact"), values[k]):
+                self.histories[g][key].append(v)
+            if callback is not None:
+                callback(self.steps[g], {"loss": value, "angle": a_value, "foot": f_value, "contact": c_value})
+            if value < self.best_value[g]:  # Adam can overshoot: keep the best iterate seen, not the last
+                self.best_value[g], self.best_step[g] = value, self.steps[g]
+                b0, b1 = p.bounds[g], p.bounds[g + 1]
+                self.best_rot[b0:b1] = out.local_rot[row : row + n].detach()
+                self.best_pos[b0:b1] = out.positions[row : row + n].detach()
+                self.best_phi[b0:b1] = phi[row : row + n].detach()
+            if value < self.best[g] * (1.0 - cfg.min_delta):
+                self.best[g], self.since_best[g] = value, 0
+            else:
+                self.since_best[g] += 1
+            if value < cfg.threshold:
+                self.reasons[g] = "threshold"
+            elif cfg.patience and self.since_best[g] >= cfg.patience:
+                self.reasons[g] = "plateau"
+            elif self.steps[g] < cfg.max_steps:
+                row += n
+                continue
+            stopped.append(k)
+            row += n
+        return stopped
+
+    def results(self, bounds: np.ndarray, seconds: float) -> list[SolverResult]:
+        rot = self.best_rot.cpu().numpy().astype(np.float64)
+        pos = self.best_pos.cpu().numpy().astype(np.float64)
+        return [
+            SolverResult(
+                local_rot=rot[bounds[g] : bounds[g + 1]],
+                positions=pos[bounds[g] : bounds[g + 1]],
+                phi=self.best_phi[bounds[g] : bounds[g + 1]],
+                best_step=self.best_step[g],
+                history=self.histories[g],
+                stop_reason=self.reasons[g],
+                steps=self.steps[g],
+                seconds=seconds,
+            )
+            for g in range(len(bounds) - 1)
+        ]
+
+
+def _adam_step(steps: _Steps, group_loss: torch.Tensor, active: list, stopped: list) -> list:
+    """One Adam update of the groups still running, their δ put back on the grid; the groups left."""
+    keep = torch.ones(len(active), dtype=group_loss.dtype, device=group_loss.device)
+    keep[stopped] = 0.0
+    steps.opt.zero_grad(set_to_none=True)
+    (group_loss * keep).sum().backward()
+    for k in stopped:
+        steps.deltas[active[k]].grad = None  # Adam skips it: a stopped problem keeps its latent
+    steps.opt.step()
+    active = [g for k, g in enumerate(active) if k not in stopped]
+    with torch.no_grad():  # on the grid: the same iterates on every CPU (see step_grid)
+        for g in active:
+            steps.deltas[g].copy_(torch.round(steps.deltas[g] / steps.grids[g]) * steps.grids[g])
+    return active
+
+
 def _iterate(
     model, x, source, offsets, root_height, cfg, sizes, callback, progress, contact=None
 ) -> list[SolverResult]:
     """The latent iteration for consecutive groups of sequences (``sizes`` rows each), each group
     an independent problem: group loss = mean of its sequences' losses, own step size and stop.
     ``contact``: ``(root_world, yaw, planted)`` of :func:`_contact_inputs`, or None."""
-    device = next(model.parameters()).device
-    x, src = x.to(device), source.to(device=device, dtype=x.dtype)
-    offsets = torch.as_tensor(offsets, dtype=x.dtype, device=device)
-    root_height = root_height.to(device=device, dtype=x.dtype)
-    per_row_offsets = offsets.ndim == 3
-    bounds = np.cumsum([0] + list(sizes))
-    groups = len(sizes)
-    group_of_row = torch.as_tensor(np.repeat(np.arange(groups), sizes), device=device)
-    was_training = model.training
-    flags = [p.requires_grad for p in model.parameters()]
-    model.eval()
-    for p in model.parameters():
-        p.requires_grad_(False)
-    if contact is not None:
-        contact = tuple(t.to(device) for t in contact)
-    histories = [{"loss": [], "angle": [], "foot": [], "contact": []} for _ in range(groups)]
+    p, x = _problem(model, x, source, offsets, root_height, cfg, sizes, contact)
     start = time.perf_counter()
-    try:
-        with torch.no_grad():  # one sequence at a time: a row's numbers then do not depend on the batch
-            phi0 = torch.cat([model.encode(x[i : i + 1]) for i in range(x.shape[0])])
-            embedding = (
-                model.skeleton_embedding(offsets)
-                if offsets.ndim == 2
-                else torch.cat([model.skeleton_embedding(o) for o in offsets])
-            )
-        smooth = _smoother(cfg.smooth_sigma, phi0.shape[-1], x.dtype, device)
-        if cfg.init == "project" or (cfg.init == "auto" and cfg.theta == "rotations"):
-            steps_filter = smooth if cfg.smooth_projection else None
-            with torch.no_grad():  # row by row, as the encoder: no dependence on the batch
-                phi0 = torch.cat(
-                    [
-                        project_latent(
-                            model,
-                            phi0[i : i + 1],
-                            src[i : i + 1],
-                            offsets[i] if per_row_offsets else offsets,
-                            cfg.project_iters,
-                            smooth=steps_filter,
-                            exact_rounds=cfg.project_exact,
-                        )
-                        for i in range(x.shape[0])
-                    ]
-                )
-        deltas, param_groups, grids = [], [], []
-        for g in range(groups):
-            part = phi0[bounds[g] : bounds[g + 1]]
-            scale = max(float(part.std()) if part.numel() > 1 else 1.0, 1e-6)
-            with torch.no_grad():  # the start on the grid too (see step_grid)
-                part.copy_(torch.round(part / step_grid(scale)) * step_grid(scale))
-            deltas.append(torch.zeros_like(part, requires_grad=True))
-            param_groups.append({"params": [deltas[-1]], "lr": cfg.lr * scale})
-            grids.append(step_grid(param_groups[-1]["lr"]))
-        opt = torch.optim.Adam(param_groups)
-        best = [float("inf")] * groups  # best loss that counted as an improvement (plateau rule)
-        since_best, reasons = [0] * groups, ["max_steps"] * groups
-        best_value, best_step, steps = [float("inf")] * groups, [0] * groups, [0] * groups
-        best_rot = torch.empty(x.shape[:2] + (22, 4), dtype=x.dtype, device=device)
-        best_pos = torch.empty(x.shape[:2] + (22, 3), dtype=x.dtype, device=device)
-        best_phi = torch.empty_like(phi0)
-        active = list(range(groups))
+    with _frozen(model):
+        phi0, embedding, smooth = _start(p, x)
+        steps = _steps(phi0, p.bounds, cfg.lr)
+        track = _Track.new(phi0, len(sizes))
+        active = list(range(len(sizes)))
         bar = tqdm(total=cfg.max_steps, desc="latent iteration", disable=not progress, leave=False)
         while active:
-            everyone = len(active) == groups
-            rows = None if everyone else torch.cat([torch.arange(bounds[g], bounds[g + 1]) for g in active]).to(device)
-            delta = deltas[0] if groups == 1 else torch.cat([deltas[g] for g in active])
-            phi = (phi0 if everyone else phi0[rows]) + smooth(delta)
-            if per_row_offsets and not everyone:
-                out = model.decode(phi, offsets[rows], embedding[rows])
-            else:
-                out = model.decode(phi, offsets, embedding)
-            s, h = (src, root_height) if everyone else (src[rows], root_height[rows])
-            extra = {}
-            if contact is not None:
-                extra = dict(
-                    zip(("root_world", "yaw", "planted", "fps"), contact if everyone else [c[rows] for c in contact])
-                )
-            loss, angle, foot, touch = sequence_losses(s, out, h, cfg, **extra)  # (rows,): each sequence on its own
-            owner = group_of_row if everyone else group_of_row[rows]
-            which = owner if everyone else torch.searchsorted(torch.as_tensor(active, device=device), owner)
-            count = torch.zeros(len(active), dtype=x.dtype, device=device).index_add_(0, which, torch.ones_like(loss))
-            parts = [
-                torch.zeros(len(active), dtype=x.dtype, device=device).index_add_(0, which, v) / count
-                for v in (loss, angle, foot, touch)
-            ]
-            group_loss = parts[0]  # (active groups,): the mean over each group's sequences
-            values = torch.stack([p.detach() for p in parts], 1).tolist()
-            stopped, row = [], 0
-            for k, g in enumerate(active):
-                value, a_value, f_value, c_value = values[k]
-                n = sizes[g]
-                hist = histories[g]
-                hist["loss"].append(value)
-                hist["angle"].append(a_value)
-                hist["foot"].append(f_value)
-                hist["contact"].append(c_value)
-                if callback is not None:
-                    callback(steps[g], {"loss": value, "angle": a_value, "foot": f_value, "contact": c_value})
-                if value < best_value[g]:  # Adam can overshoot: keep the best iterate seen, not the last
-                    best_value[g], best_step[g] = value, steps[g]
-                    b0, b1 = bounds[g], bounds[g + 1]
-                    best_rot[b0:b1] = out.local_rot[row : row + n].detach()
-                    best_pos[b0:b1] = out.positions[row : row + n].detach()
-                    best_phi[b0:b1] = phi[row : row + n].detach()
-                if value < best[g] * (1.0 - cfg.min_delta):
-                    best[g], since_best[g] = value, 0
-                else:
-                    since_best[g] += 1
-                if value < cfg.threshold:
-                    reasons[g] = "threshold"
-                elif cfg.patience and since_best[g] >= cfg.patience:
-                    reasons[g] = "plateau"
-                elif steps[g] < cfg.max_steps:
-                    row += n
-                    continue
-                stopped.append(k)
-                row += n
+            out, phi, group_loss, values = _losses(p, phi0, embedding, smooth, steps, active)
+            stopped = track.record(p, active, values, out, phi, callback)
             if len(stopped) == len(active):
                 break
-            keep = torch.ones(len(active), dtype=x.dtype, device=device)
-            keep[stopped] = 0.0
-            opt.zero_grad(set_to_none=True)
-            (group_loss * keep).sum().backward()
-            for k in stopped:
-                deltas[active[k]].grad = None  # Adam skips it: a stopped problem keeps its latent
-            opt.step()
-            active = [g for k, g in enumerate(active) if k not in stopped]
-            with torch.no_grad():  # on the grid: the same iterates on every CPU (see step_grid)
-                for g in active:
-                    deltas[g].copy_(torch.round(deltas[g] / grids[g]) * grids[g])
+            active = _adam_step(steps, group_loss, active, stopped)
             for g in active:
-                steps[g] += 1
+                track.steps[g] += 1
             bar.update(1)
             bar.set_postfix(loss=f"{float(group_loss.detach().mean()):.4g}")
         bar.close()
-    finally:
-        for p, f in zip(model.parameters(), flags):
-            p.requires_grad_(f)
-        model.train(was_training)
-    seconds = time.perf_counter() - start
-    rot = best_rot.cpu().numpy().astype(np.float64)
-    pos = best_pos.cpu().numpy().astype(np.float64)
-    return [
-        SolverResult(
-            local_rot=rot[bounds[g] : bounds[g + 1]],
-            positions=pos[bounds[g] : bounds[g + 1]],
-            phi=best_phi[bounds[g] : bounds[g + 1]],
-            best_step=best_step[g],
-            history=histories[g],
-            stop_reason=reasons[g],
-            steps=steps[g],
-            seconds=seconds,
-        )
-        for g in range(groups)
-    ]
+    return track.results(p.bounds, time.perf_counter() - start)

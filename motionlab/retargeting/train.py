@@ -281,6 +281,60 @@ def turned_window(
     return out, turned, pos
 
 
+@dataclass
+class _Windows:
+    """The training windows as tensors: normalised features x (W, T, 70), FK positions (W, T, 22, 3)
+    and local rotations (W, T, 22, 4) on the device; A's offsets ``base`` (22, 3), root offset zeroed,
+    and the feature statistics ``mean``, ``std`` (70,) on the CPU."""
+
+    x: torch.Tensor
+    positions: torch.Tensor
+    local_rot: torch.Tensor
+    base: torch.Tensor
+    mean: torch.Tensor
+    std: torch.Tensor
+
+    def __len__(self) -> int:
+        return len(self.x)
+
+
+def _windows(data: TrainingSet, dtype: torch.dtype, device: torch.device) -> _Windows:
+    mean = torch.as_tensor(data.stats.mean, dtype=dtype)
+    std = torch.as_tensor(data.stats.std, dtype=dtype)
+    x_all = ((torch.from_numpy(data.x).to(dtype) - mean) / std).to(device)
+    pos_all = torch.from_numpy(data.positions).to(device=device, dtype=dtype)
+    rot_all = torch.from_numpy(data.local_rot).to(device=device, dtype=dtype)
+    base = torch.tensor(data.skeleton.offsets, dtype=dtype)
+    base[0] = 0.0
+    return _Windows(x_all, pos_all, rot_all, base, mean, std)
+
+
+def _batch(w: _Windows, cfg: TrainConfig, gen: torch.Generator):
+    """One batch ``(x, local_rot, target positions, offsets)``: windows drawn with ``gen``; the first
+    ``augment`` of them on re-proportioned skeletons (targets by FK of A's rotations), the last
+    ``pose_augment`` with joints turned and features recomputed."""
+    device, dtype = w.x.device, w.x.dtype
+    n_aug = int(round(cfg.augment * cfg.batch_size))
+    n_pose = min(int(round(cfg.pose_augment * cfg.batch_size)), cfg.batch_size - n_aug)
+    idx = torch.randint(len(w), (cfg.batch_size,), generator=gen)
+    offsets = w.base[None].repeat(cfg.batch_size, 1, 1)
+    if n_aug:
+        offsets[:n_aug] = random_offsets(w.base, n_aug, cfg, gen)
+    offsets = offsets.to(device)
+    x, rot = w.x[idx], w.local_rot[idx]
+    target = w.positions[idx]
+    if n_aug:
+        with torch.no_grad():
+            target = target.clone()
+            target[:n_aug] = RetargetNet.forward_kinematics(rot[:n_aug], offsets[:n_aug])
+    if n_pose:  # the last n_pose rows: A's skeleton, joints turned, features recomputed
+        rows = slice(cfg.batch_size - n_pose, None)
+        x, rot, target = x.clone(), rot.clone(), target.clone()
+        turns = random_turns(n_pose, cfg, gen).to(device=device, dtype=dtype)
+        x[rows], rot[rows], target[rows] = turned_window(x[rows], rot[rows], offsets[rows], turns, w.mean, w.std)
+    return x, rot, target, offsets
+
+
 def train(
     data: TrainingSet | Sequence[Motion],
     config: TrainConfig | None = None,
@@ -312,38 +366,15 @@ def train(
     dtype = DTYPES[cfg.dtype]
     model = RetargetNet(model_config).to(device=device, dtype=dtype)
     model.train()
-    mean = torch.as_tensor(data.stats.mean, dtype=dtype)
-    std = torch.as_tensor(data.stats.std, dtype=dtype)
-    x_all = ((torch.from_numpy(data.x).to(dtype) - mean) / std).to(device)
-    pos_all = torch.from_numpy(data.positions).to(device=device, dtype=dtype)
-    rot_all = torch.from_numpy(data.local_rot).to(device=device, dtype=dtype)
-    base = torch.tensor(data.skeleton.offsets, dtype=dtype)
-    base[0] = 0.0
+    windows = _windows(data, dtype, device)
     opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, cfg.steps, eta_min=cfg.lr / 10)
-    n_aug = int(round(cfg.augment * cfg.batch_size))
-    n_pose = min(int(round(cfg.pose_augment * cfg.batch_size)), cfg.batch_size - n_aug)
     history: list[dict] = []
     start = time.perf_counter()
     bar = tqdm(range(1, cfg.steps + 1), desc="training", disable=not progress)
     running = None
     for step in bar:
-        idx = torch.randint(len(data), (cfg.batch_size,), generator=gen)
-        offsets = base[None].repeat(cfg.batch_size, 1, 1)
-        if n_aug:
-            offsets[:n_aug] = random_offsets(base, n_aug, cfg, gen)
-        offsets = offsets.to(device)
-        x, rot = x_all[idx], rot_all[idx]
-        target = pos_all[idx]
-        if n_aug:
-            with torch.no_grad():
-                target = target.clone()
-                target[:n_aug] = RetargetNet.forward_kinematics(rot[:n_aug], offsets[:n_aug])
-        if n_pose:  # the last n_pose rows: A's skeleton, joints turned, features recomputed
-            rows = slice(cfg.batch_size - n_pose, None)
-            x, rot, target = x.clone(), rot.clone(), target.clone()
-            turns = random_turns(n_pose, cfg, gen).to(device=device, dtype=dtype)
-            x[rows], rot[rows], target[rows] = turned_window(x[rows], rot[rows], offsets[rows], turns, mean, std)
+        x, rot, target, offsets = _batch(windows, cfg, gen)
         out = model(x, offsets)
         recon = losses.recon_loss(out.positions, target, cfg.recon_weight)
         rot_l = losses.rotation_loss(out.local_rot, rot) if cfg.rot_weight > 0 else torch.zeros((), device=device)
