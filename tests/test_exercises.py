@@ -1,4 +1,4 @@
-"""Every exercise check of notebooks 00, 01, 02, 03, 04, 05 and 06 against the instructor's key (must pass),
+"""Every exercise check of notebooks 00 to 07 against the instructor's key (must pass),
 typical wrong answers written as a student would (must fail, with the matching hint), an
 alternative correct answer where one exists (must pass), and an unattempted stub (must not raise).
 """
@@ -35,6 +35,7 @@ K02 = _key("key_02_training_autoencoder")
 K03 = _key("key_03_latent_iteration")
 K05 = _key("key_05_motion_graphs")
 K06 = _key("key_06_keypose_interpolation")
+K07 = _key("key_07_expanding_a_database")
 
 # (exercise, the key's solution) for every exercise of the notebooks
 SOLUTIONS = {
@@ -381,7 +382,7 @@ def style_takes():
 
 
 EXPERIMENT_NAMES = {"nlerp_turn", "euler_order", "hips_heading", "shorter_legs"}  # notebooks 00, 01, 04
-EXPERIMENT_NAMES |= {"q_delta_legs", "no_correction"}  # notebook 02
+EXPERIMENT_NAMES |= {"q_delta_legs", "no_correction", "arm_length"}  # notebooks 02, 07
 EXPERIMENT_NAMES |= {
     "encoder_start",
     "contact_weight",
@@ -581,6 +582,46 @@ def test_no_correction_experiment(decoded_clip):
     wrong = {"with the correction": with_correction, "metres": error_m(on_a.q)}
     _check_wrong(q, answer, wrong, decoded_clip)
     assert not q.check(answer + 1.0, *decoded_clip).passed
+
+
+@pytest.fixture(scope="module")
+def squat_file(tmp_path_factory):
+    """A synthetic squat saved as BVH (notebook 07 checks a clip by its path), the shipped network, a short solve."""
+    from motionlab import retargeting, synthetic
+    from motionlab.core import bvh
+    from motionlab.retargeting.solver import SolverConfig
+
+    clip = synthetic.generate("squat", humanoid.canonical_skeleton(), num_frames=60, seed=3)
+    path = bvh.save(tmp_path_factory.mktemp("clips") / "squat.bvh", clip)
+    return str(path), retargeting.load_default("cpu"), SolverConfig(max_steps=5)
+
+
+def test_arm_length_experiment(squat_file):
+    from motionlab.core import bvh
+    from motionlab.retargeting.pipeline import retarget
+
+    q = exercises.arm_length
+    answer = K07.my_arm_length_experiment(*squat_file)
+    assert q.check(answer, *squat_file).passed
+    clip_path, ckpt, cfg = squat_file
+
+    def result(arms):  # as a student runs it
+        return retarget(
+            bvh.load(clip_path), humanoid.scale_bones(humanoid.canonical_skeleton(), arms=arms), ckpt, solver=cfg
+        )
+
+    arms_13 = result(1.3)
+    assert q.check(arms_13.plausibility.lowest, *squat_file).passed  # unrounded
+    lowest_m = float(arms_13.positions[..., 1].min())
+    assert abs(arms_13.plausibility.lowest - lowest_m / humanoid.leg_length(arms_13.motion.skeleton)) < 1e-6
+    wrong = {
+        "1.35": result(1.35).plausibility.lowest,
+        "source_lowest": arms_13.plausibility.source_lowest,
+        "centimetres": 100 * lowest_m,
+        "metres": lowest_m,
+    }
+    _check_wrong(q, answer, wrong, squat_file)
+    assert not q.check(answer + 0.5, *squat_file).passed
 
 
 def test_held_out_q_experiment(behaviour_clips):

@@ -34,7 +34,8 @@ smaller turn), ``euler_order`` (the same angles in another channel order); 01 ``
 legs), ``no_correction`` (decoding without q_Δ); 03 ``encoder_start`` (motionlab without the
 Gauss–Newton start), ``contact_weight`` (a fifth of the contact weight), ``foot_weight`` (λ_foot in
 the paper's set-up), 06 ``held_out_q`` (q by likelihood on truly held-out frames), 05
-``vanishing_threshold`` (the graph threshold at which a style leaves the pruned standard graph).
+``vanishing_threshold`` (the graph threshold at which a style leaves the pruned standard graph); 07
+``arm_length`` (how low a longer arm reaches under the floor).
 
 Their reference solutions, as a student would write them, are in ``instructor/solutions/`` (the
 instructor's key, outside the students' ``notebooks/`` folder), and ``tests/test_exercises.py`` runs every check against the key, typical wrong
@@ -48,7 +49,15 @@ from .basics import euler_order, hand_height, hips_heading, joint_speed, nlerp_t
 from .core import Exercise, Mistake, Question, Result, check
 from .interpolation import ease, held_out_q, jumps, sigma2
 from .motion_graphs import distance_matrix, local_minima, vanishing_threshold
-from .retargeting import contact_weight, encoder_start, foot_loss, foot_weight, no_correction, q_delta_legs
+from .retargeting import (
+    arm_length,
+    contact_weight,
+    encoder_start,
+    foot_loss,
+    foot_weight,
+    no_correction,
+    q_delta_legs,
+)
 
 __all__ = [
     "Exercise",
@@ -76,6 +85,7 @@ __all__ = [
     "foot_weight",
     "held_out_q",
     "vanishing_threshold",
+    "arm_length",
     "EXERCISES",
     "EXPERIMENTS",
 ]
@@ -108,6 +118,7 @@ EXPERIMENTS: dict[str, Question] = {
     "foot_weight": foot_weight,
     "held_out_q": held_out_q,
     "vanishing_threshold": vanishing_threshold,
+    "arm_length": arm_length,
 }
 """Every experiment exercise (a :class:`Question`: change a parameter, run, report a number).
 

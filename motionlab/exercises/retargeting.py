@@ -1,10 +1,10 @@
-"""Exercises of notebooks 02 (the retargeting network) and 03 (the latent iteration).
+"""Exercises of notebooks 02 (the retargeting network), 03 (the latent iteration) and 07 (a database).
 
 Most are experiments (:class:`~motionlab.exercises.core.Question`): the student changes one
 parameter of a cell, runs it and types the number it gives; the check reruns the changed
 experiment with the package on the notebook's own inputs (its network, clip and target), so one
 key fits real and synthetic data. Each run is cached per inputs, so a check costs one decode
-(notebook 02) or one latent iteration (notebook 03) at most.
+(notebook 02) or one latent iteration (notebooks 03 and 07) at most.
 
 ``foot_loss`` asks for a function: its cases are small torch tensors drawn from a fixed seed (a
 private generator: the notebook's own random state is left alone). torch is imported only when a
@@ -17,7 +17,7 @@ import numpy as np
 
 from .core import Exercise, Mistake, Question
 
-__all__ = ["q_delta_legs", "no_correction", "foot_loss", "encoder_start", "contact_weight", "foot_weight"]
+__all__ = ["q_delta_legs", "no_correction", "foot_loss", "encoder_start", "contact_weight", "foot_weight", "arm_length"]
 
 
 def _gen(seed: int):
@@ -285,6 +285,51 @@ foot_weight = Question(
         Mistake(
             lambda source, target, ckpt: _paper_angle(source, target, ckpt, 5.0, degrees=False),
             "that number is in radians; plots.joint_angle_errors gives degrees.",
+        ),
+    ],
+)
+
+
+# --------------------------------------------------------------------------- notebook 07, experiment
+_PLAUSIBILITY: dict = {}
+
+
+def _arms_plausibility(clip_path, checkpoint, solver, arms: float = 1.3):
+    """The plausibility of ``clip_path`` retargeted onto the canonical character with arms × ``arms``."""
+    from motionlab.core import bvh, humanoid
+    from motionlab.retargeting.pipeline import retarget
+
+    key = (str(clip_path), id(checkpoint), repr(solver), arms)
+    if key not in _PLAUSIBILITY:
+        target = humanoid.scale_bones(humanoid.canonical_skeleton(), arms=arms)
+        result = retarget(bvh.load(clip_path), target, checkpoint, solver=solver)
+        _PLAUSIBILITY[key] = (result.plausibility, float(result.positions[..., 1].min()))
+    return _PLAUSIBILITY[key]
+
+
+arm_length = Question(
+    "07 · exercise 1 (experiment: how long may the arms be?)",
+    lambda clip_path, ckpt, solver: _arms_plausibility(clip_path, ckpt, solver)[0].lowest,
+    atol=0.0006,  # an answer typed with three decimals passes
+    rtol=0.005,
+    mistakes=[
+        Mistake(
+            lambda clip_path, ckpt, solver: _arms_plausibility(clip_path, ckpt, solver, 1.35)[0].lowest,
+            "that is the `long_arms` preset (arms × 1.35); the exercise asks for arms × 1.3.",
+        ),
+        Mistake(
+            lambda clip_path, ckpt, solver: _arms_plausibility(clip_path, ckpt, solver)[0].source_lowest,
+            "that is A's lowest joint in the source (`source_lowest`); report B's, `plausibility.lowest`.",
+        ),
+        Mistake(
+            lambda clip_path, ckpt, solver: 100 * _arms_plausibility(clip_path, ckpt, solver)[1],
+            "that is the lowest joint's height in centimetres; the floor test measures it as a fraction "
+            "of B's leg length (`plausibility.lowest`).",
+        ),
+        Mistake(
+            lambda clip_path, ckpt, solver: _arms_plausibility(clip_path, ckpt, solver)[1],
+            "that is the lowest joint's height in metres; the floor test measures it as a fraction of "
+            "B's leg length (`plausibility.lowest`).",
         ),
     ],
 )
