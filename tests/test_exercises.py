@@ -42,7 +42,7 @@ SOLUTIONS = {
     "hand_height": K00.left_hand_height_with_arm_raised,
     "window_count": K01.my_window_count,
     "joint_speed": K04.my_joint_speed,
-    "foot_loss": K03.my_foot_loss,
+    "contact_loss": K03.my_contact_loss,
     "local_minima": K05.my_local_minima,
     "distance_matrix": K05.my_distance_matrix,
     "ease": K06.my_ease,
@@ -100,16 +100,20 @@ def _speed_short(motion):
 
 
 # notebooks 03, 05, 06
-def _foot_all_joints(world_y):
-    return torch.relu(-world_y).mean()
+def _contact_per_frame(feet, planted, fps):
+    both = planted[..., 1:, :] & planted[..., :-1, :]
+    return torch.diff(feet, dim=-3).norm(dim=-1)[both].mean() if both.any() else torch.zeros(())
 
 
-def _foot_signed(world_y):
-    return torch.minimum(world_y[..., K03.FEET], torch.zeros(())).mean()
+def _contact_start_frame_only(feet, planted, fps):
+    step, start = torch.diff(feet, dim=-3).norm(dim=-1), planted[..., :-1, :]
+    return fps * step[start].mean() if start.any() else torch.zeros(())
 
 
-def _foot_abs(world_y):
-    return world_y[..., K03.FEET].abs().mean()
+def _contact_horizontal(feet, planted, fps):
+    both = planted[..., 1:, :] & planted[..., :-1, :]
+    step = torch.diff(feet[..., [0, 2]], dim=-3).norm(dim=-1)
+    return fps * step[both].mean() if both.any() else torch.zeros(())
 
 
 def _minima_strict(m):
@@ -179,9 +183,9 @@ WRONG = [
     ("joint_speed", _speed_per_frame, "metres per second"),
     ("joint_speed", _speed_short, "one frame fewer"),
     ("joint_speed", lambda m: np.gradient(m.global_positions(), axis=0) * m.fps, "velocity"),
-    ("foot_loss", _foot_all_joints, "four foot joints"),
-    ("foot_loss", _foot_signed, "negative"),
-    ("foot_loss", _foot_abs, "costs nothing"),
+    ("contact_loss", _contact_per_frame, "m/s"),
+    ("contact_loss", _contact_start_frame_only, "both"),
+    ("contact_loss", _contact_horizontal, "3-D step"),
     ("local_minima", _minima_strict, "<="),
     ("local_minima", _minima_four, "diagonal"),
     ("local_minima", _minima_roll, "np.roll"),
@@ -244,8 +248,16 @@ def _speed_backward(motion):
     return np.linalg.norm(v, axis=-1) * motion.fps
 
 
-def _foot_relu(world_y):
-    return torch.relu(-world_y[..., K03.FEET]).mean()
+def _contact_numpy(feet, planted, fps):
+    """Frame pair by frame pair, in numpy."""
+    f, p = feet.numpy(), planted.numpy()
+    speeds = [
+        fps * np.linalg.norm(f[..., t + 1, j, :] - f[..., t, j, :], axis=-1)[p[..., t, j] & p[..., t + 1, j]]
+        for t in range(f.shape[-3] - 1)
+        for j in range(4)
+    ]
+    speeds = np.concatenate(speeds)
+    return float(speeds.mean()) if speeds.size else 0.0
 
 
 def _minima_loop(m):
@@ -295,7 +307,7 @@ ALTERNATIVES = [
     ("window_count", _window_count_ceil),
     ("joint_speed", _speed_forward),
     ("joint_speed", _speed_backward),
-    ("foot_loss", _foot_relu),
+    ("contact_loss", _contact_numpy),
     ("local_minima", _minima_loop),
     ("distance_matrix", _distance_by_alignment),
     ("ease", _ease_sin),

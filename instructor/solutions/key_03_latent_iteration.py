@@ -7,10 +7,14 @@ from motionlab.core import humanoid
 FEET = [humanoid.JOINTS.index(n) for n in humanoid.FEET]  # as in the notebook
 
 
-def my_foot_loss(world_y):
-    """Exercise 1: L_foot (eq. 17), mean of |min(y, 0)| over frames and the four foot joints."""
-    feet = world_y[..., FEET]  # (..., T, 4) metres
-    return torch.clamp(feet, max=0.0).abs().mean()
+def my_contact_loss(feet, planted, fps):
+    """Exercise 1: L_contact, the mean speed (m/s) of the foot joints over the steps t -> t + 1 where
+    A's foot is planted in both frames; 0 when it never is."""
+    step = (feet[..., 1:, :, :] - feet[..., :-1, :, :]).norm(dim=-1)  # (..., T-1, 4) metres per frame
+    both = planted[..., 1:, :] & planted[..., :-1, :]
+    if not both.any():
+        return torch.zeros(())
+    return fps * step[both].mean()
 
 
 def _full_method(source, target_rig, ckpt, cfg):

@@ -22,7 +22,7 @@ The named exercises, by notebook (each module holds its exercises' cases, refere
 typical mistakes):
 
 * :mod:`~motionlab.exercises.basics`: 00 ``hand_height``; 01 ``window_count``; 04 ``joint_speed``;
-* :mod:`~motionlab.exercises.retargeting`: 03 ``foot_loss``;
+* :mod:`~motionlab.exercises.retargeting`: 03 ``contact_loss``;
 * :mod:`~motionlab.exercises.motion_graphs`: 05 ``local_minima``, ``distance_matrix``;
 * :mod:`~motionlab.exercises.interpolation`: 06 ``ease``, ``sigma2``, ``jumps``.
 
@@ -51,9 +51,9 @@ from .interpolation import ease, held_out_q, jumps, sigma2
 from .motion_graphs import distance_matrix, local_minima, vanishing_threshold
 from .retargeting import (
     arm_length,
+    contact_loss,
     contact_weight,
     encoder_start,
-    foot_loss,
     foot_weight,
     no_correction,
     q_delta_legs,
@@ -68,7 +68,7 @@ __all__ = [
     "hand_height",
     "window_count",
     "joint_speed",
-    "foot_loss",
+    "contact_loss",
     "local_minima",
     "distance_matrix",
     "ease",
@@ -94,7 +94,7 @@ EXERCISES: dict[str, Exercise] = {
     "hand_height": hand_height,
     "window_count": window_count,
     "joint_speed": joint_speed,
-    "foot_loss": foot_loss,
+    "contact_loss": contact_loss,
     "local_minima": local_minima,
     "distance_matrix": distance_matrix,
     "ease": ease,

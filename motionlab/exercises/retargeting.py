@@ -6,7 +6,7 @@ experiment with the package on the notebook's own inputs (its network, clip and 
 key fits real and synthetic data. Each run is cached per inputs, so a check costs one decode
 (notebook 02) or one latent iteration (notebooks 03 and 07) at most.
 
-``foot_loss`` asks for a function: its cases are small torch tensors drawn from a fixed seed (a
+``contact_loss`` asks for a function: its cases are small torch tensors drawn from a fixed seed (a
 private generator: the notebook's own random state is left alone). torch is imported only when a
 check runs.
 """
@@ -17,7 +17,15 @@ import numpy as np
 
 from .core import Exercise, Mistake, Question
 
-__all__ = ["q_delta_legs", "no_correction", "foot_loss", "encoder_start", "contact_weight", "foot_weight", "arm_length"]
+__all__ = [
+    "q_delta_legs",
+    "no_correction",
+    "contact_loss",
+    "encoder_start",
+    "contact_weight",
+    "foot_weight",
+    "arm_length",
+]
 
 
 def _gen(seed: int):
@@ -119,54 +127,69 @@ no_correction = Question(
 
 
 # --------------------------------------------------------------------------- notebook 03
-def _foot_cases():
+def _contact_cases():
     import torch
 
     g = _gen(300)
+
+    def walk(*shape):  # positions that move a few centimetres per frame, metres
+        return torch.cumsum(0.02 * torch.randn(*shape, 4, 3, generator=g), dim=-3)
+
+    def labels(*shape):
+        return torch.rand(*shape, 4, generator=g) < 0.6
+
     return [
-        (0.05 * torch.randn(3, 50, 22, generator=g),),
-        (0.05 * torch.randn(40, 22, generator=g) - 0.02,),  # no batch dimension, mostly below ground
-        (torch.rand(20, 22, generator=g) + 0.01,),  # every joint above ground: L_foot = 0
+        (walk(2, 30), labels(2, 30), 60.0),
+        (walk(25), labels(25), 30.0),  # no batch dimension, another frame rate
+        (walk(1, 12), torch.zeros(1, 12, 4, dtype=torch.bool), 60.0),  # never planted: 0
     ]
 
 
-def _foot_ref(world_y):
+def _contact_ref(feet, planted, fps):
     from motionlab.retargeting import losses
 
-    return losses.foot_loss(world_y)
+    return losses.contact_loss(feet, planted, fps)
 
 
-def _feet(world_y):
-    from motionlab.retargeting import losses
+def _steps(feet, horizontal=False):
+    d = feet[..., 1:, :, :] - feet[..., :-1, :, :]
+    if horizontal:
+        d = d[..., [0, 2]]
+    return d.norm(dim=-1)  # (..., T-1, 4)
 
-    return world_y[..., list(losses.FOOT_JOINTS)]
+
+def _mean_over(values, mask):
+    mask = mask.to(values.dtype)
+    return (values * mask).sum() / mask.sum().clamp_min(1.0)
 
 
-foot_loss = Exercise(
-    "03 · exercise 1 (L_foot)",
-    _foot_ref,
-    _foot_cases,
-    atol=1e-7,
+def _both(planted):
+    return planted[..., 1:, :] & planted[..., :-1, :]
+
+
+contact_loss = Exercise(
+    "03 · exercise 1 (L_contact)",
+    _contact_ref,
+    _contact_cases,
+    atol=1e-6,
     mistakes=[
         Mistake(
-            lambda y: _feet(y).clamp(max=0).mean(),
-            "your loss is negative: a foot below the floor must cost a positive amount (the depth |min(y, 0)|).",
+            lambda f, p, fps: _mean_over(_steps(f), _both(p)),
+            "that is a distance per frame; L_contact is a speed in m/s (a frame lasts 1 / fps seconds).",
         ),
         Mistake(
-            lambda y: y.clamp(max=0).abs().mean(),
-            "only the four foot joints (FEET: both ankles and toes) count, not all 22 joints.",
+            lambda f, p, fps: fps * _mean_over(_steps(f), p[..., :-1, :]),
+            "a step from frame t to t + 1 counts only when the foot is planted in *both* frames (a foot "
+            "that lifts off or lands moves legitimately).",
         ),
         Mistake(
-            lambda y: _feet(y).abs().mean(),
-            "a foot above the floor costs nothing: only heights below y = 0 enter the loss.",
+            lambda f, p, fps: fps * (_steps(f) * _both(p)).mean(),
+            "average over the planted steps only: dividing by every step (planted or not) makes the "
+            "loss depend on how often the foot is planted.",
         ),
         Mistake(
-            lambda y: (_feet(y).clamp(max=0) ** 2).mean(),
-            "eq. 17 averages the depths |min(y, 0)| themselves, not their squares.",
-        ),
-        Mistake(
-            lambda y: _feet(y).clamp(max=0).abs().sum(-1).mean(),
-            "average over the four feet too, not only over the frames.",
+            lambda f, p, fps: fps * _mean_over(_steps(f, horizontal=True), _both(p)),
+            "a planted foot should not move in the world at all: measure the whole 3-D step, not only x and z.",
         ),
     ],
 )
