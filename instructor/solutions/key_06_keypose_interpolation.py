@@ -37,7 +37,5 @@ def my_held_out_q(clips):
         test.append(f[k:])
     train, test = np.concatenate(train), np.concatenate(test)
     mean, std = train.mean(axis=0), np.maximum(train.std(axis=0), 1e-6)
-    best = max(
-        (1, 2, 4, 8, 16, 32), key=lambda q: PPCA(q).fit((train - mean) / std).log_likelihood((test - mean) / std)
-    )
+    best = max((1, 2, 4, 8, 16, 32), key=lambda q: PPCA(q).fit((train - mean) / std).log_likelihood((test - mean) / std))
     return best
