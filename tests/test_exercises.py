@@ -1,4 +1,4 @@
-"""Every exercise check of notebooks 00, 01, 02, 03, 04, 05 and 06 against the instructor's key (must pass),
+"""Every exercise check of notebooks 00 to 07 against the instructor's key (must pass),
 typical wrong answers written as a student would (must fail, with the matching hint), an
 alternative correct answer where one exists (must pass), and an unattempted stub (must not raise).
 """
@@ -35,18 +35,14 @@ K02 = _key("key_02_training_autoencoder")
 K03 = _key("key_03_latent_iteration")
 K05 = _key("key_05_motion_graphs")
 K06 = _key("key_06_keypose_interpolation")
+K07 = _key("key_07_expanding_a_database")
 
 # (exercise, the key's solution) for every exercise of the notebooks
 SOLUTIONS = {
     "hand_height": K00.left_hand_height_with_arm_raised,
     "window_count": K01.my_window_count,
     "joint_speed": K04.my_joint_speed,
-    "recon_loss": K02.my_recon_loss,
-    "combine": K02.my_combine,
-    "rotations": K02.my_rotations,
-    "foot_loss": K03.my_foot_loss,
-    "root_scale": K03.my_root_scale,
-    "angle_loss": K03.my_angle_loss,
+    "contact_loss": K03.my_contact_loss,
     "local_minima": K05.my_local_minima,
     "ease": K06.my_ease,
     "sigma2": K06.my_sigma2,
@@ -102,67 +98,21 @@ def _speed_short(motion):
     return np.linalg.norm(np.diff(motion.global_positions(), axis=0), axis=-1) * motion.fps
 
 
-# notebooks 02, 03, 05, 06
-def _recon_squared(pred, target):
-    return 0.5 * ((pred - target) ** 2).sum(-1).mean() / 3
+# notebooks 03, 05, 06
+def _contact_per_frame(feet, planted, fps):
+    both = planted[..., 1:, :] & planted[..., :-1, :]
+    return torch.diff(feet, dim=-3).norm(dim=-1)[both].mean() if both.any() else torch.zeros(())
 
 
-def _recon_summed_batch(pred, target):
-    T, J = pred.shape[-3], pred.shape[-2]
-    return 0.5 / (3 * T * J) * torch.sqrt(((pred - target) ** 2).sum(-1)).sum()
+def _contact_start_frame_only(feet, planted, fps):
+    step, start = torch.diff(feet, dim=-3).norm(dim=-1), planted[..., :-1, :]
+    return fps * step[start].mean() if start.any() else torch.zeros(())
 
 
-def _combine_reversed(q, d):
-    return K02.my_combine(d, q)
-
-
-def _combine_plus_dot(q, d):
-    w = q[..., :1] * d[..., :1] + (q[..., 1:] * d[..., 1:]).sum(-1, keepdim=True)
-    v = q[..., :1] * d[..., 1:] + d[..., :1] * q[..., 1:] + torch.cross(q[..., 1:], d[..., 1:], dim=-1)
-    return torch.cat([w, v], -1)
-
-
-def _rotations_unnormalised(net, phi):
-    return net.f_qlinear(phi).reshape(phi.shape[0], phi.shape[1], 22, 4)
-
-
-def _rotations_whole_frame(net, phi):
-    raw = net.f_qlinear(phi)
-    raw = raw / torch.linalg.norm(raw, dim=-1, keepdim=True)
-    return raw.reshape(phi.shape[0], phi.shape[1], 22, 4)
-
-
-def _foot_all_joints(world_y):
-    return torch.relu(-world_y).mean()
-
-
-def _foot_signed(world_y):
-    return torch.minimum(world_y[..., K03.FEET], torch.zeros(())).mean()
-
-
-def _foot_abs(world_y):
-    return world_y[..., K03.FEET].abs().mean()
-
-
-def _root_hip_ratio(a, b):
-    return (b.rest_positions()[0, 1] - b.rest_positions()[:, 1].min()) / (
-        a.rest_positions()[0, 1] - a.rest_positions()[:, 1].min()
-    )
-
-
-def _root_thigh_shin(a, b):
-    def legs(s):
-        return sum(np.linalg.norm(s.offsets[s.index(n)]) for n in ("LeftLeg", "LeftFoot"))
-
-    return legs(b) / legs(a)
-
-
-def _angle_no_sign(a, b):
-    return torch.linalg.norm(a - b, dim=-1).mean()
-
-
-def _angle_radians(a, b):
-    return (2 * torch.acos(torch.clamp(torch.abs((a * b).sum(-1)), max=1.0))).mean()
+def _contact_horizontal(feet, planted, fps):
+    both = planted[..., 1:, :] & planted[..., :-1, :]
+    step = torch.diff(feet[..., [0, 2]], dim=-3).norm(dim=-1)
+    return fps * step[both].mean() if both.any() else torch.zeros(())
 
 
 def _minima_strict(m):
@@ -222,20 +172,9 @@ WRONG = [
     ("joint_speed", _speed_per_frame, "metres per second"),
     ("joint_speed", _speed_short, "one frame fewer"),
     ("joint_speed", lambda m: np.gradient(m.global_positions(), axis=0) * m.fps, "velocity"),
-    ("recon_loss", _recon_squared, "not squared distances"),
-    ("recon_loss", _recon_summed_batch, "average over the batch"),
-    ("combine", _combine_reversed, "not commutative"),
-    ("combine", _combine_plus_dot, "scalar part"),
-    ("rotations", _rotations_unnormalised, "divide each by its norm"),
-    ("rotations", _rotations_whole_frame, "each joint's 4 numbers"),
-    ("foot_loss", _foot_all_joints, "four foot joints"),
-    ("foot_loss", _foot_signed, "negative"),
-    ("foot_loss", _foot_abs, "costs nothing"),
-    ("root_scale", _root_hip_ratio, "r_y"),
-    ("root_scale", _root_thigh_shin, "thigh + shin"),
-    ("root_scale", lambda a, b: K03.my_root_scale(b, a), "upside down"),
-    ("angle_loss", _angle_no_sign, "smaller of"),
-    ("angle_loss", _angle_radians, "rotation angle"),
+    ("contact_loss", _contact_per_frame, "m/s"),
+    ("contact_loss", _contact_start_frame_only, "both"),
+    ("contact_loss", _contact_horizontal, "3-D step"),
     ("local_minima", _minima_strict, "<="),
     ("local_minima", _minima_four, "diagonal"),
     ("local_minima", _minima_roll, "np.roll"),
@@ -297,45 +236,16 @@ def _speed_backward(motion):
     return np.linalg.norm(v, axis=-1) * motion.fps
 
 
-def _recon_numpy_style(pred, target):
-    return 0.5 * torch.sqrt(((pred - target) ** 2).sum(-1)).mean() / 3
-
-
-def _combine_by_matrix(q, d):
-    """q ⊗ p as the 4x4 left-multiplication matrix of q applied to p."""
-    w, x, y, z = q.unbind(-1)
-    rows = [
-        torch.stack([w, -x, -y, -z], -1),
-        torch.stack([x, w, -z, y], -1),
-        torch.stack([y, z, w, -x], -1),
-        torch.stack([z, -y, x, w], -1),
+def _contact_numpy(feet, planted, fps):
+    """Frame pair by frame pair, in numpy."""
+    f, p = feet.numpy(), planted.numpy()
+    speeds = [
+        fps * np.linalg.norm(f[..., t + 1, j, :] - f[..., t, j, :], axis=-1)[p[..., t, j] & p[..., t + 1, j]]
+        for t in range(f.shape[-3] - 1)
+        for j in range(4)
     ]
-    return (torch.stack(rows, -2) @ d[..., None])[..., 0]
-
-
-def _rotations_functional(net, phi):
-    raw = torch.nn.functional.linear(phi, net.f_qlinear.weight, net.f_qlinear.bias)
-    return torch.nn.functional.normalize(raw.view(*phi.shape[:-1], 22, 4), dim=-1)
-
-
-def _foot_relu(world_y):
-    return torch.relu(-world_y[..., K03.FEET]).mean()
-
-
-def _root_from_rest_positions(a, b):
-    def chain(s):
-        p = s.rest_positions()
-        total = 0.0
-        for side in ("Left", "Right"):
-            names = ["Hips"] + [side + j for j in ("UpLeg", "Leg", "Foot", "ToeBase")]
-            total += sum(np.linalg.norm(p[s.index(n)] - p[s.index(m)]) for m, n in zip(names[:-1], names[1:]))
-        return total / 2
-
-    return chain(b) / chain(a)
-
-
-def _angle_by_stack(a, b):
-    return torch.stack([(a - b).norm(dim=-1), (a + b).norm(dim=-1)]).min(dim=0).values.mean()
+    speeds = np.concatenate(speeds)
+    return float(speeds.mean()) if speeds.size else 0.0
 
 
 def _minima_loop(m):
@@ -368,12 +278,7 @@ ALTERNATIVES = [
     ("window_count", _window_count_ceil),
     ("joint_speed", _speed_forward),
     ("joint_speed", _speed_backward),
-    ("recon_loss", _recon_numpy_style),
-    ("combine", _combine_by_matrix),
-    ("rotations", _rotations_functional),
-    ("foot_loss", _foot_relu),
-    ("root_scale", _root_from_rest_positions),
-    ("angle_loss", _angle_by_stack),
+    ("contact_loss", _contact_numpy),
     ("local_minima", _minima_loop),
     ("ease", _ease_sin),
     ("sigma2", _sigma2_svd),
@@ -459,7 +364,9 @@ def style_takes():
 
 
 EXPERIMENT_NAMES = {"nlerp_turn", "euler_order", "hips_heading", "shorter_legs"}  # notebooks 00, 01, 04
-EXPERIMENT_NAMES |= {"foot_weight", "held_out_q", "vanishing_threshold", "style_change"}  # notebooks 03, 05, 06
+EXPERIMENT_NAMES |= {"q_delta_legs", "no_correction", "arm_length"}  # notebooks 02, 07
+EXPERIMENT_NAMES |= {"encoder_start", "contact_weight", "foot_weight"}  # notebook 03
+EXPERIMENT_NAMES |= {"held_out_q", "vanishing_threshold", "style_change"}  # notebooks 05, 06
 
 
 def test_every_experiment_is_listed():
@@ -513,6 +420,185 @@ def test_foot_weight_experiment(retarget_pair):
         if not any(close(value, other) for p, other in wrong.items() if p != phrase):
             assert phrase in result.hint, (phrase, result.message)
     assert not q.check(answer + 10.0, *retarget_pair).passed
+
+
+@pytest.fixture(scope="module")
+def running_pair():
+    """A run onto short legs: unlike the walk, the iteration runs and the contact weight matters."""
+    from motionlab import retargeting, synthetic
+
+    source = synthetic.generate("run", humanoid.canonical_skeleton(), num_frames=60, seed=7)
+    target = synthetic.random_character(5, name="short-legged B", legs=(0.75, 0.8))
+    return source, target, retargeting.load_default()
+
+
+def _full_method_numbers(source, target, ckpt, **settings):
+    """(mean angle to A °, planted-foot slide cm/s, skating cm/s, steps) of the full method, as a student measures them."""
+    from motionlab import retargeting
+    from motionlab.core import metrics, preprocess
+    from motionlab.retargeting import pipeline, plots
+    from motionlab.retargeting.solver import SolverConfig
+
+    run = retargeting.retarget(source, target, ckpt, "full", SolverConfig(**settings))
+    src = preprocess.prepare(source, ckpt.fps)
+    feet = [humanoid.JOINTS.index(n) for n in humanoid.FEET]
+    angle = float(plots.joint_angle_errors(run.motion.local_rot, src.local_rot).mean())
+    slide = 100 * float(metrics.planted_slide(run.positions, feet, pipeline.source_contacts(src), ckpt.fps))
+    return angle, slide, 100 * float(metrics.foot_skating(run.positions, feet, ckpt.fps)), run.steps
+
+
+def _check_wrong(q, answer, wrong, inputs):
+    """Every wrong value fails with a hint, and with its own hint where no other wrong value coincides."""
+
+    def close(a, b):
+        return abs(a - b) <= q.atol + q.rtol * abs(b)
+
+    for phrase, value in wrong.items():
+        if close(value, answer):
+            continue  # on this small case the wrong experiment happens to give the right number
+        result = q.check(value, *inputs)
+        assert not result.passed and result.attempted and result.hint is not None, (phrase, result.message)
+        if not any(close(value, other) for p, other in wrong.items() if p != phrase):
+            assert phrase in result.hint, (phrase, result.message)
+
+
+def test_encoder_start_experiment(running_pair):
+    q = exercises.encoder_start
+    answer = K03.my_encoder_start_experiment(*running_pair)
+    assert q.check(answer, *running_pair).passed
+    angle, _, _, steps = _full_method_numbers(*running_pair, init="encoder")
+    assert q.check(angle, *running_pair).passed  # unrounded
+    default_angle = _full_method_numbers(*running_pair)[0]
+    assert angle > default_angle + 0.1, "without the Gauss-Newton start the result ends further from A's angles"
+    wrong = {
+        "lr=0.1": _full_method_numbers(*running_pair, init="encoder", lr=0.1)[0],
+        "paper's set-up": _full_method_numbers(*running_pair, init="encoder", lambda_contact=0.0, lr=0.1)[0],
+        "default run": default_angle,
+        "radians": np.radians(angle),
+    }
+    _check_wrong(q, answer, wrong, running_pair)
+    assert not q.check(answer + 5.0, *running_pair).passed
+
+
+def test_contact_weight_experiment(running_pair):
+    q = exercises.contact_weight
+    answer = K03.my_contact_weight_experiment(*running_pair)
+    assert q.check(answer, *running_pair).passed
+    _, slide, skating, _ = _full_method_numbers(*running_pair, lambda_contact=0.1)
+    assert q.check(slide, *running_pair).passed  # unrounded
+    no_contact, default = (_full_method_numbers(*running_pair, lambda_contact=w)[1] for w in (0.0, 0.5))
+    assert default < slide < no_contact, "a fifth of the weight removes part of the sliding, the default more"
+    wrong = {"λ_contact = 0.5": default, "λ_contact = 0)": no_contact, "skating": skating, "m/s": slide / 100}
+    _check_wrong(q, answer, wrong, running_pair)
+    assert not q.check(answer + 1.0, *running_pair).passed
+
+
+@pytest.fixture(scope="module")
+def decoded_clip():
+    """The shipped network and a synthetic run on its own character (notebook 02's held-out clip, synthetic)."""
+    from motionlab import retargeting, synthetic
+
+    ckpt = retargeting.load_default()
+    return ckpt, synthetic.generate("run", ckpt.skeleton, num_frames=60, seed=123)
+
+
+def _decode_as_a_student(ckpt, clip, legs):
+    """(true positions, decoded on A, decoded with legs × ``legs``, A's offsets), written from section 6's cell."""
+    from motionlab.core import preprocess
+    from motionlab.retargeting.features import clip_features
+
+    prepared = preprocess.prepare(clip, ckpt.fps)
+    feats = clip_features(prepared)
+    x = torch.as_tensor(ckpt.stats.normalize(feats.x), dtype=ckpt.dtype)[None]
+    own = torch.tensor(prepared.skeleton.offsets, dtype=ckpt.dtype)
+    other = torch.tensor(humanoid.scale_bones(prepared.skeleton, legs=legs).offsets, dtype=ckpt.dtype)
+    with torch.no_grad():
+        phi = ckpt.model.encode(x)
+        return feats.positions, ckpt.model.decode(phi, own), ckpt.model.decode(phi, other), own
+
+
+def test_q_delta_legs_experiment(decoded_clip):
+    from motionlab.core import quat
+
+    q = exercises.q_delta_legs
+    answer = K02.my_q_delta_legs_experiment(*decoded_clip)
+    assert q.check(answer, *decoded_clip).passed
+
+    def per_joint(legs, identity=False):  # degrees, mean over frames, with numpy's quaternions (the alternative)
+        _, on_a, on_b, _ = _decode_as_a_student(*decoded_clip, legs)
+        a = on_a.q_delta[0].numpy()
+        b = np.broadcast_to(quat.IDENTITY, a.shape) if identity else on_b.q_delta[0].numpy()
+        return np.degrees(quat.angle_between(a, b)).mean(axis=0)
+
+    assert q.check(per_joint(0.7).max(), *decoded_clip).passed
+    wrong = {
+        "1.3": per_joint(1.3).max(),
+        "mean over the joints": per_joint(0.7).mean(),
+        "size of q_Δ": per_joint(0.7, identity=True).max(),
+        "radians": np.radians(per_joint(0.7).max()),
+    }
+    _check_wrong(q, answer, wrong, decoded_clip)
+    assert not q.check(answer + 1.0, *decoded_clip).passed
+
+
+def test_no_correction_experiment(decoded_clip):
+    q = exercises.no_correction
+    answer = K02.my_no_correction_experiment(*decoded_clip)
+    assert q.check(answer, *decoded_clip).passed
+    truth, on_a, _, own = _decode_as_a_student(*decoded_clip, 0.7)
+
+    def error_m(local_rot):
+        return float(np.linalg.norm(ckpt_fk(local_rot, own) - truth, axis=-1).mean())
+
+    def ckpt_fk(local_rot, offsets):
+        return decoded_clip[0].model.forward_kinematics(local_rot, offsets)[0].numpy()
+
+    assert q.check(100 * error_m(on_a.q), *decoded_clip).passed  # unrounded
+    with_correction = 100 * error_m(on_a.local_rot)
+    assert 100 * error_m(on_a.q) > with_correction, "dropping q_Δ makes A's own reconstruction worse"
+    wrong = {"with the correction": with_correction, "metres": error_m(on_a.q)}
+    _check_wrong(q, answer, wrong, decoded_clip)
+    assert not q.check(answer + 1.0, *decoded_clip).passed
+
+
+@pytest.fixture(scope="module")
+def squat_file(tmp_path_factory):
+    """A synthetic squat saved as BVH (notebook 07 checks a clip by its path), the shipped network, a short solve."""
+    from motionlab import retargeting, synthetic
+    from motionlab.core import bvh
+    from motionlab.retargeting.solver import SolverConfig
+
+    clip = synthetic.generate("squat", humanoid.canonical_skeleton(), num_frames=60, seed=3)
+    path = bvh.save(tmp_path_factory.mktemp("clips") / "squat.bvh", clip)
+    return str(path), retargeting.load_default("cpu"), SolverConfig(max_steps=5)
+
+
+def test_arm_length_experiment(squat_file):
+    from motionlab.core import bvh
+    from motionlab.retargeting.pipeline import retarget
+
+    q = exercises.arm_length
+    answer = K07.my_arm_length_experiment(*squat_file)
+    assert q.check(answer, *squat_file).passed
+    clip_path, ckpt, cfg = squat_file
+
+    def result(arms):  # as a student runs it
+        return retarget(
+            bvh.load(clip_path), humanoid.scale_bones(humanoid.canonical_skeleton(), arms=arms), ckpt, solver=cfg
+        )
+
+    arms_13 = result(1.3)
+    assert q.check(arms_13.plausibility.lowest, *squat_file).passed  # unrounded
+    lowest_m = float(arms_13.positions[..., 1].min())
+    assert abs(arms_13.plausibility.lowest - lowest_m / humanoid.leg_length(arms_13.motion.skeleton)) < 1e-6
+    wrong = {
+        "1.35": result(1.35).plausibility.lowest,
+        "source_lowest": arms_13.plausibility.source_lowest,
+        "centimetres": 100 * lowest_m,
+        "metres": lowest_m,
+    }
+    _check_wrong(q, answer, wrong, squat_file)
+    assert not q.check(answer + 0.5, *squat_file).passed
 
 
 def test_held_out_q_experiment(behaviour_clips):

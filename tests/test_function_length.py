@@ -18,12 +18,6 @@ LIMIT = 80
 MARK = "# long-function:"
 
 ALLOWED = {
-    "retargeting/solver.py::_iterate",
-    "retargeting/cli.py::register",
-    "retargeting/cli.py::_cmd_evaluate",
-    "retargeting/train.py::train",
-    "retargeting/evaluate.py::evaluate",
-    "retargeting/plots.py::draw_architecture",
     "interpolation/gaps.py::fill",
     "interpolation/detect.py::estimate_missing",
 }

@@ -1,28 +1,44 @@
-"""Instructor's key for notebook 02 (the retargeting network and its training)."""
+"""Instructor's key for notebook 02 (the retargeting network and its training).
 
+Both exercises are experiments: the key reruns section 6's cell with the changed setting and
+returns the number the cell prints. ``ckpt`` is the notebook's loaded checkpoint (``loaded``),
+``held_out`` its held-out clip.
+"""
+
+import numpy as np
 import torch
 
-LAMBDA = 0.5
+from motionlab.core import humanoid, preprocess
+from motionlab.core import quat_torch as tq
+from motionlab.retargeting.features import clip_features
 
 
-def my_recon_loss(pred, target):
-    """Exercise 1: L_recon (eq. 8) of positions (..., T, J, 3), averaged over leading dimensions."""
-    T, J = pred.shape[-3], pred.shape[-2]
-    per_window = LAMBDA / (3 * T * J) * (pred - target).norm(dim=-1).sum(dim=(-2, -1))  # (...,)
-    return per_window.mean()
+def _encode(ckpt, held_out):
+    clip = preprocess.prepare(held_out, ckpt.fps)
+    feats = clip_features(clip)
+    x_clip = torch.as_tensor(ckpt.stats.normalize(feats.x), dtype=ckpt.dtype)[None]
+    clip_offsets = torch.tensor(clip.skeleton.offsets, dtype=ckpt.dtype)
+    with torch.no_grad():
+        phi_clip = ckpt.model.encode(x_clip)
+    return clip, feats, phi_clip, clip_offsets
 
 
-def my_combine(q, q_delta):
-    """Exercise 2: the Hamilton product q ⊗ q_Δ of (..., 4) quaternions (w, x, y, z), written out."""
-    w1, v1 = q[..., :1], q[..., 1:]
-    w2, v2 = q_delta[..., :1], q_delta[..., 1:]
-    w = w1 * w2 - (v1 * v2).sum(dim=-1, keepdim=True)
-    v = w1 * v2 + w2 * v1 + torch.linalg.cross(v1, v2, dim=-1)
-    return torch.cat([w, v], dim=-1)
+def my_q_delta_legs_experiment(ckpt, held_out):
+    """Exercise 1: section 6's comparison with legs × 0.7; the largest change of q_Δ over all joints, degrees."""
+    clip, _, phi_clip, clip_offsets = _encode(ckpt, held_out)
+    short_legs = humanoid.scale_bones(clip.skeleton, legs=0.7)
+    with torch.no_grad():
+        on_a = ckpt.model.decode(phi_clip, clip_offsets)
+        on_b = ckpt.model.decode(phi_clip, torch.tensor(short_legs.offsets, dtype=ckpt.dtype))
+    change = np.degrees(tq.angle_between(on_a.q_delta, on_b.q_delta).mean(dim=(0, 1)).numpy())
+    return round(float(change.max()), 3)
 
 
-def my_rotations(net, phi):
-    """Exercise 3: F_qlinear's output, (B, T, D) -> unit quaternions (B, T, 22, 4)."""
-    raw = net.f_qlinear(phi)  # (B, T, 88)
-    q = raw.reshape(phi.shape[0], phi.shape[1], 22, 4)
-    return q / q.norm(dim=-1, keepdim=True)
+def my_no_correction_experiment(ckpt, held_out):
+    """Exercise 2: the held-out clip decoded with q alone (no q_Δ) on A's skeleton; mean joint error, cm."""
+    _, feats, phi_clip, clip_offsets = _encode(ckpt, held_out)
+    with torch.no_grad():
+        decoded = ckpt.model.decode(phi_clip, clip_offsets)
+        positions = ckpt.model.forward_kinematics(decoded.q, clip_offsets)[0].numpy()
+    err = 100 * np.linalg.norm(positions - feats.positions, axis=-1)
+    return round(float(err.mean()), 2)

@@ -1,6 +1,5 @@
 """Instructor's key for notebook 03 (the latent iteration)."""
 
-import numpy as np
 import torch
 
 from motionlab.core import humanoid
@@ -8,30 +7,43 @@ from motionlab.core import humanoid
 FEET = [humanoid.JOINTS.index(n) for n in humanoid.FEET]  # as in the notebook
 
 
-def my_foot_loss(world_y):
-    """Exercise 1: L_foot (eq. 17), mean of |min(y, 0)| over frames and the four foot joints."""
-    feet = world_y[..., FEET]  # (..., T, 4) metres
-    return torch.clamp(feet, max=0.0).abs().mean()
+def my_contact_loss(feet, planted, fps):
+    """Exercise 1: L_contact, the mean speed (m/s) of the foot joints over the steps t -> t + 1 where
+    A's foot is planted in both frames; 0 when it never is."""
+    step = (feet[..., 1:, :, :] - feet[..., :-1, :, :]).norm(dim=-1)  # (..., T-1, 4) metres per frame
+    both = planted[..., 1:, :] & planted[..., :-1, :]
+    if not both.any():
+        return torch.zeros(())
+    return fps * step[both].mean()
 
 
-def _leg_chain(skeleton):
-    lengths = []
-    for side in ("Left", "Right"):
-        chain = [side + j for j in ("UpLeg", "Leg", "Foot", "ToeBase")]
-        lengths.append(sum(np.linalg.norm(skeleton.offsets[skeleton.index(name)]) for name in chain))
-    return np.mean(lengths)
+def _full_method(source, target_rig, ckpt, cfg):
+    """(the full method's result, A prepared) for one solver configuration."""
+    from motionlab import retargeting
+    from motionlab.core import preprocess
+
+    run = retargeting.retarget(source, target_rig, ckpt, "full", cfg)
+    return run, preprocess.prepare(source, ckpt.fps)
 
 
-def my_root_scale(source_skeleton, target_skeleton):
-    """Exercise 2: r_xz, B's leg chain over A's (both legs averaged), from the bone offsets."""
-    return _leg_chain(target_skeleton) / _leg_chain(source_skeleton)
+def my_encoder_start_experiment(source, target_rig, ckpt):
+    """Exercise 2: motionlab's settings with the encoder's start; mean angle to A's rotations, degrees."""
+    from motionlab.retargeting import plots
+    from motionlab.retargeting.solver import SolverConfig
+
+    run, src = _full_method(source, target_rig, ckpt, SolverConfig(init="encoder"))
+    return round(float(plots.joint_angle_errors(run.motion.local_rot, src.local_rot).mean()), 2)
 
 
-def my_angle_loss(source_rot, generated_rot):
-    """Exercise 3: L_angle, mean of min(‖q_A − q_B'‖, ‖q_A + q_B'‖) over frames and joints."""
-    minus = (source_rot - generated_rot).norm(dim=-1)
-    plus = (source_rot + generated_rot).norm(dim=-1)
-    return torch.minimum(minus, plus).mean()
+def my_contact_weight_experiment(source, target_rig, ckpt):
+    """Exercise 3: λ_contact = 0.1; speed of A's planted feet on B, cm/s, as section 5 measures it."""
+    from motionlab.core import metrics
+    from motionlab.retargeting import pipeline
+    from motionlab.retargeting.solver import SolverConfig
+
+    run, src = _full_method(source, target_rig, ckpt, SolverConfig(lambda_contact=0.1))
+    planted_a = pipeline.source_contacts(src)
+    return round(100 * float(metrics.planted_slide(run.positions, FEET, planted_a, ckpt.fps)), 2)
 
 
 def my_foot_weight_experiment(source, target_rig, ckpt):

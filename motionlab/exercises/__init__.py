@@ -22,8 +22,7 @@ The named exercises, by notebook (each module holds its exercises' cases, refere
 typical mistakes):
 
 * :mod:`~motionlab.exercises.basics`: 00 ``hand_height``; 01 ``window_count``; 04 ``joint_speed``;
-* :mod:`~motionlab.exercises.retargeting`: 02 ``recon_loss``, ``combine``, ``rotations``;
-  03 ``foot_loss``, ``root_scale``, ``angle_loss``;
+* :mod:`~motionlab.exercises.retargeting`: 03 ``contact_loss``;
 * :mod:`~motionlab.exercises.motion_graphs`: 05 ``local_minima``;
 * :mod:`~motionlab.exercises.interpolation`: 06 ``ease``, ``sigma2``, ``jumps``.
 
@@ -31,9 +30,13 @@ Experiments (:class:`Question`: change a parameter, run the experiment, type the
 the check reruns it on the notebook's own inputs): 00 ``nlerp_turn`` (SLERP against nlerp on a
 smaller turn), ``euler_order`` (the same angles in another channel order); 01 ``hips_heading``
 (the heading from the hips alone); 04 ``shorter_legs`` (copying rotations onto shorter legs);
-03 ``foot_weight`` (λ_foot in the paper's set-up); 05 ``style_change`` (the ``dwell`` at which a
-style change lasts a gait cycle) and ``vanishing_threshold`` (the graph threshold at which a style
-leaves the pruned standard graph); 06 ``held_out_q`` (q by likelihood on truly held-out frames).
+02 ``q_delta_legs`` (how much q_Δ changes on shorter
+legs), ``no_correction`` (decoding without q_Δ); 03 ``encoder_start`` (motionlab without the
+Gauss–Newton start), ``contact_weight`` (a fifth of the contact weight), ``foot_weight`` (λ_foot in
+the paper's set-up), 06 ``held_out_q`` (q by likelihood on truly held-out frames), 05
+``style_change`` (the ``dwell`` at which a style change lasts a gait cycle),
+``vanishing_threshold`` (the graph threshold at which a style leaves the pruned standard graph); 07
+``arm_length`` (how low a longer arm reaches under the floor).
 
 Their reference solutions, as a student would write them, are in ``instructor/solutions/`` (the
 instructor's key, outside the students' ``notebooks/`` folder), and ``tests/test_exercises.py`` runs every check against the key, typical wrong
@@ -47,7 +50,15 @@ from .basics import euler_order, hand_height, hips_heading, joint_speed, nlerp_t
 from .core import Exercise, Mistake, Question, Result, check
 from .interpolation import ease, held_out_q, jumps, sigma2
 from .motion_graphs import local_minima, style_change, vanishing_threshold
-from .retargeting import angle_loss, combine, foot_loss, foot_weight, recon_loss, root_scale, rotations
+from .retargeting import (
+    arm_length,
+    contact_loss,
+    contact_weight,
+    encoder_start,
+    foot_weight,
+    no_correction,
+    q_delta_legs,
+)
 
 __all__ = [
     "Exercise",
@@ -58,12 +69,7 @@ __all__ = [
     "hand_height",
     "window_count",
     "joint_speed",
-    "recon_loss",
-    "combine",
-    "rotations",
-    "foot_loss",
-    "root_scale",
-    "angle_loss",
+    "contact_loss",
     "local_minima",
     "ease",
     "sigma2",
@@ -72,10 +78,15 @@ __all__ = [
     "euler_order",
     "hips_heading",
     "shorter_legs",
+    "q_delta_legs",
+    "no_correction",
+    "encoder_start",
+    "contact_weight",
     "foot_weight",
     "held_out_q",
     "vanishing_threshold",
     "style_change",
+    "arm_length",
     "EXERCISES",
     "EXPERIMENTS",
 ]
@@ -84,12 +95,7 @@ EXERCISES: dict[str, Exercise] = {
     "hand_height": hand_height,
     "window_count": window_count,
     "joint_speed": joint_speed,
-    "recon_loss": recon_loss,
-    "combine": combine,
-    "rotations": rotations,
-    "foot_loss": foot_loss,
-    "root_scale": root_scale,
-    "angle_loss": angle_loss,
+    "contact_loss": contact_loss,
     "local_minima": local_minima,
     "ease": ease,
     "sigma2": sigma2,
@@ -105,10 +111,15 @@ EXPERIMENTS: dict[str, Question] = {
     "euler_order": euler_order,
     "hips_heading": hips_heading,
     "shorter_legs": shorter_legs,
+    "q_delta_legs": q_delta_legs,
+    "no_correction": no_correction,
+    "encoder_start": encoder_start,
+    "contact_weight": contact_weight,
     "foot_weight": foot_weight,
     "held_out_q": held_out_q,
     "vanishing_threshold": vanishing_threshold,
     "style_change": style_change,
+    "arm_length": arm_length,
 }
 """Every experiment exercise (a :class:`Question`: change a parameter, run, report a number).
 

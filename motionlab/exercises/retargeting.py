@@ -1,8 +1,14 @@
-"""Exercises of notebooks 02 (the retargeting network) and 03 (the latent iteration).
+"""Exercises of notebooks 02 (the retargeting network), 03 (the latent iteration) and 07 (a database).
 
-The cases are small torch tensors drawn from a fixed seed (a private generator: the notebook's
-own random state is left alone), so every check is deterministic and takes milliseconds. torch
-is imported only when a check runs.
+Most are experiments (:class:`~motionlab.exercises.core.Question`): the student changes one
+parameter of a cell, runs it and types the number it gives; the check reruns the changed
+experiment with the package on the notebook's own inputs (its network, clip and target), so one
+key fits real and synthetic data. Each run is cached per inputs, so a check costs one decode
+(notebook 02) or one latent iteration (notebooks 03 and 07) at most.
+
+``contact_loss`` asks for a function: its cases are small torch tensors drawn from a fixed seed (a
+private generator: the notebook's own random state is left alone). torch is imported only when a
+check runs.
 """
 
 from __future__ import annotations
@@ -11,7 +17,15 @@ import numpy as np
 
 from .core import Exercise, Mistake, Question
 
-__all__ = ["recon_loss", "combine", "rotations", "foot_loss", "root_scale", "angle_loss", "foot_weight"]
+__all__ = [
+    "q_delta_legs",
+    "no_correction",
+    "contact_loss",
+    "encoder_start",
+    "contact_weight",
+    "foot_weight",
+    "arm_length",
+]
 
 
 def _gen(seed: int):
@@ -20,368 +34,260 @@ def _gen(seed: int):
     return torch.Generator().manual_seed(seed)
 
 
-def _unit_quats(shape: tuple, seed: int):
+# --------------------------------------------------------------------------- notebook 02, experiments
+_DECODED: dict = {}
+
+
+def _decoded(checkpoint, clip, legs: float):
+    """(features of the prepared clip, its offsets, the clip decoded on its own skeleton and on it with legs × ``legs``)."""
     import torch
 
-    q = torch.randn(*shape, 4, generator=_gen(seed))
-    return q / q.norm(dim=-1, keepdim=True)
+    from motionlab.core import humanoid, preprocess
+    from motionlab.retargeting.features import clip_features
+
+    key = (id(checkpoint), id(clip), legs)
+    if key not in _DECODED:
+        prepared = preprocess.prepare(clip, checkpoint.fps)
+        feats = clip_features(prepared)
+        x = torch.as_tensor(checkpoint.stats.normalize(feats.x), dtype=checkpoint.dtype)[None]
+        own = torch.tensor(prepared.skeleton.offsets, dtype=checkpoint.dtype)
+        other = torch.tensor(humanoid.scale_bones(prepared.skeleton, legs=legs).offsets, dtype=checkpoint.dtype)
+        model = checkpoint.model.cpu()
+        with torch.no_grad():
+            phi = model.encode(x)
+            _DECODED[key] = (feats, own, model.decode(phi, own), model.decode(phi, other))
+    return _DECODED[key]
 
 
-# --------------------------------------------------------------------------- notebook 02
-def _recon_cases():
-    import torch
+def _q_delta_change(checkpoint, clip, legs: float = 0.7, reduce=np.max, against_identity=False, degrees=True):
+    """Largest (over joints) mean (over frames) angle between q_Δ on A's skeleton and on A with legs × ``legs``."""
+    from motionlab.core import quat_torch as tq
 
-    g = _gen(200)
-    return [
-        (torch.randn(2, 120, 22, 3, generator=g), torch.randn(2, 120, 22, 3, generator=g)),
-        (0.1 * torch.randn(30, 22, 3, generator=g), torch.zeros(30, 22, 3)),  # no batch dimension
-        (torch.randn(3, 4, 10, 5, 3, generator=g), torch.randn(3, 4, 10, 5, 3, generator=g)),  # two batch dims
-    ]
-
-
-def _recon_ref(pred, target):
-    from motionlab.retargeting import losses
-
-    return losses.recon_loss(pred, target)
+    _, _, on_a, on_b = _decoded(checkpoint, clip, legs)
+    other = tq.IDENTITY.to(on_a.q_delta) if against_identity else on_b.q_delta
+    per_joint = tq.angle_between(on_a.q_delta, other).mean(dim=(0, 1)).numpy()  # (22,) radians
+    value = float(reduce(per_joint))
+    return float(np.degrees(value)) if degrees else value
 
 
-def _distances(pred, target):
-    return (pred - target).norm(dim=-1)  # (..., T, J)
-
-
-recon_loss = Exercise(
-    "02 · exercise 1 (L_recon)",
-    _recon_ref,
-    _recon_cases,
-    atol=1e-6,
+q_delta_legs = Question(
+    "02 · exercise 1 (experiment: q_Δ on shorter legs)",
+    lambda checkpoint, clip: _q_delta_change(checkpoint, clip, 0.7),
+    atol=0.0006,  # an answer typed with three decimals, as section 6 prints it, passes
+    rtol=0.005,
     mistakes=[
         Mistake(
-            lambda p, t: 0.5 * ((p - t) ** 2).sum(-1).mean() / 3,
-            "eq. 8 sums Euclidean distances ‖p − p'‖₂, not squared distances.",
+            lambda checkpoint, clip: _q_delta_change(checkpoint, clip, 1.3),
+            "that is section 6's experiment, legs × 1.3; the exercise asks for legs × 0.7.",
         ),
         Mistake(
-            lambda p, t: 0.5 * (p - t).abs().mean(),
-            "the distance between two joints is the length of the difference vector (a norm over "
-            "x, y, z), not the sum of its coordinates' absolute values.",
-        ),
-        Mistake(lambda p, t: _distances(p, t).mean() / 3, "you left out λ_recon = 0.5."),
-        Mistake(
-            lambda p, t: 0.5 * _distances(p, t).mean(),
-            "look again at the normalisation: eq. 8 divides by 3TJ, not by TJ.",
+            lambda checkpoint, clip: _q_delta_change(checkpoint, clip, 0.7, np.mean),
+            "that is the mean over the joints; report the largest change over all joints, as section 6 prints it.",
         ),
         Mistake(
-            lambda p, t: 0.5 * _distances(p, t).sum() / (3 * p.shape[-3] * p.shape[-2]),
-            "right for one window only: average over the batch (any leading dimensions), do not sum over it.",
+            lambda checkpoint, clip: _q_delta_change(checkpoint, clip, 0.7, against_identity=True),
+            "that is the size of q_Δ itself (its angle to the identity); the question is how much q_Δ "
+            "*changes* between A's legs and the shorter legs.",
+        ),
+        Mistake(
+            lambda checkpoint, clip: _q_delta_change(checkpoint, clip, 0.7, degrees=False),
+            "that number is in radians; section 6 prints degrees.",
         ),
     ],
 )
 
 
-def _combine_cases():
-    return [
-        (_unit_quats((5,), 201), _unit_quats((5,), 202)),
-        (_unit_quats((2, 3, 22), 203), _unit_quats((2, 3, 22), 204)),
-    ]
-
-
-def _combine_ref(q, q_delta):
+def _joint_error_cm(checkpoint, clip, correction: bool = False, centimetres: bool = True):
+    """Mean joint error of the clip decoded on its own skeleton, with or without the correction q_Δ."""
     from motionlab.retargeting.model import RetargetNet
 
-    return RetargetNet.combine(q, q_delta)
+    feats, offsets, on_a, _ = _decoded(checkpoint, clip, 0.7)
+    positions = on_a.positions if correction else RetargetNet.forward_kinematics(on_a.q, offsets)
+    err = np.linalg.norm(positions[0].numpy() - feats.positions, axis=-1).mean()
+    return float(100 * err if centimetres else err)
 
 
-def _hamilton(q, p, cross_sign: float = 1.0, dot_sign: float = -1.0):
-    import torch
-
-    w1, v1, w2, v2 = q[..., :1], q[..., 1:], p[..., :1], p[..., 1:]
-    w = w1 * w2 + dot_sign * (v1 * v2).sum(-1, keepdim=True)
-    v = w1 * v2 + w2 * v1 + cross_sign * torch.linalg.cross(v1, v2, dim=-1)
-    return torch.cat([w, v], dim=-1)
-
-
-combine = Exercise(
-    "02 · exercise 2 (Hamilton correction)",
-    _combine_ref,
-    _combine_cases,
-    atol=1e-6,
+no_correction = Question(
+    "02 · exercise 2 (experiment: decoding without q_Δ)",
+    lambda checkpoint, clip: _joint_error_cm(checkpoint, clip),
+    atol=0.006,  # an answer typed with two decimals passes
+    rtol=0.005,
     mistakes=[
         Mistake(
-            lambda q, d: _hamilton(q, d, cross_sign=-1.0),
-            "the order of the factors matters (the product is not commutative): look at the sign "
-            "of the cross-product term, v₁ × v₂ is not v₂ × v₁.",
+            lambda checkpoint, clip: _joint_error_cm(checkpoint, clip, correction=True),
+            "that is section 6's error, with the correction; decode with q alone: FK of `decoded.q`, not "
+            "of `decoded.local_rot` (= q ⊗ q_Δ).",
         ),
         Mistake(
-            lambda q, d: _hamilton(q, d, dot_sign=1.0),
-            "check the sign of the scalar part: w₁w₂ and v₁·v₂ do not simply add.",
-        ),
-        Mistake(
-            lambda q, d: _hamilton(q, d, cross_sign=0.0),
-            "the vector part has three terms; one of them is a cross product.",
-        ),
-        Mistake(lambda q, d: q * d, "that is the component-wise product, not the Hamilton product."),
-    ],
-)
-
-
-def _small_net():
-    """A small RetargetNet whose F_qlinear has seeded random weights (the default init is the identity)."""
-    import torch
-
-    from motionlab.retargeting.model import ModelConfig, RetargetNet
-
-    net = RetargetNet(ModelConfig(latent=16, hidden=16, skel_embed=4)).eval()
-    g = _gen(205)
-    with torch.no_grad():
-        net.f_qlinear.weight.copy_(0.3 * torch.randn(net.f_qlinear.weight.shape, generator=g))
-        net.f_qlinear.bias.copy_(0.3 * torch.randn(net.f_qlinear.bias.shape, generator=g))
-    return net
-
-
-def _rotations_cases():
-    import torch
-
-    net, g = _small_net(), _gen(206)
-    return [(net, torch.randn(2, 30, 16, generator=g)), (net, torch.randn(1, 5, 16, generator=g))]
-
-
-def _rotations_ref(net, phi):
-    import torch
-
-    with torch.no_grad():
-        return net.rotations(phi)
-
-
-def _raw(net, phi):
-    import torch
-
-    with torch.no_grad():
-        return net.f_qlinear(phi)
-
-
-rotations = Exercise(
-    "02 · exercise 3 (F_qlinear)",
-    _rotations_ref,
-    _rotations_cases,
-    atol=1e-5,
-    mistakes=[
-        Mistake(
-            lambda n, phi: _raw(n, phi).reshape(*phi.shape[:2], 22, 4),
-            "the shape is right but the quaternions are not unit length: divide each by its norm.",
-        ),
-        Mistake(
-            lambda n, phi: (_raw(n, phi) / _raw(n, phi).norm(dim=-1, keepdim=True)).reshape(*phi.shape[:2], 22, 4),
-            "you normalised the 88 numbers of a frame together; each joint's 4 numbers must have length 1.",
-        ),
-        Mistake(
-            lambda n, phi: _unit_last(_raw(n, phi).reshape(*phi.shape[:2], 4, 22).transpose(-1, -2)),
-            "the 88 outputs are 22 groups of 4 consecutive numbers (joint by joint): reshape to (B, T, 22, 4) directly.",
+            lambda checkpoint, clip: _joint_error_cm(checkpoint, clip, centimetres=False),
+            "that number is in metres; section 6 prints centimetres.",
         ),
     ],
 )
-
-
-def _unit_last(x):
-    return x / x.norm(dim=-1, keepdim=True)
 
 
 # --------------------------------------------------------------------------- notebook 03
-def _foot_cases():
+def _contact_cases():
     import torch
 
     g = _gen(300)
+
+    def walk(*shape):  # positions that move a few centimetres per frame, metres
+        return torch.cumsum(0.02 * torch.randn(*shape, 4, 3, generator=g), dim=-3)
+
+    def labels(*shape):
+        return torch.rand(*shape, 4, generator=g) < 0.6
+
     return [
-        (0.05 * torch.randn(3, 50, 22, generator=g),),
-        (0.05 * torch.randn(40, 22, generator=g) - 0.02,),  # no batch dimension, mostly below ground
-        (torch.rand(20, 22, generator=g) + 0.01,),  # every joint above ground: L_foot = 0
+        (walk(2, 30), labels(2, 30), 60.0),
+        (walk(25), labels(25), 30.0),  # no batch dimension, another frame rate
+        (walk(1, 12), torch.zeros(1, 12, 4, dtype=torch.bool), 60.0),  # never planted: 0
     ]
 
 
-def _foot_ref(world_y):
+def _contact_ref(feet, planted, fps):
     from motionlab.retargeting import losses
 
-    return losses.foot_loss(world_y)
+    return losses.contact_loss(feet, planted, fps)
 
 
-def _feet(world_y):
-    from motionlab.retargeting import losses
-
-    return world_y[..., list(losses.FOOT_JOINTS)]
-
-
-foot_loss = Exercise(
-    "03 · exercise 1 (L_foot)",
-    _foot_ref,
-    _foot_cases,
-    atol=1e-7,
-    mistakes=[
-        Mistake(
-            lambda y: _feet(y).clamp(max=0).mean(),
-            "your loss is negative: a foot below the floor must cost a positive amount (the depth |min(y, 0)|).",
-        ),
-        Mistake(
-            lambda y: y.clamp(max=0).abs().mean(),
-            "only the four foot joints (FEET: both ankles and toes) count, not all 22 joints.",
-        ),
-        Mistake(
-            lambda y: _feet(y).abs().mean(),
-            "a foot above the floor costs nothing: only heights below y = 0 enter the loss.",
-        ),
-        Mistake(
-            lambda y: (_feet(y).clamp(max=0) ** 2).mean(),
-            "eq. 17 averages the depths |min(y, 0)| themselves, not their squares.",
-        ),
-        Mistake(
-            lambda y: _feet(y).clamp(max=0).abs().sum(-1).mean(),
-            "average over the four feet too, not only over the frames.",
-        ),
-    ],
-)
+def _steps(feet, horizontal=False):
+    d = feet[..., 1:, :, :] - feet[..., :-1, :, :]
+    if horizontal:
+        d = d[..., [0, 2]]
+    return d.norm(dim=-1)  # (..., T-1, 4)
 
 
-def _root_cases():
-    from motionlab import synthetic
-    from motionlab.core import humanoid
-
-    base = humanoid.canonical_skeleton(1.75)
-    return [
-        (base, humanoid.scale_bones(base, legs=1.3)),
-        (base, synthetic.random_character(5, legs=(0.75, 0.8))),
-        (humanoid.canonical_skeleton(1.60), base),
-        (base, humanoid.scale_bones(base, arms=1.4)),  # arms only: the legs, and r_xz, do not change
-    ]
+def _mean_over(values, mask):
+    mask = mask.to(values.dtype)
+    return (values * mask).sum() / mask.sum().clamp_min(1.0)
 
 
-def _root_ref(source_skeleton, target_skeleton):
-    from motionlab.retargeting import pipeline
-
-    return pipeline.root_scale(source_skeleton, target_skeleton)[0]
+def _both(planted):
+    return planted[..., 1:, :] & planted[..., :-1, :]
 
 
-def _ratio_of(measure):
-    def wrong(a, b):
-        return measure(b) / measure(a)
-
-    return wrong
-
-
-def _hip_height(sk):
-    from motionlab.retargeting import pipeline
-
-    return pipeline.hip_height(sk)
-
-
-def _thigh_shin(sk):
-    from motionlab.core import humanoid
-
-    return humanoid.leg_length(sk)
-
-
-def _height(sk):
-    return sk.height()
-
-
-root_scale = Exercise(
-    "03 · exercise 2 (root scale r_xz)",
-    _root_ref,
-    _root_cases,
+contact_loss = Exercise(
+    "03 · exercise 1 (L_contact)",
+    _contact_ref,
+    _contact_cases,
     atol=1e-6,
     mistakes=[
         Mistake(
-            _ratio_of(_hip_height),
-            "that is r_y, the ratio of the hip heights. r_xz sums the lengths of the leg's bones.",
+            lambda f, p, fps: _mean_over(_steps(f), _both(p)),
+            "that is a distance per frame; L_contact is a speed in m/s (a frame lasts 1 / fps seconds).",
         ),
         Mistake(
-            _ratio_of(_thigh_shin),
-            "thigh + shin is not the whole chain: it starts with the bone into UpLeg (the hip "
-            "offset) and ends with the bone into ToeBase.",
+            lambda f, p, fps: fps * _mean_over(_steps(f), p[..., :-1, :]),
+            "a step from frame t to t + 1 counts only when the foot is planted in *both* frames (a foot "
+            "that lifts off or lands moves legitimately).",
         ),
         Mistake(
-            _ratio_of(_height),
-            "that is the ratio of the whole heights; r_xz compares the legs only (try a character with longer arms).",
+            lambda f, p, fps: fps * (_steps(f) * _both(p)).mean(),
+            "average over the planted steps only: dividing by every step (planted or not) makes the "
+            "loss depend on how often the foot is planted.",
         ),
         Mistake(
-            lambda a, b: _root_ref(b, a),
-            "upside down: the ratio is B's leg chain over A's (a longer leg takes a longer stride).",
+            lambda f, p, fps: fps * _mean_over(_steps(f, horizontal=True), _both(p)),
+            "a planted foot should not move in the world at all: measure the whole 3-D step, not only x and z.",
         ),
     ],
 )
 
 
-def _angle_cases():
-    import torch
-
-    qa = _unit_quats((1, 40, 22), 301)
-    near = qa + 0.05 * torch.randn(qa.shape, generator=_gen(302))
-    near = near / near.norm(dim=-1, keepdim=True)
-    flip = torch.where(torch.rand(qa.shape[:-1] + (1,), generator=_gen(303)) < 0.5, -1.0, 1.0)
-    return [
-        (qa, _unit_quats((1, 40, 22), 304)),
-        (qa, near * flip),  # half of the quaternions negated: the same rotations
-        (_unit_quats((2, 10, 22), 305), _unit_quats((2, 10, 22), 306)),
-    ]
-
-
-def _angle_ref(source_rot, generated_rot):
-    from motionlab.retargeting import losses
-
-    return losses.angle_loss(source_rot, generated_rot)
-
-
-def _angle_between(a, b):
-    import torch
-
-    return 2 * torch.arccos((a * b).sum(-1).abs().clamp(max=1.0))
-
-
-angle_loss = Exercise(
-    "03 · exercise 3 (L_angle)",
-    _angle_ref,
-    _angle_cases,
-    atol=1e-5,
-    mistakes=[
-        Mistake(
-            lambda a, b: (a - b).norm(dim=-1).mean(),
-            "q and −q are the same rotation: take the smaller of ‖q_A − q_B'‖ and ‖q_A + q_B'‖.",
-        ),
-        Mistake(
-            lambda a, b: (a - b).norm(dim=-1).maximum((a + b).norm(dim=-1)).mean(),
-            "q and −q are the same rotation, so the distance is the *smaller* of the two norms.",
-        ),
-        Mistake(
-            lambda a, b: ((a - b).norm(dim=-1) ** 2).minimum((a + b).norm(dim=-1) ** 2).mean(),
-            "eq. 16 averages the norms themselves, not their squares.",
-        ),
-        Mistake(
-            lambda a, b: _angle_between(a, b).mean(),
-            "that is the rotation angle α; L_angle uses the length of the quaternions' difference (2 sin(α/4)).",
-        ),
-    ],
-)
-
-
-# --------------------------------------------------------------------------- notebook 03, experiment
+# --------------------------------------------------------------------------- notebook 03, experiments
 _RUNS: dict = {}
+PAPER = {"init": "encoder", "lambda_contact": 0.0, "lr": 0.1}
+"""The paper's set-up in :class:`~motionlab.retargeting.solver.SolverConfig` terms (section 5 of notebook 03)."""
+
+
+def _measure(source, target, checkpoint, what: str, **settings) -> float:
+    """One number of the full method's result on (source, target) with ``SolverConfig(**settings)``.
+
+    ``what``: ``"angle"`` (mean angle to A's local rotations, degrees), ``"slide"`` (speed of A's
+    planted feet on B, cm/s), ``"skating"`` (foot speed near the ground, cm/s) or ``"steps"``.
+    """
+    from motionlab import retargeting
+    from motionlab.core import humanoid, metrics, preprocess
+    from motionlab.retargeting import pipeline, plots
+    from motionlab.retargeting.solver import SolverConfig
+
+    key = (id(source), id(target), id(checkpoint), tuple(sorted(settings.items())))
+    if key not in _RUNS:
+        run = retargeting.retarget(source, target, checkpoint, "full", SolverConfig(**settings))
+        src = preprocess.prepare(source, checkpoint.fps)
+        feet = [humanoid.JOINTS.index(n) for n in humanoid.FEET]
+        n = min(len(run.positions), src.num_frames)
+        planted = pipeline.source_contacts(src)[:n]
+        _RUNS[key] = {
+            "angle": float(plots.joint_angle_errors(run.motion.local_rot, src.local_rot).mean()),
+            "slide": 100 * float(metrics.planted_slide(run.positions[:n], feet, planted, checkpoint.fps)),
+            "skating": 100 * float(metrics.foot_skating(run.positions, feet, checkpoint.fps)),
+            "steps": float(run.steps),
+        }
+    return _RUNS[key][what]
 
 
 def _paper_angle(source, target, checkpoint, lambda_foot: float = 5.0, paper: bool = True, degrees: bool = True):
-    """Mean angle (over joints and frames) between A's rotations and the full method's, in the
-    paper's set-up (encoder start, no contact term, lr 0.1) or motionlab's, for ``lambda_foot``."""
-    from motionlab import retargeting
-    from motionlab.core import preprocess
-    from motionlab.retargeting import plots
-    from motionlab.retargeting.solver import SolverConfig
-
-    key = (id(source), id(target), id(checkpoint), lambda_foot, paper)
-    if key not in _RUNS:
-        if paper:
-            cfg = SolverConfig(init="encoder", lambda_contact=0.0, lr=0.1, lambda_foot=lambda_foot)
-        else:
-            cfg = SolverConfig(lambda_foot=lambda_foot)
-        run = retargeting.retarget(source, target, checkpoint, "full", cfg)
-        src = preprocess.prepare(source, checkpoint.fps)
-        _RUNS[key] = float(plots.joint_angle_errors(run.motion.local_rot, src.local_rot).mean())
-    value = _RUNS[key]
+    """Mean angle (degrees) between A's rotations and the full method's, in the paper's set-up
+    (encoder start, no contact term, lr 0.1) or motionlab's, for ``lambda_foot``."""
+    settings = dict(PAPER, lambda_foot=lambda_foot) if paper else {"lambda_foot": lambda_foot}
+    value = _measure(source, target, checkpoint, "angle", **settings)
     return value if degrees else float(np.radians(value))
+
+
+encoder_start = Question(
+    "03 · exercise 2 (experiment: motionlab without the Gauss–Newton start)",
+    lambda source, target, ckpt: _measure(source, target, ckpt, "angle", init="encoder"),
+    atol=0.006,  # an answer typed with two decimals passes
+    rtol=0.005,
+    mistakes=[
+        Mistake(
+            lambda source, target, ckpt: _measure(source, target, ckpt, "angle", init="encoder", lr=0.1),
+            "that is section 5's row 'encoder start + contact term', which also sets lr=0.1; change "
+            "only the start: SolverConfig(init='encoder').",
+        ),
+        Mistake(
+            lambda source, target, ckpt: _measure(source, target, ckpt, "angle", **PAPER),
+            "that is the paper's set-up (no contact term, lr=0.1); keep motionlab's other settings.",
+        ),
+        Mistake(
+            lambda source, target, ckpt: _measure(source, target, ckpt, "angle"),
+            "that is the default run (the Gauss–Newton start); set init='encoder'.",
+        ),
+        Mistake(
+            lambda source, target, ckpt: float(np.radians(_measure(source, target, ckpt, "angle", init="encoder"))),
+            "that number is in radians; plots.joint_angle_errors gives degrees.",
+        ),
+    ],
+)
+
+
+contact_weight = Question(
+    "03 · exercise 3 (experiment: a fifth of the contact weight)",
+    lambda source, target, ckpt: _measure(source, target, ckpt, "slide", lambda_contact=0.1),
+    atol=0.006,  # an answer typed with two decimals passes
+    rtol=0.005,
+    mistakes=[
+        Mistake(
+            lambda source, target, ckpt: _measure(source, target, ckpt, "slide"),
+            "that is the default weight's slide (λ_contact = 0.5, the full method); set lambda_contact=0.1.",
+        ),
+        Mistake(
+            lambda source, target, ckpt: _measure(source, target, ckpt, "slide", lambda_contact=0.0),
+            "that is the run without the contact term (λ_contact = 0); set lambda_contact=0.1.",
+        ),
+        Mistake(
+            lambda source, target, ckpt: _measure(source, target, ckpt, "skating", lambda_contact=0.1),
+            "that is the skating (any foot near the ground); the slide counts A's planted feet only "
+            "(metrics.planted_slide with pipeline.source_contacts(src)).",
+        ),
+        Mistake(
+            lambda source, target, ckpt: _measure(source, target, ckpt, "slide", lambda_contact=0.1) / 100,
+            "that number is in m/s; section 5 prints cm/s.",
+        ),
+    ],
+)
 
 
 foot_weight = Question(
@@ -402,6 +308,51 @@ foot_weight = Question(
         Mistake(
             lambda source, target, ckpt: _paper_angle(source, target, ckpt, 5.0, degrees=False),
             "that number is in radians; plots.joint_angle_errors gives degrees.",
+        ),
+    ],
+)
+
+
+# --------------------------------------------------------------------------- notebook 07, experiment
+_PLAUSIBILITY: dict = {}
+
+
+def _arms_plausibility(clip_path, checkpoint, solver, arms: float = 1.3):
+    """The plausibility of ``clip_path`` retargeted onto the canonical character with arms × ``arms``."""
+    from motionlab.core import bvh, humanoid
+    from motionlab.retargeting.pipeline import retarget
+
+    key = (str(clip_path), id(checkpoint), repr(solver), arms)
+    if key not in _PLAUSIBILITY:
+        target = humanoid.scale_bones(humanoid.canonical_skeleton(), arms=arms)
+        result = retarget(bvh.load(clip_path), target, checkpoint, solver=solver)
+        _PLAUSIBILITY[key] = (result.plausibility, float(result.positions[..., 1].min()))
+    return _PLAUSIBILITY[key]
+
+
+arm_length = Question(
+    "07 · exercise 1 (experiment: how long may the arms be?)",
+    lambda clip_path, ckpt, solver: _arms_plausibility(clip_path, ckpt, solver)[0].lowest,
+    atol=0.0006,  # an answer typed with three decimals passes
+    rtol=0.005,
+    mistakes=[
+        Mistake(
+            lambda clip_path, ckpt, solver: _arms_plausibility(clip_path, ckpt, solver, 1.35)[0].lowest,
+            "that is the `long_arms` preset (arms × 1.35); the exercise asks for arms × 1.3.",
+        ),
+        Mistake(
+            lambda clip_path, ckpt, solver: _arms_plausibility(clip_path, ckpt, solver)[0].source_lowest,
+            "that is A's lowest joint in the source (`source_lowest`); report B's, `plausibility.lowest`.",
+        ),
+        Mistake(
+            lambda clip_path, ckpt, solver: 100 * _arms_plausibility(clip_path, ckpt, solver)[1],
+            "that is the lowest joint's height in centimetres; the floor test measures it as a fraction "
+            "of B's leg length (`plausibility.lowest`).",
+        ),
+        Mistake(
+            lambda clip_path, ckpt, solver: _arms_plausibility(clip_path, ckpt, solver)[1],
+            "that is the lowest joint's height in metres; the floor test measures it as a fraction of "
+            "B's leg length (`plausibility.lowest`).",
         ),
     ],
 )
