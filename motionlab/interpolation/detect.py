@@ -117,7 +117,7 @@ WINDOW = 8
 
 LOCAL_SECONDS = 0.1
 """Seconds of ground speeds on each side of a gap that the local count fits (:func:`_local_count`;
-0.1, 0.2, 0.3 and 0.5 s and degrees 1–3 tried on the Xia clips of ``scripts/check_gaps.py`` part
+0.1, 0.2, 0.3 and 0.5 s and degrees 1–3 tried on the Xia clips of ``experiments/interpolation/check_gaps.py`` part
 5, which are therefore no longer held out; checked on part 6, clips never looked at before)."""
 
 REHEARSAL_SECONDS = 2.0
@@ -359,7 +359,7 @@ def track(motion: Motion, graph, delta: float | None = None) -> GraphTrack:
     The work grows as stream frames × graph frames × the 13 tempi (matrix products, in blocks of
     512 stream windows, so memory stays bounded).
 
-    ``scripts/check_tracking_pose.py`` compares this match with single frames, with and without
+    ``experiments/interpolation/check_tracking_pose.py`` compares this match with single frames, with and without
     velocities (false gaps on the clean walk takes of ``sessions/walk``, and on the same takes moved
     3 m in the capture volume).
 
@@ -589,7 +589,7 @@ def estimate_missing(motion: Motion, steps_at, seconds: float = 1.0, takes=None)
       where the cycle's cumulative ground distance reaches the arc; both sides are averaged;
     * otherwise ``n + 1 = arc / v`` with ``v`` the mean ground speed (metres per frame) over
       ``seconds`` on each side. (A straight-line fit of speed on each side, read at the gap's
-      edges, was tried on the choose set of ``scripts/check_gaps.py`` and rejected.)
+      edges, was tried on the choose set of ``experiments/interpolation/check_gaps.py`` and rejected.)
     * **speeding up or slowing down**: both rules assume the speed of the sides holds across the
       gap. Where the two sides' mean speeds differ by more than ``TRANSIENT`` (20%) of their mean
       (a walker starting off, a runner accelerating), the count is taken from the *step phase*
@@ -599,7 +599,7 @@ def estimate_missing(motion: Motion, steps_at, seconds: float = 1.0, takes=None)
       rhythm while the speed changes; the distance does not. Used everywhere, the phase made
       irregular gaits (elderly, exhausted) worse, hence only in transients. ``TRANSIENT`` was
       chosen on the ``normal`` walk takes (0.1–0.5 tried, 0.2 best there) and validated on the
-      other six styles (``scripts/check_gaps.py --dense 15``). Where no stride can be read (sides
+      other six styles (``experiments/interpolation/check_gaps.py --dense 15``). Where no stride can be read (sides
       shorter than a stride, as in the 2–2.5 s ``dataset-2`` runs), the speed is the mean of the
       two *edge* speeds, each over the nearest 0.35 s (about one running step): constant
       acceleration across the gap. (This fallback was added after seeing two accelerating runs,
@@ -630,7 +630,7 @@ def estimate_missing(motion: Motion, steps_at, seconds: float = 1.0, takes=None)
     pose after it, time-scaled to the stream (:func:`~.recorded.recorded_missing`, §3.3). The two
     counts rest on independent evidence (this stream's ground distance and step phase; the
     recordings' timing), and the count is their mean with equal weights. (The recorded count alone
-    was 0.2 points better on the choose set of ``scripts/check_gaps.py``, but 3 cases worse on the
+    was 0.2 points better on the choose set of ``experiments/interpolation/check_gaps.py``, but 3 cases worse on the
     validate set, where each ``dataset-1`` run has a style no other take has; the mean was chosen
     after seeing both, see the README.)
 

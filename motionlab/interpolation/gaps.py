@@ -547,7 +547,7 @@ def _follow_strides(motion: Motion, a: int, b: int, joint: int, target: np.ndarr
     is wrong near the other end: on ``sessions/walk`` ``walk_normal_001`` cut at frame 20 the root
     missed by 11.0% of its displacement (SLERP with the Hermite root: 2.9%), now 4.1%. Chosen on
     the normal walk takes against the strides' own speed, the swap everywhere and SLERP with the
-    Hermite root where the speed changes (``scripts/compare_stride_root.py``; ``docs/results_interpolation.md``)."""
+    Hermite root where the speed changes (``experiments/interpolation/compare_stride_root.py``; ``docs/results_interpolation.md``)."""
     out = _follow(motion, a, b, joint, target)
     if detect.changes_speed(*side_speeds(motion, a, b, joint)):
         out = smooth_root(out, [a, b], joint=joint)

@@ -1,6 +1,6 @@
 """Gap detection, missing counts and the root across gaps, measured on the shared real mocap.
 
-    MOTIONLAB_DATA=/path/to/shared/data python scripts/check_gaps.py [--quick]
+    MOTIONLAB_DATA=/path/to/shared/data python -m experiments.interpolation.check_gaps [--quick]
 
 1. **False gaps**: every clean BVH under ``$MOTIONLAB_DATA`` through the detector that
    ``motionlab fill-gaps`` uses without a graph (:func:`motionlab.interpolation.detect.consecutive_gaps`);
@@ -52,8 +52,9 @@ from pathlib import Path
 
 import numpy as np
 
+from experiments.interpolation import gap_eval
 from motionlab.core import bvh, humanoid
-from motionlab.interpolation import detect, gap_eval
+from motionlab.interpolation import detect
 from motionlab.interpolation.action_graph import ActionGraph
 from motionlab.interpolation.recorded import RecordedTakes
 

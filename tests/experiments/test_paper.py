@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
+from experiments.interpolation import paper
 from motionlab import synthetic
-from motionlab.interpolation import demo, paper
+from motionlab.interpolation import demo
 from tests.conftest import require_data
 
 
