@@ -32,22 +32,7 @@ from motionlab.interpolation.alignment import reference_joint, reference_transfo
 
 __all__ = ["WALK_JOINTS", "WalkResult", "walk_experiment", "RunSquatResult", "run_to_squat_graph", "run_to_squat"]
 
-WALK_JOINTS = (
-    "Hips",
-    "Spine",
-    "Neck",
-    "LeftUpLeg",
-    "RightUpLeg",
-    "LeftLeg",
-    "RightLeg",
-    "LeftFoot",
-    "RightFoot",
-    "LeftArm",
-    "RightArm",
-    "LeftForeArm",
-    "RightForeArm",
-)
-"""The 13 walking joints (canonical names); ``LeftUpLeg`` is the paper's ``lThigh``."""
+WALK_JOINTS = demo.WALK_JOINTS
 
 
 @dataclass

@@ -25,12 +25,13 @@ typical mistakes):
   ``window_count``; 04 ``pose_error``, ``joint_speed``;
 * :mod:`~motionlab.exercises.retargeting`: 02 ``recon_loss``, ``combine``, ``rotations``;
   03 ``foot_loss``, ``root_scale``, ``angle_loss``;
-* :mod:`~motionlab.exercises.motion_graphs`: 05 ``local_minima``, ``distance_matrix``;
-* :mod:`~motionlab.exercises.interpolation`: 06 ``ease``, ``sigma2``, ``jumps``.
+* :mod:`~motionlab.exercises.motion_graphs`: 05 ``local_minima``, ``distance_matrix``.
 
 Experiments (:class:`Question`: change a parameter, run the experiment, type the number it gives;
 the check reruns it on the notebook's own inputs): 03 ``foot_weight`` (λ_foot in the paper's
-set-up), 06 ``held_out_q`` (q by likelihood on truly held-out frames), 05
+set-up), 06 ``held_out_q`` (q by likelihood on truly held-out frames), ``walk_spacing`` (the
+paper's walk experiment with key frames further apart) and ``smallest_gap`` (the fewest dropped
+frames the stream-against-itself rule finds), 05
 ``vanishing_threshold`` (the graph threshold at which a style leaves the pruned standard graph).
 
 Their reference solutions, as a student would write them, are in ``instructor/solutions/`` (the
@@ -43,7 +44,7 @@ from __future__ import annotations
 
 from .basics import conj, hand_height, heading, joint_speed, pose_error, slerp, window_count
 from .core import Exercise, Mistake, Question, Result, check
-from .interpolation import ease, held_out_q, jumps, sigma2
+from .interpolation import held_out_q, smallest_gap, walk_spacing
 from .motion_graphs import distance_matrix, local_minima, vanishing_threshold
 from .retargeting import angle_loss, combine, foot_loss, foot_weight, recon_loss, root_scale, rotations
 
@@ -68,11 +69,10 @@ __all__ = [
     "angle_loss",
     "local_minima",
     "distance_matrix",
-    "ease",
-    "sigma2",
-    "jumps",
     "foot_weight",
     "held_out_q",
+    "walk_spacing",
+    "smallest_gap",
     "vanishing_threshold",
     "EXERCISES",
     "EXPERIMENTS",
@@ -94,9 +94,6 @@ EXERCISES: dict[str, Exercise] = {
     "angle_loss": angle_loss,
     "local_minima": local_minima,
     "distance_matrix": distance_matrix,
-    "ease": ease,
-    "sigma2": sigma2,
-    "jumps": jumps,
 }
 """Every named exercise of the notebooks that asks for a function, by the attribute name the notebooks use.
 
@@ -106,6 +103,8 @@ EXERCISES: dict[str, Exercise] = {
 EXPERIMENTS: dict[str, Question] = {
     "foot_weight": foot_weight,
     "held_out_q": held_out_q,
+    "walk_spacing": walk_spacing,
+    "smallest_gap": smallest_gap,
     "vanishing_threshold": vanishing_threshold,
 }
 """Every experiment exercise (a :class:`Question`: change a parameter, run, report a number).

@@ -23,6 +23,7 @@ __all__ = [
     "walk_clip",
     "walk_takes",
     "paper_walk",
+    "WALK_JOINTS",
     "fig8_graph",
     "run_squat_gap",
     "load_clips",
@@ -177,6 +178,13 @@ def paper_walk() -> tuple[Motion, str]:
     return synthetic.generate(
         "walk", None, 360, 120.0, seed=3
     ), "synthetic 120 Hz walk (set MOTIONLAB_DATA for real mocap)"
+
+
+WALK_JOINTS = ("Hips", "Spine", "Neck", "LeftUpLeg", "RightUpLeg", "LeftLeg", "RightLeg", "LeftFoot", "RightFoot",
+               "LeftArm", "RightArm", "LeftForeArm", "RightForeArm")  # fmt: skip
+"""The 13 walking joints of the paper's Table 1 (its list is not in the text), read as the CMU
+skeleton's hips, lower spine, neck, thighs, shins, feet, upper arms and forearms, canonical names;
+``LeftUpLeg`` is the paper's ``lThigh``."""
 
 
 def fig8_graph(clips: dict[str, Motion]):
