@@ -28,13 +28,8 @@ Where no stride is found (both sides shorter than ``MIN_STRIDES`` strides, a mot
 not repeat) :func:`stride_fill` returns ``None`` and :func:`.gaps.fill` falls back to SLERP with the
 Hermite root. Fractional frames are read linearly (positions) and by SLERP (rotations).
 
-Chosen on the CHOOSE set of ``experiments/interpolation/check_gaps.py`` (normal walk takes, the left turn, one
-run): the root path alone (:func:`stride_path` on SLERP-filled poses) halved the mean root error
-of straight walks against the Hermite curve but lost to it once the feet were kept above the
-floor (SLERP legs, hips lowered by the recorded bob, lifted back); filling the poses from the
-same strides keeps feet and hips consistent. Without turning the strides the turn takes got worse
-than with Hermite; without the end correction the worst straight walk did. Figures: README,
-*Key-pose interpolation and gap filling*.
+How it compares with SLERP and a Hermite root on the shared walks and runs:
+``docs/results_interpolation.md`` (``python -m experiments.interpolation.check_gaps``).
 """
 
 from __future__ import annotations
@@ -66,9 +61,7 @@ SIDE_SECONDS = 3.0
 
 MIN_STRIDES = 1.5
 """A side lends its stride only if it holds this many strides: the stride and half of the one
-before it, so a first stride from standing (not yet a repeat) is not carried across a gap
-(chosen on the CHOOSE set among 1, 1.25, 1.5, 2: the left-turn take cut 40 frames after its
-start fell from 10.4% to 6.7% root error)."""
+before it, so a first stride from standing (not yet a repeat) is not carried across a gap."""
 
 
 def known_side(motion: Motion, t: int, step: int, limit: int) -> np.ndarray:
