@@ -6,7 +6,7 @@
 Two ways to keep filled frames out of the floor, each on the *same* counts (the detection runs once
 per cut) and the same fill otherwise:
 
-* **body lifted** (the fill until session 24): every filled frame raised by how far its lowest
+* **body lifted**: every filled frame raised by how far its lowest
   joint went below the floor (``gaps.lift_above_floor``);
 * **leg bent** (what ``gaps.fill`` does): each sunk foot moved up onto the floor by bending its
   leg (:func:`motionlab.interpolation.footing.plant_feet`), the body lifted only by what the legs

@@ -7,7 +7,7 @@ The stride fill (:mod:`motionlab.interpolation.stride`) carries each side's stri
 that side's speed. Where the walker speeds up or slows down across the gap, that speed is wrong
 near one end. The rules, each filling the *same* counts (the detection runs once per cut):
 
-* **the strides' own speed**: the strides' path as it comes (the fill before session 22);
+* **the strides' own speed**: the strides' path as it comes;
 * **end velocities swapped where the speed changes** (what ``gaps.fill`` does,
   ``gaps._follow_strides``): where :func:`motionlab.interpolation.detect.changes_speed` holds for
   the mean ground speeds over a second on each side, the path keeps the strides' bob and sway but

@@ -1,4 +1,4 @@
-"""The experiments of the key-pose paper (``004_*.txt``, §4), on the shared real mocap.
+"""The experiments of the key-pose paper (Yang et al. 2019, §4), on the shared real mocap.
 
 **Walk within one node (Fig. 6/7, Table 1).** The paper takes 495 frames of a CMU walk at 120 Hz,
 keeps frames 5 and 35 and interpolates 10, 15, …, 30 between them ("at regular intervals"), and

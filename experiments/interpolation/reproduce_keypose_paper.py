@@ -1,4 +1,4 @@
-"""Reproduce the experiments of the key-pose paper (``004_*.txt``, §4) on the shared real mocap.
+"""Reproduce the experiments of the key-pose paper (Yang et al. 2019, §4) on the shared real mocap.
 
     MOTIONLAB_DATA=/path/to/shared/data python -m experiments.interpolation.reproduce_keypose_paper [--figure PATH]
 
