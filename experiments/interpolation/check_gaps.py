@@ -173,7 +173,7 @@ def removed_frames(name: str, files: list[Path], rng, other_takes: OtherTakes) -
                        ("all", hermite)):  # fmt: skip
         w = gap_eval.summary(sub)
         print(
-            f"     (before: --method slerp --root hermite, same cases) {label}: mean {w['root_rel_mean']:.1%}, worst {w['root_rel_max']:.1%}, "
+            f"     (for comparison, --method slerp --root hermite, same cases) {label}: mean {w['root_rel_mean']:.1%}, worst {w['root_rel_max']:.1%}, "
             f"joints about the root {w['pose_cm_mean']:.1f} cm off"
         )
     return results
