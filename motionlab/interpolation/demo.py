@@ -1,7 +1,9 @@
 """Clips for notebook 06: real mocap when ``MOTIONLAB_DATA`` is set, synthetic motion otherwise.
 
-Every function returns canonical 22-joint motions at ``fps`` and says where they came from, so a
-notebook cell can print its data source. Nothing is downloaded.
+:func:`behaviours`, :func:`walk_clip` and :func:`paper_walk` return canonical 22-joint motions and
+say where they came from, so a notebook cell can print its data source; :func:`load_clips` loads
+any BVH files the same way; :func:`fig8_graph` and :func:`run_squat_gap` set up the paper's Fig. 8.
+Nothing is downloaded.
 """
 
 from __future__ import annotations
@@ -27,8 +29,6 @@ __all__ = [
     "fig8_graph",
     "run_squat_gap",
     "load_clips",
-    "benchmark_clips",
-    "benchmark_apart_clips",
 ]
 
 BEHAVIOUR_CLIPS = {
@@ -127,43 +127,12 @@ def load_clips(paths: Sequence[str | Path], fps: float = 30.0, canonical: bool =
     return out
 
 
-def benchmark_clips(fps: float = 30.0) -> tuple[list[Motion], str]:
-    """The in-betweening test clips (Bandai Namco dataset-2) or synthetic stand-ins."""
-    if data.has_data("bandai_namco", "dataset-2"):
-        return load_clips([data.data_root() / "bandai_namco" / "dataset-2"], fps=fps), "real: bandai_namco/dataset-2"
-    from motionlab import synthetic
-
-    clips = []
-    for i, b in enumerate(["walk", "walk", "walk", "run", "run"]):
-        m = synthetic.generate(b, None, 200, fps, seed=10 + i)
-        m.name = f"synthetic_{b}_{i:03d}"
-        clips.append(m)
-    return clips, "synthetic walks and runs (set MOTIONLAB_DATA for real mocap)"
-
-
 def walk_takes(takes=(4, 5, 6), style: str = "normal", fps: float = 30.0) -> list[Motion]:
     """Walk takes of ``bandai_namco/sessions/walk`` (canonical, at ``fps``), other recordings than
     :func:`walk_clip`'s; an empty list without real data."""
     if not data.has_data("bandai_namco", "sessions", "walk"):
         return []
     return [_load(f"bandai_namco/sessions/walk/dataset-2_walk_{style}_{t:03d}", fps) for t in takes]
-
-
-def benchmark_apart_clips(fps: float = 30.0) -> tuple[list[Motion], str]:
-    """Clips of the benchmark's skeleton kept apart from :func:`benchmark_clips` (L2P statistics
-    and extra library material): Bandai Namco dataset-1 normal-style clips, or synthetic ones with
-    other seeds."""
-    if data.has_data("bandai_namco", "dataset-1"):
-        files = sorted((data.data_root() / "bandai_namco" / "dataset-1").rglob("*_normal_*.bvh"))
-        return load_clips(files, fps=fps), "real: bandai_namco/dataset-1 normal-style clips"
-    from motionlab import synthetic
-
-    clips = []
-    for i, b in enumerate(["walk", "walk", "run", "run"]):
-        m = synthetic.generate(b, None, 200, fps, seed=50 + i)
-        m.name = f"synthetic_apart_{b}_{i:03d}"
-        clips.append(m)
-    return clips, "synthetic walks and runs with other seeds"
 
 
 def paper_walk() -> tuple[Motion, str]:
