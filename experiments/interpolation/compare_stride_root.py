@@ -33,7 +33,7 @@ from tqdm.auto import tqdm
 
 from experiments.interpolation import check_gaps, gap_eval
 from motionlab.core import bvh
-from motionlab.interpolation import detect, gaps, stride
+from motionlab.interpolation import alignment, detect, gaps, stride
 
 RULES = ("strides' own speed", "swapped where the speed changes", "swapped everywhere",
          "SLERP + Hermite root where the speed changes")  # fmt: skip
@@ -85,7 +85,7 @@ def score(motion, s: int, n: int) -> list[float] | None:
     shift = sum(c for t, c in found if t < s - 1)
     a = s - 1 + shift
     holed, _ = gaps.insert_missing(stream, found)
-    ref = gaps._known_reference_joint(holed)
+    ref = alignment.reference_joint(stream)  # the known frames of `holed`
     changes = own(*stride.side_speeds(holed, a, a + dict(found)[s - 1] + 1, ref))
     hermite = (
         gap_eval.evaluate_cut(motion, s, n, method="slerp", root="hermite", found=found).root_rel if changes else chosen
