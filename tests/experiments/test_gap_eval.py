@@ -1,4 +1,4 @@
-"""Cut, detect, fill, compare: the measurement behind scripts/check_gaps.py."""
+"""Cut, detect, fill, compare: the measurement behind experiments/interpolation/check_gaps.py."""
 
 import numpy as np
 import pytest
