@@ -44,9 +44,6 @@ SOLUTIONS = {
     "joint_speed": K04.my_joint_speed,
     "contact_loss": K03.my_contact_loss,
     "local_minima": K05.my_local_minima,
-    "ease": K06.my_ease,
-    "sigma2": K06.my_sigma2,
-    "jumps": K06.my_jumps,
 }
 
 
@@ -137,31 +134,6 @@ def _minima_roll(m):
     return out
 
 
-def _sigma2_np_cov(X, q):
-    lam = np.sort(np.linalg.eigvalsh(np.cov(X.T)))[::-1]
-    return lam[q:].mean()
-
-
-def _sigma2_unsorted(X, q):
-    xc = X - X.mean(0)
-    lam, _ = np.linalg.eigh(xc.T @ xc / len(X))
-    return lam[q:].mean()
-
-
-def _sigma2_over_d(X, q):
-    xc = X - X.mean(0)
-    lam = np.sort(np.linalg.eigvalsh(xc.T @ xc / len(X)))[::-1]
-    return lam[q:].sum() / X.shape[1]
-
-
-def _jumps_unshifted(s):
-    return np.flatnonzero(s[1:-1] > 2.5 * np.maximum(s[:-2], s[2:]))
-
-
-def _jumps_min(s):
-    return np.array([t for t in range(1, len(s) - 1) if s[t] > 2.5 * min(s[t - 1], s[t + 1])])
-
-
 WRONG = [
     ("hand_height", _wrong_hand(angle=-np.pi / 2), "below the shoulder"),
     ("hand_height", _wrong_hand(angle=90), "radians"),
@@ -178,13 +150,6 @@ WRONG = [
     ("local_minima", _minima_strict, "<="),
     ("local_minima", _minima_four, "diagonal"),
     ("local_minima", _minima_roll, "np.roll"),
-    ("ease", lambda n: np.arange(1, n + 1) / (n + 1), "linear weights"),
-    ("ease", lambda n: 0.5 * (1 - np.cos(np.pi * np.arange(1, n + 1) / n)), "N + 1"),
-    ("sigma2", _sigma2_np_cov, "N − 1"),
-    ("sigma2", _sigma2_unsorted, "increasing"),
-    ("sigma2", _sigma2_over_d, "not over all D"),
-    ("jumps", _jumps_unshifted, "one too small"),
-    ("jumps", _jumps_min, "larger"),
 ]
 
 
@@ -258,21 +223,6 @@ def _minima_loop(m):
     return out
 
 
-def _ease_sin(num):
-    return np.sin(np.pi * np.arange(1, num + 1) / (2 * (num + 1))) ** 2  # ½(1 − cos 2x) = sin² x
-
-
-def _sigma2_svd(X, q):
-    s = np.linalg.svd(X - X.mean(0), compute_uv=False)
-    lam = np.zeros(X.shape[1])
-    lam[: len(s)] = s**2 / len(X)
-    return lam[q:].mean()
-
-
-def _jumps_loop(s):
-    return np.array([t for t in range(1, len(s) - 1) if s[t] > 2.5 * max(s[t - 1], s[t + 1])], dtype=int)
-
-
 ALTERNATIVES = [
     ("hand_height", _hand_height_by_offsets),
     ("window_count", _window_count_ceil),
@@ -280,9 +230,6 @@ ALTERNATIVES = [
     ("joint_speed", _speed_backward),
     ("contact_loss", _contact_numpy),
     ("local_minima", _minima_loop),
-    ("ease", _ease_sin),
-    ("sigma2", _sigma2_svd),
-    ("jumps", _jumps_loop),
 ]
 
 
@@ -366,7 +313,8 @@ def style_takes():
 EXPERIMENT_NAMES = {"nlerp_turn", "euler_order", "hips_heading", "shorter_legs"}  # notebooks 00, 01, 04
 EXPERIMENT_NAMES |= {"q_delta_legs", "no_correction", "arm_length"}  # notebooks 02, 07
 EXPERIMENT_NAMES |= {"encoder_start", "contact_weight", "foot_weight"}  # notebook 03
-EXPERIMENT_NAMES |= {"held_out_q", "vanishing_threshold", "style_change"}  # notebooks 05, 06
+EXPERIMENT_NAMES |= {"vanishing_threshold", "style_change"}  # notebook 05
+EXPERIMENT_NAMES |= {"held_out_q", "walk_spacing", "smallest_gap"}  # notebook 06
 
 
 def test_every_experiment_is_listed():
@@ -626,6 +574,57 @@ def test_held_out_q_experiment(behaviour_clips):
     result = q.check(32 if answer != 32 else 1, behaviour_clips)
     assert not result.passed and result.attempted
     assert not q.check("two", behaviour_clips).passed
+
+
+@pytest.fixture(scope="module")
+def walk_120():
+    from motionlab import synthetic
+
+    return synthetic.generate("walk", None, 360, 120.0, seed=3)  # notebook 06's walk without real data
+
+
+def _walk_error(walk, every, curve="linear", degrees=True):
+    """The walk experiment written independently of the key: frames 5, 5+every, … kept, the rest filled."""
+    from motionlab.core import quat
+    from motionlab.interpolation import demo, gaps
+
+    kept = np.arange(5, walk.num_frames, every)
+    span = walk[5 : kept[-1] + 1]
+    holed, _ = gaps.insert_missing(span[kept - 5], [(i, every - 1) for i in range(len(kept) - 1)])
+    filled, _ = gaps.fill(holed, method="slerp", root="hermite", curve=curve)
+    lost = np.setdiff1d(np.arange(span.num_frames), kept - 5)
+    idx = [walk.skeleton.index(n) for n in demo.WALK_JOINTS]
+    e = quat.angle_between(filled.local_rot[lost][:, idx], span.local_rot[lost][:, idx]).mean()
+    return np.degrees(e) if degrees else e
+
+
+def test_walk_spacing_experiment(walk_120):
+    q = exercises.walk_spacing
+    answer = K06.my_walk_spacing(walk_120)
+    assert q.check(answer, walk_120).passed
+    assert q.check(round(float(answer), 1), walk_120).passed  # typed with one decimal
+    assert q.check(_walk_error(walk_120, 60, curve="ease"), walk_120).passed  # an eased α(k): accepted
+    result = q.check(_walk_error(walk_120, 30), walk_120)  # the notebook's spacing left at 30
+    assert not result.passed and "every = 60" in result.hint
+    result = q.check(_walk_error(walk_120, 60, degrees=False), walk_120)
+    assert not result.passed and "radians" in result.hint
+    assert not q.check(answer * 2, walk_120).passed
+
+
+def test_smallest_gap_experiment():
+    from motionlab.interpolation import demo
+
+    walk, _ = demo.walk_clip()  # the notebook's walk (real or synthetic)
+    q = exercises.smallest_gap
+    answer = K06.my_smallest_gap(walk)
+    assert answer > 1
+    assert q.check(answer, walk).passed
+    assert q.check(float(answer), walk).passed
+    result = q.check(1, walk)  # "any missing frame is found"
+    assert not result.passed and "D ≈ 2" in result.hint
+    result = q.check(answer - 1, walk)
+    assert not result.passed and result.hint is not None
+    assert not q.check(answer + 3, walk).passed
 
 
 def test_vanishing_threshold_experiment(style_takes):

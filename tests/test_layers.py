@@ -119,3 +119,22 @@ def test_no_import_loop_between_modules():
         if name not in state:
             visit(name, [name])
     assert not loops, "import loops:\n" + "\n".join(loops)
+
+
+def test_the_package_and_the_notebooks_never_import_the_studies():
+    """``experiments/`` imports motionlab like a user; neither motionlab nor a notebook imports it."""
+    import json
+
+    bad = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        name = path.relative_to(PACKAGE.parent).with_suffix("").parts
+        bad += [f"{path.relative_to(PACKAGE.parent)}:{line} imports {m}"
+                for line, m in _imports(path.read_text(), name) if m.split(".")[0] == "experiments"]  # fmt: skip
+    for path in sorted((PACKAGE.parent / "notebooks").glob("*.ipynb")):
+        cells = json.loads(path.read_text())["cells"]
+        source = "\n".join("".join(c["source"]) for c in cells if c["cell_type"] == "code")
+        source = "\n".join(line for line in source.splitlines() if not line.lstrip().startswith(("%", "!")))
+        bad += [
+            f"{path.name}: imports {m}" for _, m in _imports(source, ("notebook",)) if m.split(".")[0] == "experiments"
+        ]
+    assert not bad, "the studies in experiments/ are not part of the package:\n" + "\n".join(bad)

@@ -3,29 +3,8 @@
 import numpy as np
 
 
-def my_ease(num):
-    """Exercise 1: ease-in-out weights α(k) = ½(1 − cos(πk/(N+1))), k = 1..N."""
-    k = np.arange(1, num + 1)
-    return 0.5 * (1.0 - np.cos(np.pi * k / (num + 1)))
-
-
-def my_sigma2(X, q):
-    """Exercise 2: closed-form PPCA noise variance, the mean of the D − q smallest eigenvalues of S."""
-    xc = X - X.mean(axis=0)
-    S = xc.T @ xc / len(X)  # maximum-likelihood covariance (divides by N)
-    lam = np.sort(np.linalg.eigvalsh(S))[::-1]  # largest first
-    return lam[q:].mean()
-
-
-def my_jumps(steps):
-    """Exercise 3: indices t (not first or last) with s(t) > 2.5 max(s(t-1), s(t+1))."""
-    s = np.asarray(steps)
-    t = np.arange(1, len(s) - 1)
-    return t[s[t] > 2.5 * np.maximum(s[t - 1], s[t + 1])]
-
-
 def my_held_out_q(clips):
-    """Exercise 4: q in (1, 2, 4, 8, 16, 32) with the best likelihood on the last quarter of every clip."""
+    """Exercise 1: q in (1, 2, 4, 8, 16, 32) with the best likelihood on the last quarter of every clip."""
     from motionlab.interpolation import features
     from motionlab.interpolation.ppca import PPCA
 
@@ -37,5 +16,38 @@ def my_held_out_q(clips):
         test.append(f[k:])
     train, test = np.concatenate(train), np.concatenate(test)
     mean, std = train.mean(axis=0), np.maximum(train.std(axis=0), 1e-6)
-    best = max((1, 2, 4, 8, 16, 32), key=lambda q: PPCA(q).fit((train - mean) / std).log_likelihood((test - mean) / std))
+    best = max(
+        (1, 2, 4, 8, 16, 32), key=lambda q: PPCA(q).fit((train - mean) / std).log_likelihood((test - mean) / std)
+    )
     return best
+
+
+def my_walk_spacing(walk):
+    """Exercise 2: the walk experiment with every 60th frame kept (5, 65, 125, …), mean angle error in degrees."""
+    from motionlab.core import quat
+    from motionlab.interpolation import gaps
+
+    joints = ["Hips", "Spine", "Neck", "LeftUpLeg", "RightUpLeg", "LeftLeg", "RightLeg", "LeftFoot", "RightFoot",
+              "LeftArm", "RightArm", "LeftForeArm", "RightForeArm"]  # fmt: skip
+    every = 60
+    kept = np.arange(5, walk.num_frames, every)
+    span = walk[5 : kept[-1] + 1]
+    broken = span.copy()
+    lost = np.setdiff1d(np.arange(span.num_frames), kept - 5)
+    broken.local_rot[lost] = np.nan
+    broken.root_pos[lost] = np.nan
+    if broken.local_pos is not None:
+        broken.local_pos[lost] = np.nan
+    filled, _ = gaps.fill(broken, method="slerp", root="hermite")
+    idx = [walk.skeleton.names.index(n) for n in joints]
+    return np.degrees(quat.angle_between(filled.local_rot[lost][:, idx], span.local_rot[lost][:, idx])).mean()
+
+
+def my_smallest_gap(walk):
+    """Exercise 3: remove 1, 2, 3, … frames from frame 100 on until the rule flags the step before them."""
+    from motionlab.interpolation import detect
+
+    n = 1
+    while 99 not in detect.consecutive_gaps(walk[np.r_[0:100, 100 + n : walk.num_frames]]):
+        n += 1
+    return n

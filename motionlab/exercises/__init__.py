@@ -23,19 +23,19 @@ typical mistakes):
 
 * :mod:`~motionlab.exercises.basics`: 00 ``hand_height``; 01 ``window_count``; 04 ``joint_speed``;
 * :mod:`~motionlab.exercises.retargeting`: 03 ``contact_loss``;
-* :mod:`~motionlab.exercises.motion_graphs`: 05 ``local_minima``;
-* :mod:`~motionlab.exercises.interpolation`: 06 ``ease``, ``sigma2``, ``jumps``.
+* :mod:`~motionlab.exercises.motion_graphs`: 05 ``local_minima``.
 
 Experiments (:class:`Question`: change a parameter, run the experiment, type the number it gives;
 the check reruns it on the notebook's own inputs): 00 ``nlerp_turn`` (SLERP against nlerp on a
 smaller turn), ``euler_order`` (the same angles in another channel order); 01 ``hips_heading``
-(the heading from the hips alone); 04 ``shorter_legs`` (copying rotations onto shorter legs);
-02 ``q_delta_legs`` (how much q_Δ changes on shorter
-legs), ``no_correction`` (decoding without q_Δ); 03 ``encoder_start`` (motionlab without the
+(the heading from the hips alone); 02 ``q_delta_legs`` (how much q_Δ changes on shorter legs),
+``no_correction`` (decoding without q_Δ); 03 ``encoder_start`` (motionlab without the
 Gauss–Newton start), ``contact_weight`` (a fifth of the contact weight), ``foot_weight`` (λ_foot in
-the paper's set-up), 06 ``held_out_q`` (q by likelihood on truly held-out frames), 05
-``style_change`` (the ``dwell`` at which a style change lasts a gait cycle),
-``vanishing_threshold`` (the graph threshold at which a style leaves the pruned standard graph); 07
+the paper's set-up); 04 ``shorter_legs`` (copying rotations onto shorter legs); 05 ``style_change``
+(the ``dwell`` at which a style change lasts a gait cycle), ``vanishing_threshold`` (the graph
+threshold at which a style leaves the pruned standard graph); 06 ``held_out_q`` (q by likelihood
+on truly held-out frames), ``walk_spacing`` (the paper's walk experiment with key frames further
+apart), ``smallest_gap`` (the fewest dropped frames the stream-against-itself rule finds); 07
 ``arm_length`` (how low a longer arm reaches under the floor).
 
 Their reference solutions, as a student would write them, are in ``instructor/solutions/`` (the
@@ -48,7 +48,7 @@ from __future__ import annotations
 
 from .basics import euler_order, hand_height, hips_heading, joint_speed, nlerp_turn, shorter_legs, window_count
 from .core import Exercise, Mistake, Question, Result, check
-from .interpolation import ease, held_out_q, jumps, sigma2
+from .interpolation import held_out_q, smallest_gap, walk_spacing
 from .motion_graphs import local_minima, style_change, vanishing_threshold
 from .retargeting import (
     arm_length,
@@ -71,9 +71,6 @@ __all__ = [
     "joint_speed",
     "contact_loss",
     "local_minima",
-    "ease",
-    "sigma2",
-    "jumps",
     "nlerp_turn",
     "euler_order",
     "hips_heading",
@@ -84,6 +81,8 @@ __all__ = [
     "contact_weight",
     "foot_weight",
     "held_out_q",
+    "walk_spacing",
+    "smallest_gap",
     "vanishing_threshold",
     "style_change",
     "arm_length",
@@ -97,9 +96,6 @@ EXERCISES: dict[str, Exercise] = {
     "joint_speed": joint_speed,
     "contact_loss": contact_loss,
     "local_minima": local_minima,
-    "ease": ease,
-    "sigma2": sigma2,
-    "jumps": jumps,
 }
 """Every named exercise of the notebooks that asks for a function, by the attribute name the notebooks use.
 
@@ -117,6 +113,8 @@ EXPERIMENTS: dict[str, Question] = {
     "contact_weight": contact_weight,
     "foot_weight": foot_weight,
     "held_out_q": held_out_q,
+    "walk_spacing": walk_spacing,
+    "smallest_gap": smallest_gap,
     "vanishing_threshold": vanishing_threshold,
     "style_change": style_change,
     "arm_length": arm_length,

@@ -1,171 +1,26 @@
-"""Exercises of notebook 06 (key-pose interpolation): α(k), the PPCA noise variance, the D > Δ rule."""
+"""Experiment exercises of notebook 06 (key-pose interpolation): each changes one parameter of an
+experiment the notebook runs, and the check reruns the experiment on the notebook's own inputs.
+
+1. :data:`held_out_q`: choose PPCA's q by the likelihood of frames held out in one block;
+2. :data:`walk_spacing`: the paper's walk experiment (Fig. 6/7) with key frames further apart;
+3. :data:`smallest_gap`: the fewest dropped frames the stream-against-itself rule finds.
+"""
 
 from __future__ import annotations
 
 import numpy as np
 
-from .core import Exercise, Mistake, Question
+from .core import Mistake, Question
 
-__all__ = ["ease", "sigma2", "jumps", "DELTA", "held_out_q", "Q_CHOICES", "HELD_OUT"]
-
-DELTA = 2.5
-"""Δ of exercise 3 (the same threshold as ``motionlab.interpolation.detect.DELTA``)."""
+__all__ = ["held_out_q", "Q_CHOICES", "HELD_OUT", "walk_spacing", "SPACING", "smallest_gap", "CUT_AT"]
 
 
-# --------------------------------------------------------------------------- exercise 1
-def _ease_ref(num):
-    from motionlab.interpolation import slerp
-
-    return slerp.alphas(num, "ease")
-
-
-def _ease_cases():
-    return [(1,), (5,), (30,), (2,)]
-
-
-def _cosine(u):
-    return 0.5 * (1.0 - np.cos(np.pi * u))
-
-
-ease = Exercise(
-    "06 · exercise 1 (ease-in-out weights)",
-    _ease_ref,
-    _ease_cases,
-    mistakes=[
-        Mistake(
-            lambda n: _cosine(np.arange(1, n + 1) / n),
-            "the last weight is 1, so the last in-between frame repeats the key pose: divide k by N + 1.",
-        ),
-        Mistake(
-            lambda n: _cosine(np.arange(n) / (n + 1)),
-            "the first weight is 0, so the first in-between frame repeats the key pose: k runs from 1 to N.",
-        ),
-        Mistake(
-            lambda n: np.arange(1, n + 1) / (n + 1), "those are the linear weights k/(N+1); ease-in-out uses a cosine."
-        ),
-        Mistake(
-            lambda n: 1.0 - np.cos(np.pi * np.arange(1, n + 1) / (n + 1)),
-            "your weights go beyond 1: look at the factor in front of the bracket.",
-        ),
-        Mistake(
-            lambda n: 0.5 * (1.0 + np.cos(np.pi * np.arange(1, n + 1) / (n + 1))),
-            "your weights decrease from 1 to 0; α(k) must grow with k.",
-        ),
-    ],
-)
-
-
-# --------------------------------------------------------------------------- exercise 2
-def _sigma2_cases():
-    rng = np.random.default_rng(600)
-    n, d = 300, 12
-    latent = rng.normal(size=(n, 3)) @ rng.normal(size=(3, d)) * 2.0  # three strong directions
-    x = latent + rng.normal(scale=0.5, size=(n, d)) + rng.normal(size=d) * 3.0  # noise and a mean far from 0
-    y = rng.normal(size=(80, 6)) * np.array([3.0, 2.0, 1.0, 0.5, 0.4, 0.3])
-    return [(x, 3), (x, 5), (y, 2)]
-
-
-def _sigma2_ref(X, q):
-    from motionlab.interpolation.ppca import PPCA
-
-    return PPCA(q).fit(X).sigma2
-
-
-def _eig(X, centre: bool = True, ddof: int = 0):
-    X = np.asarray(X, dtype=float)
-    xc = X - X.mean(axis=0) if centre else X
-    return np.linalg.eigvalsh(xc.T @ xc / (len(X) - ddof))  # increasing
-
-
-sigma2 = Exercise(
-    "06 · exercise 2 (PPCA noise variance)",
-    _sigma2_ref,
-    _sigma2_cases,
-    atol=1e-9,
-    mistakes=[
-        Mistake(
-            lambda X, q: _eig(X, ddof=1)[::-1][q:].mean(),
-            "close, but the maximum-likelihood covariance S divides by N, not N − 1 (np.cov divides by N − 1).",
-        ),
-        Mistake(
-            lambda X, q: _eig(X)[q:].mean(),
-            "np.linalg.eigh and eigvalsh return the eigenvalues in *increasing* order: sort them largest first.",
-        ),
-        Mistake(
-            lambda X, q: _eig(X)[::-1][:q].mean(),
-            "σ² is the variance the q principal directions leave unexplained: the D − q *smallest* eigenvalues.",
-        ),
-        Mistake(
-            lambda X, q: _eig(X)[::-1][q:].sum() / X.shape[1],
-            "average over the D − q discarded eigenvalues, not over all D.",
-        ),
-        Mistake(
-            lambda X, q: _eig(X, centre=False)[::-1][q:].mean(),
-            "S is the covariance about the mean: subtract the mean of X first.",
-        ),
-    ],
-)
-
-
-# --------------------------------------------------------------------------- exercise 3
-def _jumps_ref(steps):
-    s = np.asarray(steps, dtype=float)
-    return np.flatnonzero(s[1:-1] > DELTA * np.maximum(s[:-2], s[2:])) + 1
-
-
-def _jumps_cases():
-    rng = np.random.default_rng(601)
-    a = np.abs(rng.normal(1.0, 0.1, size=50))
-    a[[7, 31]] = 9.0
-    b = np.abs(rng.normal(1.0, 0.1, size=40))
-    b[[0, 39, 20]] = 8.0  # the first and last steps are never flagged
-    c = np.abs(rng.normal(1.0, 0.1, size=30))
-    c[[12, 13]] = 6.0  # two large steps side by side: neither is isolated
-    c[25] = 2.0  # twice its neighbours: below Δ
-    c[5], c[6] = 3.0, 6.0  # 6 > Δ × the neighbours' mean, not Δ × the larger neighbour
-    return [(a,), (b,), (c,)]
-
-
-def _jumps_variant(mode: str):
-    def wrong(steps):
-        s = np.asarray(steps, dtype=float)
-        if mode == "ends":
-            p = np.concatenate([[0.0], s, [0.0]])
-            return np.flatnonzero(p[1:-1] > DELTA * np.maximum(p[:-2], p[2:]))
-        if mode == "min":
-            return np.flatnonzero(s[1:-1] > DELTA * np.minimum(s[:-2], s[2:])) + 1
-        if mode == "mean":
-            return np.flatnonzero(s[1:-1] > DELTA * 0.5 * (s[:-2] + s[2:])) + 1
-        return np.flatnonzero(s[1:-1] > DELTA * np.maximum(s[:-2], s[2:]))  # "shift"
-
-    return wrong
-
-
-jumps = Exercise(
-    "06 · exercise 3 (the D > Δ rule)",
-    _jumps_ref,
-    _jumps_cases,
-    mistakes=[
-        Mistake(
-            _jumps_variant("shift"),
-            "your indices are one too small: s[1:-1] starts at t = 1, so shift the positions you find.",
-        ),
-        Mistake(_jumps_variant("ends"), "the first and the last step have only one neighbour and are never flagged."),
-        Mistake(
-            _jumps_variant("min"),
-            "compare with the *larger* of the two neighbours: two large steps side by side are not an isolated jump.",
-        ),
-        Mistake(_jumps_variant("mean"), "compare with the larger of the two neighbours, not with their mean."),
-    ],
-)
-
-
-# --------------------------------------------------------------------------- exercise 4 (experiment)
+# --------------------------------------------------------------------------- exercise 1: q on held-out frames
 Q_CHOICES = (1, 2, 4, 8, 16, 32)
-"""The latent sizes exercise 4 chooses among."""
+"""The latent sizes exercise 1 chooses among."""
 
 HELD_OUT = 0.25
-"""Exercise 4 holds out the last quarter of every clip's frames."""
+"""Exercise 1 holds out the last quarter of every clip's frames."""
 
 
 def _best_q(clips, split: str = "tail", stats: str = "train") -> int:
@@ -193,7 +48,7 @@ def _best_q(clips, split: str = "tail", stats: str = "train") -> int:
 
 
 held_out_q = Question(
-    "06 · exercise 4 (experiment: q by held-out likelihood)",
+    "06 · exercise 1 (experiment: q by held-out likelihood)",
     lambda clips: _best_q(clips),
     accept=[lambda clips: _best_q(clips, stats="all")],
     mistakes=[
@@ -209,3 +64,77 @@ held_out_q = Question(
         ),
     ],
 )
+
+
+# --------------------------------------------------------------------------- exercise 2: key frames further apart
+SPACING = 60
+"""Exercise 2 keeps every ``SPACING``-th frame (the notebook keeps every 30th)."""
+
+
+def _walk_error(walk, every: int = SPACING, first: int = 5, curve: str = "linear", unit: str = "deg") -> float:
+    """Mean angle error over :data:`motionlab.interpolation.demo.WALK_JOINTS` and the filled frames when frames ``first,
+    first+every, …`` of ``walk`` are kept and the rest filled by SLERP with a Hermite root."""
+    from motionlab.core import quat
+    from motionlab.interpolation import gaps
+    from motionlab.interpolation.demo import WALK_JOINTS
+
+    kept = np.arange(first, walk.num_frames, every)
+    span = walk[first : kept[-1] + 1]
+    holed, _ = gaps.insert_missing(span[kept - first], [(i, every - 1) for i in range(len(kept) - 1)])
+    filled, _ = gaps.fill(holed, method="slerp", root="hermite", curve=curve)
+    lost = np.setdiff1d(np.arange(span.num_frames), kept - first)
+    idx = [list(walk.skeleton.names).index(n) for n in WALK_JOINTS]
+    err = quat.angle_between(filled.local_rot[lost][:, idx], span.local_rot[lost][:, idx]).mean()
+    return float(np.degrees(err) if unit == "deg" else err)
+
+
+walk_spacing = Question(
+    "06 · exercise 2 (experiment: key frames further apart)",
+    lambda walk: _walk_error(walk),
+    accept=[lambda walk: _walk_error(walk, curve="ease"), lambda walk: _walk_error(walk, curve="smoothstep")],
+    rtol=0.02,
+    mistakes=[
+        Mistake(
+            lambda walk: _walk_error(walk, every=30),
+            "that is the notebook's own spacing (every 30th frame): set every = 60.",
+        ),
+        Mistake(lambda walk: _walk_error(walk, unit="rad"), "the error is asked in degrees, not radians."),
+    ],
+)
+"""Exercise 2: the mean angle error (degrees) of the walk experiment with every 60th frame kept."""
+
+
+# --------------------------------------------------------------------------- exercise 3: the smallest gap found
+CUT_AT = 100
+"""Exercise 3 removes frames from ``CUT_AT`` on."""
+
+
+def _smallest_gap(walk, at: int = CUT_AT, largest: int = 8, rule: str = "flagged") -> int:
+    """The fewest frames (1 … ``largest``) removed from frame ``at`` on whose gap
+    :func:`motionlab.interpolation.detect.consecutive_gaps` flags; ``largest + 1`` if none."""
+    from motionlab.interpolation import detect
+
+    for n in range(1, largest + 1):
+        cut = walk[np.r_[0:at, at + n : walk.num_frames]]
+        if rule == "flagged" and at - 1 in detect.consecutive_gaps(cut):
+            return n
+        if rule == "any" and detect.consecutive_gaps(cut):
+            return n
+    return largest + 1
+
+
+smallest_gap = Question(
+    "06 · exercise 3 (experiment: the smallest gap found)",
+    lambda walk: _smallest_gap(walk),
+    mistakes=[
+        Mistake(
+            lambda walk: 1,
+            "one missing frame makes a step about twice its neighbours (D ≈ 2): is that above Δ = 2.5?",
+        ),
+        Mistake(
+            lambda walk: _smallest_gap(walk) - 1,
+            "that many removed frames are not flagged yet: the answer is the fewest that are.",
+        ),
+    ],
+)
+"""Exercise 3: the fewest frames removed from frame :data:`CUT_AT` on that ``detect.consecutive_gaps`` flags."""

@@ -15,24 +15,21 @@ Modules, one concept each:
 * :mod:`.recorded`     missing counts read off other recordings of the action
 * :mod:`.gaps`         inserting and filling missing frames
 * :mod:`.stride`       gaps in a gait filled from the recorded strides on both sides
-* :mod:`.gap_eval`     measuring detection and filling on clips with frames removed
-* :mod:`.paper`        the paper's experiments (§4: Fig. 6/7 walk, Fig. 8 run → squat)
-* :mod:`.benchmark`    LaFAN1-style benchmark (L2Q, L2P, NPSS)
 * :mod:`.plots`        figures (matplotlib imported lazily)
+* :mod:`.demo`         the clips notebook 06 uses (real mocap or synthetic) and the paper's Fig. 8 set-up
 
-Taught in ``notebooks/06_keypose_interpolation.ipynb``.
+Taught in ``notebooks/06_keypose_interpolation.ipynb``. The studies that measure it (gap
+evaluation, the paper's experiments, a LaFAN1-style benchmark) are in ``experiments/interpolation/``.
 """
 
 from motionlab.interpolation import (
     alignment,
     detect,
     features,
-    gap_eval,
     gaps,
     inbetween,
     keyposes,
     labels,
-    paper,
     ppca,
     recorded,
     slerp,
@@ -54,8 +51,6 @@ __all__ = [
     "detect",
     "recorded",
     "labels",
-    "gap_eval",
-    "paper",
     "ActionGraph",
     "MotionLibrary",
     "PCA",

@@ -1,12 +1,16 @@
 """Clips for notebook 06: real mocap when ``MOTIONLAB_DATA`` is set, synthetic motion otherwise.
 
-Every function returns canonical 22-joint motions at ``fps`` and says where they came from, so a
-notebook cell can print its data source. Nothing is downloaded.
+:func:`behaviours`, :func:`walk_clip` and :func:`paper_walk` return canonical 22-joint motions and
+say where they came from, so a notebook cell can print its data source; :func:`load_clips` loads
+any BVH files the same way; :func:`fig8_graph` and :func:`run_squat_gap` set up the paper's Fig. 8.
+Nothing is downloaded.
 """
 
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
+from pathlib import Path
 
 import numpy as np
 
@@ -21,8 +25,10 @@ __all__ = [
     "walk_clip",
     "walk_takes",
     "paper_walk",
-    "benchmark_clips",
-    "benchmark_apart_clips",
+    "WALK_JOINTS",
+    "fig8_graph",
+    "run_squat_gap",
+    "load_clips",
 ]
 
 BEHAVIOUR_CLIPS = {
@@ -89,20 +95,36 @@ def walk_clip(fps: float = 30.0, frames: int = 240) -> tuple[Motion, str]:
     return m, "synthetic walk (set MOTIONLAB_DATA for real mocap)"
 
 
-def benchmark_clips(fps: float = 30.0) -> tuple[list[Motion], str]:
-    """The in-betweening test clips (Bandai Namco dataset-2) or synthetic stand-ins."""
-    if data.has_data("bandai_namco", "dataset-2"):
-        from motionlab.interpolation.benchmark import load_clips
+def load_clips(paths: Sequence[str | Path], fps: float = 30.0, canonical: bool = True) -> list[Motion]:
+    """Load BVH files (or every ``*.bvh`` under folders), reduce to 22 joints, resample to ``fps``.
 
-        return load_clips([data.data_root() / "bandai_namco" / "dataset-2"], fps=fps), "real: bandai_namco/dataset-2"
-    from motionlab import synthetic
+    Files that fail to load or map are skipped with a warning naming them.
+    """
+    from motionlab.core import bvh, humanoid
 
-    clips = []
-    for i, b in enumerate(["walk", "walk", "walk", "run", "run"]):
-        m = synthetic.generate(b, None, 200, fps, seed=10 + i)
-        m.name = f"synthetic_{b}_{i:03d}"
-        clips.append(m)
-    return clips, "synthetic walks and runs (set MOTIONLAB_DATA for real mocap)"
+    files: list[Path] = []
+    for p in paths:
+        p = Path(p)
+        if p.is_dir():
+            files.extend(sorted(p.rglob("*.bvh")))
+        elif p.is_file():
+            files.append(p)
+        else:
+            raise FileNotFoundError(f"{p} is neither a BVH file nor a folder")
+    out = []
+    for f in files:
+        try:
+            m = bvh.load(f)
+            if canonical:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", UserWarning)
+                    m = humanoid.to_canonical(m)
+            if fps is not None:
+                m = m.resample(fps)
+            out.append(m)
+        except (ValueError, KeyError) as e:
+            warnings.warn(f"skipping {f}: {e}", UserWarning, stacklevel=2)
+    return out
 
 
 def walk_takes(takes=(4, 5, 6), style: str = "normal", fps: float = 30.0) -> list[Motion]:
@@ -111,25 +133,6 @@ def walk_takes(takes=(4, 5, 6), style: str = "normal", fps: float = 30.0) -> lis
     if not data.has_data("bandai_namco", "sessions", "walk"):
         return []
     return [_load(f"bandai_namco/sessions/walk/dataset-2_walk_{style}_{t:03d}", fps) for t in takes]
-
-
-def benchmark_apart_clips(fps: float = 30.0) -> tuple[list[Motion], str]:
-    """Clips of the benchmark's skeleton kept apart from :func:`benchmark_clips` (L2P statistics
-    and extra library material): Bandai Namco dataset-1 normal-style clips, or synthetic ones with
-    other seeds."""
-    if data.has_data("bandai_namco", "dataset-1"):
-        from motionlab.interpolation.benchmark import load_clips
-
-        files = sorted((data.data_root() / "bandai_namco" / "dataset-1").rglob("*_normal_*.bvh"))
-        return load_clips(files, fps=fps), "real: bandai_namco/dataset-1 normal-style clips"
-    from motionlab import synthetic
-
-    clips = []
-    for i, b in enumerate(["walk", "walk", "run", "run"]):
-        m = synthetic.generate(b, None, 200, fps, seed=50 + i)
-        m.name = f"synthetic_apart_{b}_{i:03d}"
-        clips.append(m)
-    return clips, "synthetic walks and runs with other seeds"
 
 
 def paper_walk() -> tuple[Motion, str]:
@@ -144,3 +147,57 @@ def paper_walk() -> tuple[Motion, str]:
     return synthetic.generate(
         "walk", None, 360, 120.0, seed=3
     ), "synthetic 120 Hz walk (set MOTIONLAB_DATA for real mocap)"
+
+
+WALK_JOINTS = ("Hips", "Spine", "Neck", "LeftUpLeg", "RightUpLeg", "LeftLeg", "RightLeg", "LeftFoot", "RightFoot",
+               "LeftArm", "RightArm", "LeftForeArm", "RightForeArm")  # fmt: skip
+"""The 13 walking joints of the paper's Table 1 (its list is not in the text), read as the CMU
+skeleton's hips, lower spine, neck, thighs, shins, feet, upper arms and forearms, canonical names;
+``LeftUpLeg`` is the paper's ``lThigh``."""
+
+
+def fig8_graph(clips: dict[str, Motion]):
+    """The action graph of the paper's Fig. 8: nodes run, walk, stand and squat (the clips of
+    :func:`behaviours`), transitions run ↔ walk ↔ stand ↔ squat; returns an
+    :class:`~motionlab.interpolation.action_graph.ActionGraph`."""
+    from motionlab.interpolation.action_graph import ActionGraph
+
+    g = ActionGraph()
+    for name in ("run", "walk", "stand", "squat"):
+        g.add_node(name, clips[name])
+    g.allow(["run -> walk", "walk -> stand", "stand -> squat"], both_ways=True)
+    return g
+
+
+def run_squat_gap(clips: dict[str, Motion], missing: int = 10, context: int = 10) -> tuple[Motion, tuple[int, int]]:
+    """The stream of the paper's Fig. 8: the last ``context`` frames of ``clips["run"]``, ``missing``
+    NaN frames, then ``clips["squat"]`` from two frames before its deepest crouch.
+
+    The squat faces the run's last heading and stands ahead of the last run frame by the distance
+    the runner covers slowing uniformly to rest over the gap (half the run's mean ground speed ×
+    ``missing + 1`` frames); the paper does not say where its squat stands.
+
+    Returns
+    -------
+    stream : Motion     ``context + missing + len(squat part)`` frames
+    gap : (int, int)    the NaN frames ``start … stop-1`` (:func:`.gaps.insert_missing`)
+    """
+    from motionlab.core import quat
+    from motionlab.interpolation import gaps
+    from motionlab.interpolation.alignment import align_to, reference_joint, reference_transform
+    from motionlab.interpolation.inbetween import concatenate
+
+    run, squat = clips["run"], clips["squat"]
+    head = run[run.num_frames - context :]
+    low = int(np.argmin(squat.global_positions()[:, 0, 1]))  # the deepest crouch
+    tail = squat[max(0, low - 2) : min(squat.num_frames, low + context)]
+    ref = reference_joint(run)
+    _, path = reference_transform(head, joint=ref)
+    v = np.linalg.norm(np.diff(path[:, [0, 2]], axis=0), axis=1).mean()
+    tail = align_to(tail, head, frame=0, to_frame=-1)
+    rot, _ = reference_transform(head, [-1], joint=ref)
+    fwd = quat.rotate(quat.from_yaw(float(quat.yaw(rot[0]))), np.array([0.0, 0.0, 1.0]))
+    expected = float(v * (missing + 1) * 0.5)  # slowing from a run to rest: half the run speed on average
+    tail = tail.copy(root_pos=tail.root_pos + expected * fwd)
+    joined, where = gaps.insert_missing(concatenate([head, tail]), [(head.num_frames - 1, missing)])
+    return joined, where[0]

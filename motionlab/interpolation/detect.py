@@ -1,69 +1,36 @@
 """Finding dropped frames in a motion stream, and how many went missing (paper C, §3.3).
 
-A BVH file with a constant frame time cannot say that frames are missing; the motion has to.
-One measure of "how far the body moved between stream frames ``t`` and ``t+1``" is used:
+A BVH file with a constant frame time cannot say that frames are missing; the motion has to. The
+measure is :func:`joint_steps`: the root-mean-square over joints of every joint's *world*
+displacement between stream frames ``t`` and ``t+1``, metres per step.
 
-* :func:`joint_steps` — the root-mean-square over joints of the *world* displacement of every
-  joint, metres per stream step. It is what the eye sees: a dive roll that turns the hips upside
-  down moves the joints a few centimetres per frame, however fast the hips' heading spins.
-  (A heading-frame distance — joints relative to a facing direction read off the hips — jumps
-  whenever that heading is ill-defined, which is how the old rule found "gaps" in clean rolls.)
-
-**Stream against the graph** (:func:`graph_gaps`, the paper's rule). Each incoming frame ``M_c`` is
-tracked to a graph frame ``M_i`` (:func:`track`): the 0.4 s of stream just before the step into
-it, or just after, whichever matches better, is matched against every stretch of every graph
-clip, time-warped to tempi from half to twice the recordings', by the body's heading-frame joint
-positions and velocities. The distance compares how the stream moved into ``M_c`` with how the
-graph moves at ``M_i``, time-scaled by the matched tempo ``ρ``:
+**Stream against the graph** (:func:`track`, :func:`graph_gaps`; the paper's rule). Each stream
+frame ``M_c`` is tracked to a graph frame ``M_i`` by matching the :data:`TRACK_CONTEXT` seconds of
+stream beside it, time-warped by the tempi :data:`TRACK_RATES`, and
 
 .. math::  r(t) = \\frac{s(t)}{\\rho(t)\\,\\bar s_{\\text{graph}}(i(t))}, \\qquad
            D(M_c, M_i) = \\frac{r(t)}{\\operatorname{median}_{\\text{around } t}\\, r}
 
-with ``s(t)`` the stream's joint step into frame ``t`` and ``ρ s̄_graph(i)`` the graph clip's
-joint step at the matched frame ``i`` (mean over ``i−2 … i+2``) scaled to a stream step (never
-below ``STEP_FLOOR``). The graph predicts how fast the body moves *at this point of the motion*
-(slow at a walk's double support, fast in swing); the running median of ``r`` (``WINDOW`` frames
-on each side, the larger side, and the two adjacent values, as in :func:`consecutive_gaps`, so
-only an isolated jump counts) removes what the tempo leaves: a walker who takes shorter steps
-than the recordings at the same tempo (an elderly or exhausted walk moves far slower than a
-normal one). With nothing missing ``D ≈ 1``;
-with ``n`` frames missing the stream moved ``n+1`` steps at once, ``D ≈ n+1``. ``D > Δ`` flags a
-gap. **Δ is chosen by principle, not fitted**: one missing frame doubles the step (``D = 2``), the
-largest ``D`` over all 418 clean shared files by the stream-only rule is 1.6, so ``Δ = 2.5``
-(``DELTA``); a single dropped frame can then go unreported, which SLERP fills unnoticed anyway.
+with ``s(t)`` the stream's joint step into frame ``t``, ``ρ`` the matched tempo and
+``s̄_graph(i)`` the graph clip's joint step at the matched frame (mean over ``i−2 … i+2``, never
+below :data:`STEP_FLOOR`). The typical value around ``t`` is the larger of the medians of
+:data:`WINDOW` values on each side and of the two adjacent values, so only an isolated jump counts.
+With nothing missing ``D ≈ 1``; with ``n`` frames missing ``D ≈ n+1``. ``D > Δ`` flags a gap
+(:data:`DELTA` = 2.5: one missing frame gives ``D ≈ 2`` and is not flagged).
 
-**Stream against itself** (:func:`consecutive_gaps`, no graph). The step into a frame is compared
-with the typical steps just before and after it (medians of ``WINDOW`` steps on each side, and
-the two adjacent steps; the largest of the four, so a motion that starts or stops sharply, or a
-brief burst like a cough, is judged by its moving side). A gap makes one isolated step ``n+1``
-times its neighbours; smooth motion, however fast, does not.
-``D = s(t) / max(median before, median after, s(t−1), s(t+1)) > Δ`` with the same ``Δ = 2.5`` default, and steps
-below ``STEP_FLOOR`` are never flagged (a body that hardly moves cannot reveal what it skipped,
-and nothing visible is lost there). This is what ``motionlab fill-gaps`` uses without ``--action``.
+**Stream against itself** (:func:`consecutive_gaps`, no graph; what ``motionlab fill-gaps`` uses
+without ``--action``): ``D = s(t) / max(median before, median after, s(t−1), s(t+1)) > Δ``, and
+steps below :data:`STEP_FLOOR` are never flagged.
 
-**How many frames** (:func:`estimate_missing`). Not from the size of the jump alone — a jump in
-pose saturates once the gap exceeds half a step cycle — but from the motion on both sides: the
-ground distance the reference joint covered across the gap, against how far it travels per frame.
-Walking and running bodies speed up and slow down within every step (±10–20%), so a 10-frame gap
-cut at the fast phase holds more ground than the average speed says: where the ground speed on a
-side of the gap repeats with a step period ``P`` (autocorrelation ≥ 0.5 at a lag of 0.3–1.3 s),
-the gap is filled, in thought, with the last ``P`` steps before it repeated (or the first ``P``
-after it, backwards), and the count is where their cumulative distance reaches the gap's; else
-the mean ground speed over a second on each side is used; where the two sides' speeds differ by
-more than 20% (a body speeding up or slowing down) the step phase at both ends, matched against
-the stride period, decides instead. A body that does not travel (speed
-below ``STEP_FLOOR``) falls back to the joint-step ratio.
-A gap short against a step (as 10–30 frames are at 120 fps) is better served by the speeds
-right at its edges: a quadratic in time through the nearest 0.1 s of ground speeds on both sides.
-Which of the two a gap gets is decided by the stream itself: both are *rehearsed* on gaps of the
-same length cut out of the known frames beside the real one, and the local count is used only
-where it gets clearly more of those within 10% (or one frame): a sign test at ``SIGNIFICANCE``
-(:func:`count_choice`).
-Given other recordings of the action (:mod:`.recorded`), the count also reads how long they need
-from the pose before the gap to the pose after it, and the two counts are averaged.
+**How many frames** (:func:`estimate_missing`): from the ground distance the reference joint
+covers across the gap against the motion on both sides (step cycle, mean speed, step phase, or
+the speeds at the gap's edges, chosen per gap by :func:`count_choice`), and optionally the time
+other recordings of the action need between the poses that bound it (:mod:`.recorded`).
 Timestamps, where the input has them, give the count exactly (:func:`~.gaps.timestamp_gaps`).
 
-Taught in ``notebooks/06_keypose_interpolation.ipynb``; ``motionlab fill-gaps`` uses it.
+How these rules do on the shared data: ``docs/results_interpolation.md`` (``python -m
+experiments.interpolation.check_gaps``). Taught in ``notebooks/06_keypose_interpolation.ipynb``;
+``motionlab fill-gaps`` uses it.
 """
 
 from __future__ import annotations
@@ -107,7 +74,7 @@ __all__ = [
 ]
 
 DELTA = 2.5
-"""Default Δ: a step 2.5× its neighbours' (one missing frame gives 2×; see the module docstring)."""
+"""Default Δ: a step 2.5× the typical step is a gap (one missing frame gives about 2×)."""
 
 STEP_FLOOR = 0.05
 """Steps slower than this fraction of the body height per second are never flagged."""
@@ -116,9 +83,7 @@ WINDOW = 8
 """Steps on each side whose median is the typical step (:func:`consecutive_gaps`)."""
 
 LOCAL_SECONDS = 0.1
-"""Seconds of ground speeds on each side of a gap that the local count fits (:func:`_local_count`;
-0.1, 0.2, 0.3 and 0.5 s and degrees 1–3 tried on the Xia clips of ``scripts/check_gaps.py`` part
-5, which are therefore no longer held out; checked on part 6, clips never looked at before)."""
+"""Seconds of ground speeds on each side of a gap that the local count fits (:func:`_local_count`)."""
 
 REHEARSAL_SECONDS = 2.0
 """How far from a gap, on each side, the two counts are rehearsed (:func:`count_choice`)."""
@@ -132,12 +97,12 @@ HELD = 1e-6
 frame exactly: a held pose, as in Mixamo clips padded to 60 frames with copies of their last
 pose (:func:`held_steps`; :func:`.demo.trim_frozen` trims such a tail off the action clips).
 Held frames carry no speed and no timing, so the counts read nothing from them
-(:func:`count_choice`): 1e-6 of a body height is one or two micrometres, far below any capture's noise."""
+(:func:`count_choice`)."""
 
 TRANSIENT = 0.2
 """Relative difference of the mean ground speeds on the two sides of a gap above which the body is
 taken to be speeding up or slowing down, and the count comes from the step phase
-(:func:`estimate_missing`; chosen on the ``normal`` walk takes of ``sessions/walk``)."""
+(:func:`estimate_missing`, :func:`changes_speed`)."""
 
 
 def changes_speed(v_before: float, v_after: float) -> bool:
@@ -359,10 +324,6 @@ def track(motion: Motion, graph, delta: float | None = None) -> GraphTrack:
     The work grows as stream frames × graph frames × the 13 tempi (matrix products, in blocks of
     512 stream windows, so memory stays bounded).
 
-    ``scripts/check_tracking_pose.py`` compares this match with single frames, with and without
-    velocities (false gaps on the clean walk takes of ``sessions/walk``, and on the same takes moved
-    3 m in the capture volume).
-
     Parameters
     ----------
     motion : Motion on the graph's skeleton, at any frame rate
@@ -439,8 +400,7 @@ def _step_period(speed: np.ndarray, lo: int, hi: int) -> tuple[int | None, float
     and that normalised autocorrelation (``None, -1`` when the signal is too short).
 
     Only lags up to half the signal are tried, so that a period is claimed only where the signal
-    holds two of it: at a longer lag the correlation rests on a few pairs of frames and comes out
-    near 1 by chance (a 2 s side of a 120 fps walk once gave a "period" of 152 frames from 9 pairs).
+    holds two of it (at a longer lag the correlation rests on a few pairs of frames).
     """
     if len(speed) < 2 * lo:  # not two of even the shortest period (an empty side, say)
         return None, -1.0
@@ -577,73 +537,46 @@ def _phase_missing(pose: np.ndarray, t: int, start: int, stop: int, guess: float
 def estimate_missing(motion: Motion, steps_at, seconds: float = 1.0, takes=None) -> list[int]:
     """How many frames went missing at each stream step ``t → t+1`` in ``steps_at``.
 
-    From the motion on both sides, not the jump alone:
+    From the motion on both sides of each gap (the known steps end at the neighbouring gaps and
+    at the nearest held step, :data:`HELD`), not from the jump alone:
 
-    * the ground distance across the gap is the chord ``|g(t+1) − g(t)|`` of the reference
-      joint's ground point, lengthened to the arc of a circle turning by the change ``ψ`` of travel
+    * the ground distance across the gap is the chord ``|g(t+1) − g(t)|`` of the reference joint's
+      ground point, lengthened to the arc of a circle turning by the change ``ψ`` of travel
       direction between the two sides, ``arc = chord · (ψ/2) / sin(ψ/2)``;
-    * **step phase**: where the ground speed on a side (up to two seconds, other gaps left out)
-      repeats with a period ``P`` of 0.3–1.3 s (normalised autocorrelation ≥ 0.5; the side must hold
-      two periods, see :func:`_step_period`), the gap is taken
-      to repeat that side's last cycle (before) or first cycle (after, backwards) and ``n + 1`` is
-      where the cycle's cumulative ground distance reaches the arc; both sides are averaged;
-    * otherwise ``n + 1 = arc / v`` with ``v`` the mean ground speed (metres per frame) over
-      ``seconds`` on each side. (A straight-line fit of speed on each side, read at the gap's
-      edges, was tried on the choose set of ``scripts/check_gaps.py`` and rejected.)
-    * **speeding up or slowing down**: both rules assume the speed of the sides holds across the
-      gap. Where the two sides' mean speeds differ by more than ``TRANSIENT`` (20%) of their mean
-      (a walker starting off, a runner accelerating), the count is taken from the *step phase*
-      instead (:func:`_phase_missing`): the pose just after the gap is matched to the stride before
-      it and the pose just before to the stride after, which fixes ``n`` modulo the stride period;
-      of those values the one nearest the distance estimate is kept. The gait cycle keeps its
-      rhythm while the speed changes; the distance does not. Used everywhere, the phase made
-      irregular gaits (elderly, exhausted) worse, hence only in transients. ``TRANSIENT`` was
-      chosen on the ``normal`` walk takes (0.1–0.5 tried, 0.2 best there) and validated on the
-      other six styles (``scripts/check_gaps.py --dense 15``). Where no stride can be read (sides
-      shorter than a stride, as in the 2–2.5 s ``dataset-2`` runs), the speed is the mean of the
-      two *edge* speeds, each over the nearest 0.35 s (about one running step): constant
-      acceleration across the gap. (This fallback was added after seeing two accelerating runs,
-      one in the choose set and one in the validate set, so the validate figure is not fully
-      held out for it.)
-
-    * **a gap short against a step**: the speeds at its edges say more than the step cycle. The
-      *local* count (:func:`_local_count`) fits a quadratic in time to the ground speeds of the
-      nearest ``LOCAL_SECONDS`` (0.1 s) on both sides, the after side placed ``n + 1`` steps later,
-      and takes the ``n`` for which that curve covers the arc. Which count a gap gets, this *stride*
-      count (the rules above) or the local one, is decided by :func:`count_choice`: gaps of the same
-      length are cut out of the known frames on both sides (up to ``REHEARSAL_SECONDS``), both
-      counts are made for each, and the local count is used only where it gets more of them
-      within 10% (or one frame) by a one-sided sign test at ``SIGNIFICANCE``. At 30 fps a 10–30-frame gap spans one to two steps and the
-      stride count wins the rehearsal; at 120 fps the same gaps span a fraction of a step and the
-      local count does.
-
-    When the body does not travel (speed below ``STEP_FLOOR``), ``n + 1`` is the joint step across
-    the gap over the median joint step around it. Always at least 1.
-
-    **Held frames** (a step that moves no joint by ``HELD`` of the body height: exact copies, as in
-    a clip padded with its last pose) are no motion: the known frames around a gap end at the
-    nearest held step on each side, so a held side adds no zero speed to the count. What such a
-    stream lost of the held pose itself no count can say; the count is of the moving frames.
-
-    **Other recordings of the action** (``takes``, a :class:`~.recorded.RecordedTakes` of *other*
-    takes, never this one): how long the recorded takes need from the pose before the gap to the
-    pose after it, time-scaled to the stream (:func:`~.recorded.recorded_missing`, §3.3). The two
-    counts rest on independent evidence (this stream's ground distance and step phase; the
-    recordings' timing), and the count is their mean with equal weights. (The recorded count alone
-    was 0.2 points better on the choose set of ``scripts/check_gaps.py``, but 3 cases worse on the
-    validate set, where each ``dataset-1`` run has a style no other take has; the mean was chosen
-    after seeing both, see the README.)
+    * **stride count**: where the ground speed on a side (up to two seconds) repeats with a period
+      of 0.3–1.3 s (normalised autocorrelation ≥ 0.5, :func:`_step_period`), ``n + 1`` is where
+      that side's nearest cycle, repeated, covers the arc (both sides averaged); otherwise
+      ``n + 1 = arc / v`` with ``v`` the mean ground speed over ``seconds`` on each side. Where the
+      two sides' mean speeds differ by more than :data:`TRANSIENT` (:func:`changes_speed`), the
+      step phase decides instead (:func:`_phase_missing`: ``n`` modulo the stride period from the
+      poses that bound the gap, the value nearest the distance estimate), or, where no stride can
+      be read, the mean of the two edge speeds over the nearest 0.35 s;
+    * **local count** (:func:`_local_count`): the ``n`` for which a quadratic in time through the
+      ground speeds of the nearest :data:`LOCAL_SECONDS` on both sides covers the arc. It replaces
+      the stride count only where, on gaps of the same length cut out of the known frames beside
+      the real one (up to :data:`REHEARSAL_SECONDS`), it gets significantly more of them within
+      10% (or one frame): a one-sided sign test at :data:`SIGNIFICANCE` (:func:`count_choice`);
+    * a body that does not travel (speed below :data:`STEP_FLOOR`): ``n + 1`` is the joint step
+      across the gap over the median joint step around it;
+    * with ``takes`` (other recordings of the action, never this one): the mean of the count above
+      and how long the recordings need from the pose before the gap to the pose after it,
+      time-scaled to the stream (:func:`~.recorded.recorded_missing`).
 
     Parameters
     ----------
     motion : Motion, the stream with the frames already missing (nothing inserted)
-    steps_at : sequence of int, steps ``t → t+1`` that hide missing frames
-    seconds : float, the mean-speed window on each side
+    steps_at : sequence of int, steps ``t → t+1`` that hide missing frames, in ``0 … T-2``
+    seconds : float, the mean-speed window on each side, seconds
     takes : :class:`~.recorded.RecordedTakes`, optional, other recordings of the stream's action
 
     Returns
     -------
-    list of int, the estimated missing count per step, in the order of ``sorted(steps_at)``
+    list of int, the estimated missing count per step (at least 1), in the order of ``sorted(steps_at)``
+
+    Raises
+    ------
+    ValueError
+        if a step lies outside ``0 … T-2``.
     """
     at = sorted(int(t) for t in steps_at)
     if not at:

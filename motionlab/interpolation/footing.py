@@ -2,10 +2,9 @@
 
 SLERP between the two poses bounding a gap turns each leg joint at a constant rate, and half-way
 the leg is longer, top to bottom, than either end pose holds it: the stance foot sinks into the
-floor (measured on the Bandai Namco walks: up to 7 cm). :func:`.gaps.lift_above_floor` lifts the
-whole body out by that depth, which keeps the feet dry but makes the hips hop: on the slow
-``dataset-1`` ``proud`` walk cut by 10 frames at 211 the hips rose 4.5 cm where the walker's rose
-0.5 cm, 11.6% of the root's displacement across the gap.
+floor. :func:`.gaps.lift_above_floor` lifts the whole body out by that depth, which keeps the feet
+dry but makes the hips hop where the walker's stay level (``docs/results_interpolation.md``,
+``python -m experiments.interpolation.compare_feet``).
 
 :func:`plant_feet` instead moves each foot that went below the floor straight up by its depth,
 rigidly (the ankle's world rotation kept, so the toes follow), and bends that leg to reach it: the

@@ -542,12 +542,10 @@ def _follow_strides(motion: Motion, a: int, b: int, joint: int, target: np.ndarr
     the path's end velocities are then swapped for the ones measured outside the gap
     (:func:`smooth_root`), keeping the strides' bob and sway in between.
 
-    The strides carry the speed of the side they come from across the gap. Where only one side
+    The strides carry the speed of the side they come from across the gap; where only one side
     holds a stride (:data:`.stride.MIN_STRIDES`) and the other is a start from standing, that speed
-    is wrong near the other end: on ``sessions/walk`` ``walk_normal_001`` cut at frame 20 the root
-    missed by 11.0% of its displacement (SLERP with the Hermite root: 2.9%), now 4.1%. Chosen on
-    the normal walk takes against the strides' own speed, the swap everywhere and SLERP with the
-    Hermite root where the speed changes (``scripts/compare_stride_root.py``; ``docs/results_interpolation.md``)."""
+    is wrong near the other end, which the measured end velocities correct. The rules compared:
+    ``docs/results_interpolation.md`` (``python -m experiments.interpolation.compare_stride_root``)."""
     out = _follow(motion, a, b, joint, target)
     if detect.changes_speed(*side_speeds(motion, a, b, joint)):
         out = smooth_root(out, [a, b], joint=joint)
@@ -594,16 +592,7 @@ def fill(
         foot-through-floor guard of :func:`smooth_root` applies to both. (The ``"graph"`` method
         always uses the Hermite curve through its key poses.)
     """
-    if method not in METHODS:
-        raise ValueError(f"unknown filling method {method!r}; expected one of {METHODS}")
-    if root not in ROOTS:
-        raise ValueError(f"unknown root mode {root!r}; expected one of {ROOTS}")
-    if method == "graph":
-        if graph is None or not graph.nodes:
-            raise ValueError("method='graph' needs an ActionGraph with at least one action")
-        sk = next(iter(graph.nodes.values())).motion.skeleton
-        if sk.names != motion.skeleton.names:
-            raise ValueError("the action graph's clips use another skeleton than the motion to fill")
+    _check_fill(motion, method, graph, root)
     out = motion.copy()
     report = []
     T = motion.num_frames
@@ -614,58 +603,101 @@ def fill(
                 raise ValueError("every frame is missing; nothing to fill from")
             out = _edge_fill(out, start, stop)
             report.append(FilledGap(start, stop, "hold"))
-            continue
-        a, b = start - 1, stop
-        if method == "stride":
-            strided = stride_fill(out, a, b, ref)
-            if strided is not None:
-                out = _feet_on_floor(_follow_strides(strided[0], a, b, ref, strided[1]), a, b)
-                report.append(FilledGap(start, stop, "stride"))
-                continue
-        if method in ("slerp", "hermite", "stride"):  # stride: SLERP where no stride is found
-            mode = "hermite" if method == "hermite" else "linear"
-            out = inbetween.fill_between(out, start, stop, curve=curve, root=mode,
-                                         rotation="hermite" if method == "hermite" else "slerp")  # fmt: skip
-            if root == "stride":
-                out = _stride_root(out, a, b, ref)
-            elif root == "hermite":
-                out = smooth_root(out, [a, b], joint=ref)
-            out = _feet_on_floor(out, a, b)
-            report.append(FilledGap(start, stop, "slerp" if method == "stride" else method))
-            continue
-        node_a = graph.classify(_frame_features(out, a, before=True)[None])[0]
-        node_b = graph.classify(_frame_features(out, b, before=False)[None])[0]
-        path = graph.path(node_a, node_b)
-        lib = graph.library()
-        inner = path[1:-1]
-        slots = [a + int(round((i + 1) * (b - a) / (len(inner) + 1))) for i in range(len(inner))]
-        slots = [s for s in slots if a < s < b]
-        if len(slots) < len(inner) or len(set(slots)) < len(slots):
-            inner, slots = [], []  # gap too short for the intermediate key poses: plain filling
-        prev = path[0]
-        placed = {a: (path[0], _node_frame(graph, path[0], _frame_features(out, a, before=True)))}
-        for name, slot in zip(inner, slots):
-            _, j, _ = graph.best_transition(prev, name)
-            _place_key_pose(out, slot, graph.nodes[name].motion, j, a, b, ref)
-            placed[slot] = (name, j)
-            prev = name
-        placed[b] = (path[-1], _node_frame(graph, path[-1], _frame_features(out, b, before=False)))
-        anchors = [a] + slots + [b]
-        used = "library"
-        for lo, hi in zip(anchors[:-1], anchors[1:]):
-            if hi - lo < 2:
-                continue
-            if inner:  # across nodes: eq. 4, node lo's clip running on, node hi's clip running in
-                (na, m), (nb, n) = placed[lo], placed[hi]
-                L = hi - lo
-                run_a = _clip_run(graph.nodes[na].motion, m, L + 1, out, lo, m, ref)
-                run_b = _clip_run(graph.nodes[nb].motion, n - L, L + 1, out, hi, n, ref)
-                _moving_piece(out, lo, hi, run_a, run_b, curve)
-                continue
-            ok = _library_fill(out, lo, hi, lib, sorted(set(path)), prev_frame=None if lo == a else lo)
-            if not ok:
-                out = inbetween.fill_between(out, lo + 1, hi, curve=curve)
-                used = "graph+slerp"
-        out = _feet_on_floor(smooth_root(out, anchors, joint=ref), a, b)
-        report.append(FilledGap(start, stop, "graph" if inner else used, path, slots))
+        elif method == "graph":
+            out, gap = _fill_through_graph(out, start, stop, graph, curve, ref)
+            report.append(gap)
+        else:
+            out, gap = _fill_inside(out, start, stop, method, curve, root, ref)
+            report.append(gap)
     return out, report
+
+
+def _check_fill(motion: Motion, method: str, graph: ActionGraph | None, root: str) -> None:
+    """The ``ValueError`` of :func:`fill` for an unknown method or root mode, or a graph that is
+    missing, empty or on another skeleton than ``motion``."""
+    if method not in METHODS:
+        raise ValueError(f"unknown filling method {method!r}; expected one of {METHODS}")
+    if root not in ROOTS:
+        raise ValueError(f"unknown root mode {root!r}; expected one of {ROOTS}")
+    if method == "graph":
+        if graph is None or not graph.nodes:
+            raise ValueError("method='graph' needs an ActionGraph with at least one action")
+        sk = next(iter(graph.nodes.values())).motion.skeleton
+        if sk.names != motion.skeleton.names:
+            raise ValueError("the action graph's clips use another skeleton than the motion to fill")
+
+
+def _fill_inside(out: Motion, start: int, stop: int, method: str, curve: str, root: str, ref: int):
+    """One gap ``[start, stop)`` with known frames on both sides, filled without a graph (methods
+    ``"slerp"``, ``"hermite"``, ``"stride"`` of :func:`fill`); returns the filled motion and its
+    :class:`FilledGap`."""
+    a, b = start - 1, stop
+    if method == "stride":
+        strided = stride_fill(out, a, b, ref)
+        if strided is not None:
+            out = _feet_on_floor(_follow_strides(strided[0], a, b, ref, strided[1]), a, b)
+            return out, FilledGap(start, stop, "stride")
+    mode = "hermite" if method == "hermite" else "linear"  # stride: SLERP where no stride is found
+    out = inbetween.fill_between(out, start, stop, curve=curve, root=mode,
+                                 rotation="hermite" if method == "hermite" else "slerp")  # fmt: skip
+    if root == "stride":
+        out = _stride_root(out, a, b, ref)
+    elif root == "hermite":
+        out = smooth_root(out, [a, b], joint=ref)
+    out = _feet_on_floor(out, a, b)
+    return out, FilledGap(start, stop, "slerp" if method == "stride" else method)
+
+
+def _place_path(out: Motion, a: int, b: int, graph: ActionGraph, ref: int):
+    """The graph stage of :func:`fill` before the pieces: the path from ``a``'s action to ``b``'s,
+    the key pose of every intermediate action placed (in ``out``, in place) at evenly spaced
+    frames, and ``{anchor frame: (action, frame of its clip)}`` for ``a``, the key poses and ``b``.
+
+    Returns ``(path, inner, slots, placed)``; ``inner`` and ``slots`` are empty where the gap is
+    too short to hold the intermediate key poses (then the gap is filled without them).
+    """
+    node_a = graph.classify(_frame_features(out, a, before=True)[None])[0]
+    node_b = graph.classify(_frame_features(out, b, before=False)[None])[0]
+    path = graph.path(node_a, node_b)
+    inner = path[1:-1]
+    slots = [a + int(round((i + 1) * (b - a) / (len(inner) + 1))) for i in range(len(inner))]
+    slots = [s for s in slots if a < s < b]
+    if len(slots) < len(inner) or len(set(slots)) < len(slots):
+        inner, slots = [], []  # gap too short for the intermediate key poses: plain filling
+    prev = path[0]
+    placed = {a: (path[0], _node_frame(graph, path[0], _frame_features(out, a, before=True)))}
+    for name, slot in zip(inner, slots):
+        _, j, _ = graph.best_transition(prev, name)
+        _place_key_pose(out, slot, graph.nodes[name].motion, j, a, b, ref)
+        placed[slot] = (name, j)
+        prev = name
+    placed[b] = (path[-1], _node_frame(graph, path[-1], _frame_features(out, b, before=False)))
+    return path, inner, slots, placed
+
+
+def _fill_through_graph(out: Motion, start: int, stop: int, graph: ActionGraph, curve: str, ref: int):
+    """One gap ``[start, stop)`` filled through ``graph`` (method ``"graph"`` of :func:`fill`):
+    across actions, eq. 4 between consecutive key poses; inside one action, the node's recordings
+    (:mod:`.library`, SLERP where none fits); the root then C1 through the anchors. Returns the
+    filled motion and its :class:`FilledGap`."""
+    a, b = start - 1, stop
+    path, inner, slots, placed = _place_path(out, a, b, graph, ref)
+    lib = graph.library()
+    anchors = [a] + slots + [b]
+    used = "library"
+    for lo, hi in zip(anchors[:-1], anchors[1:]):
+        if hi - lo < 2:
+            continue
+        if inner:  # across nodes: eq. 4, node lo's clip running on, node hi's clip running in
+            (na, m), (nb, n) = placed[lo], placed[hi]
+            L = hi - lo
+            run_a = _clip_run(graph.nodes[na].motion, m, L + 1, out, lo, m, ref)
+            run_b = _clip_run(graph.nodes[nb].motion, n - L, L + 1, out, hi, n, ref)
+            _moving_piece(out, lo, hi, run_a, run_b, curve)
+            continue
+        ok = _library_fill(out, lo, hi, lib, sorted(set(path)), prev_frame=None if lo == a else lo)
+        if not ok:
+            out = inbetween.fill_between(out, lo + 1, hi, curve=curve)
+            used = "graph+slerp"
+    out = _feet_on_floor(smooth_root(out, anchors, joint=ref), a, b)
+    return out, FilledGap(start, stop, "graph" if inner else used, path, slots)

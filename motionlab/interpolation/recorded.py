@@ -31,7 +31,7 @@ standing by other starts. For a gap between stream frames ``t`` and ``t+1``:
 
 Every take is also used mirrored (left and right joints swapped, lateral axis negated), so a left
 turn can be read off recorded right turns. The take being scored must never be among the
-recordings (``scripts/check_gaps.py`` leaves it out).
+recordings.
 
 Taught in ``notebooks/06_keypose_interpolation.ipynb``; used by :func:`~.detect.estimate_missing`
 when recordings are given.
@@ -52,11 +52,10 @@ from motionlab.interpolation.features import VELOCITY_WEIGHT, heading_frame
 __all__ = ["CONTEXT", "BEST", "MAX_SECONDS", "RecordedTakes", "mirror_index", "body_features", "recorded_missing"]
 
 CONTEXT = 0.4
-"""Seconds of known frames matched on each side of a gap (``K`` = 12 frames at 30 fps; 0.2 and 0.4
-tried, 0.4 chosen on the CHOOSE set of ``scripts/check_gaps.py``)."""
+"""Seconds of known frames matched on each side of a gap (``K`` = 12 frames at 30 fps)."""
 
 BEST = 9
-"""How many takes vote (the lowest matching costs; 5 and 9 tried, 9 chosen on the CHOOSE set)."""
+"""How many takes vote (those with the lowest matching costs)."""
 
 RATES = np.geomspace(2.0 / 3.0, 1.5, 17)
 """Time scales ``ρ`` (take frames per stream frame) tried when matching a window (5% apart)."""

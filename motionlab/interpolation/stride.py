@@ -28,13 +28,8 @@ Where no stride is found (both sides shorter than ``MIN_STRIDES`` strides, a mot
 not repeat) :func:`stride_fill` returns ``None`` and :func:`.gaps.fill` falls back to SLERP with the
 Hermite root. Fractional frames are read linearly (positions) and by SLERP (rotations).
 
-Chosen on the CHOOSE set of ``scripts/check_gaps.py`` (normal walk takes, the left turn, one
-run): the root path alone (:func:`stride_path` on SLERP-filled poses) halved the mean root error
-of straight walks against the Hermite curve but lost to it once the feet were kept above the
-floor (SLERP legs, hips lowered by the recorded bob, lifted back); filling the poses from the
-same strides keeps feet and hips consistent. Without turning the strides the turn takes got worse
-than with Hermite; without the end correction the worst straight walk did. Figures: README,
-*Key-pose interpolation and gap filling*.
+How it compares with SLERP and a Hermite root on the shared walks and runs:
+``docs/results_interpolation.md`` (``python -m experiments.interpolation.check_gaps``).
 """
 
 from __future__ import annotations
@@ -48,7 +43,17 @@ from motionlab.core.motion import Motion
 from motionlab.interpolation import detect
 from motionlab.interpolation.alignment import reference_transform
 
-__all__ = ["SIDE_SECONDS", "MIN_STRIDES", "known_side", "side_speeds", "stride_period", "stride_path", "stride_fill"]
+__all__ = [
+    "SIDE_SECONDS",
+    "MIN_STRIDES",
+    "known_side",
+    "side_speeds",
+    "stride_period",
+    "sample_rows",
+    "sample_rotations",
+    "stride_path",
+    "stride_fill",
+]
 
 SIDE_SECONDS = 3.0
 """How much of each side of a gap (seconds) the stride is read from."""
@@ -56,9 +61,7 @@ SIDE_SECONDS = 3.0
 
 MIN_STRIDES = 1.5
 """A side lends its stride only if it holds this many strides: the stride and half of the one
-before it, so a first stride from standing (not yet a repeat) is not carried across a gap
-(chosen on the CHOOSE set among 1, 1.25, 1.5, 2: the left-turn take cut 40 frames after its
-start fell from 10.4% to 6.7% root error)."""
+before it, so a first stride from standing (not yet a repeat) is not carried across a gap."""
 
 
 def known_side(motion: Motion, t: int, step: int, limit: int) -> np.ndarray:
@@ -93,16 +96,18 @@ def stride_period(motion: Motion, a: int, b: int) -> tuple[float | None, np.ndar
     return detect._stride([poses[: len(before)], poses[len(before) :]], motion.fps), before, after
 
 
-def _sample(values: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """``values`` (F, ...) read at fractional rows ``x`` (K,), linearly: (K, ...)."""
+def sample_rows(values: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``values`` (F, ...) read at fractional rows ``x`` (K,), linearly: (K, ...); rows outside
+    ``0 … F-1`` read the nearest end row."""
     lo = np.clip(np.floor(x).astype(np.int64), 0, len(values) - 1)
     hi = np.minimum(lo + 1, len(values) - 1)
     f = (x - lo).reshape((-1,) + (1,) * (values.ndim - 1))
     return values[lo] + f * (values[hi] - values[lo])
 
 
-def _sample_rot(rot: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """Rotations (F, J, 4) read at fractional rows ``x`` (K,) by SLERP: (K, J, 4)."""
+def sample_rotations(rot: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Rotations (F, J, 4) unit quaternions (w, x, y, z) read at fractional rows ``x`` (K,) by SLERP
+    between the two bounding rows: (K, J, 4)."""
     lo = np.clip(np.floor(x).astype(np.int64), 0, len(rot) - 1)
     hi = np.minimum(lo + 1, len(rot) - 1)
     return quat.slerp(rot[lo], rot[hi], np.broadcast_to((x - lo)[:, None], rot[lo].shape[:-1]))
@@ -133,16 +138,16 @@ def _continue(motion: Motion, frames: np.ndarray, period: float, offsets: np.nda
     yaw = np.unwrap(quat.yaw(g_rot))
     m = np.ceil(offsets / period - 1e-9).astype(np.int64)
     x = end + offsets - m * period
-    start = _sample(path, np.array([end - period]))[0]
+    start = sample_rows(path, np.array([end - period]))[0]
     psi = float(yaw[end] - np.interp(end - period, np.arange(len(yaw)), yaw))
-    q = _sample(path, x)
+    q = sample_rows(path, x)
     turn = _turn_y(psi)
     for i in range(int(m.max(initial=0))):  # a few strides at most: a loop over strides, not frames
         moved = m > i
         q[moved] = path[end] + (q[moved] - start) @ turn.T
-    rot = _sample_rot(motion.local_rot[frames], x)
+    rot = sample_rotations(motion.local_rot[frames], x)
     rot[:, 0] = quat.mul(quat.from_yaw(m * psi), rot[:, 0])
-    local_pos = None if motion.local_pos is None else _sample(motion.local_pos[frames], x)
+    local_pos = None if motion.local_pos is None else sample_rows(motion.local_pos[frames], x)
     return _Side(q, rot, local_pos)
 
 
@@ -156,7 +161,7 @@ def _bend(side: _Side, motion: Motion, frames: np.ndarray, period: float, far: t
     if not poses:
         return side
     rot = motion.local_rot[frames]
-    back = _sample_rot(rot, np.array([end - period]))[0]  # (J, 4)
+    back = sample_rotations(rot, np.array([end - period]))[0]  # (J, 4)
     diff = quat.mul(rot[end], quat.inv(back))  # (J, 4): this stride's end against the last
     fade = quat.slerp(np.broadcast_to(np.array([1.0, 0.0, 0.0, 0.0]), diff.shape), diff,
                       np.broadcast_to((1.0 - w)[:, None], side.rot.shape[:-1]))  # fmt: skip
@@ -165,7 +170,7 @@ def _bend(side: _Side, motion: Motion, frames: np.ndarray, period: float, far: t
     if side.local_pos is not None:
         lp = motion.local_pos[frames]
         side.local_pos = side.local_pos + (1.0 - w)[:, None, None] * (
-            lp[end] - _sample(lp, np.array([end - period]))[0]
+            lp[end] - sample_rows(lp, np.array([end - period]))[0]
         )
     return side
 

@@ -180,7 +180,7 @@ def test_rehearsal_reads_the_stream_itself(monkeypatch):
 def test_real_elderly_walk_tracked_in_normal_takes_wherever_it_was_recorded():
     """Shuffling elderly steps tracked in normal walks: no false gap, every cut found, and the same
     answer with the walker moved 3 m in the capture volume (the rig's origin marker left behind).
-    Matched by single poses, this take gets false gaps (``scripts/check_tracking_pose.py``)."""
+    Matched by single poses, this take gets false gaps (``experiments/interpolation/check_tracking_pose.py``)."""
     walk = require_data("bandai_namco", "sessions", "walk")
     g = ActionGraph()
     for i in (1, 2, 3):

@@ -3,9 +3,10 @@
 import numpy as np
 import pytest
 
+from experiments.interpolation import gap_eval
 from motionlab.core import bvh, humanoid, quat
 from motionlab.core.motion import Motion
-from motionlab.interpolation import footing, gap_eval, gaps, inbetween
+from motionlab.interpolation import footing, gaps, inbetween
 from tests.conftest import require_data
 from tests.interpolation.conftest import toy_motion
 

@@ -62,7 +62,7 @@ def test_a_left_turn_that_slows_is_counted_from_the_mirrored_right_turn():
     b = require_data("bandai_namco", "dataset-2")
     left = bvh.load(b / "walk-turn-left" / "dataset-2_walk-turn-left_normal_001.bvh")
     right = bvh.load(b / "walk-turn-right" / "dataset-2_walk-turn-right_normal_001.bvh")
-    s, n = 43, 30  # the cut of scripts/check_gaps.py (seeded)
+    s, n = 43, 30  # the cut of experiments/interpolation/check_gaps.py (seeded)
     cut = left[np.r_[0:s, s + n : left.num_frames]]
     (alone,) = detect.estimate_missing(cut, [s - 1])
     (both,) = detect.estimate_missing(cut, [s - 1], takes=recorded.RecordedTakes([right]))

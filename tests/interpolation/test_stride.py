@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
+from experiments.interpolation import gap_eval
 from motionlab.core import bvh
-from motionlab.interpolation import detect, gap_eval, gaps, stride
+from motionlab.interpolation import detect, gaps, stride
 from tests.conftest import require_data
 
 from .conftest import toy_motion

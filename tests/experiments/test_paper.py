@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
+from experiments.interpolation import paper
 from motionlab import synthetic
-from motionlab.interpolation import demo, paper
+from motionlab.interpolation import demo
 from tests.conftest import require_data
 
 
@@ -33,3 +34,14 @@ def test_real_walk_and_run_to_squat():
     assert [a - rs.first + 1 for a in rs.anchors] == [5, 8]
     assert all(is_key for _, _, is_key in rs.keys)
     assert rs.speeds.min() > 0.1 * rs.run_speed and rs.below == 0.0
+
+
+def test_walk_experiment_agrees_with_the_construction_of_notebook_06():
+    """Notebook 06 (and its exercise 2) keeps the frames with gaps.insert_missing instead of
+    blanking the others with NaN: the same fill, the same errors."""
+    from motionlab import exercises
+
+    walk = synthetic.generate("walk", None, 360, 120.0, seed=3)
+    res = paper.walk_experiment(walk, first=5, every=30)
+    mean = float(np.mean(list(res.angle_error.values())))
+    assert exercises.interpolation._walk_error(walk, every=30) == pytest.approx(mean, rel=1e-12)

@@ -1,6 +1,6 @@
 """How :func:`motionlab.interpolation.detect.track` matches the stream to the graph, against simpler matches.
 
-    MOTIONLAB_DATA=/path/to/shared/data python scripts/check_tracking_pose.py [--every N]
+    MOTIONLAB_DATA=/path/to/shared/data python -m experiments.interpolation.check_tracking_pose [--every N]
 
 Every clean walk take of ``bandai_namco/sessions/walk`` but three (172 takes, seven styles) is
 tracked in a graph of the three left out (``normal`` takes 1–3), and ``D > Δ`` asked for gaps:
@@ -39,8 +39,9 @@ from pathlib import Path
 
 import numpy as np
 
+from experiments.interpolation import gap_eval
 from motionlab.core import bvh
-from motionlab.interpolation import detect, gap_eval
+from motionlab.interpolation import detect
 from motionlab.interpolation.action_graph import ActionGraph
 from motionlab.interpolation.features import heading_frame
 

@@ -1,6 +1,6 @@
 """Gap detection, missing counts and the root across gaps, measured on the shared real mocap.
 
-    MOTIONLAB_DATA=/path/to/shared/data python scripts/check_gaps.py [--quick]
+    MOTIONLAB_DATA=/path/to/shared/data python -m experiments.interpolation.check_gaps [--quick]
 
 1. **False gaps**: every clean BVH under ``$MOTIONLAB_DATA`` through the detector that
    ``motionlab fill-gaps`` uses without a graph (:func:`motionlab.interpolation.detect.consecutive_gaps`);
@@ -19,22 +19,19 @@
 3. **Stream against the graph** (§3.3): walk takes of one style tracked in an action graph built
    from *other* takes (normal style, takes 1–3), precision and recall.
 4. (``--dense EVERY``) every walk take of ``sessions/walk``, a cut every ``EVERY`` frames.
-5. **Held-out sources**: the walks and runs of Xia (120 fps), Mixamo and GANimator's Mixamo clips
-   (60 fps), other studios and rigs than everything above. Held out until session 20; since then
-   seen: the step-period fix and the local count's window (``detect.LOCAL_SECONDS``) were found
-   or chosen on them. For Xia's walks and runs (and part 7's Bandai Namco ``dataset-1`` clips) the
-   count is also made with the source's other clips, other styles of the action, as recordings
-   (``SAME_ACTION``; leave one clip out).
-6. **Clips held out until session 23** (``FRESH_SOURCES``): fixed before the local count and its
-   rehearsal were written, and run once after they were chosen; session 23's changes (held
-   frames, the step phase's "nothing missing") were found on them. Where a cut takes frames of a
+5. **Other sources** (``OTHER_SOURCES``): the walks and runs of Xia (120 fps), Mixamo and
+   GANimator's Mixamo clips (60 fps), other studios and rigs than everything above. For Xia's
+   walks and runs (and part 7's Bandai Namco ``dataset-1`` clips) the count is also made with the
+   source's other clips, other styles of the action, as recordings (``SAME_ACTION``; leave one
+   clip out).
+6. **Starts, stops and padded clips** (``FRESH_SOURCES``): Mixamo runs and backward clips padded
+   with a held pose, idle-to-walk starts, CMU start-walk-stop takes. Where a cut takes frames of a
    held pose, the count is also scored against the frames that are not copies of a kept one
-   (:func:`motionlab.interpolation.gap_eval.countable`).
-7. **Locomotion never scored before session 23** (``UNSCORED_SOURCES``): Bandai Namco
-   ``dataset-1`` walks, dashes and side steps, and Mixamo clips of other locomotion; fixed before
-   the session-23 changes were tried, scored once after they were chosen.
+   (:func:`experiments.interpolation.gap_eval.countable`).
+7. **Other locomotion** (``UNSCORED_SOURCES``): Bandai Namco ``dataset-1`` walks, dashes and side
+   steps, and Mixamo clips of other locomotion.
 
-Rules were chosen on the CHOOSE set and are reported separately on the VALIDATE set:
+Parts 2 and 4 report two sets separately:
 
 * CHOOSE: ``bandai_namco/sessions/walk`` takes of style ``normal`` and
   ``bandai_namco/dataset-2/walk-turn-left``, ``dataset-2/run/…_001``;
@@ -52,8 +49,9 @@ from pathlib import Path
 
 import numpy as np
 
+from experiments.interpolation import gap_eval
 from motionlab.core import bvh, humanoid
-from motionlab.interpolation import detect, gap_eval
+from motionlab.interpolation import detect
 from motionlab.interpolation.action_graph import ActionGraph
 from motionlab.interpolation.recorded import RecordedTakes
 
@@ -175,7 +173,7 @@ def removed_frames(name: str, files: list[Path], rng, other_takes: OtherTakes) -
                        ("all", hermite)):  # fmt: skip
         w = gap_eval.summary(sub)
         print(
-            f"     (before: --method slerp --root hermite, same cases) {label}: mean {w['root_rel_mean']:.1%}, worst {w['root_rel_max']:.1%}, "
+            f"     (for comparison, --method slerp --root hermite, same cases) {label}: mean {w['root_rel_mean']:.1%}, worst {w['root_rel_max']:.1%}, "
             f"joints about the root {w['pose_cm_mean']:.1f} cm off"
         )
     return results
@@ -228,8 +226,7 @@ OTHER_SOURCES = {
     ],
     "mixamo injured walk, turning (60 fps, 7 characters)": ["mixamo/*/Injured_Walk_Left_Turn.bvh"],
 }
-"""Walks and runs from other studios, rigs and frame rates than the Bandai Namco takes every
-rule was chosen on (part 5; held out until session 20, see the module docstring)."""
+"""Walks and runs from other studios, rigs and frame rates than the Bandai Namco takes (part 5)."""
 
 
 FRESH_SOURCES = {
@@ -241,8 +238,7 @@ FRESH_SOURCES = {
     ],
     "cmu start, walk, stop (120 fps)": ["cmu/131/*.bvh"],
 }
-"""Locomotion clips fixed before the local count (``detect._local_count``) and its rehearsal were
-written, and scored once after they were chosen (part 6)."""
+"""Starts, stops, turns and clips padded with a held pose (part 6)."""
 
 
 UNSCORED_SOURCES = {
@@ -259,9 +255,7 @@ UNSCORED_SOURCES = {
         "mixamo/Aj/Wheelbarrow_Walk_Turn.bvh",
     ],
 }
-"""Locomotion clips whose missing counts and roots were never scored before session 23 (part 7):
-fixed, and committed, before the session-23 changes to the count (held frames, the stride period
-from the poses) were tried, and scored once after they were chosen on parts 2, 5 and 6."""
+"""Other locomotion: Bandai Namco ``dataset-1`` walks, dashes and side steps, and Mixamo clips (part 7)."""
 
 
 SAME_ACTION = (
@@ -293,7 +287,7 @@ def other_sources(root: Path, rng, cuts: int = 4, sources: dict | None = None, l
     """The walks and runs of ``sources`` (default ``OTHER_SOURCES``), ``cuts`` seeded cuts of 10,
     20 and 30 frames per clip: detection, missing count (the stream alone; for the ``SAME_ACTION``
     sources also with the source's other clips as recordings), root error."""
-    print(label or f"5. held-out sources (seen since session 20), {cuts} cuts of 10/20/30 frames per clip:")
+    print(label or f"5. other sources, {cuts} cuts of 10/20/30 frames per clip:")
     for name, patterns in (OTHER_SOURCES if sources is None else sources).items():
         files = sorted({f for p in patterns for f in root.glob(p)})
         takes = RecordedTakes([bvh.load(f) for f in files]) if name in SAME_ACTION and len(files) > 1 else None
@@ -386,9 +380,9 @@ def main(argv=None) -> int:
     other_sources(root, np.random.default_rng(5), cuts=1 if args.quick else 4)
     cuts = 1 if args.quick else 4
     other_sources(root, np.random.default_rng(7), cuts, FRESH_SOURCES,
-                  f"6. clips held out until session 23, {cuts} cuts of 10/20/30 frames per clip:")  # fmt: skip
+                  f"6. starts, stops and padded clips, {cuts} cuts of 10/20/30 frames per clip:")  # fmt: skip
     other_sources(root, np.random.default_rng(11), cuts, UNSCORED_SOURCES,
-                  f"7. locomotion never scored before session 23, {cuts} cuts of 10/20/30 frames per clip:")  # fmt: skip
+                  f"7. other locomotion, {cuts} cuts of 10/20/30 frames per clip:")  # fmt: skip
     print(f"total time {time.perf_counter() - t0:.1f} s")
     return 0
 

@@ -1,20 +1,20 @@
 """A foot that a fill swings into the floor: the body lifted out, or the leg bent (README,
 *Key-pose interpolation and gap filling*).
 
-    MOTIONLAB_DATA=/path/to/shared/data python scripts/compare_feet.py [--every 90] [--quick]
+    MOTIONLAB_DATA=/path/to/shared/data python -m experiments.interpolation.compare_feet [--every 90] [--quick]
 
 Two ways to keep filled frames out of the floor, each on the *same* counts (the detection runs once
 per cut) and the same fill otherwise:
 
-* **body lifted** (the fill until session 24): every filled frame raised by how far its lowest
+* **body lifted**: every filled frame raised by how far its lowest
   joint went below the floor (``gaps.lift_above_floor``);
 * **leg bent** (what ``gaps.fill`` does): each sunk foot moved up onto the floor by bending its
   leg (:func:`motionlab.interpolation.footing.plant_feet`), the body lifted only by what the legs
   cannot reach.
 
-Cuts of 10, 20 and 30 frames: the CHOOSE and VALIDATE cases of ``scripts/check_gaps.py`` part 2
+Cuts of 10, 20 and 30 frames: the CHOOSE and VALIDATE cases of ``experiments/interpolation/check_gaps.py`` part 2
 (same seed) with every walk take of ``bandai_namco/sessions/walk`` cut every ``EVERY`` frames
-(as ``scripts/compare_stride_root.py`` makes them), and the cuts of parts 5, 6 and 7 (same seeds).
+(as ``experiments/interpolation/compare_stride_root.py`` makes them), and the cuts of parts 5, 6 and 7 (same seeds).
 Prints, per set and rule, the mean and worst root error over the gap relative to the true
 displacement, the cuts above 10%, the lowest filled foot below the clip's floor and the mean joint
 error about the root; and every cut whose gap the detection did not find, with its D/Δ.
@@ -27,11 +27,11 @@ import time
 from contextlib import contextmanager
 from pathlib import Path
 
-import check_gaps
 import numpy as np
-from compare_stride_root import cases, print_missed, scored
 
-from motionlab.interpolation import detect, gap_eval, gaps
+from experiments.interpolation import check_gaps, gap_eval
+from experiments.interpolation.compare_stride_root import cases, print_missed, scored
+from motionlab.interpolation import detect, gaps
 
 RULES = ("body lifted", "leg bent")
 

@@ -1,13 +1,13 @@
 """The root across a stride fill where the body changes speed: the rules compared (README,
 *Key-pose interpolation and gap filling*).
 
-    MOTIONLAB_DATA=/path/to/shared/data python scripts/compare_stride_root.py [--every 30] [--quick]
+    MOTIONLAB_DATA=/path/to/shared/data python -m experiments.interpolation.compare_stride_root [--every 30] [--quick]
 
 The stride fill (:mod:`motionlab.interpolation.stride`) carries each side's stride across the gap at
 that side's speed. Where the walker speeds up or slows down across the gap, that speed is wrong
 near one end. The rules, each filling the *same* counts (the detection runs once per cut):
 
-* **the strides' own speed**: the strides' path as it comes (the fill before session 22);
+* **the strides' own speed**: the strides' path as it comes;
 * **end velocities swapped where the speed changes** (what ``gaps.fill`` does,
   ``gaps._follow_strides``): where :func:`motionlab.interpolation.detect.changes_speed` holds for
   the mean ground speeds over a second on each side, the path keeps the strides' bob and sway but
@@ -15,7 +15,7 @@ near one end. The rules, each filling the *same* counts (the detection runs once
 * **swapped everywhere**;
 * **SLERP and the Hermite root where the speed changes** (no strides there).
 
-Cuts of 10, 20 and 30 frames: the CHOOSE and VALIDATE cases of ``scripts/check_gaps.py`` (same
+Cuts of 10, 20 and 30 frames: the CHOOSE and VALIDATE cases of ``experiments/interpolation/check_gaps.py`` (same
 seed), and every walk take of ``bandai_namco/sessions/walk`` cut every ``EVERY`` frames from frame
 20 (normal takes with CHOOSE, the six other styles with VALIDATE). Prints, per set and rule, the
 mean and worst root error over the gap relative to the true displacement, and the cuts above 10%.
@@ -28,12 +28,12 @@ import time
 from contextlib import contextmanager
 from pathlib import Path
 
-import check_gaps
 import numpy as np
 from tqdm.auto import tqdm
 
+from experiments.interpolation import check_gaps, gap_eval
 from motionlab.core import bvh
-from motionlab.interpolation import detect, gap_eval, gaps, stride
+from motionlab.interpolation import alignment, detect, gaps, stride
 
 RULES = ("strides' own speed", "swapped where the speed changes", "swapped everywhere",
          "SLERP + Hermite root where the speed changes")  # fmt: skip
@@ -85,7 +85,7 @@ def score(motion, s: int, n: int) -> list[float] | None:
     shift = sum(c for t, c in found if t < s - 1)
     a = s - 1 + shift
     holed, _ = gaps.insert_missing(stream, found)
-    ref = gaps._known_reference_joint(holed)
+    ref = alignment.reference_joint(stream)  # the known frames of `holed`
     changes = own(*stride.side_speeds(holed, a, a + dict(found)[s - 1] + 1, ref))
     hermite = (
         gap_eval.evaluate_cut(motion, s, n, method="slerp", root="hermite", found=found).root_rel if changes else chosen

@@ -1,4 +1,4 @@
-"""The experiments of the key-pose paper (``004_*.txt``, §4), on the shared real mocap.
+"""The experiments of the key-pose paper (Yang et al. 2019, §4), on the shared real mocap.
 
 **Walk within one node (Fig. 6/7, Table 1).** The paper takes 495 frames of a CMU walk at 120 Hz,
 keeps frames 5 and 35 and interpolates 10, 15, …, 30 between them ("at regular intervals"), and
@@ -15,7 +15,7 @@ their best transition frames, root-aligned), and interpolation fills the rest.
 :func:`run_to_squat` does exactly this with the Mixamo Aj clips of
 :data:`~.demo.BEHAVIOUR_CLIPS`, each checked by content (:mod:`.labels`).
 
-``scripts/reproduce_keypose_paper.py`` prints both and draws the README figure; notebook 06
+``experiments/interpolation/reproduce_keypose_paper.py`` prints both and draws the README figure; notebook 06
 shows them.
 """
 
@@ -27,28 +27,12 @@ import numpy as np
 
 from motionlab.core import quat
 from motionlab.core.motion import Motion
-from motionlab.interpolation import gaps
-from motionlab.interpolation.action_graph import ActionGraph
-from motionlab.interpolation.alignment import align_to, reference_joint, reference_transform
+from motionlab.interpolation import demo, gaps
+from motionlab.interpolation.alignment import reference_joint, reference_transform
 
 __all__ = ["WALK_JOINTS", "WalkResult", "walk_experiment", "RunSquatResult", "run_to_squat_graph", "run_to_squat"]
 
-WALK_JOINTS = (
-    "Hips",
-    "Spine",
-    "Neck",
-    "LeftUpLeg",
-    "RightUpLeg",
-    "LeftLeg",
-    "RightLeg",
-    "LeftFoot",
-    "RightFoot",
-    "LeftArm",
-    "RightArm",
-    "LeftForeArm",
-    "RightForeArm",
-)
-"""The 13 walking joints (canonical names); ``LeftUpLeg`` is the paper's ``lThigh``."""
+WALK_JOINTS = demo.WALK_JOINTS
 
 
 @dataclass
@@ -143,13 +127,8 @@ class RunSquatResult:
     below: float
 
 
-def run_to_squat_graph(clips: dict[str, Motion]) -> ActionGraph:
-    """The graph of Fig. 8: nodes run, walk, stand, squat; transitions run ↔ walk ↔ stand ↔ squat."""
-    g = ActionGraph()
-    for name in ("run", "walk", "stand", "squat"):
-        g.add_node(name, clips[name])
-    g.allow(["run -> walk", "walk -> stand", "stand -> squat"], both_ways=True)
-    return g
+run_to_squat_graph = demo.fig8_graph
+"""The graph of Fig. 8 (:func:`motionlab.interpolation.demo.fig8_graph`)."""
 
 
 def run_to_squat(clips: dict[str, Motion], missing: int = 10, context: int = 10) -> RunSquatResult:
@@ -160,26 +139,14 @@ def run_to_squat(clips: dict[str, Motion], missing: int = 10, context: int = 10)
     the runner covers slowing uniformly to rest over the gap (half the run speed × its duration);
     the paper does not say where its squat stands, and a squat on the spot would force a stop.
     """
-    g = run_to_squat_graph(clips)
+    g = demo.fig8_graph(clips)
     run, squat = clips["run"], clips["squat"]
-    head = run[run.num_frames - context :]
-    low = int(np.argmin(squat.global_positions()[:, 0, 1]))  # the deepest crouch
-    tail = squat[max(0, low - 2) : min(squat.num_frames, low + context)]
-    # the squat continues the run: same heading, and placed where the run's speed would take it
     ref = reference_joint(run)
-    _, path = reference_transform(head, joint=ref)
+    joined, where = demo.run_squat_gap(clips, missing, context)
+    _, path = reference_transform(run[run.num_frames - context :], joint=ref)
     v = np.linalg.norm(np.diff(path[:, [0, 2]], axis=0), axis=1).mean()
-    tail = align_to(tail, head, frame=0, to_frame=-1)
-    rot, _ = reference_transform(head, [-1], joint=ref)
-    fwd = quat.rotate(quat.from_yaw(float(quat.yaw(rot[0]))), np.array([0.0, 0.0, 1.0]))
-    expected = float(v * (missing + 1) * 0.5)  # slowing from a run to rest: half the run speed on average
-    tail = tail.copy(root_pos=tail.root_pos + expected * fwd)
-    from motionlab.interpolation.inbetween import concatenate
-
-    stream = concatenate([head, tail])
-    joined, where = gaps.insert_missing(stream, [(head.num_frames - 1, missing)])
     filled, report = gaps.fill(joined, method="graph", graph=g)
-    a, b = where[0][0] - 1, where[0][1]
+    a, b = where[0] - 1, where[1]
     keys, prev = [], report[0].path[0]
     for name in report[0].path[1:-1]:
         _, j, _ = g.best_transition(prev, name)

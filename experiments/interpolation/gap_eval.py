@@ -16,7 +16,7 @@ A clean clip has its frames ``start … start+n-1`` cut out; the shortened strea
 * **pose**: the mean distance of every joint, taken about the reference joint, from the truth
   (resampled the same way), centimetres.
 
-Used by ``scripts/check_gaps.py`` and notebook 06.
+Used by ``experiments/interpolation/check_gaps.py`` and notebook 06.
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ from motionlab.core.motion import Motion
 from motionlab.interpolation import detect, gaps
 from motionlab.interpolation.alignment import reference_joint, reference_transform
 from motionlab.interpolation.inbetween import concatenate
-from motionlab.interpolation.stride import _sample, _sample_rot
+from motionlab.interpolation.stride import sample_rotations, sample_rows
 
 __all__ = ["CutResult", "cut", "retimed", "countable", "evaluate_cut", "summary", "detection_counts"]
 
@@ -98,8 +98,8 @@ def retimed(motion: Motion, start: int, n: int, m: int) -> Motion:
         raise ValueError(f"cannot replay {n} frames over {m}: expected at least one frame")
     frames = np.arange(start - 1, start + n)  # n steps, from the frame kept before
     x = np.arange(1, m + 1) * (n / m)  # m new frames, at fractional rows of ``frames``; the last is row n
-    local_pos = None if motion.local_pos is None else _sample(motion.local_pos[frames], x)
-    middle = Motion(motion.skeleton, _sample_rot(motion.local_rot[frames], x), _sample(motion.root_pos[frames], x),
+    local_pos = None if motion.local_pos is None else sample_rows(motion.local_pos[frames], x)
+    middle = Motion(motion.skeleton, sample_rotations(motion.local_rot[frames], x), sample_rows(motion.root_pos[frames], x),
                     motion.fps, local_pos, motion.name)  # fmt: skip
     return concatenate([motion[:start], middle, motion[start + n :]])
 

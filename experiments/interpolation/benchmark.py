@@ -16,7 +16,7 @@ Protocol (as in the LaFAN1 evaluation code, restated):
 * **L2P**: mean over windows and frames of ``‖(x̂ − μ)/σ − (x − μ)/σ‖₂`` over all joints' global
   positions stacked, with per-coordinate μ, σ of global positions. LaFAN1 takes them from its
   training subjects; here they come from a fixed set of clips of the *same skeleton* kept apart
-  from the scored windows (``benchmarks/bench_inbetween.py`` names both sets), one skeleton at a
+  from the scored windows (``experiments/interpolation/bench_inbetween.py`` names both sets), one skeleton at a
   time (statistics mixing two rigs mean nothing for either);
 * **NPSS** (Gopalakrishnan et al. 2019): per dimension of the stacked global quaternions, the
   earth mover's distance between the normalised power spectra (real FFT part squared, cumulative)
@@ -26,22 +26,21 @@ Any folder of BVH files can be evaluated; clips are reduced to the 22-joint huma
 (:func:`motionlab.core.humanoid.to_canonical`) and resampled to 30 fps. These are *not* LaFAN1
 numbers: LaFAN1 is not available here, so report the data the table was computed on.
 
-Taught in ``notebooks/06_keypose_interpolation.ipynb``; run ``benchmarks/bench_inbetween.py``.
+Run ``experiments/interpolation/bench_inbetween.py``.
 """
 
 from __future__ import annotations
 
 import re
-import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
 from motionlab.core import quat
 from motionlab.core.fk import fk
 from motionlab.core.motion import Motion
+from motionlab.interpolation.demo import load_clips
 from motionlab.interpolation.inbetween import interpolate, log, zero_velocity
 
 __all__ = [
@@ -97,38 +96,6 @@ class Windows:
 
     def fk(self) -> tuple[np.ndarray, np.ndarray]:
         return fk(self.local_rot, self.trans, self.parents)
-
-
-def load_clips(paths: Sequence[str | Path], fps: float = 30.0, canonical: bool = True) -> list[Motion]:
-    """Load BVH files (or every ``*.bvh`` under folders), reduce to 22 joints, resample to ``fps``.
-
-    Files that fail to load or map are skipped with a warning naming them.
-    """
-    from motionlab.core import bvh, humanoid
-
-    files: list[Path] = []
-    for p in paths:
-        p = Path(p)
-        if p.is_dir():
-            files.extend(sorted(p.rglob("*.bvh")))
-        elif p.is_file():
-            files.append(p)
-        else:
-            raise FileNotFoundError(f"{p} is neither a BVH file nor a folder")
-    out = []
-    for f in files:
-        try:
-            m = bvh.load(f)
-            if canonical:
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore", UserWarning)
-                    m = humanoid.to_canonical(m)
-            if fps is not None:
-                m = m.resample(fps)
-            out.append(m)
-        except (ValueError, KeyError) as e:
-            warnings.warn(f"skipping {f}: {e}", UserWarning, stacklevel=2)
-    return out
 
 
 def continuous(q: np.ndarray, axis: int = -3) -> np.ndarray:

@@ -1,6 +1,6 @@
-"""Reproduce the experiments of the key-pose paper (``004_*.txt``, §4) on the shared real mocap.
+"""Reproduce the experiments of the key-pose paper (Yang et al. 2019, §4) on the shared real mocap.
 
-    MOTIONLAB_DATA=/path/to/shared/data python scripts/reproduce_keypose_paper.py [--figure PATH]
+    MOTIONLAB_DATA=/path/to/shared/data python -m experiments.interpolation.reproduce_keypose_paper [--figure PATH]
 
 1. **Walk inside one node (Fig. 6/7, Table 1).** The paper's 495-frame CMU walk at 120 Hz is not in
    the shared data; the nearest real walk is ``xia/walk/normal_ganimator.bvh`` (CMU skeleton,
@@ -27,7 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
-from motionlab.interpolation import benchmark, demo, labels, paper
+from experiments.interpolation import benchmark, paper
+from motionlab.interpolation import demo, labels
 
 WALK = "xia/walk/normal_ganimator.bvh"
 OTHER_WALKS = ["xia/walk/neutral_01_000.bvh", "xia/walk/sexy_01_000.bvh", "xia/walk/strutting_01_000.bvh"]

@@ -3,10 +3,9 @@
 import numpy as np
 import pytest
 
-from motionlab.interpolation import benchmark as bm
+from experiments.interpolation import benchmark as bm
 from motionlab.interpolation.library import MotionLibrary
-
-from .conftest import toy_motion
+from tests.interpolation.conftest import toy_motion
 
 
 @pytest.fixture(scope="module")

@@ -1,12 +1,11 @@
-"""Cut, detect, fill, compare: the measurement behind scripts/check_gaps.py."""
+"""Cut, detect, fill, compare: the measurement behind experiments/interpolation/check_gaps.py."""
 
 import numpy as np
 import pytest
 
-from motionlab.interpolation import gap_eval
+from experiments.interpolation import gap_eval
 from motionlab.interpolation.alignment import reference_joint, reference_transform
-
-from .conftest import toy_motion
+from tests.interpolation.conftest import toy_motion
 
 
 def test_evaluate_cut_on_a_toy_walk():

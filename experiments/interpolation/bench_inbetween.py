@@ -1,7 +1,7 @@
 """In-betweening benchmark on LaFAN1's protocol, one skeleton at a time.
 
-    python benchmarks/bench_inbetween.py                # the two groups below, from $MOTIONLAB_DATA
-    python benchmarks/bench_inbetween.py --k 1
+    python -m experiments.interpolation.bench_inbetween                # the two groups below, from $MOTIONLAB_DATA
+    python -m experiments.interpolation.bench_inbetween --k 1
 
 LaFAN1 itself is not in the shared data (see its README), so two stand-in groups are scored, each
 on its own skeleton, each with its L2P statistics from a fixed set of clips of that skeleton kept
@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from motionlab.interpolation import benchmark as bm
+from experiments.interpolation import benchmark as bm
 from motionlab.interpolation.library import MotionLibrary
 
 AJ_SCORED = [
