@@ -1107,6 +1107,9 @@ def save(
 ) -> Path:
     """Write a motion as a BVH file (see :func:`dumps` for the layout) and return ``Path(path)``.
 
+    The text is built first and written through :func:`~motionlab.core.files.atomic_write`,
+    which never leaves a partial file.
+
     Parameters
     ----------
     path : str or PathLike
@@ -1115,10 +1118,12 @@ def save(
     precision : int           decimals written
     overwrite : bool          replace an existing file (default: refuse)
 
-    The text is built first and written through :func:`motionlab.core.files.atomic_write`,
-    which raises for ``path`` as :func:`~motionlab.core.files.check_output` says (a folder, an
-    existing file without ``overwrite``, a missing or read-only folder) and never leaves a
-    partial file. ``ValueError`` when the motion cannot be written (see :func:`dumps`).
+    Raises
+    ------
+    ValueError
+        the motion cannot be written (see :func:`dumps`).
+    OSError
+        as :func:`motionlab.core.files.check_output` says for ``path``.
     """
     text = dumps(motion, scale=scale, precision=precision)
     return files.atomic_write(path, lambda f: f.write(text), overwrite=overwrite, what="BVH file")

@@ -274,17 +274,22 @@ def dumps(motion: Motion) -> bytes:
 def save(path: str | os.PathLike, motion: Motion, overwrite: bool = False) -> Path:
     """Write a motion as a ``.glb`` file (see :func:`dumps`) and return ``Path(path)``.
 
+    The path is checked (suffix, then :func:`~motionlab.core.files.check_output`) before the motion is
+    converted, so nothing is written when it is refused;
+    the bytes then go through :func:`~motionlab.core.files.atomic_write`.
+
     Parameters
     ----------
     path : str or PathLike   the destination, ending in ``.glb``
     motion : Motion
     overwrite : bool         replace an existing file (default: refuse)
 
-    ``path`` must end in ``.glb`` (else ``ValueError``) and is checked by
-    :func:`motionlab.core.files.check_output` before the motion is converted, so nothing is
-    written when either is refused; the bytes then go through
-    :func:`~motionlab.core.files.atomic_write`. ``ValueError`` when the motion cannot be
-    written (see :func:`dumps`).
+    Raises
+    ------
+    ValueError
+        ``path`` does not end in ``.glb``, or the motion cannot be written (see :func:`dumps`).
+    OSError
+        as :func:`motionlab.core.files.check_output` says for ``path``.
     """
     path = Path(path)
     if path.suffix.lower() != SUFFIX:
