@@ -43,6 +43,7 @@ def _cmd_expand(args) -> int:
     check_output_folder("-o", args.output)  # before any work
     try:
         targets = ex.characters(*args.characters, presets=args.preset)
+        ex.check_output_layout(args.output, ex.find_sources(args.sources), targets, "." + args.format)
     except ValueError as e:
         raise CLIError(str(e)) from None
     ckpt = cli_options.load_checkpoint(args.checkpoint, args.device)

@@ -151,6 +151,23 @@ def test_read_only_output_folder_names_the_real_folder(walk, tmp_path, capsys, m
     assert list(out.iterdir()) == []
 
 
+def test_expand_character_folder_that_is_a_file_is_refused_before_any_work(walk, tmp_path, capsys, monkeypatch):
+    """``OUT/<character>`` is a regular file: refused up front (exit 2), naming it, with nothing written."""
+    from motionlab.retargeting import cli_options
+
+    out = tmp_path / "expanded"
+    out.mkdir()
+    (out / "child").write_text("mine")
+
+    def started(*args, **kwargs):
+        raise AssertionError("expand started work before checking its outputs")
+
+    monkeypatch.setattr(cli_options, "load_checkpoint", started)
+    code, _, err = _run(capsys, "expand", walk, "--preset", "child", "-o", out, "-q")
+    assert code == 2 and str(out / "child") in err and "expected the folder" in err and "Traceback" not in err
+    assert sorted(p.name for p in out.iterdir()) == ["child"] and (out / "child").read_text() == "mine"
+
+
 @pytest.mark.parametrize("command", ["convert", "fill-gaps", "graph-search"])
 def test_an_output_that_is_the_input_is_refused(walk, tmp_path, capsys, command):
     before = walk.read_bytes()
