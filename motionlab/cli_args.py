@@ -9,7 +9,9 @@ any work, so a refused output costs nothing and leaves nothing behind. Every mes
 option as the user typed it (``-o``, ``--report``) and says what would be accepted.
 
 Vocabulary: one option name has one meaning across sub-commands (``tests/commands/
-test_cli_vocabulary.py`` checks it). :func:`add_quiet` adds ``-q/--quiet``; :func:`renamed` keeps
+test_cli_vocabulary.py`` checks it). :func:`command` registers a sub-command (its parser, its
+``-q/--quiet`` and the function it runs); :func:`add_output`, :func:`add_force` and :func:`add_quiet`
+add the options every writing command shares (``-o/--output``, ``--force``, ``-q/--quiet``); :func:`renamed` keeps
 an option's old spelling working as a hidden, deprecated alias that prints a note;
 :class:`HelpFormatter` shows every option's default in ``--help``; :class:`Stages` is the progress
 bar of a command that runs in a few long stages.
@@ -18,6 +20,7 @@ bar of a command that runs in a few long stages.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import sys
@@ -35,6 +38,9 @@ __all__ = [
     "HelpFormatter",
     "RawDescriptionHelpFormatter",
     "DeprecatedAlias",
+    "command",
+    "add_output",
+    "add_force",
     "add_quiet",
     "renamed",
     "Stages",
@@ -234,6 +240,33 @@ def renamed(parser, old: str, new: argparse.Action) -> argparse.Action:
         action=DeprecatedAlias,
         new=new.option_strings[-1],
     )
+
+
+@contextlib.contextmanager
+def command(subparsers, name: str, run, *, summary: str, description: str, quiet: bool = True, **kwargs):
+    """Register the sub-command ``name``, which runs ``run(args)``; yields its parser.
+
+    The ``with`` block adds the command's own arguments; on leaving it, ``-q/--quiet`` is added
+    last (``quiet=False``: the block placed it itself) and ``run`` becomes the command's ``func``.
+    ``summary`` is its line in ``motionlab --help``, ``description`` the paragraph of
+    ``motionlab NAME --help``; ``kwargs`` go to ``add_parser`` (an epilog, a formatter class).
+    """
+    parser = subparsers.add_parser(name, help=summary, description=description, **kwargs)
+    yield parser
+    if quiet:
+        add_quiet(parser)
+    parser.set_defaults(func=run)
+
+
+def add_output(parser, text: str, *, required: bool = True, **kwargs) -> argparse.Action:
+    """``-o/--output``: where the command writes (a file or a folder, as the help ``text`` says);
+    ``kwargs`` (a ``default``, a ``metavar``) go to ``add_argument``."""
+    return parser.add_argument("-o", "--output", required=required, help=text, **kwargs)
+
+
+def add_force(parser, text: str) -> argparse.Action:
+    """``--force``: replace what is in the way (the help ``text`` says what, for this command)."""
+    return parser.add_argument("--force", action="store_true", help=text)
 
 
 def add_quiet(parser) -> argparse.Action:
