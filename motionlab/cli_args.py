@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import inspect
 import math
 import os
 import sys
@@ -242,15 +243,24 @@ def renamed(parser, old: str, new: argparse.Action) -> argparse.Action:
     )
 
 
+def _help_texts(run) -> tuple[str, str]:
+    """``(summary, description)`` of a command from ``run``'s docstring: its first paragraph, then the
+    others (each paragraph's lines joined by spaces, paragraphs by a blank line)."""
+    paragraphs = [" ".join(p.split("\n")) for p in (inspect.getdoc(run) or "").split("\n\n")]
+    return paragraphs[0], "\n\n".join(paragraphs[1:])
+
+
 @contextlib.contextmanager
-def command(subparsers, name: str, run, *, summary: str, description: str, quiet: bool = True, **kwargs):
+def command(subparsers, name: str, run, *, quiet: bool = True, **kwargs):
     """Register the sub-command ``name``, which runs ``run(args)``; yields its parser.
 
-    The ``with`` block adds the command's own arguments; on leaving it, ``-q/--quiet`` is added
-    last (``quiet=False``: the block placed it itself) and ``run`` becomes the command's ``func``.
-    ``summary`` is its line in ``motionlab --help``, ``description`` the paragraph of
-    ``motionlab NAME --help``; ``kwargs`` go to ``add_parser`` (an epilog, a formatter class).
+    ``run``'s docstring is the command's help: its first paragraph the line in ``motionlab --help``,
+    the rest the text of ``motionlab NAME --help``. The ``with`` block adds the command's own
+    arguments; on leaving it, ``-q/--quiet`` is added last (``quiet=False``: the block placed it
+    itself) and ``run`` becomes the command's ``func``. ``kwargs`` go to ``add_parser`` (an epilog,
+    a formatter class).
     """
+    summary, description = _help_texts(run)
     parser = subparsers.add_parser(name, help=summary, description=description, **kwargs)
     yield parser
     if quiet:

@@ -42,14 +42,7 @@ __all__ = ["register", "run_fill_gaps"]
 
 
 def register(subparsers) -> None:
-    with cli_args.command(
-        subparsers,
-        "fill-gaps",
-        run_fill_gaps,
-        summary="detect dropped frames in a BVH file and fill them (SLERP, Hermite or action-graph guided)",
-        description="Detect frames missing from a BVH stream (distance D > Δ between consecutive frames), "
-        "insert the estimated number of frames and fill them.",
-    ) as p:
+    with cli_args.command(subparsers, "fill-gaps", run_fill_gaps) as p:
         p.add_argument("input", help="BVH file with dropped frames")
         cli_args.add_output(p, "where to write the filled BVH file")
         p.add_argument("--method", choices=("stride", "slerp", "hermite", "graph"), default="stride",
@@ -245,6 +238,11 @@ def _check_args(args: argparse.Namespace):
 
 
 def run_fill_gaps(args: argparse.Namespace) -> int:
+    """detect dropped frames in a BVH file and fill them (SLERP, Hermite or action-graph guided)
+
+    Detect frames missing from a BVH stream (distance D > Δ between consecutive frames), insert the estimated number
+    of frames and fill them.
+    """
     from motionlab.cli import CLIError
     from motionlab.core import bvh
     from motionlab.interpolation import detect, gaps

@@ -34,15 +34,7 @@ on held-out takes: ``docs/results_motion_graphs.md``."""
 
 
 def register(subparsers) -> None:
-    with cli_args.command(
-        subparsers,
-        "graph-build",
-        _build,
-        summary="build a motion graph from a folder of BVH clips",
-        description="Build a structured motion graph (behaviours, styles, takes, recorded transition clips and "
-        "interpolation spaces between styles) or, with --standard, Kovar's graph, from a folder of BVH clips; "
-        "write it to a .mlgraph file and print its structure table.",
-    ) as p:
+    with cli_args.command(subparsers, "graph-build", _build) as p:
         p.add_argument("folder", nargs="?", help="folder of BVH files named Behaviour_style / B1_s1_to_B2_s2")
         cli_args.add_output(p, "graph file to write (.mlgraph)")
         p.add_argument("--synthetic", action="store_true", help="use the built-in synthetic clips instead of a folder")
@@ -73,14 +65,7 @@ def register(subparsers) -> None:
         p.add_argument("--report", help="also write the build report as JSON to this file")
         cli_args.add_force(p, "overwrite the output files")
 
-    with cli_args.command(
-        subparsers,
-        "graph-search",
-        _search,
-        summary="synthesise a motion for a request from a graph",
-        description="Search a graph from graph-build for a path that meets a request of behaviour, style and "
-        "frame count per segment, and write the synthesised motion as BVH.",
-    ) as p:
+    with cli_args.command(subparsers, "graph-search", _search) as p:
         p.add_argument("graph", help=".mlgraph file from graph-build")
         p.add_argument(
             "--request",
@@ -94,13 +79,7 @@ def register(subparsers) -> None:
         )
         cli_args.add_force(p, "overwrite the output file")
 
-    with cli_args.command(
-        subparsers,
-        "graph-info",
-        _info,
-        summary="print a graph's structure table and counts",
-        description="Print the structure table (behaviours, styles, frames) and the counts of a .mlgraph file.",
-    ) as p:
+    with cli_args.command(subparsers, "graph-info", _info) as p:
         p.add_argument("graph", help=".mlgraph file")
 
 
@@ -177,6 +156,12 @@ def _build_graph(args: argparse.Namespace, motions: list):
 
 
 def _build(args: argparse.Namespace) -> int:
+    """build a motion graph from a folder of BVH clips
+
+    Build a structured motion graph (behaviours, styles, takes, recorded transition clips and interpolation spaces
+    between styles) or, with --standard, Kovar's graph, from a folder of BVH clips; write it to a .mlgraph file and
+    print its structure table.
+    """
     from motionlab.core import files
     from motionlab.motion_graphs import io, report
 
@@ -211,6 +196,11 @@ def _build(args: argparse.Namespace) -> int:
 
 
 def _search(args: argparse.Namespace) -> int:
+    """synthesise a motion for a request from a graph
+
+    Search a graph from graph-build for a path that meets a request of behaviour, style and frame count per segment,
+    and write the synthesised motion as BVH.
+    """
     from motionlab.core import bvh
     from motionlab.motion_graphs import search, synthesis
 
@@ -242,6 +232,10 @@ def _search(args: argparse.Namespace) -> int:
 
 
 def _info(args: argparse.Namespace) -> int:
+    """print a graph's structure table and counts
+
+    Print the structure table (behaviours, styles, frames) and the counts of a .mlgraph file.
+    """
     from motionlab.motion_graphs import plots
 
     g = _load_graph(args.graph)

@@ -52,6 +52,12 @@ def _check_result(args, result):
 
 
 def _cmd_retarget(args) -> int:
+    """retarget a BVH clip onto another character (latent iteration)
+
+    Generate TARGET's version of SOURCE.bvh. The target character is defined by the rest skeleton of --target (its
+    motion is ignored) and/or --scale-* factors; the output is a BVH on the 22-joint canonical skeleton (BVH, or
+    glTF 2.0 when OUTPUT ends in .glb).
+    """
     from motionlab.cli import rig_error
     from motionlab.core import bvh, files, gltf, humanoid, rest_pose
     from motionlab.retargeting.pipeline import retarget
@@ -120,6 +126,10 @@ def _cmd_retarget(args) -> int:
 
 # ---------------------------------------------------------------------------- train
 def _cmd_train(args) -> int:
+    """train the retargeting network on one character
+
+    Train the retargeting network on the clips of ONE character (L_recon) and save a checkpoint.
+    """
     from motionlab.retargeting import checkpoint as ck
     from motionlab.retargeting.model import ModelConfig
     from motionlab.retargeting.train import TrainConfig, train, training_set
@@ -223,6 +233,12 @@ def _write_csv(args, result) -> None:
 
 
 def _cmd_evaluate(args) -> int:
+    """reproduce Table 1 (retargeting vs real clips) on a <Character>/<Animation>.bvh folder
+
+    Retarget SOURCE's clips onto each target's T-pose skeleton and compare with the targets' real clips:
+    copy-rotation baseline, network without iteration, full method. Trains the network on SOURCE's other clips first
+    if the checkpoint does not exist.
+    """
     from motionlab import data as mdata
     from motionlab.retargeting.evaluate import Evaluation, evaluate, rows_with_root
 
@@ -280,16 +296,7 @@ def register(subparsers) -> None:
 
 
 def _add_retarget(subparsers) -> None:
-    with cli_args.command(
-        subparsers,
-        "retarget",
-        _cmd_retarget,
-        summary="retarget a BVH clip onto another character (latent iteration)",
-        description="Generate TARGET's version of SOURCE.bvh. The target character is defined by the rest "
-        "skeleton of --target (its motion is ignored) and/or --scale-* factors; the output is a BVH on the "
-        "22-joint canonical skeleton (BVH, or glTF 2.0 when OUTPUT ends in .glb).",
-        quiet=False,
-    ) as p:
+    with cli_args.command(subparsers, "retarget", _cmd_retarget, quiet=False) as p:
         p.add_argument("source", help="source motion (BVH, any rig that maps onto the 22 canonical joints)")
         p.add_argument("--target", help="BVH whose rest skeleton defines the target character")
         cli_args.add_output(p, "output file: .bvh, or .glb for glTF 2.0")
@@ -322,13 +329,7 @@ def _add_retarget(subparsers) -> None:
 
 
 def _add_train(subparsers) -> None:
-    with cli_args.command(
-        subparsers,
-        "train",
-        _cmd_train,
-        summary="train the retargeting network on one character",
-        description="Train the retargeting network on the clips of ONE character (L_recon) and save a checkpoint.",
-    ) as p:
+    with cli_args.command(subparsers, "train", _cmd_train) as p:
         p.add_argument("clips", nargs="*", help="BVH clips of one character")
         p.add_argument(
             "--synthetic",
@@ -356,16 +357,7 @@ def _add_train(subparsers) -> None:
 
 
 def _add_evaluate(subparsers) -> None:
-    with cli_args.command(
-        subparsers,
-        "evaluate",
-        _cmd_evaluate,
-        summary="reproduce Table 1 (retargeting vs real clips) on a <Character>/<Animation>.bvh folder",
-        description="Retarget SOURCE's clips onto each target's T-pose skeleton and compare with the targets' real "
-        "clips: copy-rotation baseline, network without iteration, full method. Trains the network on SOURCE's "
-        "other clips first if the checkpoint does not exist.",
-        quiet=False,
-    ) as p:
+    with cli_args.command(subparsers, "evaluate", _cmd_evaluate, quiet=False) as p:
         p.add_argument(
             "--data", help="folder laid out as <Character>/<Animation>.bvh (default: $MOTIONLAB_DATA/mixamo)"
         )

@@ -21,6 +21,12 @@ __all__ = ["register"]
 
 
 def _cmd_expand(args) -> int:
+    """retarget many clips onto many characters (batched, resumable; local or Ray)
+
+    Expand a motion database: every SOURCE clip onto every character, written as OUT/<character>/<clip>.bvh (or .glb
+    with --format glb) with OUT/manifest.csv (one row per output). Rerunning the same command redoes only what is
+    missing. Exit status 1 when some pair failed (see the manifest's error column).
+    """
     from motionlab.cli import CLIError
     from motionlab.retargeting import expand as ex
 
@@ -89,10 +95,6 @@ def register(subparsers) -> None:
         subparsers,
         "expand",
         _cmd_expand,
-        summary="retarget many clips onto many characters (batched, resumable; local or Ray)",
-        description="Expand a motion database: every SOURCE clip onto every character, written as "
-        "OUT/<character>/<clip>.bvh (or .glb with --format glb) with OUT/manifest.csv (one row per output). Rerunning the same command "
-        "redoes only what is missing. Exit status 1 when some pair failed (see the manifest's error column).",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="presets: long_legs, short_legs, long_arms, stocky, tall, child, or NAME:legs=1.2,arms=0.9,...",
         quiet=False,

@@ -75,6 +75,11 @@ def _open_window(scene) -> None:
 
 
 def _cmd_view(args) -> int:
+    """play a BVH file in 3D, or write it to an MP4/GIF movie
+
+    Play FILE.bvh in a 3D window (where a display exists) or render it off-screen to a movie with -o (needed where
+    there is no display). Foot contacts light up red.
+    """
     from motionlab.core import bvh, files
     from motionlab.viz import backend
     from motionlab.viz.export import MOVIE_SUFFIXES, save_movie
@@ -140,14 +145,7 @@ def _movie_length(out: Path, motion, stride: int | None) -> tuple[int, float]:
 
 def register(subparsers) -> None:
     """Add ``view`` to the ``motionlab`` command."""
-    with cli_args.command(
-        subparsers,
-        "view",
-        _cmd_view,
-        summary="play a BVH file in 3D, or write it to an MP4/GIF movie",
-        description="Play FILE.bvh in a 3D window (where a display exists) or render it off-screen to a movie "
-        "with -o (needed where there is no display). Foot contacts light up red.",
-    ) as p:
+    with cli_args.command(subparsers, "view", _cmd_view) as p:
         p.add_argument("file", help="BVH file to play")
         cli_args.renamed(
             p,
