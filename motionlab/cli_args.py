@@ -9,7 +9,9 @@ any work, so a refused output costs nothing and leaves nothing behind. Every mes
 option as the user typed it (``-o``, ``--report``) and says what would be accepted.
 
 Vocabulary: one option name has one meaning across sub-commands (``tests/commands/
-test_cli_vocabulary.py`` checks it). :func:`add_quiet` adds ``-q/--quiet``; :func:`renamed` keeps
+test_cli_vocabulary.py`` checks it). :func:`command` registers a sub-command (its parser, its
+``-q/--quiet`` and the function it runs); :func:`add_output`, :func:`add_force` and :func:`add_quiet`
+add the options every writing command shares (``-o/--output``, ``--force``, ``-q/--quiet``); :func:`renamed` keeps
 an option's old spelling working as a hidden, deprecated alias that prints a note;
 :class:`HelpFormatter` shows every option's default in ``--help``; :class:`Stages` is the progress
 bar of a command that runs in a few long stages.
@@ -18,6 +20,8 @@ bar of a command that runs in a few long stages.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import inspect
 import math
 import os
 import sys
@@ -35,6 +39,9 @@ __all__ = [
     "HelpFormatter",
     "RawDescriptionHelpFormatter",
     "DeprecatedAlias",
+    "command",
+    "add_output",
+    "add_force",
     "add_quiet",
     "renamed",
     "Stages",
@@ -234,6 +241,42 @@ def renamed(parser, old: str, new: argparse.Action) -> argparse.Action:
         action=DeprecatedAlias,
         new=new.option_strings[-1],
     )
+
+
+def _help_texts(run) -> tuple[str, str]:
+    """``(summary, description)`` of a command from ``run``'s docstring: its first paragraph, then the
+    others (each paragraph's lines joined by spaces, paragraphs by a blank line)."""
+    paragraphs = [" ".join(p.split("\n")) for p in (inspect.getdoc(run) or "").split("\n\n")]
+    return paragraphs[0], "\n\n".join(paragraphs[1:])
+
+
+@contextlib.contextmanager
+def command(subparsers, name: str, run, *, quiet: bool = True, **kwargs):
+    """Register the sub-command ``name``, which runs ``run(args)``; yields its parser.
+
+    ``run``'s docstring is the command's help: its first paragraph the line in ``motionlab --help``,
+    the rest the text of ``motionlab NAME --help``. The ``with`` block adds the command's own
+    arguments; on leaving it, ``-q/--quiet`` is added last (``quiet=False``: the block placed it
+    itself) and ``run`` becomes the command's ``func``. ``kwargs`` go to ``add_parser`` (an epilog,
+    a formatter class).
+    """
+    summary, description = _help_texts(run)
+    parser = subparsers.add_parser(name, help=summary, description=description, **kwargs)
+    yield parser
+    if quiet:
+        add_quiet(parser)
+    parser.set_defaults(func=run)
+
+
+def add_output(parser, text: str, *, required: bool = True, **kwargs) -> argparse.Action:
+    """``-o/--output``: where the command writes (a file or a folder, as the help ``text`` says);
+    ``kwargs`` (a ``default``, a ``metavar``) go to ``add_argument``."""
+    return parser.add_argument("-o", "--output", required=required, help=text, **kwargs)
+
+
+def add_force(parser, text: str) -> argparse.Action:
+    """``--force``: replace what is in the way (the help ``text`` says what, for this command)."""
+    return parser.add_argument("--force", action="store_true", help=text)
 
 
 def add_quiet(parser) -> argparse.Action:

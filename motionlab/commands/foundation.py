@@ -7,7 +7,8 @@ import contextlib
 import io
 from pathlib import Path
 
-from motionlab.cli_args import add_quiet, check_output_folder, check_outputs, positive, positive_int, renamed
+from motionlab import cli_args
+from motionlab.cli_args import check_output_folder, check_outputs, positive, positive_int
 
 __all__ = ["register", "positive"]
 
@@ -25,6 +26,11 @@ def _load(path: str, what: str = "input"):
 
 
 def _info(args) -> int:
+    """describe a BVH file: skeleton, frames, fps, 22-joint mapping
+
+    Print a BVH file's skeleton, frame count, frame rate, rest height and whether (and by which rig profile) it maps
+    onto the canonical 22-joint humanoid.
+    """
     from motionlab.core import humanoid, rest_pose
 
     m = _load(args.file)
@@ -57,6 +63,11 @@ def _info(args) -> int:
 
 
 def _convert(args) -> int:
+    """reduce a BVH file to the 22-joint humanoid and/or resample it; write BVH or glTF (.glb)
+
+    Read a BVH file, optionally reduce it to the canonical 22 joints (--canonical) and resample it (--fps), and
+    write it as BVH or, when OUTPUT ends in .glb, as binary glTF 2.0 (docs/gltf.md).
+    """
     from motionlab.core import bvh, gltf, humanoid
 
     (out,) = check_outputs([("-o", args.output)], args.force, inputs=[("input", args.input)])
@@ -75,6 +86,11 @@ def _convert(args) -> int:
 
 
 def _synth(args) -> int:
+    """write synthetic motion (idle, walk, run, jump, squat or mix) as BVH
+
+    Generate procedural humanoid motion on a character of the given height and limb proportions and write it as BVH
+    (mix: idle -> walk -> run -> jump -> walk -> squat).
+    """
     from motionlab import synthetic
     from motionlab.core import bvh, humanoid
 
@@ -100,6 +116,11 @@ def _synth(args) -> int:
 
 
 def _demo(args) -> int:
+    """the main job on built-in data: retarget a synthetic performance onto new characters
+
+    Make a synthetic performance, retarget it onto new synthetic characters with the shipped network (copy, network
+    alone, full method), write BVH files, a figure and a table to the output folder, and print the table.
+    """
     from motionlab.demo import run_demo
 
     check_output_folder("-o", args.output)
@@ -113,72 +134,38 @@ def _demo(args) -> int:
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser(
-        "info",
-        help="describe a BVH file: skeleton, frames, fps, 22-joint mapping",
-        description="Print a BVH file's skeleton, frame count, frame rate, rest height and whether (and by "
-        "which rig profile) it maps onto the canonical 22-joint humanoid.",
-    )
-    p.add_argument("file", help="a .bvh file")
-    p.add_argument("--joints", action="store_true", help="also print the joint tree with channels")
-    add_quiet(p)
-    p.set_defaults(func=_info)
+    with cli_args.command(sub, "info", _info) as p:
+        p.add_argument("file", help="a .bvh file")
+        p.add_argument("--joints", action="store_true", help="also print the joint tree with channels")
 
-    p = sub.add_parser(
-        "convert",
-        help="reduce a BVH file to the 22-joint humanoid and/or resample it; write BVH or glTF (.glb)",
-        description="Read a BVH file, optionally reduce it to the canonical 22 joints (--canonical) and resample "
-        "it (--fps), and write it as BVH or, when OUTPUT ends in .glb, as binary glTF 2.0 (docs/gltf.md).",
-    )
-    p.add_argument("input", help="input .bvh")
-    p.add_argument(
-        "-o",
-        "--output",
-        required=True,
-        help="output file: .glb writes glTF 2.0 (Blender, web viewers, engines), any other name BVH",
-    )
-    p.add_argument("--canonical", action="store_true", help="reduce to the canonical 22 joints")
-    p.add_argument("--fps", type=positive, default=None, help="resample to this frame rate (frames per second)")
-    p.add_argument("--force", action="store_true", help="overwrite the output if it exists")
-    add_quiet(p)
-    p.set_defaults(func=_convert)
+    with cli_args.command(sub, "convert", _convert) as p:
+        p.add_argument("input", help="input .bvh")
+        cli_args.add_output(p, "output file: .glb writes glTF 2.0 (Blender, web viewers, engines), any other name BVH")
+        p.add_argument("--canonical", action="store_true", help="reduce to the canonical 22 joints")
+        p.add_argument("--fps", type=positive, default=None, help="resample to this frame rate (frames per second)")
+        cli_args.add_force(p, "overwrite the output if it exists")
 
-    p = sub.add_parser(
-        "synth",
-        help="write synthetic motion (idle, walk, run, jump, squat or mix) as BVH",
-        description="Generate procedural humanoid motion on a character of the given height and limb "
-        "proportions and write it as BVH (mix: idle -> walk -> run -> jump -> walk -> squat).",
-    )
-    p.add_argument("behaviour", choices=["idle", "walk", "run", "jump", "squat", "mix"], help="what the body does")
-    p.add_argument("-o", "--output", required=True, help="output .bvh")
-    p.add_argument("--seconds", type=positive, default=4.0, help="length in seconds (ignored for mix)")
-    p.add_argument("--fps", type=positive, default=60.0, help="frame rate (frames per second)")
-    p.add_argument("--height", type=positive, default=1.75, help="character height, metres")
-    p.add_argument("--legs", type=positive, default=1.0, help="leg length factor")
-    p.add_argument("--arms", type=positive, default=1.0, help="arm length factor")
-    p.add_argument("--seed", type=int, default=0, help="random seed")
-    p.add_argument("--force", action="store_true", help="overwrite the output if it exists")
-    add_quiet(p)
-    p.set_defaults(func=_synth)
+    with cli_args.command(sub, "synth", _synth) as p:
+        p.add_argument("behaviour", choices=["idle", "walk", "run", "jump", "squat", "mix"], help="what the body does")
+        cli_args.add_output(p, "output .bvh")
+        p.add_argument("--seconds", type=positive, default=4.0, help="length in seconds (ignored for mix)")
+        p.add_argument("--fps", type=positive, default=60.0, help="frame rate (frames per second)")
+        p.add_argument("--height", type=positive, default=1.75, help="character height, metres")
+        p.add_argument("--legs", type=positive, default=1.0, help="leg length factor")
+        p.add_argument("--arms", type=positive, default=1.0, help="arm length factor")
+        p.add_argument("--seed", type=int, default=0, help="random seed")
+        cli_args.add_force(p, "overwrite the output if it exists")
 
-    p = sub.add_parser(
-        "demo",
-        help="the main job on built-in data: retarget a synthetic performance onto new characters",
-        description="Make a synthetic performance, retarget it onto new synthetic characters with the shipped "
-        "network (copy, network alone, full method), write BVH files, a figure and a table to the output "
-        "folder, and print the table.",
-    )
-    renamed(p, "--out", p.add_argument("-o", "--output", default="outputs/demo", help="output folder"))
-    renamed(
-        p,
-        "--characters",
-        p.add_argument("--num-characters", type=positive_int, default=4, help="how many new characters (1 or more)"),
-    )
-    p.add_argument("--seed", type=int, default=0, help="random seed")
-    p.add_argument(
-        "--force",
-        action="store_true",
-        help="replace files in an output folder that an earlier demo did not write (a demo folder is always re-used)",
-    )
-    add_quiet(p)
-    p.set_defaults(func=_demo)
+    with cli_args.command(sub, "demo", _demo) as p:
+        cli_args.renamed(p, "--out", cli_args.add_output(p, "output folder", required=False, default="outputs/demo"))
+        cli_args.renamed(
+            p,
+            "--characters",
+            p.add_argument(
+                "--num-characters", type=positive_int, default=4, help="how many new characters (1 or more)"
+            ),
+        )
+        p.add_argument("--seed", type=int, default=0, help="random seed")
+        cli_args.add_force(
+            p, "replace files in an output folder that an earlier demo did not write (a demo folder is always re-used)"
+        )

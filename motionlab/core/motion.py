@@ -9,6 +9,7 @@ Taught in ``notebooks/00_quaternions_and_fk.ipynb`` and ``01_preprocessing.ipynb
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,7 +18,7 @@ from motionlab.core import fk as _fk
 from motionlab.core import quat
 from motionlab.core.skeleton import Skeleton
 
-__all__ = ["Motion"]
+__all__ = ["Motion", "check_one_rig"]
 
 
 def _check_fps(fps) -> float:
@@ -181,3 +182,24 @@ class Motion:
             None if self.local_pos is None else lerp(self.local_pos),
             self.name,
         )
+
+
+def check_one_rig(motions: Sequence[Motion], group: str | None = None) -> None:
+    """Refuse clips that do not share the first clip's skeleton (joint names and parents) and frame rate.
+
+    Parameters
+    ----------
+    motions : sequence of Motion, at least one
+    group : how the frame-rate message names what the clips must match (default: the first clip's name)
+
+    Raises
+    ------
+    ValueError
+        naming the first clip on another skeleton or at another frame rate (1e-6 relative).
+    """
+    first = motions[0]
+    for m in motions[1:]:
+        if m.skeleton.names != first.skeleton.names or not np.array_equal(m.skeleton.parents, first.skeleton.parents):
+            raise ValueError(f"clip {m.name!r} uses another skeleton than {first.name!r}")
+        if abs(m.fps - first.fps) > 1e-6 * first.fps:
+            raise ValueError(f"clip {m.name!r} is at {m.fps:g} fps, {group or repr(first.name)} at {first.fps:g}")

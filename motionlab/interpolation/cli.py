@@ -35,48 +35,42 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from motionlab.cli_args import Stages, add_quiet, renamed
+from motionlab import cli_args
+from motionlab.cli_args import Stages
 
 __all__ = ["register", "run_fill_gaps"]
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser(
-        "fill-gaps",
-        help="detect dropped frames in a BVH file and fill them (SLERP, Hermite or action-graph guided)",
-        description="Detect frames missing from a BVH stream (distance D > Δ between consecutive frames), "
-        "insert the estimated number of frames and fill them.",
-    )
-    p.add_argument("input", help="BVH file with dropped frames")
-    p.add_argument("-o", "--output", required=True, help="where to write the filled BVH file")
-    p.add_argument("--method", choices=("stride", "slerp", "hermite", "graph"), default="stride",
-                   help="stride: the strides on both sides continued (default; slerp where the motion does not "
-                   "repeat); slerp: SLERP; hermite: velocity-matched; graph: key-pose guided (needs --action)")  # fmt: skip
-    p.add_argument("--curve", choices=("linear", "ease", "smoothstep"), default="linear",
-                   help="α(k) curve of the blend weights across a gap")  # fmt: skip
-    root = p.add_argument("--gap-root", dest="root", choices=("stride", "hermite", "linear"), default="stride",
-                          help="root path across a gap: the strides on both sides continued (default; Hermite where "
-                          "the motion does not repeat), Hermite with the velocities on both sides, or linear")  # fmt: skip
-    renamed(p, "--root", root)
-    delta = p.add_argument("--delta", dest="delta", type=str, default=None, metavar="Δ",
-                           help="Δ: a step this many times the typical step means dropped frames (a number above 1; "
-                           "default 2.5, against the stream itself or, with --action, against the graph)")  # fmt: skip
-    renamed(p, "--threshold", delta)
-    renamed(p, "--factor", delta)
-    p.add_argument("--action", action="append", default=[], metavar="NAME=FILE.bvh",
-                   help="an action node of the graph and a clip of it (repeat)")  # fmt: skip
-    p.add_argument("--allow", action="append", default=[], metavar="'A -> B'",
-                   help="an allowed transition (repeat; default: every pair of actions, both ways)")  # fmt: skip
-    p.add_argument("--takes", action="append", default=[], metavar="FILE.bvh|FOLDER",
-                   help="another recording of the stream's action, or a folder of them (repeat; the input itself "
-                   "is never used): the missing count also reads how long these take from the pose before a gap "
-                   "to the pose after it; best with takes of the same session and style (docs/results_interpolation.md)")  # fmt: skip
-    p.add_argument("--times", metavar="FILE", default=None,
-                   help="the frames' capture times, one per line in seconds: the gaps and their counts are "
-                   "read from them (exact), not detected or estimated")  # fmt: skip
-    p.add_argument("--force", action="store_true", help="overwrite the output file if it exists")
-    add_quiet(p)
-    p.set_defaults(func=run_fill_gaps)
+    with cli_args.command(subparsers, "fill-gaps", run_fill_gaps) as p:
+        p.add_argument("input", help="BVH file with dropped frames")
+        cli_args.add_output(p, "where to write the filled BVH file")
+        p.add_argument("--method", choices=("stride", "slerp", "hermite", "graph"), default="stride",
+                       help="stride: the strides on both sides continued (default; slerp where the motion does not "
+                       "repeat); slerp: SLERP; hermite: velocity-matched; graph: key-pose guided (needs --action)")  # fmt: skip
+        p.add_argument("--curve", choices=("linear", "ease", "smoothstep"), default="linear",
+                       help="α(k) curve of the blend weights across a gap")  # fmt: skip
+        root = p.add_argument("--gap-root", dest="root", choices=("stride", "hermite", "linear"), default="stride",
+                              help="root path across a gap: the strides on both sides continued (default; Hermite where "
+                              "the motion does not repeat), Hermite with the velocities on both sides, or linear")  # fmt: skip
+        cli_args.renamed(p, "--root", root)
+        delta = p.add_argument("--delta", dest="delta", type=str, default=None, metavar="Δ",
+                               help="Δ: a step this many times the typical step means dropped frames (a number above 1; "
+                               "default 2.5, against the stream itself or, with --action, against the graph)")  # fmt: skip
+        cli_args.renamed(p, "--threshold", delta)
+        cli_args.renamed(p, "--factor", delta)
+        p.add_argument("--action", action="append", default=[], metavar="NAME=FILE.bvh",
+                       help="an action node of the graph and a clip of it (repeat)")  # fmt: skip
+        p.add_argument("--allow", action="append", default=[], metavar="'A -> B'",
+                       help="an allowed transition (repeat; default: every pair of actions, both ways)")  # fmt: skip
+        p.add_argument("--takes", action="append", default=[], metavar="FILE.bvh|FOLDER",
+                       help="another recording of the stream's action, or a folder of them (repeat; the input itself "
+                       "is never used): the missing count also reads how long these take from the pose before a gap "
+                       "to the pose after it; best with takes of the same session and style (docs/results_interpolation.md)")  # fmt: skip
+        p.add_argument("--times", metavar="FILE", default=None,
+                       help="the frames' capture times, one per line in seconds: the gaps and their counts are "
+                       "read from them (exact), not detected or estimated")  # fmt: skip
+        cli_args.add_force(p, "overwrite the output file if it exists")
 
 
 def _graph(actions: list[str], allow: list[str], src: Path, motion):
@@ -244,6 +238,11 @@ def _check_args(args: argparse.Namespace):
 
 
 def run_fill_gaps(args: argparse.Namespace) -> int:
+    """detect dropped frames in a BVH file and fill them (SLERP, Hermite or action-graph guided)
+
+    Detect frames missing from a BVH stream (distance D > Δ between consecutive frames), insert the estimated number
+    of frames and fill them.
+    """
     from motionlab.cli import CLIError
     from motionlab.core import bvh
     from motionlab.interpolation import detect, gaps

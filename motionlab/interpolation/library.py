@@ -36,7 +36,7 @@ import numpy as np
 
 from motionlab.core import quat
 from motionlab.core.fk import fk
-from motionlab.core.motion import Motion
+from motionlab.core.motion import Motion, check_one_rig
 from motionlab.interpolation.alignment import reference_joint
 from motionlab.interpolation.features import VELOCITY_WEIGHT, heading_frame
 
@@ -68,12 +68,8 @@ class MotionLibrary:
         motions = list(motions)
         if not motions:
             raise ValueError("a motion library needs at least one clip")
+        check_one_rig(motions, group="the library")
         sk = motions[0].skeleton
-        for m in motions[1:]:
-            if m.skeleton.names != sk.names or not np.array_equal(m.skeleton.parents, sk.parents):
-                raise ValueError(f"clip {m.name!r} uses another skeleton than {motions[0].name!r}")
-            if abs(m.fps - motions[0].fps) > 1e-6 * m.fps:
-                raise ValueError(f"clip {m.name!r} is at {m.fps:g} fps, the library at {motions[0].fps:g}")
         self.labels = [str(lab) for lab in labels] if labels is not None else [m.name for m in motions]
         if len(self.labels) != len(motions):
             raise ValueError(f"expected {len(motions)} labels, got {len(self.labels)}")

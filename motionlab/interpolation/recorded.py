@@ -45,7 +45,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from motionlab.core import quat
-from motionlab.core.motion import Motion
+from motionlab.core.motion import Motion, check_one_rig
 from motionlab.interpolation.alignment import reference_joint
 from motionlab.interpolation.features import VELOCITY_WEIGHT, heading_frame
 
@@ -158,12 +158,8 @@ class RecordedTakes:
         motions = list(motions)
         if not motions:
             raise ValueError("recorded takes: need at least one clip")
+        check_one_rig(motions)
         first = motions[0]
-        for m in motions[1:]:
-            if m.skeleton.names != first.skeleton.names:
-                raise ValueError(f"clip {m.name!r} uses another skeleton than {first.name!r}")
-            if abs(m.fps - first.fps) > 1e-6 * first.fps:
-                raise ValueError(f"clip {m.name!r} is at {m.fps:g} fps, {first.name!r} at {first.fps:g}")
         mirror = bool(mirror) and mirror_index(first.skeleton.names) is not None
         refs = [reference_joint(m) for m in motions]  # one body for all: the takes' usual reference joint
         self.ref = int(np.bincount(refs).argmax())

@@ -21,8 +21,9 @@ import json
 import time
 from pathlib import Path
 
+from motionlab import cli_args
 from motionlab.cli import CLIError
-from motionlab.cli_args import add_quiet, check_outputs, non_negative_int, positive, positive_int, renamed
+from motionlab.cli_args import check_outputs, non_negative_int, positive, positive_int
 
 __all__ = ["register", "DISTANCE_THRESHOLD"]
 
@@ -33,72 +34,53 @@ on held-out takes: ``docs/results_motion_graphs.md``."""
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser(
-        "graph-build",
-        help="build a motion graph from a folder of BVH clips",
-        description="Build a structured motion graph (behaviours, styles, takes, recorded transition clips and "
-        "interpolation spaces between styles) or, with --standard, Kovar's graph, from a folder of BVH clips; "
-        "write it to a .mlgraph file and print its structure table.",
-    )
-    p.add_argument("folder", nargs="?", help="folder of BVH files named Behaviour_style / B1_s1_to_B2_s2")
-    p.add_argument("-o", "--output", required=True, help="graph file to write (.mlgraph)")
-    p.add_argument("--synthetic", action="store_true", help="use the built-in synthetic clips instead of a folder")
-    p.add_argument("--standard", action="store_true", help="build Kovar's unstructured graph instead")
-    renamed(
-        p,
-        "--threshold",
+    with cli_args.command(subparsers, "graph-build", _build) as p:
+        p.add_argument("folder", nargs="?", help="folder of BVH files named Behaviour_style / B1_s1_to_B2_s2")
+        cli_args.add_output(p, "graph file to write (.mlgraph)")
+        p.add_argument("--synthetic", action="store_true", help="use the built-in synthetic clips instead of a folder")
+        p.add_argument("--standard", action="store_true", help="build Kovar's unstructured graph instead")
+        cli_args.renamed(
+            p,
+            "--threshold",
+            p.add_argument(
+                "--distance-threshold",
+                dest="threshold",
+                type=positive,
+                default=DISTANCE_THRESHOLD,
+                metavar="M",
+                help=f"largest frame distance of a transition, metres RMS (default {DISTANCE_THRESHOLD:g})",
+            ),
+        )
+        p.add_argument("--fps", type=positive, default=30.0, help="frame rate every clip is resampled to (default 30)")
         p.add_argument(
-            "--distance-threshold",
-            dest="threshold",
-            type=positive,
-            default=DISTANCE_THRESHOLD,
-            metavar="M",
-            help=f"largest frame distance of a transition, metres RMS (default {DISTANCE_THRESHOLD:g})",
-        ),
-    )
-    p.add_argument("--fps", type=positive, default=30.0, help="frame rate every clip is resampled to (default 30)")
-    p.add_argument(
-        "--style-pairs",
-        choices=("hub", "chain", "all"),
-        default="hub",
-        help="styles bridged by interpolation spaces: each to a hub, a chain, or all pairs",
-    )
-    p.add_argument(
-        "--neighbours", type=positive_int, default=3, help="takes each take of a style is compared with (default 3)"
-    )
-    p.add_argument("--name-map", help="JSON file {clip stem: 'behaviour_style[_take]'} for names that do not parse")
-    p.add_argument("--report", help="also write the build report as JSON to this file")
-    p.add_argument("--force", action="store_true", help="overwrite the output files")
-    add_quiet(p)
-    p.set_defaults(func=_build)
+            "--style-pairs",
+            choices=("hub", "chain", "all"),
+            default="hub",
+            help="styles bridged by interpolation spaces: each to a hub, a chain, or all pairs",
+        )
+        p.add_argument(
+            "--neighbours", type=positive_int, default=3, help="takes each take of a style is compared with (default 3)"
+        )
+        p.add_argument("--name-map", help="JSON file {clip stem: 'behaviour_style[_take]'} for names that do not parse")
+        p.add_argument("--report", help="also write the build report as JSON to this file")
+        cli_args.add_force(p, "overwrite the output files")
 
-    p = subparsers.add_parser(
-        "graph-search",
-        help="synthesise a motion for a request from a graph",
-        description="Search a graph from graph-build for a path that meets a request of behaviour, style and "
-        "frame count per segment, and write the synthesised motion as BVH.",
-    )
-    p.add_argument("graph", help=".mlgraph file from graph-build")
-    p.add_argument(
-        "--request",
-        required=True,
-        help='segments "behaviour:style:frames,...", e.g. "walk:angry:300,run:normal:200" '
-        "(at most 100000 frames in all)",
-    )
-    p.add_argument("-o", "--output", required=True, help="BVH file to write")
-    p.add_argument("--blend", type=non_negative_int, default=8, help="transition blend length in frames (default 8)")
-    p.add_argument("--force", action="store_true", help="overwrite the output file")
-    add_quiet(p)
-    p.set_defaults(func=_search)
+    with cli_args.command(subparsers, "graph-search", _search) as p:
+        p.add_argument("graph", help=".mlgraph file from graph-build")
+        p.add_argument(
+            "--request",
+            required=True,
+            help='segments "behaviour:style:frames,...", e.g. "walk:angry:300,run:normal:200" '
+            "(at most 100000 frames in all)",
+        )
+        cli_args.add_output(p, "BVH file to write")
+        p.add_argument(
+            "--blend", type=non_negative_int, default=8, help="transition blend length in frames (default 8)"
+        )
+        cli_args.add_force(p, "overwrite the output file")
 
-    p = subparsers.add_parser(
-        "graph-info",
-        help="print a graph's structure table and counts",
-        description="Print the structure table (behaviours, styles, frames) and the counts of a .mlgraph file.",
-    )
-    p.add_argument("graph", help=".mlgraph file")
-    add_quiet(p)
-    p.set_defaults(func=_info)
+    with cli_args.command(subparsers, "graph-info", _info) as p:
+        p.add_argument("graph", help=".mlgraph file")
 
 
 def _load_graph(path: str):
@@ -174,6 +156,12 @@ def _build_graph(args: argparse.Namespace, motions: list):
 
 
 def _build(args: argparse.Namespace) -> int:
+    """build a motion graph from a folder of BVH clips
+
+    Build a structured motion graph (behaviours, styles, takes, recorded transition clips and interpolation spaces
+    between styles) or, with --standard, Kovar's graph, from a folder of BVH clips; write it to a .mlgraph file and
+    print its structure table.
+    """
     from motionlab.core import files
     from motionlab.motion_graphs import io, report
 
@@ -208,6 +196,11 @@ def _build(args: argparse.Namespace) -> int:
 
 
 def _search(args: argparse.Namespace) -> int:
+    """synthesise a motion for a request from a graph
+
+    Search a graph from graph-build for a path that meets a request of behaviour, style and frame count per segment,
+    and write the synthesised motion as BVH.
+    """
     from motionlab.core import bvh
     from motionlab.motion_graphs import search, synthesis
 
@@ -239,6 +232,10 @@ def _search(args: argparse.Namespace) -> int:
 
 
 def _info(args: argparse.Namespace) -> int:
+    """print a graph's structure table and counts
+
+    Print the structure table (behaviours, styles, frames) and the counts of a .mlgraph file.
+    """
     from motionlab.motion_graphs import plots
 
     g = _load_graph(args.graph)

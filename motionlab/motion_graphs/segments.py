@@ -161,12 +161,7 @@ def _runs(mask: np.ndarray, min_frames: int) -> np.ndarray:
 def stance_mask(pos, feet: tuple[int, int], fps: float, leg: float) -> np.ndarray:
     """Frames inside a stance phase (boundary stances of an action included, module docstring).
 
-    Parameters
-    ----------
-    pos : ndarray, shape (T, J, 3)   world joint positions, metres, Y up
-    feet : indices of the left and right ankle in ``pos``
-    fps : frames per second
-    leg : leg length, metres (:func:`leg_length`)
+    Parameters and errors as :func:`segments_from_positions`, of which this is ``.stance_frames()``.
 
     Returns
     -------

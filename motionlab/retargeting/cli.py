@@ -17,15 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from motionlab.cli_args import (
-    add_quiet,
-    add_rate_and_plausibility_args,
-    check_outputs,
-    non_negative,
-    non_negative_int,
-    positive,
-    positive_int,
-)
+from motionlab import cli_args
+from motionlab.cli_args import check_outputs, non_negative, non_negative_int, positive, positive_int
 from motionlab.retargeting import cli_options
 from motionlab.retargeting.cli_options import ROOT_MODES
 
@@ -59,6 +52,12 @@ def _check_result(args, result):
 
 
 def _cmd_retarget(args) -> int:
+    """retarget a BVH clip onto another character (latent iteration)
+
+    Generate TARGET's version of SOURCE.bvh. The target character is defined by the rest skeleton of --target (its
+    motion is ignored) and/or --scale-* factors; the output is a BVH on the 22-joint canonical skeleton (BVH, or
+    glTF 2.0 when OUTPUT ends in .glb).
+    """
     from motionlab.cli import rig_error
     from motionlab.core import bvh, files, gltf, humanoid, rest_pose
     from motionlab.retargeting.pipeline import retarget
@@ -127,6 +126,10 @@ def _cmd_retarget(args) -> int:
 
 # ---------------------------------------------------------------------------- train
 def _cmd_train(args) -> int:
+    """train the retargeting network on one character
+
+    Train the retargeting network on the clips of ONE character (L_recon) and save a checkpoint.
+    """
     from motionlab.retargeting import checkpoint as ck
     from motionlab.retargeting.model import ModelConfig
     from motionlab.retargeting.train import TrainConfig, train, training_set
@@ -230,6 +233,12 @@ def _write_csv(args, result) -> None:
 
 
 def _cmd_evaluate(args) -> int:
+    """reproduce Table 1 (retargeting vs real clips) on a <Character>/<Animation>.bvh folder
+
+    Retarget SOURCE's clips onto each target's T-pose skeleton and compare with the targets' real clips:
+    copy-rotation baseline, network without iteration, full method. Trains the network on SOURCE's other clips first
+    if the checkpoint does not exist.
+    """
     from motionlab import data as mdata
     from motionlab.retargeting.evaluate import Evaluation, evaluate, rows_with_root
 
@@ -287,121 +296,112 @@ def register(subparsers) -> None:
 
 
 def _add_retarget(subparsers) -> None:
-    p = subparsers.add_parser(
-        "retarget",
-        help="retarget a BVH clip onto another character (latent iteration)",
-        description="Generate TARGET's version of SOURCE.bvh. The target character is defined by the rest "
-        "skeleton of --target (its motion is ignored) and/or --scale-* factors; the output is a BVH on the "
-        "22-joint canonical skeleton (BVH, or glTF 2.0 when OUTPUT ends in .glb).",
-    )
-    p.add_argument("source", help="source motion (BVH, any rig that maps onto the 22 canonical joints)")
-    p.add_argument("--target", help="BVH whose rest skeleton defines the target character")
-    p.add_argument("-o", "--output", required=True, help="output file: .bvh, or .glb for glTF 2.0")
-    p.add_argument("--npz", help="also write arrays (local_rot, root_pos, positions, offsets) to this .npz")
-    p.add_argument(
-        "--method",
-        choices=("full", "network", "copy"),
-        default="full",
-        help="full = latent iteration (default); network = no iteration; copy = copy rotations",
-    )
-    p.add_argument("--checkpoint", help="trained network (default: the shipped one)")
-    p.add_argument(
-        "--root",
-        choices=ROOT_MODES,
-        default="stride",
-        help="how A's root path is scaled: stride = leg chain on the ground, hip height up (default); contacts = "
-        "the ratio that keeps A's planted feet still on B's legs; "
-        "hips / legs = one ratio for all axes",
-    )
-    for name in ("legs", "arms", "spine", "neck"):
+    with cli_args.command(subparsers, "retarget", _cmd_retarget, quiet=False) as p:
+        p.add_argument("source", help="source motion (BVH, any rig that maps onto the 22 canonical joints)")
+        p.add_argument("--target", help="BVH whose rest skeleton defines the target character")
+        cli_args.add_output(p, "output file: .bvh, or .glb for glTF 2.0")
+        p.add_argument("--npz", help="also write arrays (local_rot, root_pos, positions, offsets) to this .npz")
         p.add_argument(
-            f"--scale-{name}", type=positive, default=1.0, metavar="F", help=f"scale the target's {name} bones by F"
+            "--method",
+            choices=("full", "network", "copy"),
+            default="full",
+            help="full = latent iteration (default); network = no iteration; copy = copy rotations",
         )
-    p.add_argument("--scale", type=positive, default=1.0, metavar="F", help="scale the whole target by F")
-    p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
-    p.add_argument("--force", action="store_true", help="overwrite existing output files")
-    add_rate_and_plausibility_args(p)
-    add_quiet(p)
-    cli_options.add_solver_args(p)
-    p.set_defaults(func=_cmd_retarget)
+        p.add_argument("--checkpoint", help="trained network (default: the shipped one)")
+        p.add_argument(
+            "--root",
+            choices=ROOT_MODES,
+            default="stride",
+            help="how A's root path is scaled: stride = leg chain on the ground, hip height up (default); contacts = "
+            "the ratio that keeps A's planted feet still on B's legs; "
+            "hips / legs = one ratio for all axes",
+        )
+        for name in ("legs", "arms", "spine", "neck"):
+            p.add_argument(
+                f"--scale-{name}", type=positive, default=1.0, metavar="F", help=f"scale the target's {name} bones by F"
+            )
+        p.add_argument("--scale", type=positive, default=1.0, metavar="F", help="scale the whole target by F")
+        p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
+        cli_args.add_force(p, "overwrite existing output files")
+        cli_args.add_rate_and_plausibility_args(p)
+        cli_args.add_quiet(p)
+        cli_options.add_solver_args(p)
 
 
 def _add_train(subparsers) -> None:
-    p = subparsers.add_parser(
-        "train",
-        help="train the retargeting network on one character",
-        description="Train the retargeting network on the clips of ONE character (L_recon) and save a checkpoint.",
-    )
-    p.add_argument("clips", nargs="*", help="BVH clips of one character")
-    p.add_argument(
-        "--synthetic", type=non_negative_int, default=0, metavar="N", help="train on N built-in synthetic clips instead"
-    )
-    p.add_argument("-o", "--output", required=True, help="checkpoint file to write (.pt)")
-    p.add_argument("--train-steps", type=positive_int, default=1500, help="Adam steps (default 1500)")
-    p.add_argument("--batch-size", type=positive_int, default=32, help="windows per Adam step")
-    p.add_argument(
-        "--pose-augment",
-        type=non_negative,
-        default=0.0,
-        metavar="F",
-        help="fraction of each batch with joints turned at random (up to 0.3 rad; 0..0.5, default 0 = off)",
-    )
-    p.add_argument("--train-lr", type=positive, default=2e-3, help="Adam learning rate of the training")
-    p.add_argument("--latent", type=positive_int, default=128, help="latent channels D per frame")
-    p.add_argument("--hidden", type=positive_int, default=96, help="hidden channels")
-    p.add_argument("--seed", type=int, default=0, help="random seed")
-    p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
-    p.add_argument("--force", action="store_true", help="overwrite an existing checkpoint")
-    add_quiet(p)
-    p.set_defaults(func=_cmd_train)
+    with cli_args.command(subparsers, "train", _cmd_train) as p:
+        p.add_argument("clips", nargs="*", help="BVH clips of one character")
+        p.add_argument(
+            "--synthetic",
+            type=non_negative_int,
+            default=0,
+            metavar="N",
+            help="train on N built-in synthetic clips instead",
+        )
+        cli_args.add_output(p, "checkpoint file to write (.pt)")
+        p.add_argument("--train-steps", type=positive_int, default=1500, help="Adam steps (default 1500)")
+        p.add_argument("--batch-size", type=positive_int, default=32, help="windows per Adam step")
+        p.add_argument(
+            "--pose-augment",
+            type=non_negative,
+            default=0.0,
+            metavar="F",
+            help="fraction of each batch with joints turned at random (up to 0.3 rad; 0..0.5, default 0 = off)",
+        )
+        p.add_argument("--train-lr", type=positive, default=2e-3, help="Adam learning rate of the training")
+        p.add_argument("--latent", type=positive_int, default=128, help="latent channels D per frame")
+        p.add_argument("--hidden", type=positive_int, default=96, help="hidden channels")
+        p.add_argument("--seed", type=int, default=0, help="random seed")
+        p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
+        cli_args.add_force(p, "overwrite an existing checkpoint")
 
 
 def _add_evaluate(subparsers) -> None:
-    p = subparsers.add_parser(
-        "evaluate",
-        help="reproduce Table 1 (retargeting vs real clips) on a <Character>/<Animation>.bvh folder",
-        description="Retarget SOURCE's clips onto each target's T-pose skeleton and compare with the targets' real "
-        "clips: copy-rotation baseline, network without iteration, full method. Trains the network on SOURCE's "
-        "other clips first if the checkpoint does not exist.",
-    )
-    p.add_argument("--data", help="folder laid out as <Character>/<Animation>.bvh (default: $MOTIONLAB_DATA/mixamo)")
-    p.add_argument("--source", default="Aj", help="the character trained on and retargeted from (a folder of --data)")
-    p.add_argument(
-        "--targets",
-        nargs="+",
-        default=["BigVegas", "Kaya", "SportyGranny", "Goblin_m", "Mousey_m", "Vampire_m"],
-        help="the characters retargeted onto (folders of --data)",
-    )
-    p.add_argument("--animations", nargs="+", help="clip stems (default: the 10 retarget_gt animations)")
-    p.add_argument("--all-animations", action="store_true", help="use every animation shared by source and targets")
-    p.add_argument(
-        "--checkpoint", help="checkpoint to use, trained there if missing (default: <tmp>/motionlab_<source>.pt)"
-    )
-    p.add_argument("--retrain", action="store_true", help="train even if the checkpoint exists")
-    p.add_argument(
-        "--folds",
-        type=positive_int,
-        default=1,
-        metavar="K",
-        help="leave animations out: split the evaluated animations into K folds and evaluate each with a network "
-        "trained on the source's other clips (checkpoints <checkpoint>_fold<k>of<K>.pt); default 1",
-    )
-    p.add_argument(
-        "--train-steps", type=positive_int, default=1500, help="Adam steps when the network is trained (default 1500)"
-    )
-    p.add_argument("--seed", type=int, default=0, help="random seed")
-    p.add_argument("--csv", help="write the per-clip records to this CSV")
-    p.add_argument("--force", action="store_true", help="overwrite an existing --csv file")
-    p.add_argument(
-        "--no-ablations", action="store_true", help="skip the ablation rows (full method without one of its parts)"
-    )
-    p.add_argument(
-        "--root",
-        choices=ROOT_MODES,
-        default="stride",
-        help="root trajectory of every row but the plain baseline (default stride, as in `motionlab retarget`)",
-    )
-    p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
-    add_quiet(p)
-    cli_options.add_solver_args(p)
-    p.set_defaults(func=_cmd_evaluate)
+    with cli_args.command(subparsers, "evaluate", _cmd_evaluate, quiet=False) as p:
+        p.add_argument(
+            "--data", help="folder laid out as <Character>/<Animation>.bvh (default: $MOTIONLAB_DATA/mixamo)"
+        )
+        p.add_argument(
+            "--source", default="Aj", help="the character trained on and retargeted from (a folder of --data)"
+        )
+        p.add_argument(
+            "--targets",
+            nargs="+",
+            default=["BigVegas", "Kaya", "SportyGranny", "Goblin_m", "Mousey_m", "Vampire_m"],
+            help="the characters retargeted onto (folders of --data)",
+        )
+        p.add_argument("--animations", nargs="+", help="clip stems (default: the 10 retarget_gt animations)")
+        p.add_argument("--all-animations", action="store_true", help="use every animation shared by source and targets")
+        p.add_argument(
+            "--checkpoint", help="checkpoint to use, trained there if missing (default: <tmp>/motionlab_<source>.pt)"
+        )
+        p.add_argument("--retrain", action="store_true", help="train even if the checkpoint exists")
+        p.add_argument(
+            "--folds",
+            type=positive_int,
+            default=1,
+            metavar="K",
+            help="leave animations out: split the evaluated animations into K folds and evaluate each with a network "
+            "trained on the source's other clips (checkpoints <checkpoint>_fold<k>of<K>.pt); default 1",
+        )
+        p.add_argument(
+            "--train-steps",
+            type=positive_int,
+            default=1500,
+            help="Adam steps when the network is trained (default 1500)",
+        )
+        p.add_argument("--seed", type=int, default=0, help="random seed")
+        p.add_argument("--csv", help="write the per-clip records to this CSV")
+        cli_args.add_force(p, "overwrite an existing --csv file")
+        p.add_argument(
+            "--no-ablations", action="store_true", help="skip the ablation rows (full method without one of its parts)"
+        )
+        p.add_argument(
+            "--root",
+            choices=ROOT_MODES,
+            default="stride",
+            help="root trajectory of every row but the plain baseline (default stride, as in `motionlab retarget`)",
+        )
+        p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
+        cli_args.add_quiet(p)
+        cli_options.add_solver_args(p)

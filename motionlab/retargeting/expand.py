@@ -71,6 +71,7 @@ __all__ = [
     "Character",
     "characters",
     "find_sources",
+    "check_output_layout",
     "read_manifest",
     "options_digest",
     "ExpandResult",
@@ -249,6 +250,40 @@ def find_sources(specs: Sequence[str]) -> list[tuple[str, Path]]:
         paths.extend(f for f in found if f not in paths)
     stems = [p.stem for p in paths]
     return [(p.stem if stems.count(p.stem) == 1 else f"{p.parent.name}_{p.stem}", p) for p in paths]
+
+
+def check_output_layout(
+    out: str | Path, clips: Sequence[tuple[str, Path]], targets: Sequence[Character], suffix: str
+) -> None:
+    """Refuse, before any work, an output location of the wrong kind under the folder ``out``.
+
+    ``out/<character>`` must be a folder (or not exist yet); ``out/manifest.csv`` and every
+    ``out/<character>/<clip><suffix>`` a file (or not exist yet). ``clips`` as from
+    :func:`find_sources`, ``suffix`` the outputs' file suffix (``".bvh"`` or ``".glb"``).
+
+    Raises
+    ------
+    ValueError
+        naming the first path of the wrong kind and what was expected there.
+    """
+    out = Path(out)
+    if (out / MANIFEST).is_dir():
+        raise ValueError(
+            f"{out / MANIFEST} is a folder; expected the job's manifest file (remove or rename the folder)"
+        )
+    for c in targets:
+        folder = out / c.name
+        if folder.exists() and not folder.is_dir():
+            raise ValueError(
+                f"{folder} is a file; expected the folder of character {c.name!r}'s outputs "
+                "(remove or rename the file, or choose another output folder)"
+            )
+        for clip, _ in clips:
+            if (folder / f"{clip}{suffix}").is_dir():
+                raise ValueError(
+                    f"{folder / f'{clip}{suffix}'} is a folder; expected the output file of clip {clip!r} "
+                    "(remove or rename the folder)"
+                )
 
 
 # ---------------------------------------------------------------------------- manifest
@@ -556,13 +591,14 @@ def _expand(
 ) -> ExpandResult:  # fmt: skip
     start = time.perf_counter()
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
     solver = solver or SolverConfig()
     clips = find_sources(sources)
     for name, _ in clips:
         _check_name(name, "clip")
     if not targets:
         raise ValueError("no target characters given")
+    check_output_layout(out, clips, targets, suffix)  # before any work: nothing is written on a refusal
+    out.mkdir(parents=True, exist_ok=True)
     known = {(r["character"], r["clip"]): r for r in read_manifest(out)}
     for c in targets:
         _clean_temporaries(out / c.name)

@@ -12,15 +12,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from motionlab.cli_args import (
-    add_quiet,
-    add_rate_and_plausibility_args,
-    check_output_folder,
-    non_negative,
-    non_negative_int,
-    positive,
-    positive_int,
-)
+from motionlab import cli_args
+from motionlab.cli_args import check_output_folder, non_negative, non_negative_int, positive, positive_int
 from motionlab.retargeting import cli_options
 from motionlab.retargeting.cli_options import ROOT_MODES
 
@@ -28,6 +21,12 @@ __all__ = ["register"]
 
 
 def _cmd_expand(args) -> int:
+    """retarget many clips onto many characters (batched, resumable; local or Ray)
+
+    Expand a motion database: every SOURCE clip onto every character, written as OUT/<character>/<clip>.bvh (or .glb
+    with --format glb) with OUT/manifest.csv (one row per output). Rerunning the same command redoes only what is
+    missing. Exit status 1 when some pair failed (see the manifest's error column).
+    """
     from motionlab.cli import CLIError
     from motionlab.retargeting import expand as ex
 
@@ -43,6 +42,7 @@ def _cmd_expand(args) -> int:
     check_output_folder("-o", args.output)  # before any work
     try:
         targets = ex.characters(*args.characters, presets=args.preset)
+        ex.check_output_layout(args.output, ex.find_sources(args.sources), targets, "." + args.format)
     except ValueError as e:
         raise CLIError(str(e)) from None
     ckpt = cli_options.load_checkpoint(args.checkpoint, args.device)
@@ -91,54 +91,52 @@ def _print_failures(job, most: int = 10) -> None:
 
 def register(subparsers) -> None:
     """Add ``expand`` to the ``motionlab`` command."""
-    p = subparsers.add_parser(
+    with cli_args.command(
+        subparsers,
         "expand",
-        help="retarget many clips onto many characters (batched, resumable; local or Ray)",
-        description="Expand a motion database: every SOURCE clip onto every character, written as "
-        "OUT/<character>/<clip>.bvh (or .glb with --format glb) with OUT/manifest.csv (one row per output). Rerunning the same command "
-        "redoes only what is missing. Exit status 1 when some pair failed (see the manifest's error column).",
+        _cmd_expand,
         formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="presets: long_legs, short_legs, long_arms, stocky, tall, child, or NAME:legs=1.2,arms=0.9,...",
-    )
-    p.add_argument("sources", nargs="+", help="source BVH files, folders (their *.bvh) or glob patterns")
-    p.add_argument(
-        "--characters",
-        nargs="+",
-        default=[],
-        metavar="CHARACTER",
-        help="BVH files whose rest skeletons define the targets, as FILE.bvh or NAME=FILE.bvh",
-    )
-    p.add_argument("--preset", action="append", default=[], help="a synthetic character (repeatable)")
-    p.add_argument("-o", "--output", required=True, help="output folder")
-    p.add_argument(
-        "--format", choices=("bvh", "glb"), default="bvh", help="output files: bvh (default) or glb (glTF 2.0)"
-    )
-    p.add_argument("--checkpoint", help="trained network (default: the shipped one)")
-    p.add_argument("--root", choices=ROOT_MODES, default="stride", help="root trajectory rule (as in retarget)")
-    p.add_argument("--batch-frames", type=positive_int, help="frames per solver batch (default: from free memory)")
-    p.add_argument(
-        "--backend",
-        choices=("local", "ray"),
-        default="local",
-        help='local: batches in this process; ray: the same batches on Ray actors (pip install "motionlab[cluster]")',
-    )
-    p.add_argument("--address", help="Ray cluster address (default: $RAY_ADDRESS, else a local Ray instance)")
-    p.add_argument("--workers", type=positive_int, default=2, help="Ray actors (default 2)")
-    p.add_argument(
-        "--threads", type=non_negative_int, default=0, help="torch threads (default: 1 on the CPU, see expand())"
-    )
-    p.add_argument(
-        "--max-penetration", type=non_negative, default=1.0, metavar="CM", help="flag above this (default 1 cm)"
-    )
-    p.add_argument(
-        "--skate-ratio",
-        type=positive,
-        default=2.0,
-        help="flag when skating exceeds this times the source's own (scaled by the root ratio; default 2)",
-    )
-    p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
-    p.add_argument("--force", action="store_true", help="redo every pair and replace existing outputs")
-    add_rate_and_plausibility_args(p)
-    add_quiet(p)
-    cli_options.add_solver_args(p)
-    p.set_defaults(func=_cmd_expand)
+        quiet=False,
+    ) as p:
+        p.add_argument("sources", nargs="+", help="source BVH files, folders (their *.bvh) or glob patterns")
+        p.add_argument(
+            "--characters",
+            nargs="+",
+            default=[],
+            metavar="CHARACTER",
+            help="BVH files whose rest skeletons define the targets, as FILE.bvh or NAME=FILE.bvh",
+        )
+        p.add_argument("--preset", action="append", default=[], help="a synthetic character (repeatable)")
+        cli_args.add_output(p, "output folder")
+        p.add_argument(
+            "--format", choices=("bvh", "glb"), default="bvh", help="output files: bvh (default) or glb (glTF 2.0)"
+        )
+        p.add_argument("--checkpoint", help="trained network (default: the shipped one)")
+        p.add_argument("--root", choices=ROOT_MODES, default="stride", help="root trajectory rule (as in retarget)")
+        p.add_argument("--batch-frames", type=positive_int, help="frames per solver batch (default: from free memory)")
+        p.add_argument(
+            "--backend",
+            choices=("local", "ray"),
+            default="local",
+            help='local: batches in this process; ray: the same batches on Ray actors (pip install "motionlab[cluster]")',
+        )
+        p.add_argument("--address", help="Ray cluster address (default: $RAY_ADDRESS, else a local Ray instance)")
+        p.add_argument("--workers", type=positive_int, default=2, help="Ray actors (default 2)")
+        p.add_argument(
+            "--threads", type=non_negative_int, default=0, help="torch threads (default: 1 on the CPU, see expand())"
+        )
+        p.add_argument(
+            "--max-penetration", type=non_negative, default=1.0, metavar="CM", help="flag above this (default 1 cm)"
+        )
+        p.add_argument(
+            "--skate-ratio",
+            type=positive,
+            default=2.0,
+            help="flag when skating exceeds this times the source's own (scaled by the root ratio; default 2)",
+        )
+        p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
+        cli_args.add_force(p, "redo every pair and replace existing outputs")
+        cli_args.add_rate_and_plausibility_args(p)
+        cli_args.add_quiet(p)
+        cli_options.add_solver_args(p)

@@ -16,7 +16,8 @@ import argparse
 import time
 from pathlib import Path
 
-from motionlab.cli_args import add_quiet, check_outputs, non_negative_int, positive, positive_int, renamed
+from motionlab import cli_args
+from motionlab.cli_args import check_outputs, non_negative_int, positive, positive_int
 
 __all__ = ["register"]
 
@@ -74,6 +75,11 @@ def _open_window(scene) -> None:
 
 
 def _cmd_view(args) -> int:
+    """play a BVH file in 3D, or write it to an MP4/GIF movie
+
+    Play FILE.bvh in a 3D window (where a display exists) or render it off-screen to a movie with -o (needed where
+    there is no display). Foot contacts light up red.
+    """
     from motionlab.core import bvh, files
     from motionlab.viz import backend
     from motionlab.viz.export import MOVIE_SUFFIXES, save_movie
@@ -139,47 +145,39 @@ def _movie_length(out: Path, motion, stride: int | None) -> tuple[int, float]:
 
 def register(subparsers) -> None:
     """Add ``view`` to the ``motionlab`` command."""
-    # the same argparse shape as every subcommand's register(); the words are view's own
-    p = subparsers.add_parser(
-        "view",
-        help="play a BVH file in 3D, or write it to an MP4/GIF movie",
-        description="Play FILE.bvh in a 3D window (where a display exists) or render it off-screen to a movie "
-        "with -o (needed where there is no display). Foot contacts light up red.",
-    )
-    p.add_argument("file", help="BVH file to play")
-    renamed(
-        p,
-        "--out",
+    with cli_args.command(subparsers, "view", _cmd_view) as p:
+        p.add_argument("file", help="BVH file to play")
+        cli_args.renamed(
+            p,
+            "--out",
+            cli_args.add_output(
+                p, "write a movie instead of opening a window (.mp4 or .gif)", required=False, metavar="MOVIE"
+            ),
+        )
+        cli_args.add_force(p, "overwrite an existing movie")
         p.add_argument(
-            "-o", "--output", metavar="MOVIE", help="write a movie instead of opening a window (.mp4 or .gif)"
-        ),
-    )
-    p.add_argument("--force", action="store_true", help="overwrite an existing movie")
-    p.add_argument(
-        "--camera",
-        choices=("follow", "frame"),
-        default="follow",
-        help="follow the character (default) or frame the whole clip from one place",
-    )
-    p.add_argument(
-        "--size", type=_size, default=(640, 480), metavar="WxH", help="picture size in pixels (default 640x480)"
-    )
-    renamed(
-        p,
-        "--scale",
+            "--camera",
+            choices=("follow", "frame"),
+            default="follow",
+            help="follow the character (default) or frame the whole clip from one place",
+        )
         p.add_argument(
-            "--unit-scale", type=positive, default=0.01, help="BVH units to metres (default 0.01: centimetres)"
-        ),
-    )
-    p.add_argument("--start", type=non_negative_int, default=0, help="first frame")
-    p.add_argument("--stop", type=int, default=None, help="frame to stop before (default: the end)")
-    p.add_argument(
-        "--stride", type=positive_int, default=None, help="movie: keep every N-th frame (GIF default: ~15 fps)"
-    )
-    p.add_argument("--canonical", action="store_true", help="show the 22-joint humanoid instead of the full rig")
-    p.add_argument("--no-trail", action="store_true", help="do not draw the root's path on the ground")
-    p.add_argument("--feet-trails", action="store_true", help="draw the feet's paths")
-    p.add_argument("--no-contacts", action="store_true", help="do not highlight foot contacts")
-    p.add_argument("--smooth", action="store_true", help="anti-aliased movie (slower in software rendering)")
-    add_quiet(p)
-    p.set_defaults(func=_cmd_view)
+            "--size", type=_size, default=(640, 480), metavar="WxH", help="picture size in pixels (default 640x480)"
+        )
+        cli_args.renamed(
+            p,
+            "--scale",
+            p.add_argument(
+                "--unit-scale", type=positive, default=0.01, help="BVH units to metres (default 0.01: centimetres)"
+            ),
+        )
+        p.add_argument("--start", type=non_negative_int, default=0, help="first frame")
+        p.add_argument("--stop", type=int, default=None, help="frame to stop before (default: the end)")
+        p.add_argument(
+            "--stride", type=positive_int, default=None, help="movie: keep every N-th frame (GIF default: ~15 fps)"
+        )
+        p.add_argument("--canonical", action="store_true", help="show the 22-joint humanoid instead of the full rig")
+        p.add_argument("--no-trail", action="store_true", help="do not draw the root's path on the ground")
+        p.add_argument("--feet-trails", action="store_true", help="draw the feet's paths")
+        p.add_argument("--no-contacts", action="store_true", help="do not highlight foot contacts")
+        p.add_argument("--smooth", action="store_true", help="anti-aliased movie (slower in software rendering)")

@@ -102,3 +102,29 @@ def test_check_output_folder(tmp_path):
     with pytest.raises(CLIError, match="is a file, so the folder cannot be made"):
         check_output_folder("-o", tmp_path / "f.txt" / "sub")
     assert not (tmp_path / "a").exists()  # checking makes nothing
+
+
+def test_command_takes_its_help_from_the_docstring_and_adds_quiet_last():
+    from motionlab import cli_args
+
+    def run(args):
+        """do the thing
+
+        Do the thing to a file,
+        carefully.
+
+        Exit status 1 when it fails.
+        """
+
+    sub = argparse.ArgumentParser(prog="motionlab").add_subparsers()
+    with cli_args.command(sub, "thing", run) as p:
+        p.add_argument("file")
+        cli_args.add_output(p, "where to write")
+        cli_args.add_force(p, "replace the output")
+    args = p.parse_args(["a.bvh", "-o", "b.bvh", "--force", "-q"])
+    assert args.func is run and args.output == "b.bvh" and args.force and args.quiet
+    assert p.description == "Do the thing to a file, carefully.\n\nExit status 1 when it fails."
+    assert [a.dest for a in p._actions][-1] == "quiet"
+    assert sub._choices_actions[0].help == "do the thing"
+    with pytest.raises(SystemExit):
+        p.parse_args(["a.bvh"])  # -o is required

@@ -151,6 +151,36 @@ def test_read_only_output_folder_names_the_real_folder(walk, tmp_path, capsys, m
     assert list(out.iterdir()) == []
 
 
+@pytest.mark.parametrize(
+    ("in_the_way", "expected"),
+    [
+        ("child", "expected the folder of character 'child'"),  # OUT/<character> is a file
+        ("manifest.csv/", "expected the job's manifest file"),  # OUT/manifest.csv is a folder
+        ("child/walk.bvh/", "expected the output file of clip 'walk'"),  # OUT/<character>/<clip>.bvh is a folder
+    ],
+)
+def test_expand_output_location_of_the_wrong_kind_is_refused_before_any_work(
+    walk, tmp_path, capsys, monkeypatch, in_the_way, expected
+):
+    """An output location that is a file where a folder goes (or the reverse): refused up front (exit 2),
+    naming the path, with nothing written and no work started."""
+    from motionlab.retargeting import cli_options
+
+    out = tmp_path / "expanded"
+    path = out / in_the_way.rstrip("/")
+    path.parent.mkdir(parents=True)
+    path.mkdir() if in_the_way.endswith("/") else path.write_text("mine")
+    before = sorted(p.relative_to(out) for p in out.rglob("*"))
+
+    def started(*args, **kwargs):
+        raise AssertionError("expand started work before checking its outputs")
+
+    monkeypatch.setattr(cli_options, "load_checkpoint", started)
+    code, _, err = _run(capsys, "expand", walk, "--preset", "child", "-o", out, "-q")
+    assert code == 2 and str(path) in err and expected in err and "Traceback" not in err
+    assert sorted(p.relative_to(out) for p in out.rglob("*")) == before
+
+
 @pytest.mark.parametrize("command", ["convert", "fill-gaps", "graph-search"])
 def test_an_output_that_is_the_input_is_refused(walk, tmp_path, capsys, command):
     before = walk.read_bytes()

@@ -246,3 +246,18 @@ def test_resample_keeps_dtype(rng):
     r = m32.resample(20)
     assert r.local_rot.dtype == np.float32
     assert m32.root_pos.dtype == np.float32
+
+
+def test_check_one_rig_names_the_odd_clip(rng):
+    from motionlab.core.motion import check_one_rig
+
+    a = make_motion(rng)
+    check_one_rig([a, a.copy()])  # same skeleton and rate: accepted
+    faster = Motion(a.skeleton, a.local_rot, a.root_pos, 60.0, name="other")
+    with pytest.raises(ValueError, match="clip 'other' is at 60 fps, the library at 30"):
+        check_one_rig([a, faster], group="the library")
+    with pytest.raises(ValueError, match="clip 'other' is at 60 fps, 'clip' at 30"):
+        check_one_rig([a, faster])
+    odd = Motion(make_motion(rng, J=4).skeleton, a.local_rot[:, :4], a.root_pos, 30.0, name="odd")
+    with pytest.raises(ValueError, match="clip 'odd' uses another skeleton than 'clip'"):
+        check_one_rig([a, odd])
