@@ -55,16 +55,24 @@ def violations(source: str) -> list[tuple[int, str]]:
     for node in ast.walk(tree):
         if isinstance(node, ast.Attribute) and _private(node.attr) and _root_name(node.value) in names:
             bad.append((node.lineno, f"{ast.unparse(node)} ({type(node.ctx).__name__.lower()})"))
-        elif isinstance(node, ast.Call):
-            func = node.func.attr if isinstance(node.func, ast.Attribute) else getattr(node.func, "id", "")
-            args = node.args
-            if func in ATTR_CALLS and len(args) >= 2 and _root_name(args[0]) in names:
-                if isinstance(args[1], ast.Constant) and isinstance(args[1].value, str) and _private(args[1].value):
-                    bad.append((node.lineno, ast.unparse(node)))
-            if func in ATTR_CALLS and args and isinstance(args[0], ast.Constant) and isinstance(args[0].value, str):
-                if DOTTED.match(args[0].value):
-                    bad.append((node.lineno, ast.unparse(node)))
+        elif isinstance(node, ast.Call) and _by_name(node, names):
+            bad.append((node.lineno, ast.unparse(node)))
     return sorted(set(bad))
+
+
+def _string(node: ast.AST) -> str:
+    return node.value if isinstance(node, ast.Constant) and isinstance(node.value, str) else ""
+
+
+def _by_name(call: ast.Call, names: set[str]) -> bool:
+    """Whether a ``setattr``-like call names a motionlab private attribute: ``(module, "_name")``
+    with ``module`` one of ``names``, or a dotted ``"motionlab.x._name"``."""
+    func = call.func.attr if isinstance(call.func, ast.Attribute) else getattr(call.func, "id", "")
+    args = call.args
+    if func not in ATTR_CALLS or not args:
+        return False
+    on_module = len(args) >= 2 and _root_name(args[0]) in names and _private(_string(args[1]))
+    return on_module or bool(DOTTED.match(_string(args[0])))
 
 
 def test_no_study_or_benchmark_uses_a_motionlab_private_name():
