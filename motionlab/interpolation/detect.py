@@ -380,17 +380,7 @@ def track(
     # windows ending at a frame take backward velocities, windows starting at one forward velocities
     ending = _match_windows(_features(features, motion, ref, "backward"), clips, k, motion.fps, rates)
     starting = _match_windows(_features(features, motion, ref, "forward"), clips, k, motion.fps, rates)
-    # step t -> t+1 (t = 0 … T-2): the window ending at t (index t-k+1) or the one starting at t+1
-    steps_at = np.arange(T - 1)
-    back = np.clip(steps_at - k + 1, 0, None)
-    ahead = np.clip(steps_at + 1, None, T - k)
-    cb = np.where(steps_at - k + 1 >= 0, ending.cost[back], np.inf)
-    ca = np.where(steps_at + 1 <= T - k, starting.cost[ahead], np.inf)
-    use_back = cb <= ca
-    node = np.where(use_back, ending.node[back], starting.node[ahead])
-    rate = np.where(use_back, ending.rate[back], starting.rate[ahead])
-    # graph frame of t (window ending there) or of t+1 (window starting there)
-    at = np.where(use_back, ending.time[back] + (k - 1) * ending.rate[back], starting.time[ahead])
+    use_back, node, rate, at = _step_matches(ending, starting, k, T)
     first = np.cumsum([0] + [len(x) for x in speeds])[:-1]  # each node's first row in the joined speeds
     joined = np.concatenate(speeds)
     predicted = np.interp(first[node] + at, np.arange(len(joined)), joined) * rate  # metres per stream step
@@ -437,6 +427,24 @@ def _graph_clips(graph, ref: int, features) -> tuple[list, list]:
         speeds.append(np.convolve(np.pad(s, 2, mode="edge"), np.ones(5) / 5.0, mode="valid"))
         clips.append((_features(features, m, ref, "central"), m.fps))
     return clips, speeds
+
+
+def _step_matches(ending: _Match, starting: _Match, k: int, T: int):
+    """For each step ``t → t+1`` (``t = 0 … T-2``) of a ``T``-frame stream, the better matched of
+    the window of ``k`` frames ending at ``t`` (``ending``, index ``t-k+1``) and the one starting at
+    ``t+1`` (``starting``). Returns ``use_back`` (T-1,) bool, True where the window ending at ``t``
+    won; its ``node`` (T-1,) and ``rate`` (T-1,), graph frames per stream frame; and ``at`` (T-1,),
+    the graph frame matched to ``t`` (window ending there) or to ``t+1`` (window starting there)."""
+    steps_at = np.arange(T - 1)
+    back = np.clip(steps_at - k + 1, 0, None)
+    ahead = np.clip(steps_at + 1, None, T - k)
+    cb = np.where(steps_at - k + 1 >= 0, ending.cost[back], np.inf)
+    ca = np.where(steps_at + 1 <= T - k, starting.cost[ahead], np.inf)
+    use_back = cb <= ca
+    node = np.where(use_back, ending.node[back], starting.node[ahead])
+    rate = np.where(use_back, ending.rate[back], starting.rate[ahead])
+    at = np.where(use_back, ending.time[back] + (k - 1) * ending.rate[back], starting.time[ahead])
+    return use_back, node, rate, at
 
 
 def _distances(motion: Motion, predicted: np.ndarray) -> np.ndarray:
