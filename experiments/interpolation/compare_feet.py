@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from experiments.interpolation import check_gaps, gap_eval
-from experiments.interpolation.compare_stride_root import cases, print_missed, scored
+from experiments.interpolation.compare_stride_root import cases, each_set
 from motionlab.interpolation import detect
 
 RULES = {"body lifted": "lift", "leg bent": "plant"}  # printed name: ``feet`` of ``gaps.fill``
@@ -63,11 +63,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     root = check_gaps.data_root()
     t0 = time.perf_counter()
-    for name, cuts in all_cuts(root, args.every, args.quick).items():
-        missed = []
-        rows = scored(cuts, score, name, missed)  # parts 2 and 4 name files; parts 5-7 give loaded motions
-        print(f"{name}: {len(rows)} cuts found of {len(cuts)}; root error over the gap / true displacement")
-        print_missed(missed)
+    for _, rows in each_set(all_cuts(root, args.every, args.quick), score):  # files or loaded motions
         for k, rule in enumerate(RULES):
             rel = np.array([r[k].root_rel for r in rows])
             below = 1000 * max(r[k].below for r in rows)
