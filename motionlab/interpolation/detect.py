@@ -342,13 +342,17 @@ def track(
     The work grows as stream frames × graph frames × the tempi (matrix products, in blocks of
     512 stream windows, so memory stays bounded).
 
+    Raises ``ValueError`` for an empty graph, a stream on another skeleton, a Δ that
+    :func:`check_delta` refuses, a ``context`` or ``rates`` outside what is stated below, or
+    ``features`` that do not give (T, J', 6) arrays.
+
     Parameters
     ----------
     motion : Motion on the graph's skeleton, at any frame rate
     graph : :class:`~.action_graph.ActionGraph`
     delta : Δ; default :data:`DELTA`
     features : keyword-only; ``features(motion, ref, difference)`` gives what frames are compared
-        by, an array (T, J', 6) per frame: positions in ``[..., :3]`` and velocities in
+        by, an array (T, J', 6), per frame and joint positions in ``[..., :3]`` and velocities in
         ``[..., 3:]`` (scaled by ``ρ`` on the graph's side), ``ref`` being the reference joint
         (:func:`~.alignment.reference_joint`) and ``difference`` ``"backward"``, ``"forward"``
         (stream windows) or ``"central"`` (graph clips). Default :func:`track_features`.
@@ -358,10 +362,6 @@ def track(
     rates : keyword-only; the tempi ``ρ`` (graph seconds per stream second), a non-empty 1-D
         array of positive finite numbers; default :data:`TRACK_RATES`. ``[1.0]`` matches
         without time warping.
-
-    Raises ``ValueError`` for an empty graph, a stream on another skeleton, a Δ that
-    :func:`check_delta` refuses, a ``context`` or ``rates`` outside the above, or ``features``
-    that do not give (T, J', 6) arrays.
     """
     if not graph.nodes:
         raise ValueError("the action graph has no actions to track the stream in")

@@ -581,6 +581,9 @@ def fill(
 ) -> tuple[Motion, list[FilledGap]]:
     """Fill every NaN frame of ``motion``; returns the filled copy and a report per gap.
 
+    Raises ``ValueError`` for an unknown ``method``, ``root`` or ``feet``, a ``"graph"`` fill
+    without a graph or with one on another skeleton, or a motion with every frame missing.
+
     Parameters
     ----------
     motion : Motion with NaN rows where frames are missing (see :func:`insert_missing`)
@@ -608,9 +611,6 @@ def fill(
         bends the leg of each foot that went below it (:func:`.footing.plant_feet`) and lifts the
         body by what the legs cannot reach; ``"lift"`` lifts the body only
         (:func:`lift_above_floor`).
-
-    Raises ``ValueError`` for an unknown ``method``, ``root`` or ``feet``, a ``"graph"`` fill
-    without a graph or with one on another skeleton, or a motion with every frame missing.
     """
     _check_fill(motion, method, graph, root, feet)
     out = motion.copy()
