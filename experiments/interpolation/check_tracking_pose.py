@@ -11,7 +11,7 @@ tracked in a graph of the three left out (``normal`` takes 1–3), and ``D > Δ`
 * **cut**: 10, 20 and 30 frames cut out of each take at random places (seeded), precision and
   recall of the cut's step.
 
-Matches compared (``detect._track_features``, ``TRACK_CONTEXT``, ``TRACK_RATES`` replaced):
+Matches compared (the ``features``, ``context`` and ``rates`` of ``detect.track``):
 
 * ``frame, every joint``: each frame alone (the better matched of the two frames beside the step),
   nearest graph frame by the heading-frame positions of every joint, the origin marker included:
@@ -53,21 +53,27 @@ def every_joint(motion, ref, difference="central"):
     return np.concatenate([local, np.zeros_like(local)], axis=-1)
 
 
-BODY = detect._track_features  # kept: the variants below replace detect._track_features
-
-
 def positions_only(motion, ref, difference="central"):
-    feat = BODY(motion, ref, difference).copy()
+    """:func:`motionlab.interpolation.detect.track_features` with the velocities zero: (T, J, 6)."""
+    feat = detect.track_features(motion, ref, difference).copy()
     feat[..., 3:] = 0.0
     return feat
 
 
-VARIANTS = {  # features, context (s), tempi
-    "frame, every joint": (every_joint, 0.0, np.array([1.0])),
-    "frame, body": (positions_only, 0.0, np.array([1.0])),
-    "frame, body+velocity": (detect._track_features, 0.0, np.array([1.0])),
-    "window, body": (positions_only, detect.TRACK_CONTEXT, detect.TRACK_RATES),
-    "window, body+velocity": (detect._track_features, detect.TRACK_CONTEXT, detect.TRACK_RATES),
+def _frames(features):
+    return {"features": features, "context": 0.0, "rates": np.array([1.0])}
+
+
+def _windows(features):
+    return {"features": features, "context": detect.TRACK_CONTEXT, "rates": detect.TRACK_RATES}
+
+
+VARIANTS = {  # keyword arguments of detect.track and detect.graph_gaps
+    "frame, every joint": _frames(every_joint),
+    "frame, body": _frames(positions_only),
+    "frame, body+velocity": _frames(detect.track_features),
+    "window, body": _windows(positions_only),
+    "window, body+velocity": {},  # what detect.track does by default
 }
 
 
@@ -91,32 +97,27 @@ def main(argv=None) -> int:
         graph.add_node(f"walk{i + 1}", bvh.load(f))
     streams = [f for f in sorted(walk.glob("*.bvh")) if f not in graph_takes][:: args.every]
     motions = [bvh.load(f) for f in streams]
-    saved = detect._track_features, detect.TRACK_CONTEXT, detect.TRACK_RATES
     print(
         f"{len(streams)} clean walk takes tracked in a graph of {len(graph_takes)} normal takes (Δ = {detect.DELTA}):"
     )
     print(f"{'match':24s} {'clean':>6s} {'moved':>6s} {'largest D':>9s}   cut: precision, recall   takes flagged")
-    try:
-        for name, (features, context, rates) in VARIANTS.items():
-            detect._track_features, detect.TRACK_CONTEXT, detect.TRACK_RATES = features, context, rates
-            rng = np.random.default_rng(1)
-            clean = shifted = tp = fp = cases = 0
-            largest, flagged = 0.0, set()
-            for f, m in zip(streams, motions):
-                tr = detect.track(m, graph)
-                clean += len(tr.gaps())
-                largest = max(largest, float(tr.distance.max()))
-                if tr.gaps():
-                    flagged.add(f.stem.split("_")[2])
-                shifted += len(detect.graph_gaps(moved(m), graph))
-                hit, false, made = gap_eval.detection_counts(
-                    m, lambda c: detect.graph_gaps(c, graph), (10, 20, 30), rng
-                )
-                tp, fp, cases = tp + hit, fp + false, cases + made
-            print(f"{name:24s} {clean:6d} {shifted:6d} {largest:9.2f}   {cases} cut: {tp / max(tp + fp, 1):.3f}, "
-                  f"{tp / max(cases, 1):.3f}   {', '.join(sorted(flagged)) or '-'}", flush=True)  # fmt: skip
-    finally:
-        detect._track_features, detect.TRACK_CONTEXT, detect.TRACK_RATES = saved
+    for name, match in VARIANTS.items():
+        rng = np.random.default_rng(1)
+        clean = shifted = tp = fp = cases = 0
+        largest, flagged = 0.0, set()
+        for f, m in zip(streams, motions):
+            tr = detect.track(m, graph, **match)
+            clean += len(tr.gaps())
+            largest = max(largest, float(tr.distance.max()))
+            if tr.gaps():
+                flagged.add(f.stem.split("_")[2])
+            shifted += len(detect.graph_gaps(moved(m), graph, **match))
+            hit, false, made = gap_eval.detection_counts(
+                m, lambda c, kw=match: detect.graph_gaps(c, graph, **kw), (10, 20, 30), rng
+            )
+            tp, fp, cases = tp + hit, fp + false, cases + made
+        print(f"{name:24s} {clean:6d} {shifted:6d} {largest:9.2f}   {cases} cut: {tp / max(tp + fp, 1):.3f}, "
+              f"{tp / max(cases, 1):.3f}   {', '.join(sorted(flagged)) or '-'}", flush=True)  # fmt: skip
     other_actions(walk.parent.parent)
     return 0
 
@@ -142,24 +143,19 @@ def other_actions(bandai: Path) -> None:
         print(f"  {name:15s} {len(files):2d} takes: {clean} false gaps clean; {cases} cut: precision "
               f"{tp / max(tp + fp, 1):.3f}, recall {tp / max(cases, 1):.3f}")  # fmt: skip
     punches = [bvh.load(f) for f in sorted((bandai / "dataset-1/punch").glob("*.bvh"))]
-    saved = detect._track_features, detect.TRACK_CONTEXT, detect.TRACK_RATES
     print("  dataset-1 punch, a cut every 15 frames (10/20/30 frames), recall and false gaps:")
-    try:
-        for label in ("window, body+velocity", "frame, every joint", "stream against itself"):
-            if label in VARIANTS:
-                detect._track_features, detect.TRACK_CONTEXT, detect.TRACK_RATES = VARIANTS[label]
-            hit = false = cases = 0
-            for i, m in enumerate(punches):
-                graph = leave_out(punches, i)
-                for s in range(20, m.num_frames - 40, 15):
-                    for n in (10, 20, 30):
-                        c = gap_eval.cut(m, s, n)
-                        found = detect.consecutive_gaps(c) if label not in VARIANTS else detect.graph_gaps(c, graph)
-                        h = (s - 1) in found
-                        hit, false, cases = hit + h, false + len(found) - h, cases + 1
-            print(f"    {label:24s} {cases} cuts: recall {hit / max(cases, 1):.3f}, {false} false gaps")
-    finally:
-        detect._track_features, detect.TRACK_CONTEXT, detect.TRACK_RATES = saved
+    for label in ("window, body+velocity", "frame, every joint", "stream against itself"):
+        match = VARIANTS.get(label)
+        hit = false = cases = 0
+        for i, m in enumerate(punches):
+            graph = leave_out(punches, i)
+            for s in range(20, m.num_frames - 40, 15):
+                for n in (10, 20, 30):
+                    c = gap_eval.cut(m, s, n)
+                    found = detect.consecutive_gaps(c) if match is None else detect.graph_gaps(c, graph, **match)
+                    h = (s - 1) in found
+                    hit, false, cases = hit + h, false + len(found) - h, cases + 1
+        print(f"    {label:24s} {cases} cuts: recall {hit / max(cases, 1):.3f}, {false} false gaps")
 
 
 def leave_out(motions: list, i: int) -> ActionGraph:

@@ -6,11 +6,11 @@
 Two ways to keep filled frames out of the floor, each on the *same* counts (the detection runs once
 per cut) and the same fill otherwise:
 
-* **body lifted**: every filled frame raised by how far its lowest
-  joint went below the floor (``gaps.lift_above_floor``);
-* **leg bent** (what ``gaps.fill`` does): each sunk foot moved up onto the floor by bending its
-  leg (:func:`motionlab.interpolation.footing.plant_feet`), the body lifted only by what the legs
-  cannot reach.
+* **body lifted** (``gaps.fill(..., feet="lift")``): every filled frame raised by how far its
+  lowest joint went below the floor (:func:`motionlab.interpolation.gaps.lift_above_floor`);
+* **leg bent** (what ``gaps.fill`` does by default, ``feet="plant"``): each sunk foot moved up
+  onto the floor by bending its leg (:func:`motionlab.interpolation.footing.plant_feet`), the
+  body lifted only by what the legs cannot reach.
 
 Cuts of 10, 20 and 30 frames: the CHOOSE and VALIDATE cases of ``experiments/interpolation/check_gaps.py`` part 2
 (same seed) with every walk take of ``bandai_namco/sessions/walk`` cut every ``EVERY`` frames
@@ -24,27 +24,15 @@ from __future__ import annotations
 
 import argparse
 import time
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 
 from experiments.interpolation import check_gaps, gap_eval
-from experiments.interpolation.compare_stride_root import cases, print_missed, scored
-from motionlab.interpolation import detect, gaps
+from experiments.interpolation.compare_stride_root import cases, each_set
+from motionlab.interpolation import detect
 
-RULES = ("body lifted", "leg bent")
-
-
-@contextmanager
-def body_lifted():
-    """``gaps.fill`` keeping feet out of the floor by lifting the body only."""
-    keep = gaps._feet_on_floor
-    gaps._feet_on_floor = gaps.lift_above_floor
-    try:
-        yield
-    finally:
-        gaps._feet_on_floor = keep
+RULES = {"body lifted": "lift", "leg bent": "plant"}  # printed name: ``feet`` of ``gaps.fill``
 
 
 def score(motion, s: int, n: int) -> list[gap_eval.CutResult] | None:
@@ -52,9 +40,7 @@ def score(motion, s: int, n: int) -> list[gap_eval.CutResult] | None:
     found = detect.detect(gap_eval.cut(motion, s, n))
     if (s - 1) not in dict(found):
         return None
-    with body_lifted():
-        lifted = gap_eval.evaluate_cut(motion, s, n, found=found)
-    return [lifted, gap_eval.evaluate_cut(motion, s, n, found=found)]
+    return [gap_eval.evaluate_cut(motion, s, n, found=found, feet=feet) for feet in RULES.values()]
 
 
 def all_cuts(root: Path, every: int, quick: bool) -> dict[str, list]:
@@ -77,11 +63,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     root = check_gaps.data_root()
     t0 = time.perf_counter()
-    for name, cuts in all_cuts(root, args.every, args.quick).items():
-        missed = []
-        rows = scored(cuts, score, name, missed)  # parts 2 and 4 name files; parts 5-7 give loaded motions
-        print(f"{name}: {len(rows)} cuts found of {len(cuts)}; root error over the gap / true displacement")
-        print_missed(missed)
+    for _, rows in each_set(all_cuts(root, args.every, args.quick), score):  # files or loaded motions
         for k, rule in enumerate(RULES):
             rel = np.array([r[k].root_rel for r in rows])
             below = 1000 * max(r[k].below for r in rows)

@@ -119,6 +119,17 @@ def print_missed(missed: list) -> None:
         print(f"   not found: {motion.name}@{s}, {n} frames cut (D/Δ {ratio:.2f})")
 
 
+def each_set(cuts_by_set: dict, score):
+    """Per set of cuts: ``(name, rows)``, the :func:`scored` rows of its found cuts, after printing
+    how many were found and every one missed (:func:`print_missed`)."""
+    for name, cuts in cuts_by_set.items():
+        missed = []
+        rows = scored(cuts, score, name, missed)
+        print(f"{name}: {len(rows)} cuts found of {len(cuts)}; root error over the gap / true displacement")
+        print_missed(missed)
+        yield name, rows
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--every", type=int, default=30, help="a cut every EVERY frames of every walk take (default 30)")
@@ -126,11 +137,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     root = check_gaps.data_root()
     t0 = time.perf_counter()
-    for name, cuts in cases(root, args.every, args.quick).items():
-        missed = []
-        e = np.array(scored(cuts, score, name, missed))
-        print(f"{name}: {len(e)} cuts found of {len(cuts)}; root error over the gap / true displacement")
-        print_missed(missed)
+    for _, rows in each_set(cases(root, args.every, args.quick), score):
+        e = np.array(rows)
         for k, rule in enumerate(RULES):
             print(f"   {rule:46s} mean {e[:, k].mean():6.2%}, worst {e[:, k].max():6.2%}, "
                   f"above 10%: {int((e[:, k] > 0.1).sum())}")  # fmt: skip

@@ -155,11 +155,13 @@ def evaluate_cut(
     root: str = "stride",
     takes=None,
     found: list[tuple[int, int]] | None = None,
+    *,
+    feet: str = "plant",
 ) -> CutResult:
     """Cut, detect (against ``graph`` if given, else the stream itself; counts also from the other
     recordings ``takes`` if given, :class:`.recorded.RecordedTakes`, never holding ``motion``), fill
-    (``method`` and ``root`` of :func:`.gaps.fill`; by default what ``motionlab fill-gaps`` does),
-    compare. ``found``: the detection's ``(step, count)`` pairs of the cut stream, if already made
+    (``method``, ``root`` and ``feet`` of :func:`.gaps.fill`; by default what ``motionlab fill-gaps``
+    does), compare. ``found``: the detection's ``(step, count)`` pairs of the cut stream, if already made
     (to compare fills on the same counts)."""
     stream = cut(motion, start, n)
     if found is None:
@@ -170,7 +172,7 @@ def evaluate_cut(
     if not hit:
         return res
     est = dict(found)[start - 1]
-    filled, _ = gaps.fill(gaps.insert_missing(stream, found)[0], method=method, root=root)
+    filled, _ = gaps.fill(gaps.insert_missing(stream, found)[0], method=method, root=root, feet=feet)
     shift = sum(c for t, c in found if t < start - 1)  # frames inserted before this gap
     a = start - 1 + shift
     ref = reference_joint(motion)

@@ -37,6 +37,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -56,6 +57,7 @@ __all__ = [
     "held_steps",
     "TRACK_CONTEXT",
     "TRACK_RATES",
+    "track_features",
     "check_delta",
     "body_height",
     "joint_steps",
@@ -275,15 +277,15 @@ class _Match:
     rate: np.ndarray  # (W,) graph frames per stream frame
 
 
-def _match_windows(q: np.ndarray, clips: list, k: int, fps: float) -> _Match:
+def _match_windows(q: np.ndarray, clips: list, k: int, fps: float, rates: np.ndarray) -> _Match:
     """Every window of ``k`` stream frames ``q`` (T, J, 6: positions, weighted velocities) matched to
     the graph clips ``clips`` (pairs of features (N, J, 6) and frame rate) at every tempo ``ρ`` of
-    :data:`TRACK_RATES`, time-warped linearly (the graph's velocities scaled by ``ρ``)."""
+    ``rates``, time-warped linearly (the graph's velocities scaled by ``ρ``)."""
     n = len(q) - k + 1
     best = _Match(np.full(n, np.inf), np.zeros(n, np.int64), np.zeros(n), np.ones(n))
     q = q.reshape(len(q), -1)
     for c, (feat, clip_fps) in enumerate(clips):
-        for rho in TRACK_RATES:
+        for rho in rates:
             step = rho * clip_fps / fps  # graph frames per stream frame
             g, times = _resampled((feat * np.array([1.0, 1.0, 1.0, rho, rho, rho])).reshape(len(feat), -1), step)
             cost, start = _window_costs(q, g, k)
@@ -293,42 +295,73 @@ def _match_windows(q: np.ndarray, clips: list, k: int, fps: float) -> _Match:
     return best
 
 
-def _track_features(motion: Motion, ref: int, difference: str = "central") -> np.ndarray:
-    """Per frame and body joint (T, J, 6): heading-frame position and weighted heading-frame
-    velocity (:func:`.recorded.body_features`, velocities by ``difference``; the velocity carries
-    the travel speed, so a stream that walks is never matched to a graph clip standing still)."""
+def track_features(motion: Motion, ref: int, difference: str = "central") -> np.ndarray:
+    """What :func:`track` compares frames by, per frame and body joint (the reference joint ``ref``
+    and the joints below it): heading-frame position and weighted heading-frame velocity
+    (:func:`.recorded.body_features`, velocities by ``difference``: ``"central"``, ``"backward"``
+    or ``"forward"``). The velocity carries the travel speed, so a stream that walks is never
+    matched to a graph clip standing still.
+
+    Returns
+    -------
+    ndarray, shape (T, J', 6): positions (metres) in ``[..., :3]``, velocities in ``[..., 3:]``
+    """
     feat, _ = body_features(motion, ref=ref, difference=difference)
     return feat.reshape(len(feat), -1, 6)
 
 
-def track(motion: Motion, graph, delta: float | None = None) -> GraphTrack:
+def track(
+    motion: Motion,
+    graph,
+    delta: float | None = None,
+    *,
+    features: Callable[[Motion, int, str], np.ndarray] = track_features,
+    context: float | None = None,
+    rates=None,
+) -> GraphTrack:
     """Track every stream frame in the graph and compute ``D(M_c, M_i)`` (module docstring).
 
     **The match.** A single frame's pose is a poor clue to where a walker is in the gait cycle
     when the walker differs from the recordings: matched by pose alone, the shuffling steps of an
     elderly walker land on graph frames where the recorded walker stands still or moves slower,
     and the stream's ordinary step then looks like a jump. So *windows* are matched: the ``K``
-    stream frames (:data:`TRACK_CONTEXT` seconds) ending at frame ``t`` and the ``K`` starting at
+    stream frames (``context`` seconds) ending at frame ``t`` and the ``K`` starting at
     ``t+1`` are each compared with every run of graph frames, time-warped by every tempo ``ρ`` of
-    :data:`TRACK_RATES` (the graph's velocities scaled by ``ρ``). Frames are compared by the body
-    alone, heading-frame positions and weighted velocities of the reference joint and the joints
-    below it (:func:`_track_features`), so where the take was recorded in the capture volume does
-    not matter; the velocities are one-sided (backward in a window ending at ``t``, forward in one
-    starting at ``t+1``), so no window differences across the step it judges. Of the two windows beside the step ``t → t+1`` the one matched better is kept:
-    near a gap, the window that spans it matches badly.
+    ``rates`` (the graph's velocities scaled by ``ρ``). Frames are compared by ``features``; by
+    default the body alone, heading-frame positions and weighted velocities of the reference joint
+    and the joints below it (:func:`track_features`), so where the take was recorded in the capture
+    volume does not matter; the velocities are one-sided (backward in a window ending at ``t``,
+    forward in one starting at ``t+1``), so no window differences across the step it judges. Of
+    the two windows beside the step ``t → t+1`` the one matched better is kept: near a gap, the
+    window that spans it matches badly.
 
     **The distance.** The graph then predicts the stream's step at that point: the graph clip's
     joint step at the matched frame (mean over five frames), times ``ρ``. ``r(t)`` is the stream's
     step over that prediction, and ``D = r / (typical r around t)`` as in the module docstring.
 
-    The work grows as stream frames × graph frames × the 13 tempi (matrix products, in blocks of
+    The work grows as stream frames × graph frames × the tempi (matrix products, in blocks of
     512 stream windows, so memory stays bounded).
+
+    Raises ``ValueError`` for an empty graph, a stream on another skeleton, a Δ that
+    :func:`check_delta` refuses, a ``context`` or ``rates`` outside what is stated below, or
+    ``features`` that do not give (T, J', 6) arrays.
 
     Parameters
     ----------
     motion : Motion on the graph's skeleton, at any frame rate
     graph : :class:`~.action_graph.ActionGraph`
     delta : Δ; default :data:`DELTA`
+    features : keyword-only; ``features(motion, ref, difference)`` gives what frames are compared
+        by, an array (T, J', 6), per frame and joint positions in ``[..., :3]`` and velocities in
+        ``[..., 3:]`` (scaled by ``ρ`` on the graph's side), ``ref`` being the reference joint
+        (:func:`~.alignment.reference_joint`) and ``difference`` ``"backward"``, ``"forward"``
+        (stream windows) or ``"central"`` (graph clips). Default :func:`track_features`.
+    context : keyword-only; seconds of stream in one matched window, finite and >= 0; default
+        :data:`TRACK_CONTEXT`. A window holds ``round(context · fps)`` frames, at least one and at
+        most half the stream, so ``0`` matches single frames.
+    rates : keyword-only; the tempi ``ρ`` (graph seconds per stream second), a non-empty 1-D
+        array of positive finite numbers; default :data:`TRACK_RATES`. ``[1.0]`` matches
+        without time warping.
     """
     if not graph.nodes:
         raise ValueError("the action graph has no actions to track the stream in")
@@ -336,23 +369,72 @@ def track(motion: Motion, graph, delta: float | None = None) -> GraphTrack:
     if sk.names != motion.skeleton.names:
         raise ValueError("the stream uses another skeleton than the action graph's clips")
     delta = check_delta(DELTA if delta is None else delta)
+    context, rates = _check_tracking(features, context, rates)
     names = list(graph.nodes)
     T = motion.num_frames
     if T < 4:
         return GraphTrack([names[0]] * T, np.zeros(T, np.int64), np.zeros(T), delta)
-    k = max(1, min(int(round(TRACK_CONTEXT * motion.fps)), T // 2))
+    k = max(1, min(int(round(context * motion.fps)), T // 2))
     ref = reference_joint(motion)
+    clips, speeds = _graph_clips(graph, ref, features)
+    # windows ending at a frame take backward velocities, windows starting at one forward velocities
+    ending = _match_windows(_features(features, motion, ref, "backward"), clips, k, motion.fps, rates)
+    starting = _match_windows(_features(features, motion, ref, "forward"), clips, k, motion.fps, rates)
+    use_back, node, rate, at = _step_matches(ending, starting, k, T)
+    first = np.cumsum([0] + [len(x) for x in speeds])[:-1]  # each node's first row in the joined speeds
+    joined = np.concatenate(speeds)
+    predicted = np.interp(first[node] + at, np.arange(len(joined)), joined) * rate  # metres per stream step
+    dist = _distances(motion, predicted)
+    frame_of = np.concatenate([[starting.time[0]], at + np.where(use_back, rate, 0.0)])
+    node_of = np.concatenate([[starting.node[0]], node])
+    return GraphTrack([names[c] for c in node_of], np.rint(frame_of).astype(np.int64), dist, delta)
+
+
+def _check_tracking(features, context, rates) -> tuple[float, np.ndarray]:
+    """The ``context`` (seconds) and ``rates`` (R,) that :func:`track` matches with, defaults
+    filled in, or its ``ValueError``."""
+    if not callable(features):
+        raise ValueError(f"features must be a function (motion, ref, difference) -> (T, J, 6), got {features!r}")
+    context = TRACK_CONTEXT if context is None else context
+    try:
+        context = float(context)
+    except (TypeError, ValueError):
+        raise ValueError(f"context must be a number of seconds >= 0, got {context!r}") from None
+    if not np.isfinite(context) or context < 0:
+        raise ValueError(f"context must be a finite number of seconds >= 0, got {context!r}")
+    rates = np.asarray(TRACK_RATES if rates is None else rates, dtype=np.float64)
+    if rates.ndim != 1 or rates.size == 0 or not np.all(np.isfinite(rates) & (rates > 0)):
+        raise ValueError(f"rates must be a non-empty 1-D array of positive tempi, got {rates!r}")
+    return context, rates
+
+
+def _features(features, motion: Motion, ref: int, difference: str) -> np.ndarray:
+    """``features(motion, ref, difference)``, checked to be (T, J', 6)."""
+    feat = np.asarray(features(motion, ref, difference))
+    if feat.ndim != 3 or len(feat) != motion.num_frames or feat.shape[-1] != 6:
+        raise ValueError(f"features must give ({motion.num_frames}, J, 6) arrays, got shape {feat.shape}")
+    return feat
+
+
+def _graph_clips(graph, ref: int, features) -> tuple[list, list]:
+    """Per graph node: ``(features (N, J', 6), fps)`` of its clip and its joint step per frame
+    (N,), metres, smoothed over five frames (what :func:`track` predicts the stream's step from)."""
     clips, speeds = [], []
     for node in graph.nodes.values():
         m = node.motion
         s = joint_steps(m)  # metres per graph frame, step into frame i+1
         s = np.concatenate([s[:1], 0.5 * (s[1:] + s[:-1]), s[-1:]]) if len(s) > 1 else np.repeat(s, 2)
         speeds.append(np.convolve(np.pad(s, 2, mode="edge"), np.ones(5) / 5.0, mode="valid"))
-        clips.append((_track_features(m, ref), m.fps))
-    # windows ending at a frame take backward velocities, windows starting at one forward velocities
-    ending = _match_windows(_track_features(motion, ref, "backward"), clips, k, motion.fps)
-    starting = _match_windows(_track_features(motion, ref, "forward"), clips, k, motion.fps)
-    # step t -> t+1 (t = 0 … T-2): the window ending at t (index t-k+1) or the one starting at t+1
+        clips.append((_features(features, m, ref, "central"), m.fps))
+    return clips, speeds
+
+
+def _step_matches(ending: _Match, starting: _Match, k: int, T: int):
+    """For each step ``t → t+1`` (``t = 0 … T-2``) of a ``T``-frame stream, the better matched of
+    the window of ``k`` frames ending at ``t`` (``ending``, index ``t-k+1``) and the one starting at
+    ``t+1`` (``starting``). Returns ``use_back`` (T-1,) bool, True where the window ending at ``t``
+    won; its ``node`` (T-1,) and ``rate`` (T-1,), graph frames per stream frame; and ``at`` (T-1,),
+    the graph frame matched to ``t`` (window ending there) or to ``t+1`` (window starting there)."""
     steps_at = np.arange(T - 1)
     back = np.clip(steps_at - k + 1, 0, None)
     ahead = np.clip(steps_at + 1, None, T - k)
@@ -361,11 +443,14 @@ def track(motion: Motion, graph, delta: float | None = None) -> GraphTrack:
     use_back = cb <= ca
     node = np.where(use_back, ending.node[back], starting.node[ahead])
     rate = np.where(use_back, ending.rate[back], starting.rate[ahead])
-    # graph frame of t (window ending there) or of t+1 (window starting there)
     at = np.where(use_back, ending.time[back] + (k - 1) * ending.rate[back], starting.time[ahead])
-    first = np.cumsum([0] + [len(x) for x in speeds])[:-1]  # each node's first row in the joined speeds
-    joined = np.concatenate(speeds)
-    predicted = np.interp(first[node] + at, np.arange(len(joined)), joined) * rate  # metres per stream step
+    return use_back, node, rate, at
+
+
+def _distances(motion: Motion, predicted: np.ndarray) -> np.ndarray:
+    """``D`` (T,) of every stream frame (frame 0: 0) from the predicted steps (T-1,), metres per
+    stream step: ``r = s / prediction`` over the typical ``r`` around each step (module
+    docstring), 0 where the stream's step is below :data:`STEP_FLOOR`."""
     floor = STEP_FLOOR * body_height(motion) / motion.fps
     s = joint_steps(motion)
     r = s / np.maximum(predicted, floor)
@@ -373,15 +458,22 @@ def track(motion: Motion, graph, delta: float | None = None) -> GraphTrack:
     near = np.fmax(np.concatenate([[np.nan], r[:-1]]), np.concatenate([r[1:], [np.nan]]))
     typical = np.fmax(np.fmax(before, after), near)
     typical = np.where(np.isfinite(typical) & (typical > 0), typical, np.inf)
-    dist = np.concatenate([[0.0], np.where(s > floor, r / typical, 0.0)])
-    frame_of = np.concatenate([[starting.time[0]], at + np.where(use_back, rate, 0.0)])
-    node_of = np.concatenate([[starting.node[0]], node])
-    return GraphTrack([names[c] for c in node_of], np.rint(frame_of).astype(np.int64), dist, delta)
+    return np.concatenate([[0.0], np.where(s > floor, r / typical, 0.0)])
 
 
-def graph_gaps(motion: Motion, graph, delta: float | None = None) -> list[int]:
-    """Steps ``t → t+1`` where frames were dropped, the stream tracked in ``graph`` (§3.3)."""
-    return track(motion, graph, delta).gaps()
+def graph_gaps(
+    motion: Motion,
+    graph,
+    delta: float | None = None,
+    *,
+    features: Callable[[Motion, int, str], np.ndarray] = track_features,
+    context: float | None = None,
+    rates=None,
+) -> list[int]:
+    """Steps ``t → t+1`` where frames were dropped, the stream tracked in ``graph`` (§3.3):
+    :meth:`GraphTrack.gaps` of :func:`track`, which takes ``delta`` and the keyword-only
+    ``features``, ``context`` and ``rates`` (and raises) as documented there."""
+    return track(motion, graph, delta, features=features, context=context, rates=rates).gaps()
 
 
 # ---------------------------------------------------------------------------- how many

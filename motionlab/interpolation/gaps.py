@@ -55,6 +55,7 @@ from motionlab.interpolation.stride import side_speeds, stride_fill, stride_path
 __all__ = [
     "METHODS",
     "ROOTS",
+    "FEET",
     "FilledGap",
     "nan_gaps",
     "load_times",
@@ -69,6 +70,10 @@ __all__ = [
 
 METHODS = ("slerp", "hermite", "stride", "graph")
 ROOTS = ("stride", "hermite", "linear")
+FEET = ("plant", "lift")
+"""How :func:`fill` keeps filled feet out of the floor: ``"plant"`` bends each sunk leg
+(:func:`.footing.plant_feet`) and lifts the body by what the legs cannot reach, ``"lift"`` lifts
+the body only (:func:`lift_above_floor`)."""
 
 
 @dataclass
@@ -456,6 +461,11 @@ def _feet_on_floor(motion: Motion, a: int, b: int) -> Motion:
     return lift_above_floor(plant_feet(motion, a, b), a, b)
 
 
+def _floor_rule(feet: str):
+    """The function ``(motion, a, b) -> Motion`` of the :data:`FEET` choice ``feet``."""
+    return _feet_on_floor if feet == "plant" else lift_above_floor
+
+
 def smooth_root(motion: Motion, anchors, joint: int | None = None) -> Motion:
     """A copy of ``motion`` whose root path through ``anchors`` is C1 (no corners).
 
@@ -566,8 +576,13 @@ def fill(
     graph: ActionGraph | None = None,
     curve: str = "linear",
     root: str = "linear",
+    *,
+    feet: str = "plant",
 ) -> tuple[Motion, list[FilledGap]]:
     """Fill every NaN frame of ``motion``; returns the filled copy and a report per gap.
+
+    Raises ``ValueError`` for an unknown ``method``, ``root`` or ``feet``, a ``"graph"`` fill
+    without a graph or with one on another skeleton, or a motion with every frame missing.
 
     Parameters
     ----------
@@ -591,8 +606,13 @@ def fill(
         curve where no stride can be read), which keeps the hips' bob and sway. The
         foot-through-floor guard of :func:`smooth_root` applies to both. (The ``"graph"`` method
         always uses the Hermite curve through its key poses.)
+    feet : keyword-only; how every filled gap between known frames (not a leading or trailing
+        one) is kept out of the floor of its two known ends (:data:`FEET`): ``"plant"`` (default)
+        bends the leg of each foot that went below it (:func:`.footing.plant_feet`) and lifts the
+        body by what the legs cannot reach; ``"lift"`` lifts the body only
+        (:func:`lift_above_floor`).
     """
-    _check_fill(motion, method, graph, root)
+    _check_fill(motion, method, graph, root, feet)
     out = motion.copy()
     report = []
     T = motion.num_frames
@@ -604,21 +624,23 @@ def fill(
             out = _edge_fill(out, start, stop)
             report.append(FilledGap(start, stop, "hold"))
         elif method == "graph":
-            out, gap = _fill_through_graph(out, start, stop, graph, curve, ref)
+            out, gap = _fill_through_graph(out, start, stop, graph, curve, ref, feet)
             report.append(gap)
         else:
-            out, gap = _fill_inside(out, start, stop, method, curve, root, ref)
+            out, gap = _fill_inside(out, start, stop, method, curve, root, ref, feet)
             report.append(gap)
     return out, report
 
 
-def _check_fill(motion: Motion, method: str, graph: ActionGraph | None, root: str) -> None:
-    """The ``ValueError`` of :func:`fill` for an unknown method or root mode, or a graph that is
-    missing, empty or on another skeleton than ``motion``."""
+def _check_fill(motion: Motion, method: str, graph: ActionGraph | None, root: str, feet: str) -> None:
+    """The ``ValueError`` of :func:`fill` for an unknown method, root mode or floor rule, or a
+    graph that is missing, empty or on another skeleton than ``motion``."""
     if method not in METHODS:
         raise ValueError(f"unknown filling method {method!r}; expected one of {METHODS}")
     if root not in ROOTS:
         raise ValueError(f"unknown root mode {root!r}; expected one of {ROOTS}")
+    if feet not in FEET:
+        raise ValueError(f"unknown floor rule feet={feet!r}; expected one of {FEET}")
     if method == "graph":
         if graph is None or not graph.nodes:
             raise ValueError("method='graph' needs an ActionGraph with at least one action")
@@ -627,15 +649,15 @@ def _check_fill(motion: Motion, method: str, graph: ActionGraph | None, root: st
             raise ValueError("the action graph's clips use another skeleton than the motion to fill")
 
 
-def _fill_inside(out: Motion, start: int, stop: int, method: str, curve: str, root: str, ref: int):
+def _fill_inside(out: Motion, start: int, stop: int, method: str, curve: str, root: str, ref: int, feet: str):
     """One gap ``[start, stop)`` with known frames on both sides, filled without a graph (methods
-    ``"slerp"``, ``"hermite"``, ``"stride"`` of :func:`fill`); returns the filled motion and its
-    :class:`FilledGap`."""
+    ``"slerp"``, ``"hermite"``, ``"stride"`` of :func:`fill`) and kept out of the floor by the
+    :data:`FEET` rule ``feet``; returns the filled motion and its :class:`FilledGap`."""
     a, b = start - 1, stop
     if method == "stride":
         strided = stride_fill(out, a, b, ref)
         if strided is not None:
-            out = _feet_on_floor(_follow_strides(strided[0], a, b, ref, strided[1]), a, b)
+            out = _floor_rule(feet)(_follow_strides(strided[0], a, b, ref, strided[1]), a, b)
             return out, FilledGap(start, stop, "stride")
     mode = "hermite" if method == "hermite" else "linear"  # stride: SLERP where no stride is found
     out = inbetween.fill_between(out, start, stop, curve=curve, root=mode,
@@ -644,7 +666,7 @@ def _fill_inside(out: Motion, start: int, stop: int, method: str, curve: str, ro
         out = _stride_root(out, a, b, ref)
     elif root == "hermite":
         out = smooth_root(out, [a, b], joint=ref)
-    out = _feet_on_floor(out, a, b)
+    out = _floor_rule(feet)(out, a, b)
     return out, FilledGap(start, stop, "slerp" if method == "stride" else method)
 
 
@@ -675,11 +697,14 @@ def _place_path(out: Motion, a: int, b: int, graph: ActionGraph, ref: int):
     return path, inner, slots, placed
 
 
-def _fill_through_graph(out: Motion, start: int, stop: int, graph: ActionGraph, curve: str, ref: int):
+def _fill_through_graph(
+    out: Motion, start: int, stop: int, graph: ActionGraph, curve: str, ref: int, feet: str
+) -> tuple[Motion, FilledGap]:
     """One gap ``[start, stop)`` filled through ``graph`` (method ``"graph"`` of :func:`fill`):
     across actions, eq. 4 between consecutive key poses; inside one action, the node's recordings
-    (:mod:`.library`, SLERP where none fits); the root then C1 through the anchors. Returns the
-    filled motion and its :class:`FilledGap`."""
+    (:mod:`.library`, SLERP where none fits); the root then C1 through the anchors, and the feet
+    kept out of the floor by the :data:`FEET` rule ``feet``. Returns the filled motion and its
+    :class:`FilledGap`."""
     a, b = start - 1, stop
     path, inner, slots, placed = _place_path(out, a, b, graph, ref)
     lib = graph.library()
@@ -699,5 +724,5 @@ def _fill_through_graph(out: Motion, start: int, stop: int, graph: ActionGraph, 
         if not ok:
             out = inbetween.fill_between(out, lo + 1, hi, curve=curve)
             used = "graph+slerp"
-    out = _feet_on_floor(smooth_root(out, anchors, joint=ref), a, b)
+    out = _floor_rule(feet)(smooth_root(out, anchors, joint=ref), a, b)
     return out, FilledGap(start, stop, "graph" if inner else used, path, slots)

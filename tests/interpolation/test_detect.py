@@ -262,3 +262,47 @@ def test_held_steps_mark_the_copies_and_trim_frozen_cuts_them_off():
     assert not held[:34].any() and held[34:].all()
     assert demo.trim_frozen(m).num_frames == 35
     assert demo.trim_frozen(toy_motion(40)).num_frames == 40  # nothing held: unchanged
+
+
+def _toy_graph_and_cut():
+    g = ActionGraph()
+    g.add_node("walk", toy_motion(90, phase=0.3))
+    stream = toy_motion(150, speed=1.0)
+    return g, stream[np.r_[0:70, 80:150]]
+
+
+def test_track_defaults_are_the_named_features_context_and_tempi():
+    g, cut = _toy_graph_and_cut()
+    plain = detect.track(cut, g)
+    named = detect.track(cut, g, features=detect.track_features, context=detect.TRACK_CONTEXT, rates=detect.TRACK_RATES)
+    np.testing.assert_array_equal(plain.distance, named.distance)
+    np.testing.assert_array_equal(plain.frame, named.frame)
+    assert plain.node == named.node
+
+
+def test_track_matches_by_the_features_context_and_tempi_given():
+    g, cut = _toy_graph_and_cut()
+    asked = []
+
+    def positions_only(motion, ref, difference="central"):
+        asked.append(difference)
+        feat = detect.track_features(motion, ref, difference).copy()
+        feat[..., 3:] = 0.0
+        return feat
+
+    single = {"features": positions_only, "context": 0.0, "rates": [1.0]}
+    tr = detect.track(cut, g, **single)
+    assert sorted(set(asked)) == ["backward", "central", "forward"]
+    assert tr.gaps() == detect.graph_gaps(cut, g, **single) == [69]
+    assert not np.array_equal(tr.distance, detect.track(cut, g).distance)
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [{"context": -0.1}, {"context": float("nan")}, {"rates": []}, {"rates": [1.0, 0.0]}, {"rates": [[1.0]]},
+     {"features": "body"}, {"features": lambda motion, ref, difference: np.zeros((len(motion.local_rot), 3))}],
+)  # fmt: skip
+def test_track_refuses_a_match_it_cannot_make(bad):
+    g, cut = _toy_graph_and_cut()
+    with pytest.raises(ValueError, match="context|rates|features"):
+        detect.track(cut, g, **bad)

@@ -3,7 +3,9 @@
 import numpy as np
 import pytest
 
-from motionlab.interpolation import gaps
+from motionlab.core import humanoid, quat
+from motionlab.core.motion import Motion
+from motionlab.interpolation import footing, gaps, inbetween
 from motionlab.interpolation.action_graph import ActionGraph
 
 from .conftest import toy_motion
@@ -287,3 +289,46 @@ def test_across_nodes_pieces_move_rather_than_slide_between_two_poses():
     (slot,) = report[0].anchors
     plain = fill_between(out, 30, slot)
     assert not np.allclose(out.local_rot[30:slot, 1:], plain.local_rot[30:slot, 1:], atol=1e-3)
+
+
+def _scissor_gap():
+    """A canonical humanoid whose straight legs swap a 30° scissor for the opposite one across
+    frames 1-5 (missing), the feet on the floor at frames 0 and 6: SLERP swings both legs through
+    the vertical, below that floor. Returns the motion with the gap, and the legs."""
+    sk = humanoid.canonical_skeleton()
+    legs = footing.legs(sk)
+    rot = np.tile([1.0, 0.0, 0.0, 0.0], (7, sk.num_joints, 1))
+    for (hip, _, _), sign in zip(legs, (1.0, -1.0)):
+        rot[0, hip] = quat.from_axis_angle([1.0, 0.0, 0.0], sign * np.pi / 6)
+        rot[6, hip] = quat.from_axis_angle([1.0, 0.0, 0.0], -sign * np.pi / 6)
+    m = Motion(sk, rot, np.tile([0.0, 1.0, 0.0], (7, 1)), 30.0)
+    m.local_rot[1:6] = np.nan
+    m.root_pos[1:6] = np.nan
+    return m, legs
+
+
+def test_fill_keeps_feet_out_of_the_floor_by_the_chosen_rule():
+    m, legs = _scissor_gap()
+    plant, _ = gaps.fill(m)
+    lift, _ = gaps.fill(m, feet="lift")
+    default_twin, _ = gaps.fill(m, feet="plant")
+    np.testing.assert_array_equal(plant.local_rot, default_twin.local_rot)
+    np.testing.assert_array_equal(plant.root_pos, default_twin.root_pos)
+    plain = inbetween.fill_between(m, 1, 6, root="linear")  # SLERP, nothing kept out of the floor
+    low = footing.lowest_joints(plain, 0, 6)
+    floor = min(low[0], low[-1])
+    assert low[1:-1].min() < floor - 0.05  # the legs swing through the floor half-way
+    for out in (plant, lift):
+        assert footing.lowest_joints(out, 0, 6).min() >= floor - 1e-9
+    # "lift": the SLERP pose, the body raised; "plant": the legs bent, the body raised less
+    np.testing.assert_array_equal(lift.local_rot, plain.local_rot)
+    assert np.all(lift.root_pos[1:6, 1] > plain.root_pos[1:6, 1])
+    leg_joints = [j for leg in legs for j in leg]
+    assert not np.allclose(plant.local_rot[1:6][:, leg_joints], plain.local_rot[1:6][:, leg_joints])
+    assert np.all(plant.root_pos[1:6, 1] < lift.root_pos[1:6, 1])
+
+
+def test_fill_refuses_an_unknown_floor_rule():
+    m, _ = _scissor_gap()
+    with pytest.raises(ValueError, match="feet='hover'"):
+        gaps.fill(m, feet="hover")
