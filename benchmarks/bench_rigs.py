@@ -1,14 +1,15 @@
 """Every ordered pair of rig families retargeted, with the plausibility measures of each output.
 
     MOTIONLAB_DATA=/path/to/data python benchmarks/bench_rigs.py [--seconds 3] [--pair bandai mixamo]
-    MOTIONLAB_DATA=/path/to/data python benchmarks/bench_rigs.py --methods --pair xia cmu
+    MOTIONLAB_DATA=/path/to/data python benchmarks/bench_rigs.py --methods [--source-fps 60] [--pair xia cmu]
 
 Prints, per (source, target) pair: the hip height ratio (B's median hip height over B's standing
 hip height, and the same for A on A), the median foot height in A's contact frames (cm and /
 B's leg length), foot skating (cm/s, B and A) and the output frame rate
 (:mod:`motionlab.retargeting.rig_matrix`). Without MOTIONLAB_DATA only the synthetic character runs.
 With ``--methods``: the planted-foot slide of each pair under the three methods (copy rotations,
-the network alone, the full latent iteration), beside the source's own.
+the network alone, the full latent iteration), beside the source's own; ``--source-fps`` resamples
+every source clip first.
 """
 
 from __future__ import annotations
@@ -48,12 +49,15 @@ def main() -> None:
     ap.add_argument("--seconds", type=float, default=3.0, help="seconds of each family's clip (default 3)")
     ap.add_argument("--pair", nargs=2, action="append", metavar=("SOURCE", "TARGET"), help="only these pairs")
     ap.add_argument("--methods", action="store_true", help="slide per method (copy, network, full) instead")
+    ap.add_argument("--source-fps", type=float, help="with --methods: resample every source clip to this rate")
     args = ap.parse_args()
     root = data.data_root() if data.has_data() else None
     clips = rig_matrix.family_clips(root, args.seconds)
     start = time.perf_counter()
     pairs = {tuple(p) for p in args.pair} if args.pair else None
     if args.methods:
+        if args.source_fps:
+            clips = {name: clip.resample(args.source_fps) for name, clip in clips.items()}
         method_slides(clips, retargeting.load_default(), pairs)
         print(f"{time.perf_counter() - start:.0f} s")
         return
