@@ -21,8 +21,8 @@ What it does:
    as on an offline machine; they are counted, not failures;
 6. opens every notebook page that has a web player (``motionlab.viz.web``) again, from ``file://``
    with every non-file request blocked: the player must start (three.js loaded, a WebGL context on
-   its canvas); the check presses play and requires the canvas to change between two screenshots
-   0.5 s apart, kept in ``--out/players/``. Every notebook that shows motion
+   its canvas); the check presses play and requires the canvas to change between a first
+   screenshot and one taken 0.5, 0.87 or 1.16 s after it, kept in ``--out/players/``. Every notebook that shows motion
    (:data:`MOTION_NOTEBOOKS`) must have a working player.
 
 Exit status 0 when every check passed, 1 otherwise.
@@ -146,13 +146,16 @@ def _check_player(browser, rel: str, out: Path, timeout_ms: int = 20_000) -> dic
         page.wait_for_timeout(200)
         stem = Path(rel).stem
         (out / "players").mkdir(parents=True, exist_ok=True)
-        start = time.monotonic()
+        start, changed = time.monotonic(), 0.0
         first = canvas.screenshot(path=str(out / "players" / f"{stem}_0.png"))
-        # 0.5 s from the first shot to the second, whatever the first took (a slow screenshot
-        # added to a fixed wait can land a whole loop of a 1-second clip later: the same frame)
-        page.wait_for_timeout(max(0.0, 500.0 - 1000.0 * (time.monotonic() - start)))
-        second = canvas.screenshot(path=str(out / "players" / f"{stem}_1.png"))
-        result["changed"] = round(_changed_fraction(first, second), 4)
+        # Later shots 0.5, 0.87 and 1.16 s after the first began (whatever each shot took): a
+        # loop whose length divides one gap shows the same frame in that shot, and no loop of a
+        # few frames or more divides all three.
+        for k, gap in enumerate((0.5, 0.87, 1.16), start=1):
+            page.wait_for_timeout(max(0.0, 1000.0 * (gap - (time.monotonic() - start))))
+            later = canvas.screenshot(path=str(out / "players" / f"{stem}_{k}.png"))
+            changed = max(changed, _changed_fraction(first, later))
+        result["changed"] = round(changed, 4)
         result["errors"] = errors
         result["ok"] = bool(result["webgl"]) and result["changed"] > 0.001 and not errors
         if not result["ok"]:
