@@ -44,9 +44,9 @@ from motionlab.retargeting.pipeline import (
     leg_chain,
     prepare_pair,
     prepare_source,
+    solve_pair,
     target_skeleton,
 )
-from motionlab.retargeting.solver import SolverConfig, solve
 
 RULES = {  # name -> (ground-plane measure, height measure)
     "stride": (leg_chain, hip_height),
@@ -77,20 +77,7 @@ def with_root(pair: PreparedPair, rule: str) -> PreparedPair:
 
 def full_method(ckpt, pair: PreparedPair) -> np.ndarray:
     """World joint positions (T, 22, 3) of the full method on ``pair`` (as :func:`pipeline.retarget`)."""
-    src = pair.source
-    res = solve(
-        ckpt.model,
-        src.x,
-        src.theta,
-        pair.offsets,
-        pair.root_height,
-        SolverConfig(),
-        root_xz=pair.root_xz,
-        yaw=src.yaw,
-        planted=src.planted,
-        fps=src.motion.fps,
-    )
-    return finish(pair, res.local_rot[0], "full").positions
+    return finish(pair, solve_pair(ckpt, pair).local_rot[0], "full").positions
 
 
 def score(folder: Path, ckpt, source: str, targets, animations) -> dict:

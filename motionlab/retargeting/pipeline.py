@@ -72,6 +72,7 @@ __all__ = [
     "prepare_source",
     "prepare_pair",
     "finish",
+    "solve_pair",
     "source_contacts",
     "contact_stride",
     "at_rate",
@@ -362,6 +363,29 @@ def at_rate(result: RetargetResult, fps: float, source_fps: float) -> RetargetRe
     return replace(result, motion=motion, positions=motion.global_positions(), resampled=note)
 
 
+def solve_pair(checkpoint, pair: PreparedPair, solver: SolverConfig | None = None, callback=None, progress=None):
+    """The latent iteration of the full method on one prepared pair: :func:`solver.solve` with the
+    pair's source features, target offsets, root height and ground path, A's heading and contacts.
+
+    Returns :class:`solver.SolverResult` (``local_rot`` of shape (1, T, 22, 4), heading-relative).
+    """
+    src = pair.source
+    return solve(
+        checkpoint.model,
+        src.x,
+        src.theta,
+        pair.offsets,
+        pair.root_height,
+        solver or SolverConfig(),
+        callback=callback,
+        progress=progress,
+        root_xz=pair.root_xz,
+        yaw=src.yaw,
+        planted=src.planted,
+        fps=src.motion.fps,
+    )
+
+
 def retarget(
     source: Motion,
     target: Skeleton | Motion,
@@ -423,21 +447,7 @@ def retarget(
         with torch.no_grad(), threads.torch_threads(threads.threads_for(pair.source.x.shape[1])):
             heading_rot = checkpoint.model(pair.source.x, pair.offsets).local_rot[0].cpu().numpy()
     elif method == "full":
-        src = pair.source
-        res = solve(
-            checkpoint.model,
-            src.x,
-            src.theta,
-            pair.offsets,
-            pair.root_height,
-            solver,
-            callback=callback,
-            progress=progress,
-            root_xz=pair.root_xz,
-            yaw=src.yaw,
-            planted=src.planted,
-            fps=src.motion.fps,
-        )
+        res = solve_pair(checkpoint, pair, solver, callback=callback, progress=progress)
         heading_rot, history, reason, steps = res.local_rot[0], res.history, res.stop_reason, res.steps
     result = finish(pair, heading_rot, method, history, reason, steps, time.perf_counter() - start)
     return at_rate(result, fps or source.fps, source.fps)
