@@ -146,7 +146,7 @@ def experiment_connectivity(set6, source: str, thr: float) -> None:
 
 
 def _timed_search(fn, g, req, repeats=20) -> float:
-    fn(g, req)  # warm: table lookups cached, as after loading a graph
+    fn(g, req)  # warm: imports and first-touched memory (each search reads the graph afresh)
     t = time.perf_counter()
     for _ in range(repeats):
         fn(g, req)

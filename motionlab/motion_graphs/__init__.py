@@ -29,7 +29,14 @@ from motionlab.motion_graphs import (
     synthesis,
 )
 from motionlab.motion_graphs.graph import ClipInfo, GraphError, MotionGraph, build_standard
-from motionlab.motion_graphs.search import SearchError, SearchResult, Segment, parse_request, search_standard
+from motionlab.motion_graphs.search import (
+    Planner,
+    SearchError,
+    SearchResult,
+    Segment,
+    parse_request,
+    search_standard,
+)
 from motionlab.motion_graphs.search import search as search_path
 from motionlab.motion_graphs.structured import build_structured, structure_rows
 from motionlab.motion_graphs.synthesis import synthesize, transition_quality
@@ -52,6 +59,7 @@ __all__ = [
     "build_standard",
     "build_structured",
     "structure_rows",
+    "Planner",
     "SearchError",
     "SearchResult",
     "Segment",

@@ -26,6 +26,9 @@ transition points*. Pools crossed on the way to the next segment are passed by t
 to an exit (:func:`walk_to_exit`); the **loop guard** stops it with an error once every frame
 it can reach has been visited (paper B stops at the second pass of a clip's last self-loop
 point; a pool of many takes has none). A request may ask for at most :data:`MAX_FRAMES` frames.
+:func:`search` reads the graph afresh at every call; a :class:`Planner` keeps what it built
+(each style's walker, the ways between styles) for many searches of one graph, and refuses a
+graph that has changed since.
 
 **Standard graph** (for comparison). Dijkstra's shortest path (in frames) on the compressed
 graph from the current frame to any frame of the requested clip, then the same in-clip
@@ -50,6 +53,7 @@ __all__ = [
     "SearchResult",
     "parse_request",
     "search",
+    "Planner",
     "search_standard",
     "SearchError",
     "RequestTooLong",
@@ -565,13 +569,34 @@ def _next(cw: PoolWalker, f: int) -> int:
 
 
 # ---------------------------------------------------------------------------- structured search
-class _Planner:
+def _read_by_search(graph: MotionGraph) -> tuple:
+    """The objects of ``graph`` a :class:`Planner` reads: its frames, edges, clips and table."""
+    return (graph.alive, graph.src, graph.dst, graph.cost, graph.kind, graph.clips, graph.table)
+
+
+class Planner:
+    """A structured graph prepared for many searches: each style's walker and the ways out of
+    it, built the first time a request needs them and kept for the next requests.
+
+    The planner is state the caller holds, not state hidden in the graph: :func:`search` makes a
+    fresh one for every call (always up to date, slower on a large graph); make one yourself to
+    search one graph many times. A planner belongs to the graph as it was when made: once the
+    graph's frames, edges, clips or table are replaced (``keep_edges``, ``add_edges``, a new
+    ``alive`` mask …), :meth:`search` raises :class:`SearchError`; make a new planner. (Arrays
+    edited in place are not noticed: edit a graph through its methods, as the package does.)
+
+    Raises
+    ------
+    SearchError when the graph has no structure table.
+    """
+
     def __init__(self, graph: MotionGraph):
         if not graph.table.get("behaviours"):
             raise SearchError("this graph has no structure table (a standard graph?); use search_standard")
         self.g = graph
+        self.reads = _read_by_search(graph)
         self.entries = graph.table["behaviours"]
-        self.walkers: dict[int, PoolWalker] = {}
+        self.walkers: dict[tuple[str, str], PoolWalker] = {}
         self.links: dict[tuple[str, str], list[dict]] = {}
         self.memo: dict = {}
         for link in graph.table["links"]:
@@ -665,9 +690,65 @@ class _Planner:
             enter = route["enter"]
         return pieces, frames, enter
 
+    def search(self, request, progress: bool = False) -> SearchResult:
+        """Meet a request on the planner's graph (see :func:`search`).
+
+        Raises
+        ------
+        SearchError naming a missing behaviour or style, or two behaviours with no transition
+        clip, or when the graph changed since the planner was made.
+        """
+        if any(a is not b for a, b in zip(self.reads, _read_by_search(self.g))):
+            raise SearchError(
+                "the graph changed since this Planner was made (its frames, edges, clips or table "
+                "were replaced); make a new search.Planner(graph)"
+            )
+        segs = _segments(request)
+        keys = [self.check(s) for s in segs]
+        plans = [self.hops(a, b) if a != b else [] for a, b in zip(keys[:-1], keys[1:])]
+        pieces: list[tuple[int, int, int]] = []
+        achieved: list[int] = []
+        passing = [0] * len(segs)
+        enter = self.walker(keys[0]).first_alive()
+        bar = None
+        if progress:
+            from tqdm.auto import tqdm
+
+            bar = tqdm(total=sum(s.frames for s in segs), desc="search", unit="frame", leave=False)
+        for k, seg in enumerate(segs):
+            if bar is not None:
+                bar.update(seg.frames)
+            cw = self.walker(keys[k])
+            name = f"{seg.behaviour}/{seg.style}"
+            slack = max(2, int(TOLERANCE * seg.frames))
+            if k == len(segs) - 1 or not plans[k]:
+                p, _, n = _walk(cw, enter, [seg.frames], [-1], name, slack)
+                pieces.extend(p)
+                achieved.append(n)
+                if k < len(segs) - 1:  # the same style again: continue from a frame that follows
+                    c_last, f_last = p[-1][0], p[-1][2]
+                    local = int(cw.offsets[np.flatnonzero(cw.clips == c_last)[0]]) + f_last
+                    enter = _next(cw, local)
+                continue
+            options, _, exits = self.options(plans[k])
+            own = np.array([seg.frames - o[0]["frames"] for o in options])  # the route out counts here
+            p, r, n = _walk(cw, enter, np.maximum(own, 1).tolist(), exits, name, slack)
+            route, more, more_frames, enter = options[r]
+            pieces.extend(p)
+            pieces.extend(tuple(x) for x in route["pieces"])
+            pieces.extend(more)
+            achieved.append(n + route["frames"])
+            passing[k] = more_frames
+        if bar is not None:
+            bar.close()
+        return SearchResult(_merge(pieces), [s.frames for s in segs], achieved, segs, passing)
+
 
 def search(graph: MotionGraph, request, progress: bool = False) -> SearchResult:
     """Meet a request on a structured graph (see the module docstring).
+
+    A fresh :class:`Planner` answers it, so the search always sees the graph as it is now; to
+    search one graph many times, make a planner once and call :meth:`Planner.search`.
 
     Parameters
     ----------
@@ -679,50 +760,10 @@ def search(graph: MotionGraph, request, progress: bool = False) -> SearchResult:
     Raises
     ------
     SearchError naming a missing behaviour or style, or two behaviours with no transition clip.
+    ValueError (:class:`RequestTooLong`) for a request of more than :data:`MAX_FRAMES` frames.
     """
-    segs = _segments(request)
-    planner = graph.__dict__.get("_planner")
-    if planner is None:
-        planner = _Planner(graph)
-        graph.__dict__["_planner"] = planner
-    keys = [planner.check(s) for s in segs]
-    plans = [planner.hops(a, b) if a != b else [] for a, b in zip(keys[:-1], keys[1:])]
-    pieces: list[tuple[int, int, int]] = []
-    achieved: list[int] = []
-    passing = [0] * len(segs)
-    enter = planner.walker(keys[0]).first_alive()
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(total=sum(s.frames for s in segs), desc="search", unit="frame", leave=False)
-    for k, seg in enumerate(segs):
-        if bar is not None:
-            bar.update(seg.frames)
-        cw = planner.walker(keys[k])
-        name = f"{seg.behaviour}/{seg.style}"
-        slack = max(2, int(TOLERANCE * seg.frames))
-        if k == len(segs) - 1 or not plans[k]:
-            p, _, n = _walk(cw, enter, [seg.frames], [-1], name, slack)
-            pieces.extend(p)
-            achieved.append(n)
-            if k < len(segs) - 1:  # the same style again: continue from a frame that follows
-                c_last, f_last = p[-1][0], p[-1][2]
-                local = int(cw.offsets[np.flatnonzero(cw.clips == c_last)[0]]) + f_last
-                enter = _next(cw, local)
-            continue
-        options, _, exits = planner.options(plans[k])
-        own = np.array([seg.frames - o[0]["frames"] for o in options])  # the route out counts here
-        p, r, n = _walk(cw, enter, np.maximum(own, 1).tolist(), exits, name, slack)
-        route, more, more_frames, enter = options[r]
-        pieces.extend(p)
-        pieces.extend(tuple(x) for x in route["pieces"])
-        pieces.extend(more)
-        achieved.append(n + route["frames"])
-        passing[k] = more_frames
-    if bar is not None:
-        bar.close()
-    return SearchResult(_merge(pieces), [s.frames for s in segs], achieved, segs, passing)
+    segs = _segments(request)  # a bad request is refused before the graph is read
+    return Planner(graph).search(segs, progress)
 
 
 def _segments(request) -> list[Segment]:
@@ -758,13 +799,8 @@ def search_standard(graph: MotionGraph, request, start_clip: int | None = None) 
     frames of the shortest path into the next clip count towards the segment being left.
     """
     segs = _segments(request)
-    g = graph.__dict__.get("_segment_graph")
-    if g is None:
-        g = graph.segment_graph()
-        graph.__dict__["_segment_graph"] = g
-        first, last, seg = graph.segments()
-        graph.__dict__["_segments"] = (first, last, seg)
-    first, last, seg = graph.__dict__["_segments"]
+    g = graph.segment_graph()
+    first, last, seg = graph.segments()
     label_clips: dict[tuple[str, str], list[int]] = {}
     for i, c in enumerate(graph.clips):
         if c.behaviour is not None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from motionlab.motion_graphs import graph, search, structured
+from motionlab.motion_graphs import distance, graph, search, structured
 from tests.motion_graphs.conftest import THRESHOLD
 
 REQUEST = "walk:normal:200,walk:happy:240,run:normal:220,walk:normal:180,walk:happy:200"
@@ -178,3 +178,48 @@ def test_pool_walker_of_a_style(sgraph):
     assert cw.length == cell["frames"] and cw.alive.sum() == cell["alive"]
     with pytest.raises(search.SearchError, match="walk/sneaky"):
         search.pool_walker(sgraph, "walk", "sneaky")
+
+
+def _without_jumps_inside(g, behaviour, style):
+    """A copy of ``g`` without the edges inside one style's pool (its takes can only be played on)."""
+    cw = search.pool_walker(g, behaviour, style)
+    st = g.clips[int(cw.clips[0])].start
+    inside = (g.src >= st) & (g.src < st + cw.length) & (g.dst >= st) & (g.dst < st + cw.length)
+    out = g.copy()
+    out.keep_edges(~inside)
+    return out, ~inside
+
+
+def test_search_sees_edges_dropped_after_an_earlier_search(sgraph):
+    """Issue 44: a planner kept in the graph answered from the edges of an earlier search."""
+    g = sgraph.copy()
+    before = search.search(g, "walk:normal:300")
+    assert before.num_frames == 300
+    fresh, keep = _without_jumps_inside(sgraph, "walk", "normal")
+    g.keep_edges(keep)
+    after = search.search(g, "walk:normal:300")
+    assert after.pieces == search.search(fresh, "walk:normal:300").pieces
+    assert after.num_frames < 300  # one take, no jump back: it ends before 300 frames
+    g.check_path(after.pieces)
+
+
+def test_a_planner_refuses_a_changed_graph(sgraph):
+    g = sgraph.copy()
+    planner = search.Planner(g)
+    first = planner.search(REQUEST)
+    assert planner.search(REQUEST).pieces == first.pieces == search.search(g, REQUEST).pieces
+    g.drop_dead_edges()  # new edge arrays, even when no edge is dropped
+    with pytest.raises(search.SearchError, match="graph changed since this Planner was made"):
+        planner.search(REQUEST)
+
+
+def test_standard_search_sees_edges_dropped_after_an_earlier_search(library):
+    infos = [graph.ClipInfo(m.name, "clip", *m.name.split("_")[:2]) for m in library if "_to_" not in m.name]
+    # at 0.05 m both walks survive the pruning, joined by transitions
+    g = graph.build_standard([m for m in library if "_to_" not in m.name], distance.threshold_from(0.05), infos=infos)
+    req = [("walk", "normal", 60), ("walk", "happy", 60)]
+    search.search_standard(g, req)
+    crossing = g.clip_of(g.src) != g.clip_of(g.dst)
+    g.keep_edges(~crossing)  # no way left between clips
+    with pytest.raises(search.SearchError, match=f"no path in the graph to {req[1][0]}/{req[1][1]}"):
+        search.search_standard(g, req)
