@@ -7,7 +7,9 @@
   local pruning; :mod:`.cycles` — gait cycles from foot contacts; :mod:`.segments` — gait or
   standing action from the motion, stances and segments; :mod:`.stance_links` — links between
   styles and behaviours where their stances match; :mod:`.report` — the build report;
-* :mod:`.search` — requests of (behaviour, style, frames) segments; the standard-graph baseline;
+* :mod:`.search` — requests of (behaviour, style, frames) segments, under a search cost
+  (``search_path(graph, request, cost=...)``, default :func:`.search.default_cost`); the
+  standard-graph baseline;
 * :mod:`.synthesis` — a path turned into one continuous, blended motion;
 * :mod:`.io` — save/load (``.mlgraph``, npz + JSON); :mod:`.naming` — clip-name labels;
 * :mod:`.clips` — real clips through ``MOTIONLAB_DATA`` or synthetic stand-ins; :mod:`.plots`.
@@ -34,6 +36,7 @@ from motionlab.motion_graphs.search import (
     SearchError,
     SearchResult,
     Segment,
+    default_cost,
     parse_request,
     search_standard,
 )
@@ -63,6 +66,7 @@ __all__ = [
     "SearchError",
     "SearchResult",
     "Segment",
+    "default_cost",
     "parse_request",
     "search_path",
     "search_standard",

@@ -11,22 +11,34 @@ because no route joins the two directly) are counted apart (:attr:`SearchResult.
 **Structured graph** (paper B). The structure table gives each segment's style pool (its
 takes, side by side) and the recorded routes out of it, so the search never explores the whole
 graph. Within a pool the walk from the entry frame ``e`` to an exit frame ``x`` steps along a
-take or jumps (between takes, or back inside one); which lengths are possible is a
-reachability recursion over frame counts,
+take or jumps (between takes, or back inside one); what each length costs is a recursion over
+frame counts,
 
-.. math:: R_{c+1} = \operatorname{shift}(R_c) \,\lor\, \operatorname{jumps}(R_c), \qquad R_0 = \{e\},
+.. math:: P_{c+1}(f) = \min\bigl(P_c(f - 1),\ \min_{s \to f} P_c(s) + \mathrm{price}(s \to f)\bigr),
+   \qquad P_0(e) = 0,
 
-(``R_c``: frames where a walk of ``c + 1`` frames can be) run once per segment. The exit whose
-route length ``r`` satisfies ``c + 1 + r = n`` wins; of the walks within :data:`TOLERANCE`, the
-one that costs least at :data:`JUMP_FRAMES` frames per jump and one per frame off the request
-(each jump is a blend in the synthesised motion). Long
-segments first take the shortest way to the pool's main cycle (its longest jump back inside
+(``P_c(f)``: the least price of the jumps of a walk of ``c + 1`` frames from ``e`` that ends at
+``f``; infinite where none does) run once per segment. The exit whose route length ``r``
+satisfies ``c + 1 + r = n`` wins; of the walks within :data:`TOLERANCE`, the one whose jumps
+cost least plus one per frame off the request. Long segments first take the shortest way to the pool's main cycle (its longest jump back inside
 one take) and repeat it, so the recursion stays short: the *iterative choice of self-loop and
 transition points*. Pools crossed on the way to the next segment are passed by the shortest walk
 to an exit (:func:`walk_to_exit`); the **loop guard** stops it with an error once every frame
 it can reach has been visited (paper B stops at the second pass of a clip's last self-loop
 point; a pool of many takes has none). A request may ask for at most :data:`MAX_FRAMES` frames.
-:func:`search` reads the graph afresh at every call; a :class:`Planner` keeps what it built
+
+**Search cost** (the contract of the ``cost`` argument of :func:`search`, :class:`Planner`,
+:func:`pool_walker` and :func:`search_standard`). A walk costs its frames plus a price for
+every jump, in frames. The price is a function ``cost(graph, edges) -> (E,) float`` given the
+graph and the indices ``edges`` of its jumps ``graph.src[edges] → graph.dst[edges]``; it may
+read their pose distance ``graph.cost[edges]`` (m²), their ``graph.kind`` or the clips they join,
+and returns one finite price >= 0 per edge (else ``ValueError``). The default,
+:func:`default_cost`, prices every jump at :data:`JUMP_FRAMES` frames, since each jump is a
+blend in the synthesised motion. The cost chooses among the walks of a segment (above) and the
+walk through a pool to an exit (:func:`walk_to_exit`: least frames plus price); the way to a
+pool's main cycle and the loop guard count frames only.
+
+**No hidden state.** :func:`search` reads the graph afresh at every call; a :class:`Planner` keeps what it built
 (each style's walker, the ways between styles) for many searches of one graph, and refuses a
 graph that has changed since.
 
@@ -54,6 +66,8 @@ __all__ = [
     "parse_request",
     "search",
     "Planner",
+    "default_cost",
+    "JUMP_FRAMES",
     "search_standard",
     "SearchError",
     "RequestTooLong",
@@ -71,7 +85,44 @@ limit, rather than running for minutes and filling the disk."""
 
 TOLERANCE = 0.05
 """Documented accuracy: every reachable segment gets its requested length within
-``max(2 frames, 5%)``; inside that band the walk with the fewest jumps wins (checked by the tests)."""
+``max(2 frames, 5%)``; inside that band the walk whose jumps cost least wins (with the default search
+cost, the walk with the fewest jumps; checked by the tests)."""
+
+
+JUMP_FRAMES = 8
+"""What a jump costs a walk through a pool in :func:`default_cost`, in frames: a pool of many
+takes offers a jump almost everywhere, and the walk with the fewest frames can jump on every
+frame; each jump is a blend (8 frames by default in :mod:`.synthesis`)."""
+
+
+def default_cost(graph: MotionGraph, edges: np.ndarray) -> np.ndarray:
+    """The default search cost: :data:`JUMP_FRAMES` frames for every jump, so a walk costs its
+    frames plus ``JUMP_FRAMES`` per jump.
+
+    A search cost is any function with this signature (see the module docstring).
+
+    Parameters
+    ----------
+    graph : the graph searched
+    edges : (E,) int   indices into ``graph.src``, ``graph.dst``, ``graph.cost``, ``graph.kind``
+
+    Returns
+    -------
+    (E,) float   the price of each jump, frames (finite, >= 0)
+    """
+    return np.full(np.shape(edges), float(JUMP_FRAMES))
+
+
+def _prices(graph: MotionGraph, edges: np.ndarray, cost) -> np.ndarray:
+    """``cost(graph, edges)``, checked: one finite price >= 0 per edge (float32)."""
+    price = np.asarray(cost(graph, edges), dtype=np.float64)
+    if price.shape != edges.shape or not np.all(np.isfinite(price)) or np.any(price < 0):
+        name = getattr(cost, "__name__", repr(cost))
+        raise ValueError(
+            f"search cost {name} must return one finite price >= 0 (frames) per edge, shape {edges.shape}; "
+            f"got shape {price.shape}, min {price.min() if price.size else None}"
+        )
+    return price.astype(np.float32)
 
 
 class SearchError(GraphError):
@@ -187,8 +238,10 @@ class PoolWalker:
     allowed (same take, both alive); jumps ``loop_src → loop_dst`` (transitions inside the pool,
     self-loops included); the *main cycle* ``cycle_dst … cycle_src`` is the longest jump back
     inside one take whose frames in between are all steps (``-1`` when there is none).
-    ``sparse``: the :data:`SPARSE_JUMPS` cheapest jumps into every frame (``None``: all jumps),
-    which the search tries first.
+    ``price``: what each jump costs, frames on top of the frame it plays (``None``:
+    :data:`JUMP_FRAMES` each, as :func:`default_cost`). ``sparse``: ``(src, dst, price)`` of the
+    :data:`SPARSE_JUMPS` cheapest jumps into every frame (``None``: all jumps), which the search
+    tries first.
     """
 
     index: int
@@ -201,7 +254,15 @@ class PoolWalker:
     clips: np.ndarray = field(default_factory=lambda: np.zeros(1, dtype=np.int64))
     offsets: np.ndarray = field(default_factory=lambda: np.zeros(1, dtype=np.int64))
     alive: np.ndarray | None = None
-    sparse: tuple[np.ndarray, np.ndarray] | None = None
+    sparse: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+    price: np.ndarray | None = None
+
+    def jumps(self, sparse: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(src, dst, price)`` of every jump, or (``sparse``) of the cheapest into each frame."""
+        if sparse and self.sparse is not None:
+            return self.sparse
+        price = np.full(self.loop_src.shape, JUMP_FRAMES, np.float32) if self.price is None else self.price
+        return self.loop_src, self.loop_dst, price
 
     def first_alive(self) -> int:
         """The first alive frame, preferring one on the main cycle."""
@@ -220,14 +281,15 @@ class PoolWalker:
         return np.concatenate([f, self.loop_src[m]]), np.concatenate([f + 1, self.loop_dst[m]])
 
 
-def _pool_walker(graph: MotionGraph, clips: list[int], index: int = 0) -> PoolWalker:
-    """Walker over the consecutive clips ``clips`` (one style's takes)."""
+def _pool_walker(graph: MotionGraph, clips: list[int], index: int = 0, cost=default_cost) -> PoolWalker:
+    """Walker over the consecutive clips ``clips`` (one style's takes), its jumps priced by ``cost``."""
     first, last = graph.clips[clips[0]], graph.clips[clips[-1]]
     st, sp = first.start, last.stop
     step = graph.next_in_clip()[st:sp].copy()
     m = (graph.src >= st) & (graph.src < sp) & (graph.dst >= st) & (graph.dst < sp)
     m &= graph.alive[graph.src] & graph.alive[graph.dst]
     src, dst = graph.src[m] - st, graph.dst[m] - st
+    price = _prices(graph, np.flatnonzero(m), cost)
     # the main cycle: a jump back whose frames dst..src are all steps (one take, all alive)
     run = np.concatenate([[0], np.cumsum(step)])  # run[f] = steps among 0..f-1
     back = (dst <= src) & (run[src] - run[dst] == src - dst)
@@ -237,17 +299,18 @@ def _pool_walker(graph: MotionGraph, clips: list[int], index: int = 0) -> PoolWa
     else:
         last_src, last_dst = -1, -1
     offsets = np.array([graph.clips[c].start - st for c in clips], dtype=np.int64)
-    # the SPARSE_JUMPS cheapest jumps into every frame (ties: the nearer source first)
-    order = np.lexsort((src, graph.cost[m], dst))
+    # the SPARSE_JUMPS cheapest jumps into every frame (ties: the nearer pose, then source)
+    order = np.lexsort((src, graph.cost[m], price, dst))
     few = order[np.arange(order.size) - np.searchsorted(dst[order], dst[order]) < SPARSE_JUMPS]
     return PoolWalker(
         index, sp - st, step, src, dst, last_src, last_dst, np.asarray(clips, dtype=np.int64), offsets,
-        graph.alive[st:sp].copy(), (src[few], dst[few]),
+        graph.alive[st:sp].copy(), (src[few], dst[few], price[few]), price,
     )  # fmt: skip
 
 
-def pool_walker(graph: MotionGraph, behaviour: str, style: str) -> PoolWalker:
-    """The walker over one style's pool of a structured graph (its takes, from the structure table).
+def pool_walker(graph: MotionGraph, behaviour: str, style: str, cost=default_cost) -> PoolWalker:
+    """The walker over one style's pool of a structured graph (its takes, from the structure
+    table), its jumps priced by the search cost ``cost`` (:func:`default_cost`).
 
     Raises
     ------
@@ -258,12 +321,12 @@ def pool_walker(graph: MotionGraph, behaviour: str, style: str) -> PoolWalker:
         raise SearchError("this graph has no structure table (a standard graph?)")
     if behaviour not in cells or style not in cells[behaviour]:
         raise SearchError(f"no style {behaviour}/{style} in the graph")
-    return _pool_walker(graph, [t["clip"] for t in cells[behaviour][style]["takes"]])
+    return _pool_walker(graph, [t["clip"] for t in cells[behaviour][style]["takes"]], cost=cost)
 
 
-def _clip_walker(graph: MotionGraph, c: int) -> PoolWalker:
+def _clip_walker(graph: MotionGraph, c: int, cost=default_cost) -> PoolWalker:
     """Walker over one clip (the standard graph's search)."""
-    return _pool_walker(graph, [c], c)
+    return _pool_walker(graph, [c], c, cost)
 
 
 def _distances(cw: PoolWalker, start: int, targets: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -331,40 +394,44 @@ def _runs(cw: PoolWalker | int, frames: list[int]) -> list[tuple[int, int, int]]
     return res
 
 
-_NEVER = np.iinfo(np.int16).max
+_UNREACHED = np.float32(np.inf)
+"""Entry of a walk table where no walk of that length ends (no price is that high)."""
 
 SPARSE_JUMPS = 2
 """Jumps into each frame (the cheapest) that a walk through a pool tries first: a pool of many
 takes holds dozens of jumps per frame, and the recursion's cost grows with them."""
 
+Jumps = tuple[np.ndarray, np.ndarray, np.ndarray]
+"""``(src, dst, price)``: jumps between pool-local frames and what each costs, frames."""
 
-def _reach(cw: PoolWalker, start: int, steps: int, jumps: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
-    """(steps, L) int16: fewest jumps of a walk of ``c + 1`` frames from ``start`` that ends at
-    each frame (``_NEVER`` where no walk of that length ends there).
 
-    The reachability recursion with a count: ``J[c+1, f+1] = J[c, f]`` for a step,
-    ``J[c+1, d] = min over jumps s → d of J[c, s] + 1``; the jump part is one
+def _reach(cw: PoolWalker, start: int, steps: int, jumps: Jumps | None = None) -> np.ndarray:
+    """(steps, L) float32: the least price of the jumps of a walk of ``c + 1`` frames from
+    ``start`` that ends at each frame (``inf`` where no walk of that length ends there).
+
+    The reachability recursion with a price: ``P[c+1, f+1] = P[c, f]`` for a step,
+    ``P[c+1, d] = min over jumps s → d of P[c, s] + price(s → d)``; the jump part is one
     ``np.minimum.reduceat`` over the jumps sorted by destination, so each row is vectorised.
+    ``jumps``: the jumps to use (default: all the walker's).
     """
     step_ok = cw.step[:-1]
-    src, dst = (cw.loop_src, cw.loop_dst) if jumps is None else jumps
+    src, dst, price = cw.jumps() if jumps is None else jumps
     order = np.argsort(dst, kind="stable")
-    src, dst = src[order], dst[order]
+    src, dst, price = src[order], dst[order], price[order]
     rank = np.arange(dst.size) - np.searchsorted(dst, dst)  # k-th jump into its frame
     if rank.size == 0 or rank.max() < SPARSE_JUMPS:
-        layers = [(src[rank == k], dst[rank == k]) for k in range(SPARSE_JUMPS)]
+        layers = [(src[rank == k], dst[rank == k], price[rank == k]) for k in range(SPARSE_JUMPS)]
         return _reach_few(max(steps, 1), cw.length, start, step_ok, layers)
-    out = np.full((max(steps, 1), cw.length), _NEVER, dtype=np.int16)
+    out = np.full((max(steps, 1), cw.length), _UNREACHED, dtype=np.float32)
     out[0, start] = 0
     if dst.size:
         heads = np.flatnonzero(np.concatenate([[True], dst[1:] != dst[:-1]]))
         targets = dst[heads]
     for c in range(1, steps):
         prev, cur = out[c - 1], out[c]
-        cur[1:] = np.where(step_ok, prev[:-1], _NEVER)
+        cur[1:] = np.where(step_ok, prev[:-1], _UNREACHED)
         if dst.size:
-            via = np.minimum.reduceat(prev[src], heads)
-            via = np.where(via < _NEVER, via + 1, _NEVER).astype(np.int16)
+            via = np.minimum.reduceat(prev[src] + price, heads)
             cur[targets] = np.minimum(cur[targets], via)
     return out
 
@@ -373,42 +440,40 @@ def _reach_few(steps: int, n: int, start: int, step_ok: np.ndarray, layers: list
     """:func:`_reach` when few jumps enter each frame: ``layers[k]`` holds the k-th jump into
     each frame (at most one per frame), so a row is one gather per layer, with no grouping.
 
-    Returns a (steps, n) view of an array with one more column, always ``_NEVER``: the frame a
+    Returns a (steps, n) view of an array with one more column, always ``inf``: the frame a
     missing jump comes from."""
-    out = np.full((steps, n + 1), _NEVER, dtype=np.int16)
+    out = np.full((steps, n + 1), _UNREACHED, dtype=np.float32)
     out[0, start] = 0
-    src_of = []
-    for src, dst in layers:
+    src_of, price_of = [], []
+    for src, dst, price in layers:
         s = np.full(n, n)  # the jump into each frame, n (a frame that is never reached) if none
         s[dst] = src
+        p = np.zeros(n, dtype=np.float32)
+        p[dst] = price
         src_of.append(s)
-    via, other = np.empty(n, dtype=np.int16), np.empty(n, dtype=np.int16)
+        price_of.append(p)
+    via, other = np.empty(n, dtype=np.float32), np.empty(n, dtype=np.float32)
     for c in range(1, steps):
         prev, cur = out[c - 1], out[c]
-        np.copyto(cur[1:n], prev[: n - 1], where=step_ok)  # the row starts all _NEVER
-        np.take(prev, src_of[0], out=via)
-        for s in src_of[1:]:
-            np.minimum(via, np.take(prev, s, out=other), out=via)
-        np.minimum(via, _NEVER - 1, out=via)  # a jump from nowhere stays _NEVER after the + 1
-        via += 1
+        np.copyto(cur[1:n], prev[: n - 1], where=step_ok)  # the row starts all inf
+        np.add(np.take(prev, src_of[0]), price_of[0], out=via)
+        for s, p in zip(src_of[1:], price_of[1:]):
+            np.minimum(via, np.add(np.take(prev, s), p, out=other), out=via)
         np.minimum(cur[:n], via, out=cur[:n])
     return out[:, :n]
 
 
-def _backtrack(
-    cw: PoolWalker, reach: np.ndarray, c: int, x: int, jumps: tuple[np.ndarray, np.ndarray] | None = None
-) -> list[int]:
-    """Frames of a walk with the fewest jumps reaching ``x`` after ``c + 1`` frames
-    (reverse-engineered from ``reach``, see :func:`_reach`); each jump is a blend in the
-    synthesised motion, so fewer is better."""
-    src, dst = (cw.loop_src, cw.loop_dst) if jumps is None else jumps
+def _backtrack(cw: PoolWalker, reach: np.ndarray, c: int, x: int, jumps: Jumps | None = None) -> list[int]:
+    """Frames of the cheapest walk reaching ``x`` after ``c + 1`` frames (reverse-engineered
+    from ``reach``, see :func:`_reach`, made with the same ``jumps``)."""
+    src, dst, price = cw.jumps() if jumps is None else jumps
     frames = [x]
     while c > 0:
-        j = int(reach[c, x])
-        if x > 0 and cw.step[x - 1] and reach[c - 1, x - 1] == j:
+        p = reach[c, x]
+        if x > 0 and cw.step[x - 1] and reach[c - 1, x - 1] == p:
             x -= 1
         else:
-            cand = src[(dst == x) & (reach[c - 1, src] == j - 1)]
+            cand = src[(dst == x) & (reach[c - 1, src] + price == p)]
             if cand.size == 0:
                 raise GraphError("internal: walk reconstruction failed")
             x = int(cand[0])
@@ -430,9 +495,9 @@ def _walk(
 ) -> tuple[list[tuple[int, int, int]], int, int]:
     """A walk from ``start`` of about ``need[r]`` frames ending at ``exits[r]`` (``-1``: any frame).
 
-    Of the walks within ``slack`` frames of an option's length, the cheapest wins: each jump
-    costs :data:`JUMP_FRAMES` frames (it is a blend), each frame off the request one; when there
-    is none, the walk nearest the requested length.
+    Of the walks within ``slack`` frames of an option's length, the cheapest wins: the price of
+    its jumps (the walker's search cost) plus one per frame off the request; when there is none,
+    the walk nearest the requested length.
     Returns pieces, the chosen option ``r`` and the frames played.
     """
     pieces: list[tuple[int, int, int]] = []
@@ -484,46 +549,39 @@ def _straight(cw: PoolWalker, start: int, frames: int) -> bool:
 
 def _choose(reach: np.ndarray, need_c: np.ndarray, ex: np.ndarray, steps: int, widest: int, slack: int = 0):
     """``(option, row, exit frame)``: of the walks within ``slack`` rows of an option's requested
-    row, the cheapest, at :data:`JUMP_FRAMES` per jump plus one per frame off the request (the
-    nearer length on ties); when there is none, the walk nearest the requested length (``None``:
-    none within ``widest`` rows of it)."""
+    row, the cheapest, at the price of its jumps plus one per frame off the request (the nearer
+    length on ties); when there is none, the walk nearest the requested length (``None``: none
+    within ``widest`` rows of it)."""
     best, best_key = None, None
     for order, delta in enumerate(_deltas(widest + 1)):
         if best is not None and (abs(delta) > slack or abs(delta) >= best_key[0]):
             break
-        found = _fewest_jumps(reach, need_c + delta, ex, steps)
+        found = _cheapest(reach, need_c + delta, ex, steps)
         if found is None:
             continue
-        key = (JUMP_FRAMES * found[3] + abs(delta), order)
+        key = (found[3] + abs(delta), order)
         if best is None or key < best_key:
             best, best_key = found[:3], key
     return best
 
 
-def _fewest_jumps(reach: np.ndarray, c: np.ndarray, ex: np.ndarray, steps: int):
-    """``(option, row, frame, jumps)`` of the walk with the fewest jumps ending in row ``c[r]``
+def _cheapest(reach: np.ndarray, c: np.ndarray, ex: np.ndarray, steps: int):
+    """``(option, row, frame, price)`` of the walk whose jumps cost least, ending in row ``c[r]``
     at option ``r``'s exit frame (or, ``-1``, at any frame); ``None`` when there is none."""
     ok = np.flatnonzero((c >= 0) & (c < steps))
     found = None
     for r in ok[ex[ok] < 0]:
         row = reach[c[r]]
-        j = int(row.min())
-        if j < _NEVER and (found is None or j < found[3]):
-            found = (int(r), int(c[r]), int(np.argmin(row)), j)
+        p = float(row.min())
+        if p < _UNREACHED and (found is None or p < found[3]):
+            found = (int(r), int(c[r]), int(np.argmin(row)), p)
     fixed = ok[ex[ok] >= 0]
     if fixed.size:
-        jumps = reach[c[fixed], ex[fixed]]
-        k = int(np.argmin(jumps))
-        if jumps[k] < _NEVER and (found is None or int(jumps[k]) < found[3]):
-            found = (int(fixed[k]), int(c[fixed[k]]), int(ex[fixed[k]]), int(jumps[k]))
+        prices = reach[c[fixed], ex[fixed]]
+        k = int(np.argmin(prices))
+        if prices[k] < _UNREACHED and (found is None or float(prices[k]) < found[3]):
+            found = (int(fixed[k]), int(c[fixed[k]]), int(ex[fixed[k]]), float(prices[k]))
     return found
-
-
-JUMP_FRAMES = 8
-"""What a jump costs a walk through a pool, in frames: a pool of many takes offers a jump almost
-everywhere, and the walk with the fewest frames can jump on every frame; each jump is a blend
-(8 frames by default in :mod:`.synthesis`), so a walk through a pool minimises frames plus this
-many per jump."""
 
 
 def walk_to_exit(
@@ -531,8 +589,8 @@ def walk_to_exit(
 ) -> tuple[list[tuple[int, int, int]], int, int]:
     """The cheapest walk through a pool from ``start`` to one of ``exits`` (pool-local frames).
 
-    Cost: frames plus :data:`JUMP_FRAMES` per jump, over the cheapest jumps into each frame; the
-    shortest walk (a breadth-first search) when nothing cheaper is found.
+    Cost: frames plus the price of its jumps (the walker's search cost), over the cheapest jumps
+    into each frame; the shortest walk (a breadth-first search) when nothing cheaper is found.
 
     Returns
     -------
@@ -548,14 +606,17 @@ def walk_to_exit(
     if not exits or not all(0 <= int(x) < cw.length for x in [start, *exits]):
         raise ValueError(f"expected a start and at least one exit in 0..{cw.length - 1}, got {start} and {exits}")
     frames, r = _path(cw, start, exits, name)
-    jumps = sum(b != a + 1 for a, b in zip(frames[:-1], frames[1:]))
-    rows = len(frames) + JUMP_FRAMES * jumps  # no longer walk can cost less
+    src, dst, price = cw.jumps()
+    paid = sum(float(price[(src == a) & (dst == b)].min()) for a, b in zip(frames[:-1], frames[1:]) if b != a + 1)
+    bound = len(frames) + paid
+    # a cheaper walk has fewer frames than ``bound`` (each frame costs one) and visits no frame
+    # twice (a loop costs at least a frame), so it has at most ``cw.length`` frames
+    rows = min(int(np.ceil(bound)), cw.length)
     ex = np.asarray(exits, dtype=np.int64)
     reach = _reach(cw, start, rows, cw.sparse)
-    count = reach[:, ex].astype(np.int64)
-    cost = np.where(count < _NEVER, np.arange(1, rows + 1)[:, None] + JUMP_FRAMES * count, np.iinfo(np.int64).max)
+    cost = np.arange(1, rows + 1)[:, None] + reach[:, ex].astype(np.float64)
     c, k = np.unravel_index(int(np.argmin(cost)), cost.shape)  # shortest first, then the first exit
-    if cost[c, k] < len(frames) + JUMP_FRAMES * jumps:
+    if cost[c, k] < bound:
         frames, r = _backtrack(cw, reach, int(c), int(ex[k]), cw.sparse), int(k)
     return _runs(cw, frames), r, len(frames)
 
@@ -575,8 +636,9 @@ def _read_by_search(graph: MotionGraph) -> tuple:
 
 
 class Planner:
-    """A structured graph prepared for many searches: each style's walker and the ways out of
-    it, built the first time a request needs them and kept for the next requests.
+    """A structured graph prepared for many searches under one search cost (``cost``, see the
+    module docstring): each style's walker and the ways out of it, built the first time a
+    request needs them and kept for the next requests.
 
     The planner is state the caller holds, not state hidden in the graph: :func:`search` makes a
     fresh one for every call (always up to date, slower on a large graph); make one yourself to
@@ -590,10 +652,11 @@ class Planner:
     SearchError when the graph has no structure table.
     """
 
-    def __init__(self, graph: MotionGraph):
+    def __init__(self, graph: MotionGraph, cost=default_cost):
         if not graph.table.get("behaviours"):
             raise SearchError("this graph has no structure table (a standard graph?); use search_standard")
         self.g = graph
+        self.cost = cost
         self.reads = _read_by_search(graph)
         self.entries = graph.table["behaviours"]
         self.walkers: dict[tuple[str, str], PoolWalker] = {}
@@ -605,7 +668,7 @@ class Planner:
     def walker(self, key: tuple[str, str]) -> PoolWalker:
         if key not in self.walkers:
             cell = self.entries[key[0]][key[1]]
-            self.walkers[key] = _pool_walker(self.g, [t["clip"] for t in cell["takes"]])
+            self.walkers[key] = _pool_walker(self.g, [t["clip"] for t in cell["takes"]], cost=self.cost)
         return self.walkers[key]
 
     def check(self, seg: Segment) -> tuple[str, str]:
@@ -744,7 +807,7 @@ class Planner:
         return SearchResult(_merge(pieces), [s.frames for s in segs], achieved, segs, passing)
 
 
-def search(graph: MotionGraph, request, progress: bool = False) -> SearchResult:
+def search(graph: MotionGraph, request, progress: bool = False, cost=default_cost) -> SearchResult:
     """Meet a request on a structured graph (see the module docstring).
 
     A fresh :class:`Planner` answers it, so the search always sees the graph as it is now; to
@@ -756,14 +819,17 @@ def search(graph: MotionGraph, request, progress: bool = False) -> SearchResult:
     request : list of :class:`Segment` / ``(behaviour, style, frames)`` tuples, or the text form
         ``"walk:angry:300,run:normal:200"``; at most :data:`MAX_FRAMES` frames in all
     progress : show a tqdm bar over the segments (Ctrl-C stops the search between steps)
+    cost : the search cost, ``cost(graph, edges) -> (E,) float``: the price of each jump, frames
+        (default :func:`default_cost`: :data:`JUMP_FRAMES` per jump; see the module docstring)
 
     Raises
     ------
     SearchError naming a missing behaviour or style, or two behaviours with no transition clip.
-    ValueError (:class:`RequestTooLong`) for a request of more than :data:`MAX_FRAMES` frames.
+    ValueError (:class:`RequestTooLong`) for a request of more than :data:`MAX_FRAMES` frames,
+    or when ``cost`` does not return one finite price >= 0 per edge.
     """
     segs = _segments(request)  # a bad request is refused before the graph is read
-    return Planner(graph).search(segs, progress)
+    return Planner(graph, cost).search(segs, progress)
 
 
 def _segments(request) -> list[Segment]:
@@ -792,11 +858,18 @@ def _merge(pieces: list[tuple[int, int, int]]) -> list[tuple[int, int, int]]:
 
 
 # ---------------------------------------------------------------------------- standard search
-def search_standard(graph: MotionGraph, request, start_clip: int | None = None) -> SearchResult:
+def search_standard(graph: MotionGraph, request, start_clip: int | None = None, cost=default_cost) -> SearchResult:
     """The comparison search on an unstructured graph: shortest paths between segments.
 
     Clips are matched to segments through their labels (``ClipInfo.behaviour/style``). The
-    frames of the shortest path into the next clip count towards the segment being left.
+    frames of the shortest path (Dijkstra, in frames) into the next clip count towards the
+    segment being left; inside a clip the walk is priced by the search ``cost``, as in
+    :func:`search`.
+
+    Raises
+    ------
+    SearchError when no clip carries a segment's label or no path leads to it.
+    ValueError for a bad request (see :func:`parse_request`) or a bad ``cost``.
     """
     segs = _segments(request)
     g = graph.segment_graph()
@@ -849,7 +922,7 @@ def search_standard(graph: MotionGraph, request, start_clip: int | None = None) 
             achieved[-1] += lead
             c = g.nodes[t]["clip"]
             enter = g.nodes[t]["first"] - graph.clips[c].start
-        cw = _clip_walker(graph, c)
+        cw = _clip_walker(graph, c, cost)
         p, _, n = _walk(cw, enter, [s.frames], [-1])
         pieces.extend(p)
         achieved.append(n)

@@ -116,41 +116,42 @@ def test_walk_takes_the_fewest_jumps():
     cw = search.PoolWalker(0, 20, step, np.array([5, 3, 8, 2]), np.array([12, 15, 11, 3]), -1, -1)
     pieces, _, n = search._walk(cw, 0, [15], [-1])
     assert n == 15 and pieces == [(0, 0, 8), (0, 11, 16)]  # one jump; 0..5 -> 12..19 is a frame short
-    reach = search._reach(cw, 0, 15)
-    assert reach[14].min() == 1 and reach[5, 5] == 0 and reach[6, 12] == 1
+    reach = search._reach(cw, 0, 15)  # the least price of the jumps: JUMP_FRAMES per jump
+    assert reach[14].min() == search.JUMP_FRAMES and reach[5, 5] == 0 and reach[6, 12] == search.JUMP_FRAMES
 
 
-def _reach_by_hand(step, src, dst, start, rows):
-    never = np.iinfo(np.int16).max
+def _reach_by_hand(step, src, dst, price, start, rows):
     n = step.size
-    ref = np.full((rows, n), never, dtype=np.int64)
+    ref = np.full((rows, n), np.inf, dtype=np.float32)
     ref[0, start] = 0
     for c in range(1, rows):
         for f in range(n):
-            best = ref[c - 1, f - 1] if f > 0 and step[f - 1] else never
-            for s, d in zip(src, dst):
-                if d == f and ref[c - 1, s] < never:
-                    best = min(best, ref[c - 1, s] + 1)
+            best = ref[c - 1, f - 1] if f > 0 and step[f - 1] else np.inf
+            for s, d, p in zip(src, dst, price):
+                if d == f:
+                    best = min(best, ref[c - 1, s] + p)
             ref[c, f] = best
     return ref
 
 
 def test_reach_with_few_jumps_per_frame_matches_the_recursion():
     """The per-layer recursion (at most SPARSE_JUMPS jumps into a frame) and the grouped one
-    (any number) both give the fewest jumps of every walk length, as a loop by hand does."""
+    (any number) both give the least price of the jumps of every walk length, as a loop by hand
+    does (prices drawn at random, as a search cost may give)."""
     rng = np.random.default_rng(3)
     n = 30
     step = rng.random(n) < 0.8
     step[-1] = False
     src, dst = rng.integers(0, n, 40), rng.integers(0, n, 40)
+    price = rng.uniform(0.5, 12.0, 40).astype(np.float32)
     order = np.argsort(dst, kind="stable")
     rank = np.arange(40) - np.searchsorted(dst[order], dst[order])
     few = order[rank < search.SPARSE_JUMPS]
     assert rank.max() >= search.SPARSE_JUMPS  # the full set takes the grouped path
-    cw = search.PoolWalker(0, n, step, src, dst, -1, -1)
-    for s, d in ((src[few], dst[few]), (src, dst)):
-        got = search._reach(cw, 2, 25, (s, d))
-        np.testing.assert_array_equal(got, _reach_by_hand(step, s, d, 2, 25))
+    cw = search.PoolWalker(0, n, step, src, dst, -1, -1, price=price)
+    for s, d, p in ((src[few], dst[few], price[few]), (src, dst, price)):
+        got = search._reach(cw, 2, 25, (s, d, p))
+        np.testing.assert_array_equal(got, _reach_by_hand(step, s, d, p, 2, 25))
 
 
 def test_frames_through_other_styles_are_reported_apart(sgraph):
@@ -223,3 +224,62 @@ def test_standard_search_sees_edges_dropped_after_an_earlier_search(library):
     g.keep_edges(~crossing)  # no way left between clips
     with pytest.raises(search.SearchError, match=f"no path in the graph to {req[1][0]}/{req[1][1]}"):
         search.search_standard(g, req)
+
+
+# ---------------------------------------------------------------------------- search costs
+def no_jump_price(graph, edges):
+    """A search cost written outside the package: a jump costs nothing beyond its frame."""
+    return np.zeros(len(edges))
+
+
+def test_a_search_cost_from_outside_changes_the_path(sgraph):
+    """Issue 44: a course tries a search cost without touching the package."""
+    from motionlab import motion_graphs
+
+    default = motion_graphs.search_path(sgraph, REQUEST)
+    free = motion_graphs.search_path(sgraph, REQUEST, cost=no_jump_price)
+    sgraph.check_path(free.pieces)
+    # the default trades a few frames off the request for fewer jumps (8 frames each) ...
+    assert default.achieved != default.requested
+    # ... with jumps free, a frame off the request is the only cost: every length is met exactly
+    assert free.achieved == free.requested
+    assert len(free.pieces) > len(default.pieces)
+    assert motion_graphs.Planner(sgraph, cost=no_jump_price).search(REQUEST).pieces == free.pieces
+
+
+def test_the_default_cost_is_frames_and_jump_frames(sgraph):
+    assert search.search(sgraph, REQUEST, cost=search.default_cost).pieces == search.search(sgraph, REQUEST).pieces
+    edges = np.arange(5)
+    np.testing.assert_array_equal(search.default_cost(sgraph, edges), np.full(5, search.JUMP_FRAMES))
+
+
+def test_a_cost_reads_the_jumps_it_prices(sgraph):
+    seen = []
+
+    def by_pose_distance(graph, edges):
+        seen.append(edges)
+        return 2.0 + 1e4 * graph.cost[edges]  # m² -> frames: closer poses are cheaper jumps
+
+    r = search.search(sgraph, REQUEST, cost=by_pose_distance)
+    sgraph.check_path(r.pieces)
+    _within(r)
+    edges = np.concatenate(seen)
+    assert edges.size and edges.min() >= 0 and edges.max() < sgraph.src.size
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [lambda g, e: -np.ones(len(e)), lambda g, e: np.full(len(e), np.nan), lambda g, e: np.zeros(len(e) + 1)],
+)
+def test_a_bad_cost_is_named(sgraph, bad):
+    with pytest.raises(ValueError, match="search cost .* one finite price >= 0"):
+        search.search(sgraph, REQUEST, cost=bad)
+
+
+def test_a_jump_price_below_one_frame_off_meets_the_length():
+    # frames 0..9, one jump back 9 -> 0 (the loop-guard walker): 12 frames from frame 0
+    step = np.array([True] * 9 + [False])
+    for price, frames in ((search.JUMP_FRAMES, 10), (1.0, 12)):
+        cw = search.PoolWalker(0, 10, step, np.array([9]), np.array([0]), 9, 0, price=np.float32([price]))
+        _, _, n = search._walk(cw, 0, [12], [-1], slack=2)
+        assert n == frames  # 2 frames short cost less than a jump of 8, more than one of 1
