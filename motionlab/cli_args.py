@@ -64,7 +64,12 @@ def _whole(text: str) -> int:
 
 
 def positive(text: str) -> float:
-    """argparse type: a finite number > 0 (``0``, ``-1.7``, ``nan`` refused)."""
+    """argparse type: a finite number > 0 (``0``, ``-1.7``, ``nan`` refused).
+
+    Raises
+    ------
+    argparse.ArgumentTypeError for anything but a finite number > 0.
+    """
     value = _number(text)
     if not (math.isfinite(value) and value > 0):
         raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
@@ -72,7 +77,12 @@ def positive(text: str) -> float:
 
 
 def non_negative(text: str) -> float:
-    """argparse type: a finite number >= 0 (``-1``, ``nan`` refused)."""
+    """argparse type: a finite number >= 0 (``-1``, ``nan`` refused).
+
+    Raises
+    ------
+    argparse.ArgumentTypeError for anything but a finite number >= 0.
+    """
     value = _number(text)
     if not (math.isfinite(value) and value >= 0):
         raise argparse.ArgumentTypeError(f"expected 0 or a positive number, got {text!r}")
@@ -80,7 +90,12 @@ def non_negative(text: str) -> float:
 
 
 def positive_int(text: str) -> int:
-    """argparse type: a whole number >= 1 (``0``, ``-5``, ``2.5`` refused)."""
+    """argparse type: a whole number >= 1 (``0``, ``-5``, ``2.5`` refused).
+
+    Raises
+    ------
+    argparse.ArgumentTypeError for anything but a whole number >= 1.
+    """
     value = _whole(text)
     if value < 1:
         raise argparse.ArgumentTypeError(f"expected a whole number of 1 or more, got {text!r}")
@@ -88,7 +103,12 @@ def positive_int(text: str) -> int:
 
 
 def non_negative_int(text: str) -> int:
-    """argparse type: a whole number >= 0."""
+    """argparse type: a whole number >= 0.
+
+    Raises
+    ------
+    argparse.ArgumentTypeError for anything but a whole number >= 0.
+    """
     value = _whole(text)
     if value < 0:
         raise argparse.ArgumentTypeError(f"expected a whole number of 0 or more, got {text!r}")

@@ -67,7 +67,12 @@ def has_data(*parts: str) -> bool:
 
 
 def list_clips(subdir: str = "", pattern: str = "*.bvh") -> list[Path]:
-    """All BVH files under ``MOTIONLAB_DATA/subdir`` (recursively), sorted."""
+    """All BVH files under ``MOTIONLAB_DATA/subdir`` (recursively), sorted.
+
+    Raises
+    ------
+    DataNotFound when the folder does not exist under ``MOTIONLAB_DATA``.
+    """
     root = data_root()
     base = root / subdir
     if not base.is_dir():
@@ -76,7 +81,12 @@ def list_clips(subdir: str = "", pattern: str = "*.bvh") -> list[Path]:
 
 
 def list_characters(subdir: str = "mixamo") -> dict[str, list[str]]:
-    """``{character: [clip stems]}`` for a folder laid out as ``<Character>/<Clip>.bvh``."""
+    """``{character: [clip stems]}`` for a folder laid out as ``<Character>/<Clip>.bvh``.
+
+    Raises
+    ------
+    DataNotFound when the folder does not exist under ``MOTIONLAB_DATA``.
+    """
     root = data_root()
     base = root / subdir
     if not base.is_dir():
@@ -90,7 +100,12 @@ def list_characters(subdir: str = "mixamo") -> dict[str, list[str]]:
 
 
 def clip_path(*parts: str) -> Path:
-    """Path of one file under ``MOTIONLAB_DATA`` (``.bvh`` added if missing); clear error if absent."""
+    """Path of one file under ``MOTIONLAB_DATA`` (``.bvh`` added if missing); clear error if absent.
+
+    Raises
+    ------
+    DataNotFound when the file does not exist under ``MOTIONLAB_DATA``.
+    """
     root = data_root()
     path = root.joinpath(*parts)
     if path.suffix != ".bvh":

@@ -101,6 +101,10 @@ def random_skeleton(rng: np.random.Generator, num_joints: int, bone_scale: float
     Skeleton
         Joints named ``"j0"`` … ``"j{J-1}"``; ``parents[j]`` drawn uniformly from ``0 … j-1``;
         offsets (J, 3) normally distributed (the root's offset is its rest position).
+
+    Raises
+    ------
+    ValueError when ``num_joints`` < 1.
     """
     if int(num_joints) < 1:
         raise ValueError(f"a skeleton needs at least one joint, got num_joints={num_joints}")

@@ -860,6 +860,10 @@ def frame_time(motion_or_fps: Motion | float) -> float:
 
     For a motion loaded from BVH this is exactly the file's ``Frame Time:`` value (e.g.
     0.016667 rather than 1/60); :func:`save` writes the same digits back.
+
+    Raises
+    ------
+    ValueError when the motion's fps is not a finite positive number.
     """
     fps = motion_or_fps.fps if isinstance(motion_or_fps, Motion) else float(motion_or_fps)
     if not (math.isfinite(fps) and fps > 0):

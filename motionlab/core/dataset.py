@@ -66,6 +66,10 @@ class MotionDataset(Dataset):
         """Reduce, resample and window ``motions``; fit statistics unless ``stats`` is given.
 
         Clips on skeletons with different rest offsets become different characters.
+
+        Raises
+        ------
+        ValueError when ``motions`` is empty.
         """
         if not motions:
             raise ValueError("from_motions needs at least one motion")
@@ -113,7 +117,13 @@ class MotionDataset(Dataset):
 
     @classmethod
     def load(cls, path: str | Path) -> MotionDataset:
-        """Read a dataset written by :meth:`save`; a clear error for other files."""
+        """Read a dataset written by :meth:`save`; a clear error for other files.
+
+        Raises
+        ------
+        ValueError naming ``path`` when it is not a motionlab windows dataset (unreadable, or
+        another format).
+        """
         try:
             with np.load(path, allow_pickle=False) as z:
                 meta = json.loads(str(z["meta"]))

@@ -48,6 +48,11 @@ def fk(local_rot, local_pos, parents) -> tuple[np.ndarray, np.ndarray]:
     -------
     global_rot : ndarray, shape (..., J, 4)
     global_pos : ndarray, shape (..., J, 3)
+
+    Raises
+    ------
+    ValueError when ``local_rot`` is not (..., J, 4) or ``local_pos`` not (..., J, 3) for the
+    same J.
     """
     local_rot = quat.check(local_rot, "local_rot")
     if local_rot.ndim < 2:

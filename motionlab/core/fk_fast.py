@@ -459,6 +459,11 @@ def fk_positions_fast_np(local_rot, local_pos, parents, *, root_pos=None, chunk:
     parents   : sequence of int, length J
     root_pos  : array, shape (..., 3), optional   replaces ``local_pos[..., 0, :]``
     chunk     : int   frames per step (8192 keeps a 22-joint chunk within a few MB)
+
+    Raises
+    ------
+    ValueError when an array has the wrong trailing shape, the leading shapes do not
+    broadcast, or ``chunk`` < 1.
     """
     local_rot = np.asarray(local_rot)
     if local_rot.ndim < 2 or local_rot.shape[-1] != 4:

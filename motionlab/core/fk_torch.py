@@ -36,6 +36,11 @@ def fk(local_rot: torch.Tensor, local_pos: torch.Tensor, parents) -> tuple[torch
     -------
     global_rot : Tensor, shape (..., J, 4)
     global_pos : Tensor, shape (..., J, 3)
+
+    Raises
+    ------
+    ValueError when ``local_rot`` is not (..., J, 4) or ``local_pos`` not (..., J, 3) for the
+    same J.
     """
     if (
         local_rot.ndim < 2

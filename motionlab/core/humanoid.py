@@ -359,6 +359,10 @@ def scale_bones(
     spine bones; ``neck`` the neck and head (and the head's end site); ``overall`` every offset
     afterwards. The root's rest height is moved so the lowest joint stays where it was relative to
     the ground (scaled by ``overall``). Factors must be positive.
+
+    Raises
+    ------
+    ValueError when a scale factor is not a finite number > 0.
     """
     factors = {"legs": legs, "arms": arms, "spine": spine, "neck": neck, "overall": overall}
     for k, f in factors.items():
@@ -417,6 +421,10 @@ def heading(global_pos: np.ndarray) -> np.ndarray:
     """Facing angle about +Y (radians, 0 = facing +Z) of canonical poses (..., 22, 3).
 
     Forward is ``across × up`` where ``across`` averages the right→left hip and shoulder vectors.
+
+    Raises
+    ------
+    ValueError when ``pos`` is not (..., 22, 3).
     """
     pos = np.asarray(global_pos)
     if pos.shape[-2:] != (len(JOINTS), 3):

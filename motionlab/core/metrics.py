@@ -73,6 +73,10 @@ def smoothness(pos) -> float:
     """Mean acceleration magnitude ``‖p[t+1] − 2p[t] + p[t−1]‖`` over frames and joints.
 
     Unit: position unit per frame² (lower is smoother). Needs at least 3 frames.
+
+    Raises
+    ------
+    ValueError for fewer than 3 frames.
     """
     pos = _pos(pos)
     if pos.shape[-3] < 3:
@@ -123,6 +127,10 @@ def planted_slide(pos, feet, planted, fps: float) -> float:
     Unlike :func:`foot_skating`, which decides contact by a height threshold on the motion itself,
     the labels come from elsewhere (e.g. the source's contacts in retargeting), so a foot that
     floats while it should stand still counts too, and a low swinging foot does not.
+
+    Raises
+    ------
+    ValueError when ``planted`` is not (T, feet) for the positions given.
     """
     pos = _pos(pos)
     planted = np.asarray(planted, dtype=bool)

@@ -28,6 +28,10 @@ def plot_pose(positions, parents, ax=None, view: str = "side", color="C0", joint
     """Draw one pose (J, 3) as a stick figure projected on a plane.
 
     ``view``: ``"front"`` (x–y), ``"side"`` (z–y) or ``"top"`` (x–z). Returns the axes.
+
+    Raises
+    ------
+    ValueError for an unknown ``view``.
     """
     if view not in _VIEWS:
         raise ValueError(f"view must be one of {sorted(_VIEWS)}, got {view!r}")

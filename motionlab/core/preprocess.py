@@ -84,7 +84,12 @@ class Features:
 
 
 def features(motion: Motion) -> Features:
-    """Features of a canonical (22-joint) motion; see the module docstring."""
+    """Features of a canonical (22-joint) motion; see the module docstring.
+
+    Raises
+    ------
+    ValueError when the motion is not on the 22-joint canonical skeleton.
+    """
     if not humanoid.is_canonical(motion.skeleton):
         raise ValueError("features() needs a 22-joint canonical motion; call prepare(motion) first")
     pos = motion.global_positions()
@@ -92,7 +97,12 @@ def features(motion: Motion) -> Features:
 
 
 def features_from_positions(pos: np.ndarray) -> Features:
-    """Features from world positions (T, 22, 3); see :func:`features`."""
+    """Features from world positions (T, 22, 3); see :func:`features`.
+
+    Raises
+    ------
+    ValueError for fewer than 2 frames.
+    """
     pos = np.asarray(pos, dtype=np.float64)
     T = pos.shape[0]
     if T < 2:
@@ -147,6 +157,10 @@ def sliding_windows(length_total: int, window: int = 120, stride: int = 60) -> l
     Windows are ``window`` long, ``stride`` apart; the last one is moved back to end on the last
     frame so every frame is covered. A clip shorter than one window gives one range
     ``(0, length_total)`` (callers pad it, see :func:`pad_to`).
+
+    Raises
+    ------
+    ValueError when ``window`` or ``stride`` is < 1.
     """
     if window < 1 or stride < 1:
         raise ValueError(f"window and stride must be positive, got {window} and {stride}")
@@ -179,7 +193,12 @@ class NormStats:
 
     @classmethod
     def fit(cls, arrays: Iterable[np.ndarray], eps: float = 1e-3) -> NormStats:
-        """Statistics over all frames of (T, D) arrays."""
+        """Statistics over all frames of (T, D) arrays.
+
+        Raises
+        ------
+        ValueError when there is no data.
+        """
         data = np.concatenate([np.asarray(a, dtype=np.float64) for a in arrays], axis=0)
         if data.size == 0:
             raise ValueError("cannot fit normalisation statistics on no data")
@@ -210,7 +229,12 @@ def window_stack(
     arrays: Sequence[np.ndarray], window: int, stride: int
 ) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
     """Cut each (T, ...) array into windows and stack them: returns (N, window, ...) and, for
-    each window, ``(clip index, start, stop)`` (short clips are edge-padded to ``window``)."""
+    each window, ``(clip index, start, stop)`` (short clips are edge-padded to ``window``).
+
+    Raises
+    ------
+    ValueError when there are no clips to cut.
+    """
     out, index = [], []
     for i, a in enumerate(arrays):
         for s, e in sliding_windows(len(a), window, stride):

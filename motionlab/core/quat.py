@@ -104,7 +104,12 @@ def conj(q) -> np.ndarray:
 
 
 def inv(q) -> np.ndarray:
-    """Inverse ``q* / |q|²`` (equal to :func:`conj` for unit quaternions)."""
+    """Inverse ``q* / |q|²`` (equal to :func:`conj` for unit quaternions).
+
+    Raises
+    ------
+    ValueError for a zero-norm quaternion.
+    """
     q = check(q)
     n2 = np.sum(q * q, axis=-1, keepdims=True)
     if np.any(n2 < _EPS_NORM):
@@ -149,6 +154,10 @@ def from_axis_angle(axis, angle) -> np.ndarray:
     ----------
     axis : array, shape (..., 3)
     angle : array, shape (...)
+
+    Raises
+    ------
+    ValueError for a zero-length axis.
     """
     axis = _check_vec(axis, "axis")
     n = np.linalg.norm(axis, axis=-1, keepdims=True)
@@ -188,7 +197,12 @@ def to_matrix(q) -> np.ndarray:
 
 
 def from_matrix(m) -> np.ndarray:
-    """Unit quaternions (w >= 0) of rotation matrices (..., 3, 3); numerically stable branch choice."""
+    """Unit quaternions (w >= 0) of rotation matrices (..., 3, 3); numerically stable branch choice.
+
+    Raises
+    ------
+    ValueError when ``m`` is not (..., 3, 3).
+    """
     m = np.asarray(m)
     if m.ndim < 2 or m.shape[-2:] != (3, 3):
         raise ValueError(f"expected (..., 3, 3) rotation matrices, got shape {m.shape}")

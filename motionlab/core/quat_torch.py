@@ -71,7 +71,12 @@ def conj(q: torch.Tensor) -> torch.Tensor:
 
 
 def inv(q: torch.Tensor) -> torch.Tensor:
-    """Inverse ``q* / |q|²``."""
+    """Inverse ``q* / |q|²``.
+
+    Raises
+    ------
+    ValueError for a zero-norm quaternion.
+    """
     q = _check(q)
     n2 = (q * q).sum(-1, keepdim=True)
     if bool((n2 < _EPS_NORM).any()):
@@ -147,7 +152,12 @@ def to_matrix(q: torch.Tensor) -> torch.Tensor:
 
 # Intended twin of quat.from_matrix (§2: torch twins keep the algorithm; tests/core/test_quat_torch.py pins them equal).
 def from_matrix(m: torch.Tensor) -> torch.Tensor:
-    """Unit quaternions (w >= 0) of (..., 3, 3) rotation matrices."""
+    """Unit quaternions (w >= 0) of (..., 3, 3) rotation matrices.
+
+    Raises
+    ------
+    ValueError when ``m`` is not (..., 3, 3).
+    """
     if m.ndim < 2 or tuple(m.shape[-2:]) != (3, 3):
         raise ValueError(f"expected (..., 3, 3) rotation matrices, got shape {tuple(m.shape)}")
     m00, m11, m22 = m[..., 0, 0], m[..., 1, 1], m[..., 2, 2]

@@ -104,7 +104,12 @@ class Skeleton:
         return f"Skeleton({self.num_joints} joints, root={self.names[0]!r}, height={self.height():.3f} m)"
 
     def index(self, name: str) -> int:
-        """Index of the joint called ``name``; a ``KeyError`` lists close names when absent."""
+        """Index of the joint called ``name``; a ``KeyError`` lists close names when absent.
+
+        Raises
+        ------
+        KeyError naming ``name`` and the closest joint names when there is no such joint.
+        """
         try:
             return self.names.index(name)
         except ValueError:
@@ -153,7 +158,12 @@ class Skeleton:
 
     # ------------------------------------------------------------------ derived skeletons
     def with_offsets(self, offsets: np.ndarray) -> Skeleton:
-        """The same tree with new rest offsets (J, 3); end sites scale with their bone."""
+        """The same tree with new rest offsets (J, 3); end sites scale with their bone.
+
+        Raises
+        ------
+        SkeletonError when ``offsets`` is not (J, 3).
+        """
         offsets = np.asarray(offsets, dtype=np.float64)
         if offsets.shape != self.offsets.shape:
             raise SkeletonError(f"expected offsets of shape {self.offsets.shape}, got {offsets.shape}")
@@ -183,6 +193,10 @@ class Skeleton:
         nearest kept ancestor with the rest offset summed along the removed chain.
 
         Returns the new skeleton and the kept indices as an array.
+
+        Raises
+        ------
+        SkeletonError when ``keep`` drops the root joint.
         """
         keep = np.array(sorted(set(int(k) for k in keep)), dtype=np.int64)
         if keep.size == 0 or keep[0] != 0:

@@ -30,7 +30,12 @@ the demo)."""
 
 
 def threads_for(rows: int) -> int:
-    """Threads for work of ``rows`` rows per step: 1 up to :data:`SMALL_ROWS`, else torch's setting."""
+    """Threads for work of ``rows`` rows per step: 1 up to :data:`SMALL_ROWS`, else torch's setting.
+
+    Raises
+    ------
+    ValueError when ``rows`` < 0.
+    """
     if rows < 0:
         raise ValueError(f"rows must be >= 0, got {rows}")
     return 1 if rows <= SMALL_ROWS else torch.get_num_threads()
@@ -38,7 +43,12 @@ def threads_for(rows: int) -> int:
 
 def batch_threads(device: str | torch.device, requested: int | None = None) -> int:
     """Threads for a batch job over many clips on ``device``: ``requested`` when given (>= 1),
-    else 1 on the CPU and torch's setting on other devices (module docstring)."""
+    else 1 on the CPU and torch's setting on other devices (module docstring).
+
+    Raises
+    ------
+    ValueError when ``requested`` < 1.
+    """
     if requested is not None:
         if requested < 1:
             raise ValueError(f"requested must be >= 1 thread, got {requested}")
@@ -48,7 +58,12 @@ def batch_threads(device: str | torch.device, requested: int | None = None) -> i
 
 @contextlib.contextmanager
 def torch_threads(count: int) -> Iterator[int]:
-    """Run the block with torch on ``count`` threads, restoring the previous count afterwards."""
+    """Run the block with torch on ``count`` threads, restoring the previous count afterwards.
+
+    Raises
+    ------
+    ValueError when ``count`` < 1.
+    """
     if count < 1:
         raise ValueError(f"count must be >= 1 thread, got {count}")
     before = torch.get_num_threads()

@@ -53,7 +53,12 @@ class ActionNode:
 
 
 def parse_transition(text: str) -> tuple[str, str]:
-    """``"walk -> stand"`` → ``("walk", "stand")``."""
+    """``"walk -> stand"`` → ``("walk", "stand")``.
+
+    Raises
+    ------
+    GraphError when ``text`` is not ``from -> to``.
+    """
     parts = [p.strip() for p in str(text).split("->")]
     if len(parts) != 2 or not all(parts):
         raise GraphError(f"expected a transition written 'from -> to', got {text!r}")
@@ -123,7 +128,12 @@ class ActionGraph:
         return sorted(b for a, b in self.edges if a == name)
 
     def path(self, start: str, goal: str) -> list[str]:
-        """Shortest chain of allowed transitions ``[start, …, goal]`` (breadth-first search)."""
+        """Shortest chain of allowed transitions ``[start, …, goal]`` (breadth-first search).
+
+        Raises
+        ------
+        GraphError when no chain of allowed transitions leads from ``start`` to ``goal``.
+        """
         self._need(start, goal)
         prev: dict[str, str | None] = {start: None}
         todo = deque([start])
@@ -143,7 +153,12 @@ class ActionGraph:
     def best_transition(self, a: str, b: str) -> tuple[int, int, float]:
         """``(i, j, D)``: key frame ``i`` of ``a``'s clip and key frame ``j`` of ``b``'s clip with the
         smallest inter-frame distance ``D`` (eq. 2; cached). Only the nodes' key frames
-        (:attr:`ActionNode.keys`, from PPCA) are searched, as in the paper's §3.1."""
+        (:attr:`ActionNode.keys`, from PPCA) are searched, as in the paper's §3.1.
+
+        Raises
+        ------
+        GraphError when either action has no key frames.
+        """
         self._need(a, b)
         if (a, b) not in self._best:
             ka, kb = self.nodes[a].keys, self.nodes[b].keys

@@ -97,6 +97,10 @@ def estimate(rot_a, pos_a, rot_b, pos_b, vertical: bool = False) -> RigidYaw:
     -------
     RigidYaw ``T`` with ``yaw(T.rotation ⊗ rot_b) = yaw(rot_a)`` and ``T(pos_b) = pos_a``
     (in x and z; in y too when ``vertical``).
+
+    Raises
+    ------
+    ValueError unless the rotations are (4,) and the positions (3,).
     """
     rot_a, rot_b = quat.check(rot_a, "rot_a"), quat.check(rot_b, "rot_b")
     pos_a, pos_b = np.asarray(pos_a, dtype=np.float64), np.asarray(pos_b, dtype=np.float64)
@@ -122,6 +126,11 @@ def fit_points(points_a, points_b, weights=None) -> RigidYaw:
     ----------
     points_a, points_b : array, shape (P, 3)   corresponding points, metres
     weights : array (P,), optional             non-negative weights (default: all 1)
+
+    Raises
+    ------
+    ValueError unless the point sets are two (P, 3) arrays of equal shape and the weights
+    (P,), non-negative, with a positive sum.
     """
     a, b = np.asarray(points_a, dtype=np.float64), np.asarray(points_b, dtype=np.float64)
     if a.shape != b.shape or a.ndim != 2 or a.shape[1] != 3:

@@ -242,6 +242,11 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
 
     Detect frames missing from a BVH stream (distance D > Δ between consecutive frames), insert the estimated number
     of frames and fill them.
+
+    Raises
+    ------
+    CLIError carrying the message of a BVH file that cannot be read or of a value the fill
+    refuses.
     """
     from motionlab.cli import CLIError
     from motionlab.core import bvh

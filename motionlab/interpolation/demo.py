@@ -99,6 +99,10 @@ def load_clips(paths: Sequence[str | Path], fps: float = 30.0, canonical: bool =
     """Load BVH files (or every ``*.bvh`` under folders), reduce to 22 joints, resample to ``fps``.
 
     Files that fail to load or map are skipped with a warning naming them.
+
+    Raises
+    ------
+    FileNotFoundError for a path that is neither a BVH file nor a folder.
     """
     from motionlab.core import bvh, humanoid
 

@@ -119,6 +119,10 @@ def check_delta(delta, name: str = "delta") -> float:
     """Δ as a float, or a ``ValueError`` naming ``name`` unless it is a finite number above 1.
 
     Δ compares a step with the typical step; Δ <= 1 would flag ordinary motion as dropped frames.
+
+    Raises
+    ------
+    ValueError naming ``name`` unless Δ is a finite number above 1.
     """
     try:
         value = float(delta)
@@ -713,7 +717,12 @@ class CountChoice:
 
 def count_choice(motion: Motion, t: int, start: int = 0, stop: int | None = None, seconds: float = 1.0) -> CountChoice:
     """Both stream counts of the gap at step ``t → t+1`` of ``motion`` (known steps ``start …
-    stop``, default the whole stream) and the rehearsal between them (:func:`estimate_missing`)."""
+    stop``, default the whole stream) and the rehearsal between them (:func:`estimate_missing`).
+
+    Raises
+    ------
+    ValueError unless 0 <= start <= t < stop <= the motion's last step + 1.
+    """
     last = motion.num_frames - 2  # the last step
     stop = last + 1 if stop is None else int(stop)
     t, start = int(t), int(start)

@@ -59,6 +59,10 @@ def window_features(
     """:func:`pose_features` for raw arrays ``(..., T, J, 4)`` and ``(..., T, J, 3)``: (..., T, 6J).
 
     Velocities are central differences (one-sided at the ends); ``T`` must be at least 2.
+
+    Raises
+    ------
+    ValueError for fewer than 2 frames.
     """
     g_rot, g_pos = fk(local_rot, translations, parents)
     local, yaw, _ = heading_frame(g_rot, g_pos, ref)
@@ -71,7 +75,12 @@ def window_features(
 
 
 def pose_features(motion: Motion, velocity_weight: float = VELOCITY_WEIGHT) -> np.ndarray:
-    """Per-frame features (T, 6J) of a motion: heading-frame positions and weighted velocities."""
+    """Per-frame features (T, 6J) of a motion: heading-frame positions and weighted velocities.
+
+    Raises
+    ------
+    ValueError for fewer than 2 frames.
+    """
     if motion.num_frames < 2:
         raise ValueError(f"pose features need at least 2 frames, got {motion.num_frames}")
     return window_features(
@@ -85,7 +94,12 @@ def pose_features(motion: Motion, velocity_weight: float = VELOCITY_WEIGHT) -> n
 
 
 def distance_matrix(features_a, features_b=None) -> np.ndarray:
-    """Euclidean distances (Ta, Tb) between the rows of two feature arrays (Ta, D), (Tb, D)."""
+    """Euclidean distances (Ta, Tb) between the rows of two feature arrays (Ta, D), (Tb, D).
+
+    Raises
+    ------
+    ValueError unless ``a`` and ``b`` are (Ta, D) and (Tb, D) with the same D.
+    """
     a = np.asarray(features_a, dtype=np.float64)
     b = a if features_b is None else np.asarray(features_b, dtype=np.float64)
     if a.ndim != 2 or b.ndim != 2 or a.shape[1] != b.shape[1]:

@@ -68,6 +68,10 @@ def plant_feet(motion: Motion, a: int, b: int) -> Motion:
     Returns
     -------
     Motion, a copy; the same values where no foot is below the floor
+
+    Raises
+    ------
+    ValueError unless 0 <= a < b < T and frames ``a … b`` are filled (no NaN).
     """
     a, b = int(a), int(b)
     if not 0 <= a < b < motion.num_frames:

@@ -156,7 +156,12 @@ def load_times(path, frames: int | None = None) -> np.ndarray:
 
 def timestamp_gaps(times, fps: float) -> list[tuple[int, int]]:
     """Where frames are missing from timestamps (seconds): ``(after frame i, missing count)``, the
-    count being the frame periods ``1/fps`` between two times, rounded, less one."""
+    count being the frame periods ``1/fps`` between two times, rounded, less one.
+
+    Raises
+    ------
+    ValueError unless the timestamps are (T,) and strictly increasing.
+    """
     t = np.asarray(times, dtype=np.float64)
     if t.ndim != 1 or not np.all(np.diff(t) > 0):
         raise ValueError("expected strictly increasing timestamps (T,) in seconds")
@@ -166,7 +171,12 @@ def timestamp_gaps(times, fps: float) -> list[tuple[int, int]]:
 
 def insert_missing(motion: Motion, missing: list[tuple[int, int]]) -> tuple[Motion, list[tuple[int, int]]]:
     """Insert NaN frames: ``missing`` holds ``(after frame i, count)``; returns the longer motion
-    and its gaps ``(start, stop)``."""
+    and its gaps ``(start, stop)``.
+
+    Raises
+    ------
+    ValueError for a gap after the last frame (or before the first).
+    """
     order = sorted((int(i), int(n)) for i, n in missing if n > 0)
     rot, root, lpos, gaps = [], [], [], []
     prev, shift = 0, 0
@@ -193,7 +203,12 @@ def insert_missing(motion: Motion, missing: list[tuple[int, int]]) -> tuple[Moti
 # ---------------------------------------------------------------------------- filling
 def fill_rows(x, curve: str = "linear") -> np.ndarray:
     """Fill NaN rows of a plain array (T, D) by linear interpolation between bounding rows
-    (α from ``curve``); leading/trailing NaN rows copy the nearest known row."""
+    (α from ``curve``); leading/trailing NaN rows copy the nearest known row.
+
+    Raises
+    ------
+    ValueError for an empty array or one whose every row is missing.
+    """
     x = np.asarray(x, dtype=np.float64)
     if x.ndim < 1 or len(x) == 0:
         raise ValueError(f"expected a (T, ...) array, got shape {x.shape}")
@@ -313,6 +328,10 @@ def moving_slerp(rot_a, trans_a, rot_b, trans_b, curve: str = "linear") -> tuple
     Returns
     -------
     rot : ndarray (L+1, J, 4), trans : ndarray (L+1, J, 3)
+
+    Raises
+    ------
+    ValueError unless the sequences are two (L+1, J, 4) arrays with L >= 1.
     """
     rot_a, rot_b = quat.check(rot_a, "rot_a"), quat.check(rot_b, "rot_b")
     if rot_a.shape != rot_b.shape or rot_a.ndim != 3 or len(rot_a) < 2:
@@ -504,6 +523,11 @@ def smooth_root(motion: Motion, anchors, joint: int | None = None) -> Motion:
     motion : Motion, finite at frames ``a … b`` (frames outside may hold NaN)
     anchors : sequence of int, increasing; the path changes only strictly between ``a`` and ``b``
     joint : the reference joint; default :func:`~.alignment.reference_joint` of the known frames
+
+    Raises
+    ------
+    ValueError unless ``anchors`` are two or more increasing frames of the motion whose
+    root path between them is filled.
     """
     knots = np.asarray(anchors, dtype=np.int64)
     if knots.ndim != 1 or knots.size < 2 or np.any(np.diff(knots) < 1):

@@ -105,6 +105,11 @@ def interpolate(
     -------
     rot : ndarray, shape (..., N, J, 4)
     pos : ndarray, shape (..., N, 3)
+
+    Raises
+    ------
+    ValueError for an unknown ``root`` or ``rotation`` mode, or angular velocities of the
+    wrong shape.
     """
     rot_a, pos_a, rot_b, pos_b = _check_pair(rot_a, pos_a, rot_b, pos_b)
     if root not in ROOT_MODES:
@@ -187,6 +192,10 @@ def fill_between(
     The frames in the gap may hold anything (NaN included); only the bounding frames and, for
     Hermite modes, their outer neighbours are read. Per-joint translations (``local_pos``) are
     interpolated linearly.
+
+    Raises
+    ------
+    ValueError unless the gap has a known frame on each side (1 <= start <= stop <= T-1).
     """
     T = motion.num_frames
     if not (1 <= start <= stop <= T - 1):
@@ -231,6 +240,10 @@ def inbetween(
     With ``align`` the second motion is first brought into the frame of the first (root
     alignment, eq. 3: a rotation about the vertical and a horizontal translation so that its
     first frame continues from the last frame of ``first``; see :mod:`.alignment`).
+
+    Raises
+    ------
+    ValueError when the motions differ in skeleton or frame rate, or one has no frame.
     """
     if not first.skeleton.equals(second.skeleton):
         raise ValueError("both motions must use the same skeleton (names, parents and offsets)")
@@ -250,7 +263,12 @@ def inbetween(
 
 
 def concatenate(motions: list[Motion]) -> Motion:
-    """Motions of one skeleton one after another (no alignment, no blending), at the first's fps."""
+    """Motions of one skeleton one after another (no alignment, no blending), at the first's fps.
+
+    Raises
+    ------
+    ValueError for no motion, or motions of different skeletons.
+    """
     if not motions:
         raise ValueError("nothing to concatenate")
     m0 = motions[0]

@@ -45,6 +45,10 @@ def window_stats(z, window: int) -> np.ndarray:
 
     The window is ``window`` frames wide (edges padded by repeating the end frames); computed with
     cumulative sums, no loop over frames.
+
+    Raises
+    ------
+    ValueError when ``z`` is not (T, q).
     """
     z = np.asarray(z, dtype=np.float64)
     if z.ndim != 2:
@@ -71,6 +75,10 @@ def kmeans(x, k: int, seed: int = 0, iters: int = 100, restarts: int = 4) -> tup
     -------
     labels : ndarray (N,) of int
     centres : ndarray (k, D)
+
+    Raises
+    ------
+    ValueError unless ``x`` is (N, D) and 1 <= k <= N.
     """
     x = np.asarray(x, dtype=np.float64)
     if x.ndim != 2 or not 1 <= k <= len(x):
@@ -187,6 +195,10 @@ def segment(
     q : int                   PPCA latent size
     min_length : int          shortest allowed segment, frames
     window : int              width of the window of latent statistics, frames
+
+    Raises
+    ------
+    ValueError unless the features are (T, D) with at least ``k`` frames.
     """
     f = np.asarray(features, dtype=np.float64)
     if f.ndim != 2 or len(f) < k:
@@ -216,6 +228,10 @@ def node_key_frames(features, n: int = 5, q: int = 4, seed: int = 0) -> tuple[np
     -------
     keys : ndarray (<= n,) of int   frame indices into the clip, increasing
     latent : ndarray (T, q)         the PPCA posterior means
+
+    Raises
+    ------
+    ValueError unless the features are (T, D) with at least 2 frames.
     """
     f = np.asarray(features, dtype=np.float64)
     if f.ndim != 2 or len(f) < 2:
@@ -228,7 +244,12 @@ def node_key_frames(features, n: int = 5, q: int = 4, seed: int = 0) -> tuple[np
 
 def key_frames(latent, n: int, seed: int = 0) -> np.ndarray:
     """``n`` key frames of one segment's latent trajectory (T, q): medoids of ``n`` sub-clusters,
-    sorted by time. Returns frame indices (n,) into the segment (fewer if T < n)."""
+    sorted by time. Returns frame indices (n,) into the segment (fewer if T < n).
+
+    Raises
+    ------
+    ValueError unless ``z`` is a non-empty (T, q) array.
+    """
     z = np.asarray(latent, dtype=np.float64)
     if z.ndim != 2 or len(z) == 0:
         raise ValueError(f"expected a non-empty (T, q) latent trajectory, got shape {z.shape}")
@@ -247,6 +268,10 @@ def purity(predicted, truth) -> tuple[float, dict]:
 
     Returns the fraction of frames whose cluster's majority action is their true action, and
     ``{cluster: majority action}``.
+
+    Raises
+    ------
+    ValueError when the label arrays differ in shape.
     """
     predicted, truth = np.asarray(predicted), np.asarray(truth)
     if predicted.shape != truth.shape:

@@ -68,7 +68,12 @@ well off the ground, move fast and have flight phases; a squat must bring the hi
 
 
 def measure(motion: Motion) -> ActionMeasures:
-    """:class:`ActionMeasures` of a clip on the 22-joint canonical skeleton (any frame rate, >= 2 frames)."""
+    """:class:`ActionMeasures` of a clip on the 22-joint canonical skeleton (any frame rate, >= 2 frames).
+
+    Raises
+    ------
+    ValueError for fewer than 2 frames or a skeleton that is not the canonical 22 joints.
+    """
     if motion.num_frames < 2:
         raise ValueError(f"clip {motion.name!r}: need at least 2 frames to measure speed, got {motion.num_frames}")
     names = list(motion.skeleton.names)
@@ -92,7 +97,12 @@ def measure(motion: Motion) -> ActionMeasures:
 
 
 def check(motion: Motion, label: str) -> ActionMeasures:
-    """The clip's :class:`ActionMeasures`, or :class:`LabelError` if they break ``RULES[label]``."""
+    """The clip's :class:`ActionMeasures`, or :class:`LabelError` if they break ``RULES[label]``.
+
+    Raises
+    ------
+    ValueError for an action with no rule; LabelError when a measure breaks the label's rule.
+    """
     if label not in RULES:
         raise ValueError(f"no rule for action {label!r}; known: {sorted(RULES)}")
     m = measure(motion)

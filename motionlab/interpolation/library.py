@@ -65,6 +65,12 @@ class MotionLibrary:
         velocity_weight: float = VELOCITY_WEIGHT,
         displacement_weight: float = 1.0,
     ) -> None:
+        """Index the clips (and their labels) for searches.
+
+        Raises
+        ------
+        ValueError for no clip, or a label count other than the clip count.
+        """
         motions = list(motions)
         if not motions:
             raise ValueError("a motion library needs at least one clip")
@@ -149,6 +155,10 @@ class MotionLibrary:
         (leave-one-out evaluation). ``allowed_labels``: only clips with these labels.
         ``query_labels`` (W,) of str, optional: each query may only use clips of its own label
         (the action node it lies in). A query with no usable stretch gets cost ``inf``.
+
+        Raises
+        ------
+        ValueError when no stretch of the library (with the allowed labels) is long enough.
         """
         s, keys = self._keys(gap)
         if allowed_labels is not None:
@@ -199,6 +209,10 @@ class MotionLibrary:
         trans : ndarray (W, N, J, 3)
         cost : ndarray (W,)              matching cost of the best stretch (``inf``: none was
                                          allowed; that gap's frames are then meaningless)
+
+        Raises
+        ------
+        ValueError for context arrays of the wrong shapes or ``num`` < 1.
         """
         rot_ctx, rot_b = quat.check(rot_ctx, "rot_ctx"), quat.check(rot_b, "rot_b")
         trans_ctx, trans_b = np.asarray(trans_ctx, dtype=np.float64), np.asarray(trans_b, dtype=np.float64)

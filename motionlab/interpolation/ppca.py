@@ -63,11 +63,23 @@ class PCA:
     """
 
     def __init__(self, q: int) -> None:
+        """A PCA with ``q`` latent dimensions, not fitted yet.
+
+        Raises
+        ------
+        ValueError unless ``q`` is a whole number >= 1.
+        """
         if int(q) != q or q < 1:
             raise ValueError(f"latent size q must be a positive integer, got {q!r}")
         self.q = int(q)
 
     def fit(self, x) -> PCA:
+        """Fit the mean and the ``q`` principal axes to samples ``x`` (N, D).
+
+        Raises
+        ------
+        ValueError when ``q`` exceeds the data dimension D.
+        """
         x = _data(x)
         if self.q > x.shape[1]:
             raise ValueError(f"latent size q={self.q} exceeds the data dimension D={x.shape[1]}")
@@ -111,6 +123,12 @@ class PPCA:
     """
 
     def __init__(self, q: int, method: str = "closed", max_iter: int = 500, tol: float = 1e-8, seed: int = 0) -> None:
+        """A probabilistic PCA with ``q`` latent dimensions, fitted by ``method``, not fitted yet.
+
+        Raises
+        ------
+        ValueError unless ``q`` is a whole number >= 1 and ``method`` is ``'closed'`` or ``'em'``.
+        """
         if int(q) != q or q < 1:
             raise ValueError(f"latent size q must be a positive integer, got {q!r}")
         if method not in ("closed", "em"):
@@ -119,7 +137,12 @@ class PPCA:
 
     # ------------------------------------------------------------------ fitting
     def fit(self, x) -> PPCA:
-        """Fit μ, W and σ² to samples ``x`` (N, D)."""
+        """Fit μ, W and σ² to samples ``x`` (N, D).
+
+        Raises
+        ------
+        ValueError unless ``q`` is smaller than the data dimension D.
+        """
         x = _data(x)
         n, d = x.shape
         if self.q >= d:

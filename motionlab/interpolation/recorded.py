@@ -117,6 +117,11 @@ def body_features(
                              velocities (m/s) of the reference joint and the K-1 joints below it
     pace : ndarray (T,)      RMS over those joints of the heading-frame position change into each
                              frame (frame 0: into frame 1), metres per frame
+
+    Raises
+    ------
+    ValueError for an unknown ``difference``, or (mirrored) a left or right joint with no
+    partner by name.
     """
     g_rot, g_pos = motion.fk()
     j, inside = _body(motion, ref)
@@ -153,6 +158,12 @@ class RecordedTakes:
     """
 
     def __init__(self, motions, mirror: bool = True) -> None:
+        """Per-frame features of the takes, ready to be read off.
+
+        Raises
+        ------
+        ValueError for no clip, or only clips shorter than two frames.
+        """
         if hasattr(motions, "nodes"):
             motions = [node.motion for node in motions.nodes.values()]
         motions = list(motions)
@@ -187,7 +198,12 @@ class RecordedTakes:
         self._sq = np.sum(self.feat**2, axis=1)  # (N,) |F[i]|²
 
     def without(self, name: str) -> RecordedTakes:
-        """These takes less every take named ``name`` (and its mirror image): leave one take out."""
+        """These takes less every take named ``name`` (and its mirror image): leave one take out.
+
+        Raises
+        ------
+        ValueError when no take would be left.
+        """
         keep = np.array([n != name for n in self.takes])[self.owner]
         if not keep.any():
             raise ValueError(f"recorded takes: nothing left without {name!r}")
@@ -261,6 +277,10 @@ def recorded_missing(
         quality : float, the voting takes' median matching cost over the stream's squared pace at
         the gap (dimensionless; below 1 is a match closer than one frame of the stream's motion)
         ``None`` when no take holds both ends.
+
+    Raises
+    ------
+    ValueError when the stream's skeleton or frame rate differs from the takes'.
     """
     if tuple(motion.skeleton.names) != tuple(takes.names):
         raise ValueError("the stream uses another skeleton than the recorded takes")

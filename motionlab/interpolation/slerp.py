@@ -45,6 +45,10 @@ def alphas(num: int, curve: str = "linear") -> np.ndarray:
     Returns
     -------
     ndarray, shape (num,)   increasing weights; ``alphas(N)[k-1]`` is α(k)
+
+    Raises
+    ------
+    ValueError unless ``num`` is a whole number >= 0 and ``curve`` one of :data:`CURVES`.
     """
     if int(num) != num or num < 0:
         raise ValueError(f"expected a non-negative whole number of in-between frames, got {num!r}")

@@ -74,6 +74,11 @@ def load_folder(
 
     ``name_map``: ``{stem: label text}`` or a callable (:func:`.naming.parse_name`). Files whose
     names give no label are skipped, or raise with ``strict=True``. ``progress``: a tqdm bar.
+
+    Raises
+    ------
+    FileNotFoundError when ``folder`` is not a folder or holds no BVH file with a
+    behaviour_style name.
     """
     folder = Path(folder)
     if not folder.is_dir():
@@ -121,7 +126,12 @@ def bandai_styles(
 
 
 def mixamo_aj(fps: float = 30.0, name_map: Mapping[str, str] = MIXAMO_AJ) -> list[Motion]:
-    """Mixamo Aj clips named in ``name_map`` (basic and transition clips), labelled."""
+    """Mixamo Aj clips named in ``name_map`` (basic and transition clips), labelled.
+
+    Raises
+    ------
+    DataNotFound when none of the clips is found.
+    """
     root = _data.data_root() / "mixamo" / "Aj"
     out = []
     for stem, text in name_map.items():

@@ -134,6 +134,10 @@ def segment_cycles(
     Returns
     -------
     :class:`Cycles`
+
+    Raises
+    ------
+    ValueError naming the joint when the clip lacks an ankle joint.
     """
     names = list(motion.skeleton.names)
     missing = [f for f in feet if f not in names]
@@ -158,6 +162,10 @@ def cycles_from_ankles(ankles, fps: float, height: float = 0.06, speed: float = 
     Returns
     -------
     :class:`Cycles`
+
+    Raises
+    ------
+    ValueError when ``ankles`` is not (T, 2, 3).
     """
     ankles = np.asarray(ankles, dtype=np.float64)
     if ankles.ndim != 3 or ankles.shape[1:] != (2, 3):

@@ -371,6 +371,11 @@ def threshold_from(rms_metres: float | None = None, relative: float | None = Non
     many metres (root mean square over the weighted points) — or *relative to the data*:
     ``relative × scale`` metres, where ``scale`` is a size of the data, by convention the
     character's height (so ``relative=0.03`` accepts 3% of the height, about 5 cm for an adult).
+
+    Raises
+    ------
+    ValueError unless exactly one of ``rms_metres`` and ``relative`` is given, positive
+    (``relative`` with a positive ``scale``).
     """
     if (rms_metres is None) == (relative is None):
         raise ValueError("give exactly one of rms_metres (absolute) or relative (with scale)")

@@ -172,6 +172,12 @@ class MotionGraph:
         return np.searchsorted(self.starts(), np.asarray(frames), side="right") - 1
 
     def clip_index(self, name: str) -> int:
+        """Index of the clip called ``name``.
+
+        Raises
+        ------
+        GraphError when no clip has that name.
+        """
         for i, c in enumerate(self.clips):
             if c.name == name:
                 return i
@@ -329,7 +335,13 @@ class MotionGraph:
     # ------------------------------------------------------------------ paths
     def check_path(self, pieces: Sequence[tuple[int, int, int]]) -> None:
         """Raise :class:`GraphError` unless ``pieces`` — ``(clip, first, last)`` frame runs, clip
-        frame numbers, inclusive — is a walk along the graph's edges."""
+        frame numbers, inclusive — is a walk along the graph's edges.
+
+        Raises
+        ------
+        GraphError naming the first piece outside its clip, over removed frames, or with no
+        edge from the piece before.
+        """
         prev = None
         for n, (c, a, b) in enumerate(pieces):
             info = self.clips[c]
@@ -396,7 +408,13 @@ def _reach(adj: tuple[np.ndarray, np.ndarray], start: np.ndarray, allowed: np.nd
 
 
 def check_motions(motions: Sequence[Motion]) -> tuple[Skeleton, float]:
-    """All clips must share joint count and frame rate; returns the first skeleton and fps."""
+    """All clips must share joint count and frame rate; returns the first skeleton and fps.
+
+    Raises
+    ------
+    GraphError naming the clip when there is none, or clips differ in joint count, frame
+    rate or bone offsets, or one has fewer than 3 frames.
+    """
     if len(motions) == 0:
         raise GraphError("a motion graph needs at least one clip")
     first = motions[0]

@@ -72,6 +72,10 @@ def dtw(cost: np.ndarray, min_length: int | None = None) -> Registration:
 
     See the module docstring. ``min_length``: shortest accepted path (default: half the shorter
     side, at least 2).
+
+    Raises
+    ------
+    ValueError unless the cost matrix is 2-D with at least 2 rows and columns.
     """
     c = np.asarray(cost, dtype=np.float64)
     if c.ndim != 2 or min(c.shape) < 2:
@@ -140,7 +144,12 @@ class RootTrack:
 
 
 def root_track(motion: Motion, global_pos: np.ndarray | None = None) -> RootTrack:
-    """Heading-frame description of a canonical motion's root (see :class:`RootTrack`)."""
+    """Heading-frame description of a canonical motion's root (see :class:`RootTrack`).
+
+    Raises
+    ------
+    ValueError when the motion is not on the 22-joint canonical skeleton.
+    """
     if not humanoid.is_canonical(motion.skeleton):
         raise ValueError("registration needs 22-joint canonical motions; reduce them with preprocess.prepare first")
     pos = motion.global_positions() if global_pos is None else global_pos
@@ -178,6 +187,10 @@ def blend(
     Returns a Motion of about ``(1-w)·len_A + w·len_B`` frames over the registered part,
     starting at A's first registered frame's position and heading. ``tracks``: the clips'
     :func:`root_track` if already computed.
+
+    Raises
+    ------
+    ValueError when ``weight`` is outside [0, 1] or the clips differ in joint count.
     """
     if not 0.0 <= weight <= 1.0:
         raise ValueError(f"blend weight must lie in [0, 1], got {weight}")

@@ -653,6 +653,12 @@ class Planner:
     """
 
     def __init__(self, graph: MotionGraph, cost=default_cost):
+        """A planner for ``graph`` under the search ``cost`` (nothing is built yet).
+
+        Raises
+        ------
+        SearchError when the graph has no structure table.
+        """
         if not graph.table.get("behaviours"):
             raise SearchError("this graph has no structure table (a standard graph?); use search_standard")
         self.g = graph
@@ -672,6 +678,12 @@ class Planner:
         return self.walkers[key]
 
     def check(self, seg: Segment) -> tuple[str, str]:
+        """The ``(behaviour, style)`` key of a segment, checked against the graph.
+
+        Raises
+        ------
+        SearchError naming the segment's behaviour or style when the graph lacks it.
+        """
         if seg.behaviour not in self.entries:
             raise SearchError(f"no behaviour {seg.behaviour!r} in the graph; behaviours: {sorted(self.entries)}")
         styles = self.entries[seg.behaviour]
@@ -682,7 +694,12 @@ class Planner:
         return (seg.behaviour, seg.style)
 
     def hops(self, a: tuple[str, str], b: tuple[str, str]) -> list[dict]:
-        """Links from ``a`` to ``b`` through the structure table, fewest hops (BFS)."""
+        """Links from ``a`` to ``b`` through the structure table, fewest hops (BFS).
+
+        Raises
+        ------
+        SearchError naming what is reachable from ``a`` when no link leads to ``b``.
+        """
         prev: dict[tuple[str, str], tuple] = {a: None}
         queue = deque([a])
         while queue:

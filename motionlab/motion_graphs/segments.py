@@ -143,6 +143,10 @@ def planted(ankles, fps: float, leg: float) -> np.ndarray:
     Returns
     -------
     ndarray, shape (T, 2), bool
+
+    Raises
+    ------
+    ValueError when ``ankles`` is not (T, 2, 3).
     """
     ankles = np.asarray(ankles, dtype=np.float64)
     if ankles.ndim != 3 or ankles.shape[1:] != (2, 3):

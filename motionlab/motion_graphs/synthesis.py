@@ -90,6 +90,11 @@ def synthesize(
     Returns
     -------
     Motion on the graph's skeleton, ``sum(last - first + 1)`` frames.
+
+    Raises
+    ------
+    ValueError for an empty path, a piece outside its clip, ``blend`` < 0 or an unknown
+    ``align``.
     """
     if len(pieces) == 0:
         raise ValueError("empty path: nothing to synthesise")

@@ -57,7 +57,12 @@ DEFAULT_CHECKPOINT = Path(__file__).resolve().parent.parent / "assets" / "retarg
 
 
 def load_default(device=None) -> Checkpoint:
-    """The shipped pretrained network (CUDA when available, else CPU)."""
+    """The shipped pretrained network (CUDA when available, else CPU).
+
+    Raises
+    ------
+    FileNotFoundError when the shipped checkpoint is missing.
+    """
     if not DEFAULT_CHECKPOINT.is_file():
         raise FileNotFoundError(
             f"the default retargeting checkpoint {DEFAULT_CHECKPOINT} is missing; re-create it with "

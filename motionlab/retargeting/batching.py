@@ -110,6 +110,10 @@ def plan_batches(pairs: Sequence[Pair], max_frames: int) -> list[list[Pair]]:
     """Group pairs of equal length into batches of at most ``max_frames`` frames (at least one pair).
 
     Longest clips first, pairs kept in their given order within a length; deterministic.
+
+    Raises
+    ------
+    ValueError when ``max_frames`` < 1.
     """
     if max_frames < 1:
         raise ValueError(f"max_frames must be >= 1, got {max_frames}")

@@ -152,7 +152,13 @@ def save(path: str | os.PathLike, checkpoint: Checkpoint, overwrite: bool = True
 def load(path: str | os.PathLike, device: str | torch.device | None = None, dtype: str = "float64") -> Checkpoint:
     """Read a checkpoint written by :func:`save`; the network is in ``eval()`` mode on ``device``
     (default: CUDA when available, else CPU) and computes in ``dtype`` (a key of :data:`DTYPES`,
-    whatever type its weights were stored in)."""
+    whatever type its weights were stored in).
+
+    Raises
+    ------
+    FileNotFoundError when there is no file; CheckpointError naming ``path`` when it is not
+    a readable checkpoint of this format version; ValueError for an unknown ``dtype``.
+    """
     if dtype not in DTYPES:
         raise ValueError(f"dtype must be one of {tuple(DTYPES)}, got {dtype!r}")
     path = Path(path)

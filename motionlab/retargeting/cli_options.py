@@ -24,6 +24,12 @@ def _error(msg: str):
 
 
 def load_checkpoint(path: str | None, device: str | None):
+    """The network of the checkpoint at ``path`` (the shipped one when ``path`` is None) on ``device``.
+
+    Raises
+    ------
+    CLIError when the checkpoint cannot be loaded.
+    """
     from motionlab import retargeting
 
     try:
@@ -33,6 +39,12 @@ def load_checkpoint(path: str | None, device: str | None):
 
 
 def solver_config(args):
+    """The solver settings of the parsed options, each checked against its range.
+
+    Raises
+    ------
+    CLIError naming the option whose value is out of range.
+    """
     from motionlab.retargeting.solver import SolverConfig
 
     rounds = SolverConfig().project_iters

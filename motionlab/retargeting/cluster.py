@@ -32,7 +32,12 @@ INSTALL_HINT = 'the Ray backend needs Ray: pip install "motionlab[cluster]" (or 
 
 
 def require_ray():
-    """The ``ray`` module, or ``ImportError`` saying how to install it."""
+    """The ``ray`` module, or ``ImportError`` saying how to install it.
+
+    Raises
+    ------
+    ImportError saying how to install ray.
+    """
     try:
         import ray
     except ImportError:
@@ -71,7 +76,12 @@ def solve_batches_ray(
     address: str | None = None,
     workers: int = 2,
 ) -> Iterator[list[PairResult]]:
-    """Solve ``batches`` on Ray actors; yields each batch's results as it completes."""
+    """Solve ``batches`` on Ray actors; yields each batch's results as it completes.
+
+    Raises
+    ------
+    ValueError when ``workers`` < 1.
+    """
     ray = require_ray()
     if workers < 1:
         raise ValueError(f"workers must be >= 1, got {workers}")

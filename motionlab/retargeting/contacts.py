@@ -91,6 +91,11 @@ def detect_contacts(
     Returns
     -------
     ndarray of bool, shape (T, 4), in :data:`CONTACT_JOINTS` order
+
+    Raises
+    ------
+    ValueError unless the positions are (T, 22, 3), the rest heights (4,), and ``height``
+    and ``fps`` positive.
     """
     pos = np.asarray(positions, dtype=np.float64)
     if pos.ndim != 3 or pos.shape[1:] != (len(humanoid.JOINTS), 3):

@@ -121,6 +121,10 @@ def training_clips(
     its parent (the shared data does), the rows with ``purpose == "train_character"`` and
     ``subject == source`` inside ``folder`` are used; otherwise every ``<source>/*.bvh`` whose
     stem is not in ``exclude``. Evaluated animations are always excluded.
+
+    Raises
+    ------
+    FileNotFoundError when the source's folder is missing or holds no training clip.
     """
     folder = Path(folder)
     excluded = {e.lower() for e in exclude}
@@ -150,7 +154,12 @@ def training_clips(
 
 
 def shared_animations(folder: str | Path, source: str, targets: Sequence[str]) -> list[str]:
-    """The animation stems that ``source`` and every target have in ``folder``, sorted."""
+    """The animation stems that ``source`` and every target have in ``folder``, sorted.
+
+    Raises
+    ------
+    FileNotFoundError for a missing character folder; ValueError when no animation is shared.
+    """
     folder = Path(folder)
     for name in (source, *targets):
         if not (folder / name).is_dir():

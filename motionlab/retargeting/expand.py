@@ -539,6 +539,10 @@ def expand(
     Returns
     -------
     ExpandResult
+
+    Raises
+    ------
+    ValueError for an unknown ``backend`` or ``output_format``.
     """
     if backend not in ("local", "ray"):
         raise ValueError(f"backend must be 'local' or 'ray', got {backend!r}")

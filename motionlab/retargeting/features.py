@@ -47,7 +47,13 @@ class ClipFeatures:
 
 
 def check_motion(motion: Motion, what: str = "motion") -> None:
-    """Refuse empty motions and NaN/infinite values with a clear ``ValueError``."""
+    """Refuse empty motions and NaN/infinite values with a clear ``ValueError``.
+
+    Raises
+    ------
+    ValueError for something other than a Motion, fewer than 2 frames, or NaN/infinite
+    values (naming the frame).
+    """
     if not isinstance(motion, Motion):
         raise ValueError(f"expected a motionlab Motion as {what}, got {type(motion).__name__}")
     label = f"{what} {motion.name!r}" if motion.name else what
@@ -61,7 +67,12 @@ def check_motion(motion: Motion, what: str = "motion") -> None:
 
 
 def clip_features(motion: Motion) -> ClipFeatures:
-    """Features of a canonical (22-joint) motion; see the module docstring."""
+    """Features of a canonical (22-joint) motion; see the module docstring.
+
+    Raises
+    ------
+    ValueError when the motion is not on the 22-joint canonical skeleton.
+    """
     check_motion(motion)
     if not humanoid.is_canonical(motion.skeleton):
         raise ValueError("clip_features needs a 22-joint canonical motion; call preprocess.prepare(motion) first")

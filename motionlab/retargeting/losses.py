@@ -85,7 +85,12 @@ def recon_loss(pred: torch.Tensor, target: torch.Tensor, weight: float = LAMBDA_
 
 
 def bone_directions(positions: torch.Tensor) -> torch.Tensor:
-    """θ: unit parent→joint directions (..., T, 22, 3) of root-centred heading-frame positions."""
+    """θ: unit parent→joint directions (..., T, 22, 3) of root-centred heading-frame positions.
+
+    Raises
+    ------
+    ValueError when ``positions`` is not (..., 22, 3).
+    """
     if positions.shape[-2:] != (len(humanoid.JOINTS), 3):
         raise ValueError(f"expected canonical positions (..., 22, 3), got {tuple(positions.shape)}")
     return fk_torch.bone_directions(positions, humanoid.PARENTS)
@@ -98,6 +103,10 @@ def angle_loss(source_rot: torch.Tensor, generated_rot: torch.Tensor) -> torch.T
     rotations (so ≈ α/2 for small α, in radians).
 
     Both inputs are local rotations (..., T, 22, 4) (unit quaternions; the root's in the heading frame).
+
+    Raises
+    ------
+    ValueError unless the two rotation tensors are (..., T, J, 4) of equal shape.
     """
     if source_rot.shape != generated_rot.shape or source_rot.shape[-1] != 4:
         raise ValueError(
@@ -129,6 +138,10 @@ def foot_loss(world_y: torch.Tensor) -> torch.Tensor:
     ----------
     world_y : Tensor (..., T, 22) heights of all joints above the ground, or (..., T, 4) of the
         feet only (LeftFoot, RightFoot, LeftToeBase, RightToeBase), metres.
+
+    Raises
+    ------
+    ValueError when the heights are neither (..., T, 22) nor (..., T, 4).
     """
     if world_y.shape[-1] == len(humanoid.JOINTS):
         world_y = world_y[..., list(FOOT_JOINTS)]
@@ -138,7 +151,12 @@ def foot_loss(world_y: torch.Tensor) -> torch.Tensor:
 
 
 def rotation_loss(local_rot: torch.Tensor, target_rot: torch.Tensor) -> torch.Tensor:
-    """Mean of ``1 − ⟨q, q̂⟩²`` (0 for equal rotations, sign-agnostic) over (..., J, 4) quaternions."""
+    """Mean of ``1 − ⟨q, q̂⟩²`` (0 for equal rotations, sign-agnostic) over (..., J, 4) quaternions.
+
+    Raises
+    ------
+    ValueError unless the two tensors are (..., 4) of equal shape.
+    """
     if local_rot.shape != target_rot.shape or local_rot.shape[-1] != 4:
         raise ValueError(
             f"rotation_loss: expected two (..., 4) tensors of equal shape, got {tuple(local_rot.shape)} and {tuple(target_rot.shape)}"
@@ -159,6 +177,10 @@ def contact_loss(feet: torch.Tensor, planted: torch.Tensor, fps: float | torch.T
     fps : frames per second of ``feet`` (a number or a 0-d tensor)
 
     Returns 0 (with a gradient path) when no foot is ever planted.
+
+    Raises
+    ------
+    ValueError unless ``feet`` is (..., T, F, 3) and ``planted`` (..., T, F).
     """
     if feet.shape[-1] != 3 or planted.shape != feet.shape[:-1]:
         raise ValueError(

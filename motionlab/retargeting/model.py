@@ -108,6 +108,11 @@ def skeleton_tensor(offsets, dtype=torch.float32, device=None) -> torch.Tensor:
 
     ``s̄_j = p̄_j − p̄_parent(j)`` in the T-pose, root at the origin (paper A, §2.2, eq. 3).
     Accepts a :class:`~motionlab.core.skeleton.Skeleton`, an array or a tensor (…, 22, 3).
+
+    Raises
+    ------
+    ValueError when the skeleton is not the 22-joint canonical one, or the offsets not
+    (..., 22, 3).
     """
     if hasattr(offsets, "offsets") and hasattr(offsets, "parents"):
         if not humanoid.is_canonical(offsets):
@@ -244,7 +249,12 @@ class RetargetNet(nn.Module):
     # ------------------------------------------------------------------ the five steps
     def encode(self, x: torch.Tensor) -> torch.Tensor:
         """φ = F_enc(X): normalised features (B, T, 70) → per-frame latent (B, T, D), in the
-        network's float type (``x`` is cast to it)."""
+        network's float type (``x`` is cast to it).
+
+        Raises
+        ------
+        ValueError when ``x`` is not (B, T, 70).
+        """
         if x.ndim != 3 or x.shape[-1] != FEATURE_DIM:
             raise ValueError(f"expected normalised features (B, T, {FEATURE_DIM}), got {tuple(x.shape)}")
         return self.f_enc(x.to(self.f_qlinear.weight.dtype))

@@ -178,6 +178,10 @@ def root_scale(source: Skeleton, target: Skeleton, mode: str = "stride") -> tupl
 
     ``mode="contacts"`` depends on the motion (:func:`contact_stride`); here it gives the
     skeleton-only fallback, the ``"stride"`` ratios.
+
+    Raises
+    ------
+    ValueError for an unknown ``mode`` or a root measure of (nearly) zero.
     """
     if mode == "contacts":
         mode = "stride"
@@ -285,7 +289,12 @@ class PreparedPair:
 def prepare_source(
     source: Motion, checkpoint: Checkpoint | None, method: str = "full", solver: SolverConfig | None = None
 ) -> PreparedSource:
-    """A's side of :func:`retarget`: canonical joints, the checkpoint's fps, features."""
+    """A's side of :func:`retarget`: canonical joints, the checkpoint's fps, features.
+
+    Raises
+    ------
+    ValueError for an unknown ``method``.
+    """
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     check_motion(source, "source motion")

@@ -194,6 +194,12 @@ class LiveLossPlot:
         live: bool | None = None,
         min_interval: float = 2.0,
     ) -> None:
+        """A plot of the losses ``keys``, drawn as the steps come in.
+
+        Raises
+        ------
+        ValueError when no key is given.
+        """
         if not keys:
             raise ValueError("LiveLossPlot needs at least one key to plot")
         self.keys = tuple(keys)
@@ -259,7 +265,12 @@ class LiveLossPlot:
         self._last = time.perf_counter()
 
     def finish(self):
-        """Draw the final figure and return it (live: update the shown figure and close it)."""
+        """Draw the final figure and return it (live: update the shown figure and close it).
+
+        Raises
+        ------
+        ValueError when nothing was recorded.
+        """
         if not self.steps:
             raise ValueError("LiveLossPlot.finish: nothing was recorded (was it passed as callback=?)")
         if self.live:
@@ -279,6 +290,10 @@ def plot_reconstruction(true_pos, pred_pos, joints: Sequence[str], fps: float | 
     true_pos, pred_pos : array (T, 22, 3)   canonical joint positions, metres
     joints : joint names (one panel each)
     fps : float or None                     x axis in seconds when given
+
+    Raises
+    ------
+    ValueError unless both arrays are (T, 22, 3).
     """
     true_pos, pred_pos = np.asarray(true_pos), np.asarray(pred_pos)
     if true_pos.shape != pred_pos.shape or true_pos.shape[-2:] != (len(humanoid.JOINTS), 3):
@@ -320,6 +335,10 @@ def plot_iteration(history: Mapping[str, Sequence[float]], axes=None, title: str
     Returns
     -------
     the Axes
+
+    Raises
+    ------
+    ValueError when the history lacks ``'loss'``, ``'angle'`` or ``'foot'``.
     """
     from motionlab.retargeting.solver import SolverConfig
 
@@ -359,7 +378,12 @@ def plot_iteration(history: Mapping[str, Sequence[float]], axes=None, title: str
 
 
 def foot_heights(positions) -> np.ndarray:
-    """Lowest point of each foot, ``min(y_Foot, y_ToeBase)``, left and right: (T, 22, 3) → (T, 2), metres."""
+    """Lowest point of each foot, ``min(y_Foot, y_ToeBase)``, left and right: (T, 22, 3) → (T, 2), metres.
+
+    Raises
+    ------
+    ValueError when ``pos`` is not (T, 22, 3).
+    """
     pos = np.asarray(positions)
     if pos.ndim != 3 or pos.shape[1:] != (len(humanoid.JOINTS), 3):
         raise ValueError(f"expected canonical world positions (T, 22, 3), got {pos.shape}")
@@ -399,7 +423,12 @@ def plot_foot_heights(results: Mapping[str, np.ndarray], fps: float | None = Non
 
 
 def joint_angle_errors(local_rot, reference_rot) -> np.ndarray:
-    """Mean rotation angle between two sets of local rotations, per joint: (T, 22, 4) × 2 → (22,), degrees."""
+    """Mean rotation angle between two sets of local rotations, per joint: (T, 22, 4) × 2 → (22,), degrees.
+
+    Raises
+    ------
+    ValueError unless both arrays are (T, J, 4) of the same J, with T >= 1.
+    """
     a, b = np.asarray(local_rot), np.asarray(reference_rot)
     n = min(len(a), len(b))
     if a.ndim != 3 or a.shape[1:] != b.shape[1:] or a.shape[-1] != 4 or n == 0:

@@ -68,6 +68,10 @@ def mirrored(motion: Motion) -> Motion:
     Left and right joints swap; offsets and root positions get ``x`` negated; a rotation ``R``
     becomes ``M R M`` with ``M = diag(−1, 1, 1)``, i.e. the quaternion ``(w, x, y, z)`` becomes
     ``(w, x, −y, −z)``. FK of the result is the mirror image of FK of ``motion``.
+
+    Raises
+    ------
+    ValueError when the motion is not on the 22-joint canonical skeleton.
     """
     if not humanoid.is_canonical(motion.skeleton):
         raise ValueError("mirrored needs a 22-joint canonical motion; call preprocess.prepare first")

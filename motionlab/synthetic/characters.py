@@ -82,6 +82,10 @@ def random_character(
     Returns
     -------
     Character   T-pose, Y up, facing +Z, lowest joint at the canonical skeleton's height
+
+    Raises
+    ------
+    ValueError for an unknown proportion range or one not 0 < low <= high.
     """
     rng = _generator(rng)
     unknown = sorted(set(ranges) - set(RANGES))
@@ -98,7 +102,12 @@ def random_character(
 
 
 def character_set(n: int, seed: int = 0, **ranges: tuple[float, float]) -> list[Character]:
-    """``n`` random characters named ``"char00"``, ``"char01"``, …; deterministic under ``seed``."""
+    """``n`` random characters named ``"char00"``, ``"char01"``, …; deterministic under ``seed``.
+
+    Raises
+    ------
+    ValueError unless ``n`` is a whole number >= 0.
+    """
     if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 0:
         raise ValueError(f"n must be a non-negative integer, got {n!r}")
     rng = np.random.default_rng(seed)

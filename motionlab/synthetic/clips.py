@@ -55,6 +55,10 @@ def dataset(
     Returns
     -------
     list of Motion, named ``"clip003:walk>run"``
+
+    Raises
+    ------
+    ValueError when a count is not an integer or below its minimum.
     """
     for label, value, low in (("num_clips", num_clips, 0), ("num_frames", num_frames, 1)):
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:

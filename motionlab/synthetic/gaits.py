@@ -114,6 +114,10 @@ def sequence(
     contacts : ndarray of bool, shape (T, 4), only if ``return_contacts``
         whether each joint of :data:`~motionlab.core.humanoid.FEET` (LeftFoot, RightFoot,
         LeftToeBase, RightToeBase) is planted on the ground in that frame.
+
+    Raises
+    ------
+    ValueError unless ``fps`` > 0 and ``blend`` >= 0 (finite).
     """
     skeleton = _check_skeleton(skeleton)
     segs = _check_segments(segments)

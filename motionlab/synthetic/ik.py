@@ -70,6 +70,10 @@ def two_bone(start, target, upper, lower, pole, soft=0.0) -> tuple[np.ndarray, n
     end : ndarray, shape (..., 3)    end joint position, ``|end − mid| = lower``; equal to
         ``target`` when ``|a − b| <= |target − start| <= a + b − soft``, otherwise the nearest
         point the chain reaches along the direction ``start → target``.
+
+    Raises
+    ------
+    ValueError unless the bone lengths are > 0 and ``soft`` >= 0.
     """
     start, target, pole = _vec(start, "start"), _vec(target, "target"), _vec(pole, "pole")
     upper = np.asarray(upper, dtype=np.float64)

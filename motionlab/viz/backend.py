@@ -71,6 +71,10 @@ def resolve_off_screen(off_screen: bool | None = None) -> bool:
     off_screen : bool or None
         ``True``/``False`` are returned as given. ``None`` reads ``PYVISTA_OFF_SCREEN`` (true/false)
         and otherwise renders off-screen exactly when :func:`has_display` is False.
+
+    Raises
+    ------
+    ValueError for a value other than True, False or None.
     """
     if off_screen is not None:
         if not isinstance(off_screen, (bool, int)):
@@ -125,6 +129,10 @@ def jupyter_backend(backend: str | None = None) -> str:
         ``pip install 'pyvista[jupyter]'`` and a live Jupyter server. ``None``: read
         ``PYVISTA_JUPYTER_BACKEND`` (``trame``/``server``/``client`` -> trame when installed;
         anything else -> static).
+
+    Raises
+    ------
+    ValueError for a backend other than ``'static'``, ``'trame'`` or None.
     """
     if backend is None:
         backend = os.environ.get("PYVISTA_JUPYTER_BACKEND", "").strip().lower() or None

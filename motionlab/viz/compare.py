@@ -37,6 +37,10 @@ def joint_errors(motion: Motion, reference: Motion, relative_to_root: bool = Fal
     Returns
     -------
     ndarray, shape (T, J), metres; NaN for joints the reference lacks.
+
+    Raises
+    ------
+    ValueError for arguments that are not Motions or share no joint name.
     """
     if not isinstance(motion, Motion) or not isinstance(reference, Motion):
         raise ValueError(f"expected two Motions, got {type(motion).__name__} and {type(reference).__name__}")
@@ -65,6 +69,10 @@ def side_by_side_offsets(motions: Sequence[Motion], spacing: float | None = None
     ``spacing``: metres between neighbours (default 0.6 × the tallest character's height,
     at least the widest rest pose plus a margin). ``align``: first move every motion so its
     root starts at the same ground point (x, z), then spread them out.
+
+    Raises
+    ------
+    ValueError unless ``spacing`` is a finite number >= 0.
     """
     K = len(motions)
     heights = [m.skeleton.height() for m in motions]
@@ -104,6 +112,10 @@ def side_by_side(
     relative_to_root : colour by pose error only (root positions subtracted)
     spacing, align : layout, see :func:`side_by_side_offsets`
     **scene_options : camera, window_size, trails, off_screen, ... (see Scene)
+
+    Raises
+    ------
+    ValueError for no Motion, or a ``reference`` index out of range.
     """
     motions = list(motions)
     if len(motions) < 1 or not all(isinstance(m, Motion) for m in motions):

@@ -134,6 +134,10 @@ def save_gif(
     Returns
     -------
     The path written.
+
+    Raises
+    ------
+    ValueError unless 2 <= ``colors`` <= 256.
     """
     from PIL import Image
 
@@ -207,6 +211,10 @@ def save_mp4(
     Returns
     -------
     The path written.
+
+    Raises
+    ------
+    ValueError unless 0 <= ``quality`` <= 10.
     """
     import imageio_ffmpeg
 
@@ -244,7 +252,12 @@ def save_mp4(
 
 
 def save_movie(motions: Motion | Sequence[Motion] | Scene, path, **options) -> Path:
-    """:func:`save_gif` or :func:`save_mp4`, chosen by the file name's suffix."""
+    """:func:`save_gif` or :func:`save_mp4`, chosen by the file name's suffix.
+
+    Raises
+    ------
+    ValueError for a file name that ends neither in .gif nor in .mp4.
+    """
     suffix = Path(os.fspath(path)).suffix.lower()
     if suffix == ".gif":
         return save_gif(motions, path, **options)
@@ -288,6 +301,10 @@ def filmstrip(
 
     ``frames`` defaults to ``num`` frames evenly spread over the clip. Written as PNG when
     ``path`` is given. The default window is 320 x 400 pixels per frame.
+
+    Raises
+    ------
+    ValueError when ``num`` < 1.
     """
     target = _target(path, (".png",), overwrite) if path is not None else None
     if not isinstance(motions, Scene):

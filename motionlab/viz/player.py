@@ -62,7 +62,12 @@ class OwnerThread:
 
 
 def encode_image(image: np.ndarray, fmt: str = "jpeg", quality: int = 85) -> bytes:
-    """Encode an image (H, W, 3) uint8 as JPEG or PNG bytes."""
+    """Encode an image (H, W, 3) uint8 as JPEG or PNG bytes.
+
+    Raises
+    ------
+    ValueError for a format other than ``'jpeg'`` or ``'png'``.
+    """
     from PIL import Image
 
     if fmt not in ("jpeg", "png"):

@@ -50,14 +50,24 @@ Solver = Callable[[Skeleton], "Motion | tuple[Motion, Mapping | None]"]
 
 
 def canonical_source(motion: Motion) -> Motion:
-    """The motion on the 22-joint humanoid (unchanged when it already is)."""
+    """The motion on the 22-joint humanoid (unchanged when it already is).
+
+    Raises
+    ------
+    ValueError for something other than a Motion.
+    """
     if not isinstance(motion, Motion):
         raise ValueError(f"expected a Motion, got {type(motion).__name__}")
     return motion if humanoid.is_canonical(motion.skeleton) else humanoid.to_canonical(motion)
 
 
 def feet_height(motion: Motion) -> np.ndarray:
-    """Height (T, 2) of the lowest of foot and toe, left then right, metres (ground y = 0)."""
+    """Height (T, 2) of the lowest of foot and toe, left then right, metres (ground y = 0).
+
+    Raises
+    ------
+    ValueError when the motion lacks the foot or toe joints of the 22-joint humanoid.
+    """
     sk = motion.skeleton
     pos = motion.global_positions()
     out = []
@@ -144,6 +154,12 @@ class ProportionEditor:
         slider_range: tuple[float, float] = (0.5, 1.6),
         **scene_options,
     ) -> None:
+        """Check the solver and the slider range (the widgets are built on display).
+
+        Raises
+        ------
+        ValueError when ``solve`` is not callable or ``slider_range`` is not 0 < low < 1 < high.
+        """
         import ipywidgets as widgets
 
         from motionlab.viz.player import Player
@@ -207,6 +223,10 @@ class ProportionEditor:
         """Set some sliders (without firing them one by one), solve once, refresh the view.
 
         Returns the new motion. Unknown names raise ValueError.
+
+        Raises
+        ------
+        ValueError naming unknown proportions.
         """
         unknown = set(factors) - set(GROUPS)
         if unknown:

@@ -92,6 +92,10 @@ def contact_labels(
     positions : ndarray, shape (T, J, 3)   world joint positions, metres, ground at y = 0
     fps : frames per second
     feet : foot joint indices; default :func:`foot_joints`
+
+    Raises
+    ------
+    ValueError when ``positions`` is not (T, J, 3) for the skeleton's J.
     """
     positions = np.asarray(positions, dtype=np.float64)
     if positions.ndim != 3 or positions.shape[1:] != (skeleton.num_joints, 3):
@@ -210,6 +214,12 @@ class SkeletonActor:
         label: str | None = None,
         end_sites: bool | None = None,
     ) -> None:
+        """Check the motion and the trails asked for.
+
+        Raises
+        ------
+        ValueError for something other than a Motion, or an unknown trail.
+        """
         if not isinstance(motion, Motion):
             raise ValueError(f"expected a Motion, got {type(motion).__name__}")
         unknown = set(trails) - {"root", "feet"}
@@ -388,7 +398,13 @@ class SkeletonActor:
 
     def set_motion(self, motion: Motion, joint_values: np.ndarray | None = None) -> None:
         """Show another motion (any skeleton, e.g. a retargeted character with new bone lengths)
-        with the same colour, trails and actors."""
+        with the same colour, trails and actors.
+
+        Raises
+        ------
+        ValueError for something other than a Motion, or ``joint_values`` given to a character
+        built without them (or missing for one built with them).
+        """
         if not isinstance(motion, Motion):
             raise ValueError(f"expected a Motion, got {type(motion).__name__}")
         if self._value_mode != (joint_values is not None):
@@ -649,7 +665,12 @@ class Scene:
 
     # -------------------------------------------------------------- playback
     def set_frame(self, t: int, render: bool = True) -> None:
-        """Show scene frame ``t`` (0 ≤ t < :attr:`num_frames`), moving the camera when following."""
+        """Show scene frame ``t`` (0 ≤ t < :attr:`num_frames`), moving the camera when following.
+
+        Raises
+        ------
+        ValueError when ``t`` is outside 0 … num_frames - 1.
+        """
         t = int(t)
         if not 0 <= t < self.num_frames:
             raise ValueError(f"frame {t} out of range: this scene has frames 0..{self.num_frames - 1}")
@@ -724,7 +745,12 @@ class Scene:
 
 
 def build_scene(motions: Motion | Sequence[Motion] | Scene, **kwargs) -> Scene:
-    """A :class:`Scene` of ``motions`` (a Scene passes through unchanged, ``kwargs`` must be empty)."""
+    """A :class:`Scene` of ``motions`` (a Scene passes through unchanged, ``kwargs`` must be empty).
+
+    Raises
+    ------
+    ValueError for an existing Scene given with scene options.
+    """
     if isinstance(motions, Scene):
         if kwargs:
             raise ValueError(f"got an existing Scene and scene options {sorted(kwargs)}; pass one or the other")
