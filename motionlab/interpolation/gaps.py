@@ -457,10 +457,9 @@ def lift_above_floor(motion: Motion, a: int, b: int) -> Motion:
     that no joint but the root goes below the floor of the gap's known ends ``a`` and ``b`` (the
     lower of their lowest joints).
 
-    SLERP between two strides swings a leg through the floor half-way (measured on the Bandai
-    walks: up to 7 cm); lifting the whole body by the overshoot keeps the feet on the floor at
-    the cost of a small vertical bob, which the eye forgives far more readily than a foot in the
-    ground. Frames already above the floor are untouched.
+    SLERP between two strides can swing a leg through the floor half-way; lifting the whole body
+    by the overshoot keeps the feet on the floor at the cost of a small vertical bob, which the
+    eye forgives far more readily than a foot in the ground. Frames already above the floor are untouched.
     """
     out = motion.copy()
     if b - a < 2:
@@ -506,9 +505,9 @@ def smooth_root(motion: Motion, anchors, joint: int | None = None) -> Motion:
     two-point ones describe the half-frame before (after) the anchor and would force zero
     acceleration across it, a bias that a long gap spreads into centimetres.
 
-    Alternatives measured on real data (Bandai Namco walks cut and refilled from other walks, and
-    notebook 06's run → squat) and rejected: ``p* = S`` (a pure spline) loses the recorded detail
-    and lands furthest from the truth (about twice the joint error); ``p* = S + (p − L)`` with
+    Alternatives rejected on real data (Bandai Namco walks cut and refilled from other walks, and
+    notebook 06's run → squat): ``p* = S`` (a pure spline) loses the recorded detail and lands
+    furthest from the truth; ``p* = S + (p − L)`` with
     ``L`` the chord-wise linear path keeps the pieces' corners, since a recorded stretch does not
     leave its anchor along the chord. For a piece filled linearly (SLERP fallback) all three
     agree: ``p = L = H``.

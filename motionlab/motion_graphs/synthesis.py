@@ -14,8 +14,8 @@ edges ``src → dst`` whose frame ``dst - 1`` resembles ``src``. Synthesis:
    :math:`\mathrm{slerp}(q_\text{old}, q_\text{new}, \alpha_t)` with the smooth ramp
    :math:`\alpha_t = s\!\left(\tfrac{t+1}{k+1}\right)`, :math:`s(x) = 3x^2 - 2x^3`; root
    positions linearly with the same weights.
-3. **Foot skating** near the jump: foot alignment (1) removes most of it (measured in
-   ``benchmarks/bench_motion_graphs.py``). Optionally (``fix_feet=True``) the root is also
+3. **Foot skating** near the jump: foot alignment (1) removes most of it (``python
+   benchmarks/bench_motion_graphs.py`` prints how much). Optionally (``fix_feet=True``) the root is also
    shifted inside blend windows to pin a foot that is planted when the window starts, the
    last shift carried on; it helps with root alignment, not with foot alignment.
 
