@@ -7,6 +7,7 @@ Read from the source (``ast``), so the check needs no import of torch or pyvista
 from __future__ import annotations
 
 import ast
+import functools
 import re
 from pathlib import Path
 
@@ -31,8 +32,10 @@ PENDING = {
 another branch; the test below fails once an entry is fixed, so that it is removed here."""
 
 
-def _modules():
-    return sorted(PACKAGE.rglob("*.py"))
+@functools.cache
+def _modules() -> tuple[tuple[Path, ast.Module], ...]:
+    """Every module of the package and its syntax tree (read once per session)."""
+    return tuple((path, ast.parse(path.read_text(encoding="utf-8"))) for path in sorted(PACKAGE.rglob("*.py")))
 
 
 def _raises_directly(fn: ast.AST) -> bool:
@@ -62,8 +65,7 @@ def _public_functions(body, prefix: str = ""):
 
 def _undocumented_raises() -> list[tuple[str, str, int]]:
     out = []
-    for path in _modules():
-        tree = ast.parse(path.read_text(encoding="utf-8"))
+    for path, tree in _modules():
         for name, fn in _public_functions(tree.body):
             doc = ast.get_docstring(fn) or ""
             if _raises_directly(fn) and not RAISES.search(doc):
@@ -73,8 +75,7 @@ def _undocumented_raises() -> list[tuple[str, str, int]]:
 
 def _citations() -> list[tuple[str, str, int]]:
     out = []
-    for path in _modules():
-        tree = ast.parse(path.read_text(encoding="utf-8"))
+    for path, tree in _modules():
         for node in ast.walk(tree):
             documented = isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef))
             if documented and CITES_RESULTS.search(ast.get_docstring(node) or ""):
