@@ -193,7 +193,7 @@ class MotionLibrary:
         allowed_labels: Sequence[str] | None = None,
         query_labels: Sequence[str] | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Fill ``num`` frames in each of W gaps.
+        """Fill ``num`` frames in each of W gaps (raises ValueError for arrays of the wrong shapes or ``num`` < 1).
 
         Parameters
         ----------
@@ -209,10 +209,6 @@ class MotionLibrary:
         trans : ndarray (W, N, J, 3)
         cost : ndarray (W,)              matching cost of the best stretch (``inf``: none was
                                          allowed; that gap's frames are then meaningless)
-
-        Raises
-        ------
-        ValueError for context arrays of the wrong shapes or ``num`` < 1.
         """
         rot_ctx, rot_b = quat.check(rot_ctx, "rot_ctx"), quat.check(rot_b, "rot_b")
         trans_ctx, trans_b = np.asarray(trans_ctx, dtype=np.float64), np.asarray(trans_b, dtype=np.float64)
