@@ -607,8 +607,9 @@ def walk_to_exit(
         raise ValueError(f"expected a start and at least one exit in 0..{cw.length - 1}, got {start} and {exits}")
     frames, r = _path(cw, start, exits, name)
     src, dst, price = cw.jumps()
-    paid = sum(float(price[(src == a) & (dst == b)].min()) for a, b in zip(frames[:-1], frames[1:]) if b != a + 1)
-    bound = len(frames) + paid
+    moves = zip(frames[:-1], frames[1:])
+    paid = sum(float(price[(src == a) & (dst == b)].min()) for a, b in moves if not (b == a + 1 and cw.step[a]))
+    bound = len(frames) + paid  # what the shortest walk costs
     # a cheaper walk has fewer frames than ``bound`` (each frame costs one) and visits no frame
     # twice (a loop costs at least a frame), so it has at most ``cw.length`` frames
     rows = min(int(np.ceil(bound)), cw.length)
