@@ -10,6 +10,7 @@ from motionlab.core import bvh, humanoid
 from motionlab.demo import run_demo
 
 
+@pytest.mark.slow
 def test_demo_writes_its_files_and_a_sensible_table(tmp_path, capsys):
     assert run_demo(tmp_path, characters=1, seed=0) == 0
     names = {p.name for p in tmp_path.iterdir()}

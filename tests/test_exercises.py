@@ -410,6 +410,7 @@ def _check_wrong(q, answer, wrong, inputs):
             assert phrase in result.hint, (phrase, result.message)
 
 
+@pytest.mark.slow
 def test_encoder_start_experiment(running_pair):
     q = exercises.encoder_start
     answer = K03.my_encoder_start_experiment(*running_pair)
@@ -428,6 +429,7 @@ def test_encoder_start_experiment(running_pair):
     assert not q.check(answer + 5.0, *running_pair).passed
 
 
+@pytest.mark.slow
 def test_contact_weight_experiment(running_pair):
     q = exercises.contact_weight
     answer = K03.my_contact_weight_experiment(*running_pair)

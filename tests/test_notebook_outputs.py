@@ -88,6 +88,7 @@ def _notebook(path: Path, stored_text: str | None, strict: bool) -> None:
     nbformat.write(nb, path)
 
 
+@pytest.mark.slow
 def test_a_changed_output_fails_strict_nbval_and_only_there(tmp_path):
     """One pytest --nbval run over three tiny notebooks: the stale strict one must fail."""
     _notebook(tmp_path / "fresh_strict.ipynb", "2\n", strict=True)

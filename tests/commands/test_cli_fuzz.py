@@ -186,6 +186,7 @@ def _check(argv, inputs, code, err, before, after) -> None:
     assert not [k for k in after if k.endswith((".tmp", ".motionlab-tmp"))], argv
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", sorted(COMMANDS))
 def test_every_command_ends_cleanly_on_random_arguments(command, graph_parts, monkeypatch, capsys):
     clip = bvh.dumps(synthetic.generate("walk", humanoid.canonical_skeleton(), num_frames=12, fps=30, seed=0))

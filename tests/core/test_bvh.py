@@ -696,7 +696,18 @@ def _manifest() -> dict[str, dict[str, str]]:
 
 
 @pytest.mark.realdata
-@pytest.mark.parametrize("path", REAL_FILES or [None], ids=lambda p: str(p.relative_to(DATA)) if p else "no-data")
+def _real_file_params() -> list:
+    """Every real file; all but the first of each folder marked ``slow`` (a folder holds one
+    source's files, so the fast loop, ``-m "not slow"``, still reads every source's format)."""
+    folders: set[Path] = set()
+    out = []
+    for p in REAL_FILES:
+        out.append(pytest.param(p, id=str(p.relative_to(DATA)), marks=pytest.mark.slow if p.parent in folders else ()))
+        folders.add(p.parent)
+    return out or [pytest.param(None, id="no-data")]
+
+
+@pytest.mark.parametrize("path", _real_file_params())
 def test_real_file_loads_and_round_trips(path, tmp_path):
     """file -> load -> save -> load: same skeleton, frame time and global positions"""
     if path is None:

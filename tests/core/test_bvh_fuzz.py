@@ -163,6 +163,7 @@ def _assert_round_trips(m):
     assert bvh.dumps(back) == text
 
 
+@pytest.mark.slow
 @FUZZ
 @given(bvh_files(), st.sampled_from([7, 64, 1000, 1 << 20]))
 def test_generated_files_load_exactly_and_round_trip(file, chunk):
@@ -232,6 +233,7 @@ def mutated(draw):
     return data
 
 
+@pytest.mark.slow
 @FUZZ
 @given(mutated(), st.sampled_from([7, 64, 1 << 20]))
 def test_mutated_files_load_and_round_trip_or_name_a_line(data, chunk):
@@ -250,6 +252,7 @@ def test_mutated_files_load_and_round_trip_or_name_a_line(data, chunk):
     _assert_round_trips(m)
 
 
+@pytest.mark.slow
 @FUZZ
 @given(mutated())
 def test_streamed_and_whole_reads_agree(data):

@@ -132,6 +132,7 @@ def test_scale_bones_overall_and_errors():
         humanoid.scale_bones(sk, legs=0.0)
 
 
+@pytest.mark.slow
 @pytest.mark.realdata
 def test_every_real_rig_reduces_with_positions_preserved():
     """Every BVH under MOTIONLAB_DATA maps onto the 22 joints with world positions kept to 1e-4·height."""

@@ -147,6 +147,7 @@ def test_train_and_evaluate_on_a_small_folder(tmp_path, clips, capsys):
     assert code == 2 and "Nobody" in err
 
 
+@pytest.mark.slow
 def test_evaluate_leaves_animations_out_by_folds(tmp_path, clips, capsys):
     """--folds 2: each animation is evaluated by a network trained without it (one checkpoint per fold)."""
     root = _two_characters(tmp_path, clips)

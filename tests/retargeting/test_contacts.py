@@ -168,6 +168,7 @@ def test_aj_22_joint_height_is_the_papers():
     assert aj.skeleton.height() * 100 == pytest.approx(141.97, abs=0.05)  # 141.95 cm; the paper rounds to 141.97
 
 
+@pytest.mark.slow
 def test_full_method_beats_copy_on_a_real_clip_pair():
     """Aj's injured walk onto each of the six Mixamo targets, with the shipped network: closer to
     the targets' own Mixamo clips than copied rotations (whole motion and pose alone, summed over

@@ -77,6 +77,7 @@ def test_solve_many_is_solve_per_sequence(ckpt):
         assert one.steps == many[i].steps and one.stop_reason == many[i].stop_reason
 
 
+@pytest.mark.slow
 def test_outputs_equal_single_pair_path(ckpt, library, tmp_path):
     targets = _targets(library)
     job = ex.expand([str(library / "clips")], targets, tmp_path, ckpt, FAST)

@@ -28,6 +28,7 @@ def clips():
     return rig_matrix.family_clips(data.data_root() if data.has_data() else None, seconds=2.0)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("source", FAMILIES)
 def test_every_pair_from_source_is_plausible(source, clips, ckpt):
     if source != "synthetic":
