@@ -257,10 +257,8 @@ class PoolWalker:
     sparse: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
     price: np.ndarray | None = None
 
-    def jumps(self, sparse: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(src, dst, price)`` of every jump, or (``sparse``) of the cheapest into each frame."""
-        if sparse and self.sparse is not None:
-            return self.sparse
+    def jumps(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(src, dst, price)`` of every jump of the pool."""
         price = np.full(self.loop_src.shape, JUMP_FRAMES, np.float32) if self.price is None else self.price
         return self.loop_src, self.loop_dst, price
 
