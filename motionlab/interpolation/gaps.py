@@ -175,7 +175,7 @@ def insert_missing(motion: Motion, missing: list[tuple[int, int]]) -> tuple[Moti
 
     Raises
     ------
-    ValueError for a gap after the last frame (or before the first).
+    ValueError unless every gap lies after a frame ``i`` with 0 <= i < T - 1.
     """
     order = sorted((int(i), int(n)) for i, n in missing if n > 0)
     rot, root, lpos, gaps = [], [], [], []
