@@ -136,7 +136,7 @@ def carry_by_reference(motion: Motion, a: int, b: int, joint: int | None = None)
         raise ValueError(f"frames {a} … {b} must be finite before the body can be carried by joint {j}")
     parents = motion.skeleton.parents
     g_rot, g_pos = fk(motion.local_rot[frames], trans, parents)
-    chain = np.flatnonzero(_ancestors(parents, j))
+    chain = np.asarray(motion.skeleton.ancestors(j), dtype=np.int64)
     w = ((frames[1:-1] - a) / (b - a))[:, None]  # (F, 1)
     inner = frames[1:-1]
     out.local_rot[np.ix_(inner, chain)] = quat.slerp(motion.local_rot[a, chain], motion.local_rot[b, chain], w)
@@ -155,16 +155,6 @@ def _reference_outside(motion: Motion, a: int, b: int) -> int:
     frames = np.r_[0 : a + 1, b : motion.num_frames]
     frames = frames[np.all(np.isfinite(motion.root_pos[frames]), axis=1)]
     return reference_joint(motion[frames])
-
-
-def _ancestors(parents: np.ndarray, j: int) -> np.ndarray:
-    """Mask (J,) of the joints above joint ``j`` (its parent, the parent's parent, … joint 0)."""
-    above = np.zeros(len(parents), dtype=bool)
-    k = int(parents[j])
-    while k >= 0:  # a walk up one chain of the skeleton, not a loop over frames
-        above[k] = True
-        k = int(parents[k])
-    return above
 
 
 def estimate(rot_a, pos_a, rot_b, pos_b, vertical: bool = False) -> RigidYaw:

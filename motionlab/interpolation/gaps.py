@@ -667,7 +667,7 @@ def _fill_inside(out: Motion, start: int, stop: int, method: str, curve: str, ro
             out = _floor_rule(feet)(_follow_strides(strided[0], a, b, ref, strided[1]), a, b)
             return out, FilledGap(start, stop, "stride")
     mode = "hermite" if method == "hermite" else "linear"  # stride: SLERP where no stride is found
-    out = inbetween.fill_between(out, start, stop, curve=curve, root=mode,
+    out = inbetween.fill_between(out, start, stop, curve=curve, root=mode, joint=ref,
                                  rotation="hermite" if method == "hermite" else "slerp")  # fmt: skip
     if root == "stride":
         out = _stride_root(out, a, b, ref)
