@@ -11,9 +11,9 @@ So the gap is predicted from both sides and the two predictions are blended:
   ``[a − P, a]`` is carried forward by the rigid motion that takes its start onto its end, turned
   by the change of heading over it, ``ψ = yaw(a) − yaw(a − P)``:
   ``T(q) = p(a) + R_y(ψ)(q − p(a − P))``. Frame ``a + k`` is the recorded frame
-  ``a + k − mP`` (``m = ⌈k/P⌉`` strides back) moved by ``T^m`` — its reference joint moved, its root
-  joint's rotation turned by ``mψ``. A straight walk repeats its stride, a turning one keeps
-  turning at its rate;
+  ``a + k − mP`` (``m = ⌈k/P⌉`` strides back) moved by ``T^m`` — its reference joint moved and
+  turned by ``mψ``, the joints above it (if any) left as recorded. A straight walk repeats its
+  stride, a turning one keeps turning at its rate;
 * **backward from after the gap** (known frames from ``b``): the same with the first stride
   ``[b, b + P]``, run backwards;
 * each prediction is bent to meet **both** ends of the gap by a correction linear in time: the
