@@ -129,6 +129,14 @@ class Skeleton:
             inside[k] = inside[self.parents[k]]
         return inside
 
+    def ancestors(self, j: int) -> list[int]:
+        """Indices of the joints above joint ``j``, from joint 0 down to ``j``'s parent (empty for 0)."""
+        chain, k = [], int(self.parents[j])
+        while k >= 0:  # one walk up the chain of parents
+            chain.append(k)
+            k = int(self.parents[k])
+        return chain[::-1]
+
     def depth(self) -> np.ndarray:
         """Number of ancestors of each joint, shape (J,)."""
         d = np.zeros(self.num_joints, dtype=np.int64)

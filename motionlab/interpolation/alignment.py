@@ -27,7 +27,16 @@ from motionlab.core import quat
 from motionlab.core.fk import fk
 from motionlab.core.motion import Motion
 
-__all__ = ["RigidYaw", "reference_joint", "reference_transform", "estimate", "fit_points", "apply", "align_to"]
+__all__ = [
+    "RigidYaw",
+    "reference_joint",
+    "reference_transform",
+    "carry_by_reference",
+    "estimate",
+    "fit_points",
+    "apply",
+    "align_to",
+]
 
 
 @dataclass(frozen=True)
@@ -81,6 +90,71 @@ def reference_transform(motion: Motion, frames=None, joint: int | None = None) -
         return motion.local_rot[sel, 0], motion.root_pos[sel]
     rot, pos = fk(motion.local_rot[sel], motion.translations()[sel], motion.skeleton.parents)
     return rot[..., j, :], pos[..., j, :]
+
+
+def carry_by_reference(motion: Motion, a: int, b: int, joint: int | None = None) -> Motion:
+    """A copy of ``motion`` whose frames ``a+1 … b-1`` carry the body by the reference joint, as
+    the recording does.
+
+    Filling a gap moves and turns the body through joint 0 (the root's translation and rotation).
+    On a rig whose reference joint ``j`` lies below joint 0 (:func:`reference_joint`: Bandai Namco's
+    ``joint_Root`` held at the origin while the hips' channels carry the walker) that moves the
+    joints above ``j`` off the place the recording keeps them in, and they jump back at frame ``b``.
+    Here the joints from 0 down to ``j``'s parent take, on frames ``a+1 … b-1``, the values
+    interpolated between the known frames ``a`` and ``b`` (SLERP for rotations, linear for
+    translations: held where the recording holds them), and ``j``'s local rotation and translation
+    take over the difference, so that ``j`` and every joint below it keep their world rotations and
+    positions. Joints hanging off the chain above ``j`` elsewhere follow the interpolated chain.
+    With ``j = 0`` the copy equals ``motion``.
+
+    Parameters
+    ----------
+    motion : Motion, finite at frames ``a … b``
+    a, b : int, known frames bounding the filled frames, ``0 <= a < b < T``
+    joint : the reference joint; default :func:`reference_joint` of the finite frames outside
+        ``a+1 … b-1`` (the filled frames would hide a still joint 0)
+
+    Raises
+    ------
+    ValueError
+        ``a``, ``b`` out of order or range, non-finite frames ``a … b``, or a reference joint below
+        joint 0 in a motion without per-frame translations (``local_pos``), which could not carry it.
+    """
+    a, b = int(a), int(b)
+    if not 0 <= a < b < motion.num_frames:
+        raise ValueError(f"expected known frames 0 <= a < b < {motion.num_frames}, got a={a}, b={b}")
+    j = _reference_outside(motion, a, b) if joint is None else int(joint)
+    out = motion.copy()
+    if j == 0 or b - a < 2:
+        return out
+    if motion.local_pos is None:
+        name = motion.skeleton.names[j]
+        raise ValueError(f"joint {name!r} cannot carry the body: the motion has no per-frame translations (local_pos)")
+    frames = np.arange(a, b + 1)
+    trans = motion.translations()[frames]
+    if not (np.all(np.isfinite(trans)) and np.all(np.isfinite(motion.local_rot[frames]))):
+        raise ValueError(f"frames {a} … {b} must be finite before the body can be carried by joint {j}")
+    parents = motion.skeleton.parents
+    g_rot, g_pos = fk(motion.local_rot[frames], trans, parents)
+    chain = np.asarray(motion.skeleton.ancestors(j), dtype=np.int64)
+    w = ((frames[1:-1] - a) / (b - a))[:, None]  # (F, 1)
+    inner = frames[1:-1]
+    out.local_rot[np.ix_(inner, chain)] = quat.slerp(motion.local_rot[a, chain], motion.local_rot[b, chain], w)
+    out.local_pos[np.ix_(inner, chain)] = trans[0, chain] + w[..., None] * (trans[-1, chain] - trans[0, chain])
+    out.root_pos[inner] = out.local_pos[inner, 0]
+    new_rot, new_pos = fk(out.local_rot[inner], out.translations()[inner], parents)
+    p = parents[j]
+    turn_back = quat.inv(new_rot[:, p])
+    out.local_rot[inner, j] = quat.normalize(quat.mul(turn_back, g_rot[1:-1, j]))
+    out.local_pos[inner, j] = quat.rotate(turn_back, g_pos[1:-1, j] - new_pos[:, p])
+    return out
+
+
+def _reference_outside(motion: Motion, a: int, b: int) -> int:
+    """:func:`reference_joint` of the finite frames of ``motion`` outside ``a+1 … b-1``."""
+    frames = np.r_[0 : a + 1, b : motion.num_frames]
+    frames = frames[np.all(np.isfinite(motion.root_pos[frames]), axis=1)]
+    return reference_joint(motion[frames])
 
 
 def estimate(rot_a, pos_a, rot_b, pos_b, vertical: bool = False) -> RigidYaw:

@@ -832,10 +832,12 @@ def _local_count(gstep: np.ndarray, t: int, start: int, stop: int, arc: float, g
     ground speeds of the nearest ``LOCAL_SECONDS`` on both sides covers ``arc`` in the gap's
     ``n + 1`` steps, or ``None`` (too few speeds, or no such ``n``).
 
-    Step ``k → k+1`` is placed at time ``k + ½`` before the gap (frame ``t`` at 0) and ``k + ½ + n``
-    after it; for every ``n`` on a grid (0 … 3× ``guess``, quarter frames) the quadratic is fitted
-    by least squares (one batched solve) and integrated over ``0 … n+1``; of the ``n`` where the
-    integral crosses ``arc`` the one nearest ``guess`` is kept, interpolated between grid points.
+    Stream step ``k → k+1`` is placed at its middle in time, frame ``t`` at 0: at ``k − t + ½``
+    before the gap, and at ``k − t + ½ + n`` after it, where stream frame ``t+1`` lies at ``n + 1``
+    (the step ``t+1 → t+2`` at ``n + 1½``). For every ``n`` on a grid (0 … 3× ``guess``, quarter
+    frames) the quadratic is fitted by least squares (one batched solve) and integrated over
+    ``0 … n+1``; of the ``n`` where the integral crosses ``arc`` the one nearest ``guess`` is kept,
+    interpolated between grid points. Where the speed changes linearly in time the count is exact.
     """
     w = max(3, int(round(LOCAL_SECONDS * fps)))
     kb = np.arange(max(start, t - w), t)
@@ -845,7 +847,7 @@ def _local_count(gstep: np.ndarray, t: int, start: int, stop: int, arc: float, g
     grid = np.arange(0.0, max(3.0 * guess, 10.0), 0.25)  # (G,)
     scale = grid + 1.0  # times in units of the gap, for a well-conditioned fit
     x = np.concatenate([np.broadcast_to(kb - t + 0.5, (len(grid), kb.size)),
-                        (ka - t - 0.5)[None, :] + grid[:, None]], axis=1) / scale[:, None]  # fmt: skip
+                        (ka - t + 0.5)[None, :] + grid[:, None]], axis=1) / scale[:, None]  # fmt: skip
     y = np.concatenate([gstep[kb], gstep[ka]])
     basis = np.stack([np.ones_like(x), x, x * x], axis=-1)  # (G, W, 3)
     normal = np.einsum("gwi,gwj->gij", basis, basis)

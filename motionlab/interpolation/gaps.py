@@ -44,8 +44,8 @@ from motionlab.core.motion import Motion
 from motionlab.interpolation import detect, inbetween
 from motionlab.interpolation.action_graph import ActionGraph
 from motionlab.interpolation.alignment import apply as apply_rigid
+from motionlab.interpolation.alignment import carry_by_reference, reference_joint, reference_transform
 from motionlab.interpolation.alignment import estimate as estimate_rigid
-from motionlab.interpolation.alignment import reference_joint, reference_transform
 from motionlab.interpolation.features import pose_features
 from motionlab.interpolation.footing import lowest_joints, plant_feet
 from motionlab.interpolation.library import MotionLibrary
@@ -634,6 +634,12 @@ def fill(
         bends the leg of each foot that went below it (:func:`.footing.plant_feet`) and lifts the
         body by what the legs cannot reach; ``"lift"`` lifts the body only
         (:func:`lift_above_floor`).
+
+    Every rule moves the body by the joint that carries it, the reference joint of the known
+    frames (:func:`~.alignment.reference_joint`): on a rig whose joint 0 the recording holds still
+    while a joint below it moves (Bandai Namco's ``joint_Root`` and hips), the joints above the
+    reference joint keep the recorded values between each gap's ends
+    (:func:`~.alignment.carry_by_reference`), never a path of their own.
     """
     _check_fill(motion, method, graph, root, feet)
     out = motion.copy()
@@ -646,12 +652,13 @@ def fill(
                 raise ValueError("every frame is missing; nothing to fill from")
             out = _edge_fill(out, start, stop)
             report.append(FilledGap(start, stop, "hold"))
-        elif method == "graph":
+            continue
+        if method == "graph":
             out, gap = _fill_through_graph(out, start, stop, graph, curve, ref, feet)
-            report.append(gap)
         else:
             out, gap = _fill_inside(out, start, stop, method, curve, root, ref, feet)
-            report.append(gap)
+        out = carry_by_reference(out, start - 1, stop, ref)  # the joints above the reference joint as recorded
+        report.append(gap)
     return out, report
 
 
@@ -683,7 +690,7 @@ def _fill_inside(out: Motion, start: int, stop: int, method: str, curve: str, ro
             out = _floor_rule(feet)(_follow_strides(strided[0], a, b, ref, strided[1]), a, b)
             return out, FilledGap(start, stop, "stride")
     mode = "hermite" if method == "hermite" else "linear"  # stride: SLERP where no stride is found
-    out = inbetween.fill_between(out, start, stop, curve=curve, root=mode,
+    out = inbetween.fill_between(out, start, stop, curve=curve, root=mode, joint=ref,
                                  rotation="hermite" if method == "hermite" else "slerp")  # fmt: skip
     if root == "stride":
         out = _stride_root(out, a, b, ref)

@@ -163,18 +163,20 @@ def zero_velocity(rot_a, pos_a, num: int) -> tuple[np.ndarray, np.ndarray]:
     return rot, pos
 
 
-def _velocities(motion: Motion, t: int, forward: bool) -> tuple[np.ndarray | None, np.ndarray | None]:
-    """Root velocity (3,) and joint angular velocities (J, 3) at frame ``t`` from its neighbour."""
+def _velocities(motion: Motion, t: int, forward: bool, joint: int = 0) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """Velocity (3,) of joint ``joint``'s translation (the root position for joint 0) and joint
+    angular velocities (J, 3) at frame ``t`` from its neighbour."""
     n = t + 1 if forward else t - 1
     if not 0 <= n < motion.num_frames:
         return None, None
-    if not (np.all(np.isfinite(motion.local_rot[n])) and np.all(np.isfinite(motion.root_pos[n]))):
+    path = motion.translations()[[t, n], joint]
+    if not (np.all(np.isfinite(motion.local_rot[n])) and np.all(np.isfinite(path))):
         return None, None
     if forward:
-        v = motion.root_pos[n] - motion.root_pos[t]
+        v = path[1] - path[0]
         w = log(quat.mul(quat.conj(motion.local_rot[t]), motion.local_rot[n]))
     else:
-        v = motion.root_pos[t] - motion.root_pos[n]
+        v = path[0] - path[1]
         w = log(quat.mul(quat.conj(motion.local_rot[n]), motion.local_rot[t]))
     return v, w
 
@@ -186,12 +188,17 @@ def fill_between(
     curve: str = "linear",
     root: str = "linear",
     rotation: str = "slerp",
+    *,
+    joint: int = 0,
 ) -> Motion:
     """A copy of ``motion`` with frames ``start … stop-1`` recomputed from frames ``start-1`` and ``stop``.
 
     The frames in the gap may hold anything (NaN included); only the bounding frames and, for
-    Hermite modes, their outer neighbours are read. Per-joint translations (``local_pos``) are
-    interpolated linearly.
+    Hermite modes, their outer neighbours are read. The translation of ``joint`` (keyword-only;
+    the root position for the default 0), the joint that carries the body
+    (:func:`~.alignment.reference_joint`: the hips on rigs whose joint 0 the recording holds
+    still), follows ``root``; every other per-joint translation (``local_pos``) is interpolated
+    linearly.
 
     Raises
     ------
@@ -202,13 +209,14 @@ def fill_between(
         raise ValueError(f"a gap [{start}, {stop}) needs a known frame on each side in a {T}-frame motion")
     num = stop - start
     a, b = start - 1, stop
-    vel_a, ang_a = _velocities(motion, a, forward=False)
-    vel_b, _ = _velocities(motion, b, forward=True)
+    vel_a, ang_a = _velocities(motion, a, forward=False, joint=joint)
+    vel_b, _ = _velocities(motion, b, forward=True, joint=joint)
+    path = motion.translations()[[a, b], joint]
     rot, pos = interpolate(
         motion.local_rot[a],
-        motion.root_pos[a],
+        path[0],
         motion.local_rot[b],
-        motion.root_pos[b],
+        path[1],
         num,
         curve=curve,
         root=root,
@@ -219,10 +227,14 @@ def fill_between(
     )
     out = motion.copy()
     out.local_rot[start:stop] = rot
-    out.root_pos[start:stop] = pos
+    w = alphas(num, curve)[:, None, None]
     if out.local_pos is not None:
-        w = alphas(num, curve)[:, None, None]
         out.local_pos[start:stop] = motion.local_pos[a] + w * (motion.local_pos[b] - motion.local_pos[a])
+    if joint == 0:
+        out.root_pos[start:stop] = pos
+    else:
+        out.root_pos[start:stop] = motion.root_pos[a] + w[:, 0] * (motion.root_pos[b] - motion.root_pos[a])
+        out.local_pos[start:stop, joint] = pos
     return out
 
 

@@ -11,9 +11,9 @@ So the gap is predicted from both sides and the two predictions are blended:
   ``[a − P, a]`` is carried forward by the rigid motion that takes its start onto its end, turned
   by the change of heading over it, ``ψ = yaw(a) − yaw(a − P)``:
   ``T(q) = p(a) + R_y(ψ)(q − p(a − P))``. Frame ``a + k`` is the recorded frame
-  ``a + k − mP`` (``m = ⌈k/P⌉`` strides back) moved by ``T^m`` — its reference joint moved, its root
-  joint's rotation turned by ``mψ``. A straight walk repeats its stride, a turning one keeps
-  turning at its rate;
+  ``a + k − mP`` (``m = ⌈k/P⌉`` strides back) moved by ``T^m`` — its reference joint moved and
+  turned by ``mψ``, the joints above it (if any) left as recorded. A straight walk repeats its
+  stride, a turning one keeps turning at its rate;
 * **backward from after the gap** (known frames from ``b``): the same with the first stride
   ``[b, b + P]``, run backwards;
 * each prediction is bent to meet **both** ends of the gap by a correction linear in time: the
@@ -145,17 +145,29 @@ def _continue(motion: Motion, frames: np.ndarray, period: float, offsets: np.nda
     for i in range(int(m.max(initial=0))):  # a few strides at most: a loop over strides, not frames
         moved = m > i
         q[moved] = path[end] + (q[moved] - start) @ turn.T
-    rot = sample_rotations(motion.local_rot[frames], x)
-    rot[:, 0] = quat.mul(quat.from_yaw(m * psi), rot[:, 0])
+    rot = _turned(sample_rotations(motion.local_rot[frames], x), motion.skeleton.ancestors(joint), joint, m * psi)
     local_pos = None if motion.local_pos is None else sample_rows(motion.local_pos[frames], x)
     return _Side(q, rot, local_pos)
 
 
-def _bend(side: _Side, motion: Motion, frames: np.ndarray, period: float, far: tuple, w: np.ndarray, poses: bool):
+def _turned(rot: np.ndarray, chain: list[int], joint: int, yaw: np.ndarray) -> np.ndarray:
+    """Local rotations ``rot`` (K, J, 4) with the world rotation of ``joint`` (below the joints
+    ``chain``, joint 0 first) turned about +Y by ``yaw`` (K,) radians: the body turned by the joint
+    that carries it, the joints above it untouched."""
+    above = np.broadcast_to(quat.IDENTITY, rot[:, 0].shape)
+    for k in chain:  # the few joints above the reference joint (none where it is joint 0)
+        above = quat.mul(above, rot[:, k])
+    rot[:, joint] = quat.mul(quat.inv(above), quat.mul(quat.from_yaw(yaw), quat.mul(above, rot[:, joint])))
+    return rot
+
+
+def _bend(side: _Side, motion: Motion, frames: np.ndarray, period: float, far: tuple, w: np.ndarray, poses: bool,
+          joint: int):  # fmt: skip
     """Make a side's prediction meet both ends: its path by ``w`` (N+1,) times its miss at the far
     end (``far = (index into the prediction, reference joint position (3,))``); with ``poses``, its
     rotations and translations by the difference between its own end frame and the frame one
-    stride before it, fading as ``1 − w``."""
+    stride before it, fading as ``1 − w`` (but for the reference joint ``joint``, whose heading
+    :func:`_continue` turned, and the joints above it)."""
     end = len(frames) - 1
     side.path = side.path + w[:, None] * (far[1] - side.path[far[0]])
     if not poses:
@@ -165,7 +177,7 @@ def _bend(side: _Side, motion: Motion, frames: np.ndarray, period: float, far: t
     diff = quat.mul(rot[end], quat.inv(back))  # (J, 4): this stride's end against the last
     fade = quat.slerp(np.broadcast_to(np.array([1.0, 0.0, 0.0, 0.0]), diff.shape), diff,
                       np.broadcast_to((1.0 - w)[:, None], side.rot.shape[:-1]))  # fmt: skip
-    fade[:, 0] = np.array([1.0, 0.0, 0.0, 0.0])  # the root's heading is turned, not faded
+    fade[:, motion.skeleton.ancestors(joint) + [joint]] = quat.IDENTITY  # the carrier is turned, not faded
     side.rot = quat.normalize(quat.mul(fade, side.rot))
     if side.local_pos is not None:
         lp = motion.local_pos[frames]
@@ -189,7 +201,7 @@ def _predict(motion: Motion, a: int, b: int, joint: int, with_poses: bool):
             sides.append(None)
             continue
         side = _continue(motion, frames, period, offsets, joint)
-        sides.append(_bend(side, motion, frames, period, far, weight, with_poses))
+        sides.append(_bend(side, motion, frames, period, far, weight, with_poses, joint))
     fwd, back = sides
     if fwd is None and back is None:
         return None

@@ -244,3 +244,11 @@ def test_random_skeleton_is_reproducible():
     a = random_skeleton(np.random.default_rng(3), 10)
     b = random_skeleton(np.random.default_rng(3), 10)
     assert a.equals(b, atol=0)
+
+
+def test_ancestors_run_from_the_root_down_to_the_parent():
+    sk = Skeleton(("root", "hips", "spine", "leg", "head"), np.array([-1, 0, 1, 1, 2]), np.zeros((5, 3)))
+    assert sk.ancestors(0) == []
+    assert sk.ancestors(1) == [0]
+    assert sk.ancestors(4) == [0, 1, 2]
+    assert sk.ancestors(3) == [0, 1]

@@ -4,8 +4,8 @@ import importlib
 
 import pytest
 
-STUDIES = ["bench_inbetween", "check_gaps", "check_tracking_pose", "compare_feet", "compare_stride_root",
-           "gap_cases", "reproduce_keypose_paper"]  # fmt: skip
+STUDIES = ["bench_gap_rigs", "bench_inbetween", "check_gaps", "check_tracking_pose", "compare_counts", "compare_feet",
+           "compare_stride_root", "gap_cases", "reproduce_keypose_paper"]  # fmt: skip
 
 
 @pytest.mark.parametrize("name", STUDIES)

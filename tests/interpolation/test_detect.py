@@ -306,3 +306,18 @@ def test_track_refuses_a_match_it_cannot_make(bad):
     g, cut = _toy_graph_and_cut()
     with pytest.raises(ValueError, match="context|rates|features"):
         detect.track(cut, g, **bad)
+
+
+def test_local_count_is_exact_where_the_speed_changes_linearly():
+    """The local count fits a quadratic to the ground steps placed at their middles in time; with
+    a constant acceleration each step is the speed at its middle, so the count is exact. (It was
+    7.957 for 8 while the steps after the gap were placed one frame early.)"""
+    from motionlab.core import quat
+
+    m = toy_motion(120)
+    m.local_rot[:, 0] = quat.IDENTITY  # straight ahead along +Z
+    k = np.arange(120.0)
+    m.root_pos[:, 0] = 0.0
+    m.root_pos[:, 2] = 0.02 * k + 0.5 * 0.0004 * k**2  # metres: 0.6 m/s at frame 0, speeding up 0.36 m/s² at 30 fps
+    choice = detect.count_choice(m[np.r_[0:60, 68:120]], 59)  # frames 60 … 67 dropped
+    assert choice.local == pytest.approx(8.0, abs=1e-6)

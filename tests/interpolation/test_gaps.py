@@ -332,3 +332,81 @@ def test_fill_refuses_an_unknown_floor_rule():
     m, _ = _scissor_gap()
     with pytest.raises(ValueError, match="feet='hover'"):
         gaps.fill(m, feet="hover")
+
+
+# ---------------------------------------------------------------------------- the joint that carries the body
+def _marker_rig(m: Motion) -> Motion:
+    """``m`` on a rig with a marker joint 0 held at the origin above its root, which now moves by
+    its own translation channels (as Bandai Namco's ``joint_Root`` above the hips): the same world
+    motion for every joint of ``m``."""
+    from motionlab.core.skeleton import Skeleton
+
+    sk = m.skeleton
+    parents = np.concatenate([[-1], sk.parents + 1])
+    parents[1] = 0
+    rig = Skeleton(("Marker",) + tuple(sk.names), parents, np.concatenate([np.zeros((1, 3)), sk.offsets]))
+    T = m.num_frames
+    rot = np.concatenate([np.broadcast_to(quat.IDENTITY, (T, 1, 4)), m.local_rot], axis=1)
+    local_pos = np.concatenate([np.zeros((T, 1, 3)), m.translations()], axis=1)
+    return Motion(rig, rot, np.zeros((T, 3)), m.fps, local_pos, m.name)
+
+
+@pytest.mark.parametrize(("method", "root"), [("stride", "stride"), ("slerp", "hermite"), ("slerp", "stride"),
+                                              ("slerp", "linear"), ("hermite", "linear")])  # fmt: skip
+def test_a_still_joint_zero_stays_still_and_the_joint_below_it_carries_the_fill(method, root):
+    walk = toy_motion(150)  # a turning walk, long enough for the stride fill
+    marked = _marker_rig(walk)
+    missing = [(69, 8)]  # frames 70 … 77 dropped
+    keep = np.r_[0:70, 78:150]
+    filled, report = gaps.fill(gaps.insert_missing(walk[keep], missing)[0], method=method, root=root)
+    filled_marked, report_marked = gaps.fill(gaps.insert_missing(marked[keep], missing)[0], method=method, root=root)
+    assert report_marked[0].method == report[0].method == ("stride" if method == "stride" else method)
+    pos = filled_marked.global_positions()
+    np.testing.assert_allclose(pos[:, 0], 0.0, atol=1e-12)  # the marker never leaves the origin
+    np.testing.assert_allclose(filled_marked.local_rot[:, 0], np.broadcast_to(quat.IDENTITY, (150, 4)), atol=1e-12)
+    # the body is filled as on the rig that carries it by joint 0, to rounding
+    np.testing.assert_allclose(pos[:, 1:], filled.global_positions(), atol=1e-9)
+
+
+def test_carry_by_reference_keeps_the_body_and_interpolates_the_joints_above():
+    from motionlab.interpolation.alignment import carry_by_reference
+
+    marked = _marker_rig(toy_motion(40))
+    moved = marked.copy()
+    moved.root_pos[11:19] += np.array([0.3, 0.0, -1.2])  # a fill that carried the body by joint 0
+    moved.local_pos[11:19, 0] = moved.root_pos[11:19]
+    moved.local_pos[11:19, 1] -= np.array([0.3, 0.0, -1.2])
+    moved.local_rot[11:19, 0] = quat.from_yaw(0.4)
+    out = carry_by_reference(moved, 10, 19)
+    np.testing.assert_allclose(out.root_pos, 0.0, atol=1e-12)
+    np.testing.assert_allclose(out.global_positions()[:, 1:], moved.global_positions()[:, 1:], atol=1e-12)
+    np.testing.assert_allclose(quat.mul(out.global_rotations()[:, 1:], quat.inv(moved.global_rotations()[:, 1:]))[..., 0],
+                               1.0, atol=1e-12)  # fmt: skip
+    plain = toy_motion(40)
+    np.testing.assert_array_equal(carry_by_reference(plain, 10, 19).root_pos, plain.root_pos)  # joint 0 carries
+    with pytest.raises(ValueError, match="0 <= a < b"):
+        carry_by_reference(moved, 19, 10)
+
+
+@pytest.mark.realdata
+def test_fill_gaps_leaves_the_bandai_root_marker_at_the_origin(tmp_path, capsys):
+    """Issue 39: ``dataset-1_walk_normal_001`` with frames 40–45 dropped; the filled frames moved
+    ``joint_Root`` 120 … 20 cm off the origin and frame 46 snapped it back."""
+    from motionlab.cli import main
+    from motionlab.core import bvh
+    from tests.conftest import require_data
+
+    src = require_data("bandai_namco", "dataset-1", "walk", "dataset-1_walk_normal_001.bvh")
+    m = bvh.load(src)
+    keep = np.r_[0:40, 46 : m.num_frames]
+    bvh.save(tmp_path / "gap.bvh", m[keep])
+    np.savetxt(tmp_path / "times.txt", keep / m.fps)
+    out = tmp_path / "out.bvh"
+    assert main(["fill-gaps", str(tmp_path / "gap.bvh"), "-o", str(out), "--times", str(tmp_path / "times.txt")]) == 0
+    f = bvh.load(out)
+    assert f.num_frames == m.num_frames
+    truth, pos = m.global_positions(), f.global_positions()
+    np.testing.assert_allclose(pos[:, 0], truth[:, 0], atol=1e-6)  # joint_Root as recorded: at the origin
+    hips = np.linalg.norm(pos[40:46, 1] - truth[40:46, 1], axis=-1)
+    assert hips.max() < 0.02  # metres: the hips, which carry the walker, follow their path
+    capsys.readouterr()
