@@ -97,8 +97,11 @@ def player_data(
         ``radius`` (bone radius, metres), ``root``: the root's world positions (T, 3) flattened, in
         whole millimetres, and ``joints``: every joint's position relative to the root (T, J, 3),
         whole millimetres as little-endian int16, base64 (about 2.7 characters a number);
-        ``fps`` (the highest), ``duration`` (seconds, the longest), ``height`` and ``distance``
-        (metres, for the camera), ``grid`` (floor size, metres).
+        ``fps`` (the highest), ``duration`` (seconds, the longest), ``height`` (metres: the largest
+        vertical extent of one frame's joints, over every frame of every motion, at least 0.2 m;
+        measured on the motion, so a rig whose rest pose is folded up is framed as it moves), ``middle``
+        (metres: halfway between the lowest and the highest joint, where the camera looks) and
+        ``distance`` (metres, for the camera), ``grid`` (floor size, metres).
 
     Raises
     ------
@@ -114,7 +117,7 @@ def player_data(
             raise ValueError(f"expected {len(items)} {label} (one per motion), got {len(values)}")
     if not (isinstance(max_frames, int) and max_frames >= 1):
         raise ValueError(f"max_frames must be a whole number >= 1, got {max_frames!r}")
-    skeletons, lows, highs = [], [], []
+    skeletons, lows, highs, extents = [], [], [], []
     for i, m in enumerate(items):
         step = -(-m.num_frames // max_frames)
         m = m[::step] if step > 1 else m
@@ -125,6 +128,8 @@ def player_data(
             raise ValueError(f"motion {i} ({names[i]!r}) has non-finite joint positions")
         lows.append(pos.min(axis=(0, 1)))
         highs.append(pos.max(axis=(0, 1)))
+        extent = max(float(np.ptp(pos[..., 1], axis=-1).max()), 0.2)  # the figure as it moves, not its rest pose
+        extents.append(extent)
         root = np.rint(pos[:, 0] * 1000.0).astype(np.int64)
         rel = np.rint((pos - pos[:, :1]) * 1000.0)
         if np.abs(rel).max() > np.iinfo(np.int16).max:
@@ -135,18 +140,19 @@ def player_data(
                 "color": str(colors[i]),
                 "parents": [int(p) for p in m.skeleton.parents],
                 "fps": m.fps,
-                "radius": 0.016 * max(m.skeleton.height(), 0.2),
+                "radius": 0.016 * extent,
                 "root": root.ravel().tolist(),
                 "joints": base64.b64encode(rel.astype("<i2").tobytes()).decode("ascii"),
             }
         )
-    height = max(max(m.skeleton.height() for m in items), 0.2)
+    height = max(extents)
     spread = float(np.max(np.max(highs, axis=0) - np.min(lows, axis=0)))
     return {
         "skeletons": skeletons,
         "fps": max(s["fps"] for s in skeletons),
         "duration": max(m.duration for m in items),
         "height": height,
+        "middle": float(0.5 * (np.min(lows, axis=0)[1] + np.max(highs, axis=0)[1])),
         "distance": 2.2 * height + 0.6 * min(spread, 6.0 * height),
         "grid": float(np.ceil(spread + 4.0 * height)),
     }

@@ -134,7 +134,7 @@
     }
     if (state.dirty) {
       var centre = pose(state.t);
-      view.target.set(centre.x, data.height * 0.5, centre.z);
+      view.target.set(centre.x, data.middle !== undefined ? data.middle : data.height * 0.5, centre.z);
       var ce = Math.cos(view.elevation);
       camera.position.set(
         view.target.x + view.distance * ce * Math.sin(view.azimuth),
