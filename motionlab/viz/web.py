@@ -8,8 +8,15 @@ JSON) and a small script (``web_player.js``): play/pause, a time slider, orbit (
 * the documentation site does: ``scripts/build_docs.sh`` vendors three.js from npm into the site
   (``scripts/vendor_three.sh`` writes ``build/web/three.min.js``), so a page with a player works
   from ``file://`` with no server and no network;
-* in JupyterLab or VS Code, pass ``three_js=True`` (that vendored file) or a path to a three.js
-  build: its code goes into the output, which then works anywhere, at about 0.5 MB per output.
+* in JupyterLab or VS Code, :func:`player` embeds that vendored file by itself (``three_js="auto"``,
+  the default there) in the first player it shows in a kernel, about 0.5 MB; later players of the
+  same page wait for it. ``three_js=True`` (or a path to a three.js build) embeds it in every output,
+  which then works anywhere; ``MOTIONLAB_WEB_EMBED=0`` turns the automatic embedding off (for
+  outputs stored for the documentation site, which has three.js already).
+
+A notebook reopened from disk is *not trusted*, and JupyterLab runs no script of its outputs: the
+player then shows a line saying so instead of an empty box (run the cell again, or trust the
+notebook).
 
 PyVista (:mod:`motionlab.viz.player`) stays the notebooks' interactive player; this one is for
 pages read without a kernel. Taught in ``notebooks/04_playback_and_bone_proportions.ipynb``.
@@ -31,12 +38,16 @@ import numpy as np
 from motionlab.core.motion import Motion
 from motionlab.viz.scene import PALETTE
 
-__all__ = ["THREE_JS_ENV", "vendored_three_js", "player_data", "player_html", "player"]
+__all__ = ["THREE_JS_ENV", "EMBED_ENV", "vendored_three_js", "player_data", "player_html", "player"]
 
 THREE_JS_ENV = "MOTIONLAB_THREE_JS"
 """Environment variable naming a three.js build (a classic script defining ``THREE``) for ``three_js=True``."""
 
+EMBED_ENV = "MOTIONLAB_WEB_EMBED"
+"""Environment variable: ``0`` stops :func:`player` from embedding three.js by itself (``three_js="auto"``)."""
+
 _TEMPLATE = Path(__file__).with_name("web_player.js")
+_EMBEDDED: dict = {"done": False}  # three.js already embedded in an output of this kernel ("auto")
 _COUNTER = itertools.count(1)  # with the data's hash, an element id that is unique on a page and the same in every run
 
 
@@ -186,7 +197,9 @@ def player_html(
     height : int                    canvas height in CSS pixels (the width follows the page)
     autoplay : bool                 start playing when shown
     three_js : bool, path or None   ``None``: use the page's ``window.THREE``; ``True``: embed
-                                    :func:`vendored_three_js`; a path: embed that file
+                                    :func:`vendored_three_js`; a path: embed that file;
+                                    ``"auto"``: embed the vendored file if there is one, in the
+                                    first such output of this process only (unless ``$MOTIONLAB_WEB_EMBED`` is ``0``)
     motions, colors, names, spacing, max_frames : as for :func:`player_data`
 
     Raises
@@ -201,6 +214,8 @@ def player_html(
     payload = json.dumps(data, separators=(",", ":")).replace("</", "<\\/")
     player_id = f"motionlab-player-{hashlib.sha1(payload.encode()).hexdigest()[:10]}-{next(_COUNTER)}"
     library = ""
+    if isinstance(three_js, str) and three_js == "auto":
+        three_js = _auto_three_js()
     if three_js is not None and three_js is not False:
         path = vendored_three_js() if three_js is True else Path(three_js)
         if not path.is_file():
@@ -217,18 +232,35 @@ def player_html(
         f'<span class="motionlab-label" style="min-width:9em"></span></div>\n'
         f'<div style="margin-top:0.2em;color:#444">{_legend(data)}'
         f'<span style="color:#888">drag to orbit, wheel to zoom</span></div>\n'
-        f'<div class="motionlab-message" style="color:#a33"></div>\n'
+        f'<div class="motionlab-message" style="color:#a33">The 3D player has not started: this output\'s script '
+        f"did not run (a notebook reopened from disk is not trusted: run the cell again, or trust the notebook)."
+        f"</div>\n"
         f'<script type="application/json" class="motionlab-data">{payload}</script>\n'
         f"{library}<script>\n{script}</script>\n</div>"
     )
 
 
+def _auto_three_js() -> Path | None:
+    """The vendored three.js for ``three_js="auto"``: once per process, if there is one and
+    ``$MOTIONLAB_WEB_EMBED`` is not ``0``; else None (the page must provide ``window.THREE``)."""
+    if _EMBEDDED["done"] or os.environ.get(EMBED_ENV, "1") == "0":
+        return None
+    try:
+        path = vendored_three_js()
+    except FileNotFoundError:
+        return None
+    _EMBEDDED["done"] = True
+    return path
+
+
 def player(motions: Motion | Sequence[Motion], **options):
-    """The web player as a notebook output (``IPython.display.HTML``); options as for :func:`player_html`.
+    """The web player as a notebook output (``IPython.display.HTML``); options as for :func:`player_html`,
+    with ``three_js="auto"`` unless given (three.js embedded once per kernel when vendored).
 
     In a notebook, ``web.player([source, result], names=["source", "retargeted"], spacing=1.0)``
     shows both skeletons side by side; on the documentation site the stored output plays as is.
     """
     from IPython.display import HTML
 
+    options.setdefault("three_js", "auto")
     return HTML(player_html(motions, **options))

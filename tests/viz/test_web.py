@@ -110,3 +110,26 @@ def test_a_folded_rest_pose_is_framed_as_the_figure_stands():
     standing = np.ptp(walk.global_positions()[..., 1], axis=-1).max()
     assert standing > 1.0 and data["height"] == pytest.approx(standing)
     assert data["distance"] > 2.2 * standing  # far enough back to show the whole walker
+
+
+def test_a_notebook_player_embeds_three_js_once_per_kernel(walks, tmp_path, monkeypatch):
+    lib = tmp_path / "three.js"
+    lib.write_text("var THREE = {marker: 1};")
+    monkeypatch.setenv(web.THREE_JS_ENV, str(lib))
+    monkeypatch.setitem(web._EMBEDDED, "done", False)
+    first, second = web.player(walks[0]).data, web.player(walks[1]).data
+    assert "marker" in first and "marker" not in second  # the second waits for the first's THREE
+    assert "marker" in web.player(walks[0], three_js=True).data  # asked for: embedded every time
+    monkeypatch.setitem(web._EMBEDDED, "done", False)
+    monkeypatch.setenv(web.EMBED_ENV, "0")
+    assert "marker" not in web.player(walks[0]).data  # turned off (stored outputs for the docs site)
+
+
+def test_without_a_vendored_three_js_the_notebook_player_still_renders(walks, tmp_path, monkeypatch):
+    monkeypatch.setenv(web.THREE_JS_ENV, str(tmp_path / "missing.js"))
+    monkeypatch.setitem(web._EMBEDDED, "done", False)
+    if web.Path(web.__file__).resolve().parents[2].joinpath("build", "web", "three.min.js").is_file():
+        pytest.skip("this checkout has a vendored three.js")
+    out = web.player(walks[0]).data
+    assert "motionlab-player" in out and "var THREE" not in out
+    assert "not trusted" in out  # the line shown where no script runs (a reopened notebook)
