@@ -139,23 +139,8 @@ def player_data(
             raise ValueError(f"motion {i} ({names[i]!r}) has non-finite joint positions")
         lows.append(pos.min(axis=(0, 1)))
         highs.append(pos.max(axis=(0, 1)))
-        extent = max(float(np.ptp(pos[..., 1], axis=-1).max()), 0.2)  # the figure as it moves, not its rest pose
-        extents.append(extent)
-        root = np.rint(pos[:, 0] * 1000.0).astype(np.int64)
-        rel = np.rint((pos - pos[:, :1]) * 1000.0)
-        if np.abs(rel).max() > np.iinfo(np.int16).max:
-            raise ValueError(f"motion {i} ({names[i]!r}) has a joint more than 32 m from its root")
-        skeletons.append(
-            {
-                "name": str(names[i]),
-                "color": str(colors[i]),
-                "parents": [int(p) for p in m.skeleton.parents],
-                "fps": m.fps,
-                "radius": 0.016 * extent,
-                "root": root.ravel().tolist(),
-                "joints": base64.b64encode(rel.astype("<i2").tobytes()).decode("ascii"),
-            }
-        )
+        extents.append(max(float(np.ptp(pos[..., 1], axis=-1).max()), 0.2))  # as it moves, not its rest pose
+        skeletons.append(_skeleton_entry(m, pos, f"motion {i} ({names[i]!r})", names[i], colors[i], extents[-1]))
     height = max(extents)
     spread = float(np.max(np.max(highs, axis=0) - np.min(lows, axis=0)))
     return {
@@ -166,6 +151,24 @@ def player_data(
         "middle": float(0.5 * (np.min(lows, axis=0)[1] + np.max(highs, axis=0)[1])),
         "distance": 2.2 * height + 0.6 * min(spread, 6.0 * height),
         "grid": float(np.ceil(spread + 4.0 * height)),
+    }
+
+
+def _skeleton_entry(m: Motion, pos: np.ndarray, label: str, name, color, extent: float) -> dict:
+    """One skeleton of :func:`player_data`: the root path and the joints relative to it in
+    millimetres (int16, base64); ``label`` names the motion in the error."""
+    root = np.rint(pos[:, 0] * 1000.0).astype(np.int64)
+    rel = np.rint((pos - pos[:, :1]) * 1000.0)
+    if np.abs(rel).max() > np.iinfo(np.int16).max:
+        raise ValueError(f"{label} has a joint more than 32 m from its root")
+    return {
+        "name": str(name),
+        "color": str(color),
+        "parents": [int(p) for p in m.skeleton.parents],
+        "fps": m.fps,
+        "radius": 0.016 * extent,
+        "root": root.ravel().tolist(),
+        "joints": base64.b64encode(rel.astype("<i2").tobytes()).decode("ascii"),
     }
 
 
