@@ -36,6 +36,7 @@ K03 = _key("key_03_latent_iteration")
 K05 = _key("key_05_motion_graphs")
 K06 = _key("key_06_keypose_interpolation")
 K07 = _key("key_07_expanding_a_database")
+K00B = _key("key_00b_bvh_file_format")
 
 # (exercise, the key's solution) for every exercise of the notebooks
 SOLUTIONS = {
@@ -310,11 +311,11 @@ def style_takes():
     ]
 
 
-EXPERIMENT_NAMES = {"nlerp_turn", "euler_order", "hips_heading", "shorter_legs"}  # notebooks 00, 01, 04
+EXPERIMENT_NAMES = {"nlerp_turn", "euler_order", "reader_order", "hips_heading", "shorter_legs"}  # 00, 00b, 01, 04
 EXPERIMENT_NAMES |= {"q_delta_legs", "no_correction", "arm_length"}  # notebooks 02, 07
-EXPERIMENT_NAMES |= {"encoder_start", "contact_weight", "foot_weight"}  # notebook 03
-EXPERIMENT_NAMES |= {"vanishing_threshold", "style_change"}  # notebook 05
-EXPERIMENT_NAMES |= {"held_out_q", "walk_spacing", "smallest_gap"}  # notebook 06
+EXPERIMENT_NAMES |= {"encoder_start", "contact_weight", "foot_weight", "theta_directions"}  # notebook 03
+EXPERIMENT_NAMES |= {"vanishing_threshold", "style_change", "transition_clip"}  # notebook 05
+EXPERIMENT_NAMES |= {"held_out_q", "walk_spacing", "smallest_gap", "key_frames"}  # notebook 06
 
 
 def test_every_experiment_is_listed():
@@ -585,7 +586,7 @@ def walk_120():
     return synthetic.generate("walk", None, 360, 120.0, seed=3)  # notebook 06's walk without real data
 
 
-def _walk_error(walk, every, curve="linear", degrees=True):
+def _walk_error(walk, every, curve="linear", degrees=True, per_joint=False):
     """The walk experiment written independently of the key: frames 5, 5+every, … kept, the rest filled."""
     from motionlab.core import quat
     from motionlab.interpolation import demo, gaps
@@ -596,21 +597,27 @@ def _walk_error(walk, every, curve="linear", degrees=True):
     filled, _ = gaps.fill(holed, method="slerp", root="hermite", curve=curve)
     lost = np.setdiff1d(np.arange(span.num_frames), kept - 5)
     idx = [walk.skeleton.index(n) for n in demo.WALK_JOINTS]
-    e = quat.angle_between(filled.local_rot[lost][:, idx], span.local_rot[lost][:, idx]).mean()
+    e = quat.angle_between(filled.local_rot[lost][:, idx], span.local_rot[lost][:, idx]).mean(axis=0)
+    e = e if per_joint else e.mean()
     return np.degrees(e) if degrees else e
 
 
 def test_walk_spacing_experiment(walk_120):
     q = exercises.walk_spacing
     answer = K06.my_walk_spacing(walk_120)
+    per_joint = {every: _walk_error(walk_120, every, per_joint=True) for every in (10, 15, 20, 30, 45, 60)}
+    assert answer in per_joint and per_joint[answer].max() < 6.0  # every joint under 6° at the answer
+    assert all(per_joint[e].max() >= 6.0 for e in per_joint if e > answer)
     assert q.check(answer, walk_120).passed
-    assert q.check(round(float(answer), 1), walk_120).passed  # typed with one decimal
-    assert q.check(_walk_error(walk_120, 60, curve="ease"), walk_120).passed  # an eased α(k): accepted
-    result = q.check(_walk_error(walk_120, 30), walk_120)  # the notebook's spacing left at 30
-    assert not result.passed and "every = 60" in result.hint
-    result = q.check(_walk_error(walk_120, 60, degrees=False), walk_120)
-    assert not result.passed and "radians" in result.hint
-    assert not q.check(answer * 2, walk_120).passed
+    assert q.check(float(answer), walk_120).passed  # typed as a float
+    by_mean = max(e for e in per_joint if per_joint[e].mean() < 6.0)  # the mean over joints under 6°
+    if by_mean != answer:
+        result = q.check(by_mean, walk_120)
+        assert not result.passed and "every joint" in result.hint
+    first_failing = min(e for e in per_joint if per_joint[e].max() >= 6.0)
+    result = q.check(first_failing, walk_120)
+    assert not result.passed and "largest that stays under" in result.hint
+    assert not q.check(answer + 1, walk_120).passed
 
 
 def test_smallest_gap_experiment():
@@ -660,18 +667,19 @@ def _nlerp_ratio(angle_radians, steps=50):
 def test_nlerp_turn_experiment():
     q = exercises.nlerp_turn
     answer = K00.my_nlerp_turn_experiment()
-    assert 1.0 < answer < _nlerp_ratio(np.radians(170))  # a smaller turn: nlerp's speed varies less
-    assert q.check(answer).passed and q.check(float(f"{_nlerp_ratio(np.pi / 2):.3f}")).passed
-    wrong = {  # the page's 170°, 90 typed as radians, slerp's constant speed, the ratio upside down
-        "170°": round(_nlerp_ratio(np.radians(170)), 2),
-        "radians": round(_nlerp_ratio(90), 2),
-        "slerp": 1.0,
-        "slowest / fastest": round(1 / _nlerp_ratio(np.pi / 2), 2),
+    assert _nlerp_ratio(np.radians(answer)) <= 1.10 < _nlerp_ratio(np.radians(answer + 1))
+    assert 1 < answer < 170  # nlerp cannot take the page's half turn at nearly constant speed
+    assert q.check(answer).passed and q.check(float(answer)).passed
+    wrong = {  # the first turn above the bound, radians, the ratio of a 90° turn, slerp's "every turn"
+        "first turn whose ratio is above": answer + 1,
+        "radians": round(float(np.radians(answer)), 2),
+        "ratio": round(_nlerp_ratio(np.pi / 2), 2),
+        "slerp": 179,
     }
     for phrase, value in wrong.items():
         result = q.check(value)
         assert not result.passed and result.attempted and phrase in result.hint, result.message
-    assert not q.check(answer + 0.1).passed
+    assert not q.check(answer - 5).passed
 
 
 def test_euler_order_experiment():
@@ -742,13 +750,17 @@ def test_shorter_legs_experiment():
     answer = K04.my_shorter_legs_experiment(walk)
     assert q.check(answer, walk).passed
 
-    def error(legs, relative_to_root=True):
+    def error(legs):
         copied = proportions.copy_rotation_solver(walk)(humanoid.scale_bones(skeleton, legs=legs))
-        return float(np.nanmean(compare.joint_errors(copied, walk, relative_to_root=relative_to_root)))
+        return float(np.nanmean(compare.joint_errors(copied, walk, relative_to_root=True)))
 
-    assert 0 < answer < error(1.25)  # a smaller change of proportions, a smaller pose error
-    assert q.check(error(0.8), walk).passed
-    wrong = {"1.25": error(1.25), "relative_to_root": error(0.8, False), "centimetres": round(100 * error(0.8), 2)}
+    exact = error(0.8) / error(1.25)
+    assert 0 < exact < 1.5 and abs(answer - exact) < 0.006  # a change of 0.2 against one of 0.25
+    assert q.check(exact, walk).passed and q.check(round(exact, 3), walk).passed  # more decimals: also right
+    wrong = {
+        "alone": error(0.8),
+        "inverse": round(1 / exact, 2),
+    }
     for phrase, value in wrong.items():
         result = q.check(value, walk)
         assert not result.passed and result.attempted and phrase in result.hint, (phrase, result.message)
@@ -770,3 +782,97 @@ def test_style_change_experiment(style_takes):
     result = q.check(None, style_takes, request)
     assert not result.passed and not result.attempted and "not answered yet" in result.message
     assert not q.check(answer + 100, style_takes, request).passed
+
+
+# new experiments of issue 42: 00b reader order, 03 θ, 05 transition clip, 06 key frames
+
+
+def test_reader_order_experiment(tmp_path):
+    from motionlab import synthetic
+    from motionlab.core import bvh
+
+    walk = synthetic.generate("walk", humanoid.canonical_skeleton(), num_frames=30, fps=30, seed=0)
+    path = tmp_path / "walk.bvh"
+    bvh.save(path, walk)  # 00b's file without the course data
+    channels = bvh.load(path).skeleton.channels
+    q = exercises.reader_order
+    answer = K00B.my_reader_order_experiment(path, channels)
+    assert answer > 1.0  # reversing the order changes a real pose
+    assert q.check(answer, path).passed
+    # a different, independently written reading: Euler angles of bvh.load's rotations, reversed order
+    motion = bvh.load(path)
+    gaps = []
+    for j, chans in enumerate(channels):
+        order = "".join(c[0].lower() for c in chans if c.endswith("rotation"))
+        angles = quat.to_euler(motion.local_rot[0, j], order)
+        gaps.append(quat.angle_between(motion.local_rot[0, j], quat.from_euler(angles[::-1], order[::-1])))
+    assert q.check(float(np.degrees(max(gaps))), path).passed
+    wrong = {"radians": np.radians(answer), "mean over the joints": np.degrees(np.mean(gaps)), "reverse it": 0.0}
+    for phrase, value in wrong.items():
+        result = q.check(value, path)
+        assert not result.passed and result.attempted and phrase in result.hint, (phrase, result.message)
+
+
+def test_theta_directions_experiment(retarget_pair):
+    from motionlab import retargeting
+    from motionlab.core import preprocess
+    from motionlab.retargeting import plots
+    from motionlab.retargeting.solver import SolverConfig
+
+    q = exercises.theta_directions
+    answer = K03.my_theta_directions_experiment(*retarget_pair)
+    assert q.check(answer, *retarget_pair).passed
+
+    def angle(cfg):
+        run = retargeting.retarget(*retarget_pair[:2], retarget_pair[2], "full", cfg)
+        src = preprocess.prepare(retarget_pair[0], retarget_pair[2].fps)
+        return float(plots.joint_angle_errors(run.motion.local_rot, src.local_rot).mean())
+
+    assert q.check(angle(SolverConfig(theta="directions")), *retarget_pair).passed  # unrounded: also right
+    default = angle(SolverConfig())
+    assert abs(default - answer) > 0.05  # bone directions move the rotations away from A's
+    result = q.check(default, *retarget_pair)
+    assert not result.passed and "theta='directions'" in result.hint
+    result = q.check(float(np.radians(answer)), *retarget_pair)
+    assert not result.passed and "radians" in result.hint
+
+
+def test_transition_clip_experiment():
+    from motionlab.motion_graphs import clips
+
+    library = clips.synthetic_library(seconds=4.0)  # notebook 05's library without the course data
+    request, left_out = "idle:normal:60,walk:normal:120", "idle_normal_to_walk_normal"
+    q = exercises.transition_clip
+    answer = K05.my_transition_clip(library, request, left_out)
+    assert answer in exercises.motion_graphs.LINK_THRESHOLDS_CM
+    assert q.check(answer, library, request, left_out).passed
+    assert q.check(float(answer), library, request, left_out).passed
+    with_clip = exercises.motion_graphs.link_met(library, request, None, 3)
+    assert with_clip and answer > 3  # the recorded clip joins at 3 cm; stance links need a looser threshold
+    result = q.check(3, library, request, left_out)
+    assert not result.passed and "still holds the recorded transition clip" in result.hint
+    earlier = max(cm for cm in exercises.motion_graphs.LINK_THRESHOLDS_CM if cm < answer)
+    result = q.check(earlier, library, request, left_out)
+    assert not result.passed and "still fails" in result.hint
+    result = q.check(answer / 100, library, request, left_out)
+    assert not result.passed and "centimetres" in result.hint
+
+
+def test_key_frames_experiment(behaviour_clips):
+    from motionlab.interpolation import features
+    from motionlab.interpolation.action_graph import ActionGraph
+
+    clips = dict(behaviour_clips, stand=behaviour_clips["idle"])  # notebook 06 names the standing node "stand"
+    q = exercises.key_frames
+    answer = K06.my_key_frames(clips)
+    assert answer >= 1.0  # searching key frames only can never find a closer pair than all frames
+    assert q.check(answer, clips).passed
+    graph = ActionGraph()
+    for name in ("walk", "stand"):
+        graph.add_node(name, clips[name], num_keys=5)
+    every = features.distance_matrix(features.pose_features(clips["walk"]), features.pose_features(clips["stand"]))
+    exact = graph.best_transition("walk", "stand")[2] / every.min()
+    assert q.check(float(exact), clips).passed
+    result = q.check(round(1 / exact, 3), clips)
+    assert not result.passed and "inverse" in result.hint
+    assert not q.check(exact + 0.5, clips).passed

@@ -1,6 +1,6 @@
 """Instructor's key for notebook 00 (quaternions and forward kinematics).
 
-Exercises 1 and 2 are experiments: the key reruns the notebook's cell with the changed parameter
+Exercises 1 and 2 are experiments: the key reruns the notebook's cell with the changed parameters
 and returns the number a student reads off and types (as printed).
 """
 
@@ -10,13 +10,18 @@ from motionlab.core import fk, quat
 
 
 def my_nlerp_turn_experiment():
-    """Exercise 1: section 4's cell with a 90° turn; nlerp's fastest / slowest step, as printed."""
+    """Exercise 1: the largest whole-degree turn whose nlerp fastest / slowest step (50 steps, as in
+    section 4) is at most 1.10."""
     q0 = quat.IDENTITY
-    q1 = quat.from_axis_angle([0, 1, 0], np.radians(90))
     t = np.linspace(0, 1, 50)
-    nlerp = quat.normalize((1 - t)[:, None] * q0 + t[:, None] * q1)
-    steps = np.diff(np.degrees(quat.angle_between(q0, nlerp)))
-    return round(float(steps.max() / steps.min()), 2)
+    largest = None
+    for turn in range(1, 180):
+        q1 = quat.from_axis_angle([0, 1, 0], np.radians(turn))
+        nlerp = quat.normalize((1 - t)[:, None] * q0 + t[:, None] * q1)
+        steps = np.diff(np.degrees(quat.angle_between(q0, nlerp)))
+        if steps.max() / steps.min() <= 1.10:
+            largest = turn
+    return largest
 
 
 def my_euler_order_experiment():

@@ -57,3 +57,15 @@ def my_foot_weight_experiment(source, target_rig, ckpt):
     run = retargeting.retarget(source, target_rig, ckpt, "full", cfg)
     src = preprocess.prepare(source, ckpt.fps)
     return plots.joint_angle_errors(run.motion.local_rot, src.local_rot).mean()
+
+
+def my_theta_directions_experiment(source, target_rig, ckpt):
+    """Exercise 5: the full method with θ = bone directions; mean angle to A's rotations, degrees."""
+    from motionlab import retargeting
+    from motionlab.core import preprocess
+    from motionlab.retargeting import plots
+    from motionlab.retargeting.solver import SolverConfig
+
+    run = retargeting.retarget(source, target_rig, ckpt, "full", SolverConfig(theta="directions"))
+    src = preprocess.prepare(source, ckpt.fps)
+    return round(float(plots.joint_angle_errors(run.motion.local_rot, src.local_rot).mean()), 2)

@@ -7,11 +7,14 @@ from motionlab.viz import compare, proportions
 
 
 def my_shorter_legs_experiment(walk):
-    """Exercise 1 (experiment): section 4's comparison with legs × 0.8; mean pose error, m, as printed."""
-    short_legs = humanoid.scale_bones(walk.skeleton, legs=0.8)
-    copied = proportions.copy_rotation_solver(walk)(short_legs)
-    err = compare.joint_errors(copied, walk, relative_to_root=True)
-    return round(float(np.nanmean(err)), 3)
+    """Exercise 1 (experiment): section 4's comparison on legs × 0.8 and on legs × 1.25; the first
+    mean pose error over the second, as a student types it (two decimals)."""
+
+    def mean_pose_error(legs):
+        copied = proportions.copy_rotation_solver(walk)(humanoid.scale_bones(walk.skeleton, legs=legs))
+        return float(np.nanmean(compare.joint_errors(copied, walk, relative_to_root=True)))
+
+    return round(mean_pose_error(0.8) / mean_pose_error(1.25), 2)
 
 
 def my_joint_speed(motion):

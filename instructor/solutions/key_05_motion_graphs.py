@@ -50,3 +50,22 @@ def my_vanishing_threshold(motions, style):
         if kept:
             return cm
     return 0
+
+
+LINK_THRESHOLDS_CM = (3, 5, 10, 15, 20, 25, 30, 40)  # as in the notebook (exercises.motion_graphs.LINK_THRESHOLDS_CM)
+
+
+def my_transition_clip(library, request, trans_name):
+    """Exercise 4: the first threshold (cm) at which the graph without the recorded transition clip
+    still meets the request (0 if none does)."""
+    from motionlab.motion_graphs import search, structured
+
+    without = [m for m in library if m.name != trans_name]
+    for cm in LINK_THRESHOLDS_CM:
+        g = structured.build_structured(without, distance.threshold_from(cm / 100.0))
+        try:
+            search.search(g, request)
+            return cm
+        except search.SearchError:
+            pass
+    return 0

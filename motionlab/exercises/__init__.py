@@ -26,16 +26,20 @@ typical mistakes):
 * :mod:`~motionlab.exercises.motion_graphs`: 05 ``local_minima``.
 
 Experiments (:class:`Question`: change a parameter, run the experiment, type the number it gives;
-the check reruns it on the notebook's own inputs): 00 ``nlerp_turn`` (SLERP against nlerp on a
-smaller turn), ``euler_order`` (the same angles in another channel order); 01 ``hips_heading``
+the check reruns it on the notebook's own inputs): 00 ``nlerp_turn`` (the largest turn nlerp
+takes at nearly constant speed), ``euler_order`` (the same angles in another channel order); 00b
+``reader_order`` (a reader that ignores the channel order); 01 ``hips_heading``
 (the heading from the hips alone); 02 ``q_delta_legs`` (how much q_Δ changes on shorter legs),
 ``no_correction`` (decoding without q_Δ); 03 ``encoder_start`` (motionlab without the
 Gauss–Newton start), ``contact_weight`` (a fifth of the contact weight), ``foot_weight`` (λ_foot in
-the paper's set-up); 04 ``shorter_legs`` (copying rotations onto shorter legs); 05 ``style_change``
+the paper's set-up), ``theta_directions`` (θ as bone directions); 04 ``shorter_legs`` (whether
+copying's pose error follows the change of leg length); 05 ``style_change``
 (the ``dwell`` at which a style change lasts a gait cycle), ``vanishing_threshold`` (the graph
-threshold at which a style leaves the pruned standard graph); 06 ``held_out_q`` (q by likelihood
-on truly held-out frames), ``walk_spacing`` (the paper's walk experiment with key frames further
-apart), ``smallest_gap`` (the fewest dropped frames the stream-against-itself rule finds); 07
+threshold at which a style leaves the pruned standard graph), ``transition_clip`` (what joins two
+behaviours without their recorded transition clip); 06 ``held_out_q`` (q by likelihood on truly
+held-out frames), ``walk_spacing`` (how far apart the walk experiment's key frames may be),
+``smallest_gap`` (the fewest dropped frames the stream-against-itself rule finds), ``key_frames``
+(what searching transitions between key frames only costs); 07
 ``arm_length`` (how low a longer arm reaches under the floor).
 
 Their reference solutions, as a student would write them, are in ``instructor/solutions/`` (the
@@ -46,10 +50,19 @@ answers and an alternative correct answer. :func:`check` is the same machinery f
 
 from __future__ import annotations
 
-from .basics import euler_order, hand_height, hips_heading, joint_speed, nlerp_turn, shorter_legs, window_count
+from .basics import (
+    euler_order,
+    hand_height,
+    hips_heading,
+    joint_speed,
+    nlerp_turn,
+    reader_order,
+    shorter_legs,
+    window_count,
+)
 from .core import Exercise, Mistake, Question, Result, check
-from .interpolation import held_out_q, smallest_gap, walk_spacing
-from .motion_graphs import local_minima, style_change, vanishing_threshold
+from .interpolation import held_out_q, key_frames, smallest_gap, walk_spacing
+from .motion_graphs import local_minima, style_change, transition_clip, vanishing_threshold
 from .retargeting import (
     arm_length,
     contact_loss,
@@ -58,6 +71,7 @@ from .retargeting import (
     foot_weight,
     no_correction,
     q_delta_legs,
+    theta_directions,
 )
 
 __all__ = [
@@ -86,6 +100,10 @@ __all__ = [
     "vanishing_threshold",
     "style_change",
     "arm_length",
+    "reader_order",
+    "theta_directions",
+    "transition_clip",
+    "key_frames",
     "EXERCISES",
     "EXPERIMENTS",
 ]
@@ -118,6 +136,10 @@ EXPERIMENTS: dict[str, Question] = {
     "vanishing_threshold": vanishing_threshold,
     "style_change": style_change,
     "arm_length": arm_length,
+    "reader_order": reader_order,
+    "theta_directions": theta_directions,
+    "transition_clip": transition_clip,
+    "key_frames": key_frames,
 }
 """Every experiment exercise (a :class:`Question`: change a parameter, run, report a number).
 

@@ -1,4 +1,4 @@
-"""Exercises of notebooks 00 (quaternions, FK), 01 (preprocessing) and 04 (playback)."""
+"""Exercises of notebooks 00 (quaternions, FK), 00b (the BVH format), 01 (preprocessing) and 04 (playback)."""
 
 from __future__ import annotations
 
@@ -14,6 +14,8 @@ __all__ = [
     "window_count",
     "shorter_legs",
     "joint_speed",
+    "reader_order",
+    "NLERP_LIMIT",
 ]
 
 
@@ -30,27 +32,41 @@ def _nlerp_speed_ratio(turn_degrees: float, steps: int = 50, radians_typed: bool
     return float(step.max() / step.min())
 
 
+NLERP_LIMIT = 1.10
+"""Exercise 1's bound on nlerp's fastest / slowest step (10% faster in the middle than at the ends)."""
+
+
+def _largest_turn(limit: float = NLERP_LIMIT, first_above: bool = False) -> float:
+    """The largest whole-degree turn (1…179°) whose nlerp ratio is at most ``limit`` (or, with
+    ``first_above``, the smallest whose ratio exceeds it)."""
+    turns = np.arange(1, 180)
+    ok = np.array([_nlerp_speed_ratio(float(a)) <= limit for a in turns])
+    return float(turns[~ok][0]) if first_above else float(turns[ok][-1])
+
+
 nlerp_turn = Question(
-    "00 · exercise 1 (experiment: nlerp on a smaller turn)",
-    lambda: _nlerp_speed_ratio(90.0),
-    atol=0.006,  # the ratio as printed, with two decimals
+    "00 · exercise 1 (experiment: how large a turn nlerp can take)",
+    _largest_turn,
+    atol=0.006,  # whole degrees; a radian answer typed with two decimals is still recognised
     mistakes=[
         Mistake(
-            lambda: _nlerp_speed_ratio(170.0),
-            "that is the 170° turn of the page; change the angle to 90° and run the cell again.",
+            lambda: _largest_turn(first_above=True),
+            "that is the first turn whose ratio is above 1.10; the question asks for the largest turn "
+            "whose ratio is still at most 1.10.",
         ),
         Mistake(
-            lambda: _nlerp_speed_ratio(90.0, radians_typed=True),
-            "quat.from_axis_angle takes radians: 90 radians is not a quarter turn (use np.radians(90)).",
+            lambda: float(np.radians(_largest_turn())),
+            "that is in radians; answer with the turn in whole degrees.",
         ),
-        Mistake(lambda: 1.0, "1.00 is slerp's ratio (constant speed); the question asks about nlerp."),
         Mistake(
-            lambda: 1.0 / _nlerp_speed_ratio(90.0),
-            "that is slowest / fastest; the cell prints fastest / slowest (a number above 1).",
+            lambda: round(_nlerp_speed_ratio(90.0), 2),
+            "that is a ratio; the answer is a turn, in degrees.",
         ),
+        Mistake(lambda: 179.0, "every turn passes with slerp (ratio 1.00); the question is about nlerp."),
     ],
 )
-"""Notebook 00, section 4: nlerp's fastest/slowest step ratio for a 90° turn (50 steps)."""
+"""Notebook 00, section 4: the largest whole-degree turn for which nlerp's fastest / slowest step
+(50 steps) stays at most :data:`NLERP_LIMIT`."""
 
 _EULER_ANGLES = (30.0, -20.0, 45.0)  # degrees, section 3's angles
 
@@ -228,24 +244,30 @@ def _copied_error(walk, legs: float = 0.8, relative_to_root: bool = True) -> flo
     return float(np.nanmean(compare.joint_errors(copied, walk, relative_to_root=relative_to_root)))
 
 
+def _error_ratio(walk, inverse: bool = False) -> float:
+    """Pose error of copying onto legs × 0.8 over the error onto legs × 1.25 (or the inverse)."""
+    ratio = _copied_error(walk, 0.8) / _copied_error(walk, 1.25)
+    return 1.0 / ratio if inverse else ratio
+
+
 shorter_legs = Question(
-    "04 · exercise 1 (experiment: copying onto shorter legs)",
-    _copied_error,
-    atol=0.0006,  # an answer typed with three decimals passes
+    "04 · exercise 1 (experiment: does the copying error follow the leg change?)",
+    _error_ratio,
+    atol=0.006,  # an answer typed with two decimals passes
     rtol=0.005,
     mistakes=[
         Mistake(
-            lambda walk: _copied_error(walk, 1.25),
-            "that is the page's character with legs × 1.25; make the legs × 0.8 and run the cell again.",
+            lambda walk: _copied_error(walk, 0.8),
+            "that is the error on legs × 0.8 alone; divide it by the error on legs × 1.25.",
         ),
         Mistake(
-            lambda walk: _copied_error(walk, relative_to_root=False),
-            "that error includes where the root is; keep relative_to_root=True to compare the poses only.",
+            lambda walk: _error_ratio(walk, inverse=True),
+            "that is the error on legs × 1.25 over the error on legs × 0.8; the question asks for the inverse.",
         ),
-        Mistake(lambda walk: 100 * _copied_error(walk), "that is in centimetres; the cell prints metres."),
     ],
 )
-"""Notebook 04, section 4: mean pose error (m) of the walk copied onto legs × 0.8."""
+"""Notebook 04, section 4: the mean pose error (m) of the walk copied onto legs × 0.8 over the same
+error onto legs × 1.25 (0.8 if the error grew in proportion to the change of leg length)."""
 
 
 def _speed_cases():
@@ -306,3 +328,49 @@ joint_speed = Exercise(
         ),
     ],
 )
+
+
+# --------------------------------------------------------------------------- notebook 00b
+def _reader_gap(path, degrees: bool = True, reduce=np.max, keep_order: bool = False) -> float:
+    """Largest angle, over the joints, between frame 0 of ``path`` read with each joint's declared
+    rotation order and with that order reversed (a reader that ignores ``CHANNELS``)."""
+    from pathlib import Path
+
+    from motionlab.core import bvh, quat
+
+    channels = bvh.load(path).skeleton.channels
+    lines = [line.strip() for line in Path(path).read_text().splitlines()]
+    values = np.array(lines[lines.index("MOTION") + 3].split(), dtype=float)
+    column, gaps = 0, []
+    for chans in channels:
+        v = values[column : column + len(chans)]
+        column += len(chans)
+        order = "".join(c[0].lower() for c in chans if c.endswith("rotation"))
+        angles = np.radians([v[chans.index(a.upper() + "rotation")] for a in order])
+        wrong_order = order if keep_order else order[::-1]
+        wrong_angles = angles if keep_order else angles[::-1]
+        gaps.append(quat.angle_between(quat.from_euler(angles, order), quat.from_euler(wrong_angles, wrong_order)))
+    gap = float(reduce(gaps))
+    return float(np.degrees(gap)) if degrees else gap
+
+
+reader_order = Question(
+    "00b · exercise 1 (experiment: a reader that ignores the channel order)",
+    _reader_gap,
+    atol=0.06,  # an answer typed with one decimal passes
+    rtol=0.001,
+    mistakes=[
+        Mistake(lambda path: _reader_gap(path, degrees=False), "that is in radians; the question asks for degrees."),
+        Mistake(
+            lambda path: _reader_gap(path, reduce=np.mean),
+            "that is the mean over the joints; the question asks for the largest angle.",
+        ),
+        Mistake(
+            lambda path: 0.0,
+            "the two readings agree only if you kept the declared order: reverse it (e.g. 'xyz' → 'zyx', "
+            "each angle staying with its axis).",
+        ),
+    ],
+)
+"""Notebook 00b, section 3: the largest angle (degrees) between a joint's rotation in frame 0 read
+in its declared channel order and in the reversed order."""

@@ -2,8 +2,9 @@
 experiment the notebook runs, and the check reruns the experiment on the notebook's own inputs.
 
 1. :data:`held_out_q`: choose PPCA's q by the likelihood of frames held out in one block;
-2. :data:`walk_spacing`: the paper's walk experiment (Fig. 6/7) with key frames further apart;
-3. :data:`smallest_gap`: the fewest dropped frames the stream-against-itself rule finds.
+2. :data:`walk_spacing`: the paper's walk experiment (Fig. 6/7): how far apart key frames may be;
+3. :data:`smallest_gap`: the fewest dropped frames the stream-against-itself rule finds;
+4. :data:`key_frames`: what searching best transitions between key frames only costs.
 """
 
 from __future__ import annotations
@@ -12,7 +13,17 @@ import numpy as np
 
 from .core import Mistake, Question
 
-__all__ = ["held_out_q", "Q_CHOICES", "HELD_OUT", "walk_spacing", "SPACING", "smallest_gap", "CUT_AT"]
+__all__ = [
+    "held_out_q",
+    "Q_CHOICES",
+    "HELD_OUT",
+    "walk_spacing",
+    "SPACINGS",
+    "JOINT_LIMIT",
+    "smallest_gap",
+    "CUT_AT",
+    "key_frames",
+]
 
 
 # --------------------------------------------------------------------------- exercise 1: q on held-out frames
@@ -66,14 +77,19 @@ held_out_q = Question(
 )
 
 
-# --------------------------------------------------------------------------- exercise 2: key frames further apart
-SPACING = 60
-"""Exercise 2 keeps every ``SPACING``-th frame (the notebook keeps every 30th)."""
+# --------------------------------------------------------------------------- exercise 2: how far apart key frames may be
+SPACINGS = (10, 15, 20, 30, 45, 60)
+"""The key-frame spacings (frames) exercise 2 tries."""
+
+JOINT_LIMIT = 6.0
+"""Exercise 2's bound (degrees) on every walking joint's mean angle error (section 7's claim)."""
 
 
-def _walk_error(walk, every: int = SPACING, first: int = 5, curve: str = "linear", unit: str = "deg") -> float:
-    """Mean angle error over :data:`motionlab.interpolation.demo.WALK_JOINTS` and the filled frames when frames ``first,
-    first+every, …`` of ``walk`` are kept and the rest filled by SLERP with a Hermite root."""
+def _walk_error(
+    walk, every: int = 60, first: int = 5, curve: str = "linear", unit: str = "deg", reduce=np.mean
+) -> float:
+    """Angle error (mean over the filled frames; ``reduce`` over :data:`motionlab.interpolation.demo.WALK_JOINTS`)
+    when frames ``first, first+every, …`` of ``walk`` are kept and the rest filled by SLERP with a Hermite root."""
     from motionlab.core import quat
     from motionlab.interpolation import gaps
     from motionlab.interpolation.demo import WALK_JOINTS
@@ -84,24 +100,35 @@ def _walk_error(walk, every: int = SPACING, first: int = 5, curve: str = "linear
     filled, _ = gaps.fill(holed, method="slerp", root="hermite", curve=curve)
     lost = np.setdiff1d(np.arange(span.num_frames), kept - first)
     idx = [list(walk.skeleton.names).index(n) for n in WALK_JOINTS]
-    err = quat.angle_between(filled.local_rot[lost][:, idx], span.local_rot[lost][:, idx]).mean()
+    err = reduce(quat.angle_between(filled.local_rot[lost][:, idx], span.local_rot[lost][:, idx]).mean(axis=0))
     return float(np.degrees(err) if unit == "deg" else err)
 
 
+def _largest_spacing(walk, reduce=np.max, curve: str = "linear", first_failing: bool = False) -> float:
+    """The largest spacing of :data:`SPACINGS` whose error (``reduce`` over the joints) stays below
+    :data:`JOINT_LIMIT` (0: none does); with ``first_failing``, the smallest that does not."""
+    ok = [_walk_error(walk, every, curve=curve, reduce=reduce) < JOINT_LIMIT for every in SPACINGS]
+    if first_failing:
+        return float(next((s for s, good in zip(SPACINGS, ok) if not good), 0))
+    return float(max((s for s, good in zip(SPACINGS, ok) if good), default=0))
+
+
 walk_spacing = Question(
-    "06 · exercise 2 (experiment: key frames further apart)",
-    lambda walk: _walk_error(walk),
-    accept=[lambda walk: _walk_error(walk, curve="ease"), lambda walk: _walk_error(walk, curve="smoothstep")],
-    rtol=0.02,
+    "06 · exercise 2 (experiment: how far apart key frames may be)",
+    lambda walk: _largest_spacing(walk),
     mistakes=[
         Mistake(
-            lambda walk: _walk_error(walk, every=30),
-            "that is the notebook's own spacing (every 30th frame): set every = 60.",
+            lambda walk: _largest_spacing(walk, reduce=np.mean),
+            "that spacing keeps the *mean over the joints* under 6°; the question asks that every joint stays under it.",
         ),
-        Mistake(lambda walk: _walk_error(walk, unit="rad"), "the error is asked in degrees, not radians."),
+        Mistake(
+            lambda walk: _largest_spacing(walk, first_failing=True),
+            "that is the first spacing at which a joint reaches 6°; the question asks for the largest that stays under.",
+        ),
     ],
 )
-"""Exercise 2: the mean angle error (degrees) of the walk experiment with every 60th frame kept."""
+"""Exercise 2: the largest spacing of :data:`SPACINGS` (frames) at which the walk experiment keeps
+every walking joint's mean angle error under :data:`JOINT_LIMIT`."""
 
 
 # --------------------------------------------------------------------------- exercise 3: the smallest gap found
@@ -138,3 +165,38 @@ smallest_gap = Question(
     ],
 )
 """Exercise 3: the fewest frames removed from frame :data:`CUT_AT` on that ``detect.consecutive_gaps`` flags."""
+
+
+# --------------------------------------------------------------------------- exercise 4: transitions between key frames only
+def _key_cost(clips, a: str = "walk", b: str = "stand", num_keys: int = 5, inverse: bool = False) -> float:
+    """D of the best transition ``a → b`` searched between ``num_keys`` key frames per node (§3.1),
+    over the smallest D between any two frames of the two clips."""
+    from motionlab.interpolation.action_graph import ActionGraph
+    from motionlab.interpolation.features import distance_matrix, pose_features
+
+    graph = ActionGraph()
+    for name in (a, b):
+        graph.add_node(name, clips[name], num_keys=num_keys)
+    keyed = graph.best_transition(a, b)[2]
+    every = float(distance_matrix(pose_features(clips[a]), pose_features(clips[b])).min())
+    return every / keyed if inverse else keyed / every
+
+
+key_frames = Question(
+    "06 · exercise 4 (experiment: transitions between key frames only)",
+    lambda clips: _key_cost(clips),
+    atol=0.006,  # an answer typed with two decimals passes
+    rtol=0.002,
+    mistakes=[
+        Mistake(
+            lambda clips: _key_cost(clips, inverse=True),
+            "that is D over all frames divided by D between key frames; the question asks for the inverse (a number ≥ 1).",
+        ),
+        Mistake(
+            lambda clips: _key_cost(clips, num_keys=1),
+            "that uses one key frame per node; keep section 6's num_keys=5.",
+        ),
+    ],
+)
+"""Exercise 4: D of walk → stand's best transition between 5 key frames per node over the smallest D
+between any frames of the two clips (1: the key frames lose nothing)."""

@@ -1,5 +1,6 @@
 """Exercises of notebook 05 (motion graphs): transition candidates, how long a style change lasts,
-and the threshold at which a style leaves the standard graph."""
+the threshold at which a style leaves the standard graph, and what a recorded transition clip is
+worth."""
 
 from __future__ import annotations
 
@@ -16,6 +17,9 @@ __all__ = [
     "vanishing_threshold",
     "style_frames_kept",
     "THRESHOLDS_CM",
+    "transition_clip",
+    "link_met",
+    "LINK_THRESHOLDS_CM",
 ]
 
 
@@ -240,3 +244,65 @@ vanishing_threshold = Question(
         ),
     ],
 )
+
+
+# --------------------------------------------------------------------------- exercise 4 (experiment)
+LINK_THRESHOLDS_CM = (3, 5, 10, 15, 20, 25, 30, 40)
+"""The RMS thresholds (cm) exercise 4 moves through, for the graph without its transition clip."""
+
+_MET: dict = {}
+
+
+def link_met(library, request: str, left_out: str | None, rms_cm: float) -> bool:
+    """Whether ``search.search`` meets ``request`` on the structured graph of ``library`` without the
+    clip named ``left_out`` (None: every clip), built at ``rms_cm`` cm RMS."""
+    from motionlab.motion_graphs import distance, search, structured
+
+    key = (tuple(id(m) for m in library), request, left_out, float(rms_cm))
+    if key not in _MET:
+        kept = [m for m in library if m.name != left_out]
+        g = structured.build_structured(kept, distance.threshold_from(rms_cm / 100.0))
+        try:
+            search.search(g, request)
+            _MET[key] = True
+        except search.SearchError:
+            _MET[key] = False
+    return _MET[key]
+
+
+def _first_met(library, request: str, left_out: str | None) -> float:
+    """The smallest threshold of :data:`LINK_THRESHOLDS_CM` (cm) at which the request is met (0: at none)."""
+    for cm in LINK_THRESHOLDS_CM:
+        if link_met(library, request, left_out, cm):
+            return float(cm)
+    return 0.0
+
+
+def _last_failed(library, request: str, left_out: str | None) -> float:
+    """The largest threshold of :data:`LINK_THRESHOLDS_CM` at which the request still fails (0: none)."""
+    failed = [cm for cm in LINK_THRESHOLDS_CM if not link_met(library, request, left_out, cm)]
+    return float(max(failed)) if failed else 0.0
+
+
+transition_clip = Question(
+    "05 · exercise 4 (experiment: a graph without its transition clip)",
+    _first_met,
+    mistakes=[
+        Mistake(
+            lambda library, request, left_out: _first_met(library, request, None),
+            "that graph still holds the recorded transition clip: leave the clip named by `trans_name` "
+            "out of the library before building.",
+        ),
+        Mistake(
+            _last_failed,
+            "that is the largest threshold at which the search still fails; the question asks for the "
+            "first threshold at which it succeeds.",
+        ),
+        Mistake(
+            lambda library, request, left_out: _first_met(library, request, left_out) / 100.0,
+            "answer in centimetres, as LINK_THRESHOLDS_CM lists them.",
+        ),
+    ],
+)
+"""Notebook 05, section 6: the first threshold (cm RMS) at which stance links alone join the two
+behaviours the recorded transition clip joined (0 if none of :data:`LINK_THRESHOLDS_CM` does)."""

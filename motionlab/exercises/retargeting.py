@@ -356,3 +356,30 @@ arm_length = Question(
         ),
     ],
 )
+
+
+# --------------------------------------------------------------------------- notebook 03, exercise 5 (experiment)
+__all__ += ["theta_directions"]
+
+theta_directions = Question(
+    "03 · exercise 5 (experiment: θ as bone directions)",
+    lambda source, target, ckpt: _measure(source, target, ckpt, "angle", theta="directions"),
+    atol=0.006,  # an answer typed with two decimals passes
+    rtol=0.005,
+    mistakes=[
+        Mistake(
+            lambda source, target, ckpt: _measure(source, target, ckpt, "angle"),
+            "that is the default run (θ = local rotations); set theta='directions'.",
+        ),
+        Mistake(
+            lambda source, target, ckpt: _measure(source, target, ckpt, "angle", theta="directions", **PAPER),
+            "that run also takes the paper's other settings (no contact term, lr=0.1); change only theta.",
+        ),
+        Mistake(
+            lambda source, target, ckpt: float(np.radians(_measure(source, target, ckpt, "angle", theta="directions"))),
+            "that number is in radians; plots.joint_angle_errors gives degrees.",
+        ),
+    ],
+)
+"""Notebook 03: the mean angle (degrees) between A's local rotations and the full method's with
+θ = unit bone directions (``SolverConfig(theta="directions")``), every other setting at its default."""

@@ -8,8 +8,15 @@ JSON) and a small script (``web_player.js``): play/pause, a time slider, orbit (
 * the documentation site does: ``scripts/build_docs.sh`` vendors three.js from npm into the site
   (``scripts/vendor_three.sh`` writes ``build/web/three.min.js``), so a page with a player works
   from ``file://`` with no server and no network;
-* in JupyterLab or VS Code, pass ``three_js=True`` (that vendored file) or a path to a three.js
-  build: its code goes into the output, which then works anywhere, at about 0.5 MB per output.
+* in JupyterLab or VS Code, :func:`player` embeds that vendored file by itself (``three_js="auto"``,
+  the default there) in the first player it shows in a kernel, about 0.5 MB; later players of the
+  same page wait for it. ``three_js=True`` (or a path to a three.js build) embeds it in every output,
+  which then works anywhere; ``MOTIONLAB_WEB_EMBED=0`` turns the automatic embedding off (for
+  outputs stored for the documentation site, which has three.js already).
+
+A notebook reopened from disk is *not trusted*, and JupyterLab runs no script of its outputs: the
+player then shows a line saying so instead of an empty box (run the cell again, or trust the
+notebook).
 
 PyVista (:mod:`motionlab.viz.player`) stays the notebooks' interactive player; this one is for
 pages read without a kernel. Taught in ``notebooks/04_playback_and_bone_proportions.ipynb``.
@@ -31,12 +38,16 @@ import numpy as np
 from motionlab.core.motion import Motion
 from motionlab.viz.scene import PALETTE
 
-__all__ = ["THREE_JS_ENV", "vendored_three_js", "player_data", "player_html", "player"]
+__all__ = ["THREE_JS_ENV", "EMBED_ENV", "vendored_three_js", "player_data", "player_html", "player"]
 
 THREE_JS_ENV = "MOTIONLAB_THREE_JS"
 """Environment variable naming a three.js build (a classic script defining ``THREE``) for ``three_js=True``."""
 
+EMBED_ENV = "MOTIONLAB_WEB_EMBED"
+"""Environment variable: ``0`` stops :func:`player` from embedding three.js by itself (``three_js="auto"``)."""
+
 _TEMPLATE = Path(__file__).with_name("web_player.js")
+_EMBEDDED: dict = {"done": False}  # three.js already embedded in an output of this kernel ("auto")
 _COUNTER = itertools.count(1)  # with the data's hash, an element id that is unique on a page and the same in every run
 
 
@@ -97,8 +108,11 @@ def player_data(
         ``radius`` (bone radius, metres), ``root``: the root's world positions (T, 3) flattened, in
         whole millimetres, and ``joints``: every joint's position relative to the root (T, J, 3),
         whole millimetres as little-endian int16, base64 (about 2.7 characters a number);
-        ``fps`` (the highest), ``duration`` (seconds, the longest), ``height`` and ``distance``
-        (metres, for the camera), ``grid`` (floor size, metres).
+        ``fps`` (the highest), ``duration`` (seconds, the longest), ``height`` (metres: the largest
+        vertical extent of one frame's joints, over every frame of every motion, at least 0.2 m;
+        measured on the motion, so a rig whose rest pose is folded up is framed as it moves), ``middle``
+        (metres: halfway between the lowest and the highest joint, where the camera looks) and
+        ``distance`` (metres, for the camera), ``grid`` (floor size, metres).
 
     Raises
     ------
@@ -114,7 +128,7 @@ def player_data(
             raise ValueError(f"expected {len(items)} {label} (one per motion), got {len(values)}")
     if not (isinstance(max_frames, int) and max_frames >= 1):
         raise ValueError(f"max_frames must be a whole number >= 1, got {max_frames!r}")
-    skeletons, lows, highs = [], [], []
+    skeletons, lows, highs, extents = [], [], [], []
     for i, m in enumerate(items):
         step = -(-m.num_frames // max_frames)
         m = m[::step] if step > 1 else m
@@ -125,30 +139,36 @@ def player_data(
             raise ValueError(f"motion {i} ({names[i]!r}) has non-finite joint positions")
         lows.append(pos.min(axis=(0, 1)))
         highs.append(pos.max(axis=(0, 1)))
-        root = np.rint(pos[:, 0] * 1000.0).astype(np.int64)
-        rel = np.rint((pos - pos[:, :1]) * 1000.0)
-        if np.abs(rel).max() > np.iinfo(np.int16).max:
-            raise ValueError(f"motion {i} ({names[i]!r}) has a joint more than 32 m from its root")
-        skeletons.append(
-            {
-                "name": str(names[i]),
-                "color": str(colors[i]),
-                "parents": [int(p) for p in m.skeleton.parents],
-                "fps": m.fps,
-                "radius": 0.016 * max(m.skeleton.height(), 0.2),
-                "root": root.ravel().tolist(),
-                "joints": base64.b64encode(rel.astype("<i2").tobytes()).decode("ascii"),
-            }
-        )
-    height = max(max(m.skeleton.height() for m in items), 0.2)
+        extents.append(max(float(np.ptp(pos[..., 1], axis=-1).max()), 0.2))  # as it moves, not its rest pose
+        skeletons.append(_skeleton_entry(m, pos, f"motion {i} ({names[i]!r})", names[i], colors[i], extents[-1]))
+    height = max(extents)
     spread = float(np.max(np.max(highs, axis=0) - np.min(lows, axis=0)))
     return {
         "skeletons": skeletons,
         "fps": max(s["fps"] for s in skeletons),
         "duration": max(m.duration for m in items),
         "height": height,
+        "middle": float(0.5 * (np.min(lows, axis=0)[1] + np.max(highs, axis=0)[1])),
         "distance": 2.2 * height + 0.6 * min(spread, 6.0 * height),
         "grid": float(np.ceil(spread + 4.0 * height)),
+    }
+
+
+def _skeleton_entry(m: Motion, pos: np.ndarray, label: str, name, color, extent: float) -> dict:
+    """One skeleton of :func:`player_data`: the root path and the joints relative to it in
+    millimetres (int16, base64); ``label`` names the motion in the error."""
+    root = np.rint(pos[:, 0] * 1000.0).astype(np.int64)
+    rel = np.rint((pos - pos[:, :1]) * 1000.0)
+    if np.abs(rel).max() > np.iinfo(np.int16).max:
+        raise ValueError(f"{label} has a joint more than 32 m from its root")
+    return {
+        "name": str(name),
+        "color": str(color),
+        "parents": [int(p) for p in m.skeleton.parents],
+        "fps": m.fps,
+        "radius": 0.016 * extent,
+        "root": root.ravel().tolist(),
+        "joints": base64.b64encode(rel.astype("<i2").tobytes()).decode("ascii"),
     }
 
 
@@ -180,7 +200,9 @@ def player_html(
     height : int                    canvas height in CSS pixels (the width follows the page)
     autoplay : bool                 start playing when shown
     three_js : bool, path or None   ``None``: use the page's ``window.THREE``; ``True``: embed
-                                    :func:`vendored_three_js`; a path: embed that file
+                                    :func:`vendored_three_js`; a path: embed that file;
+                                    ``"auto"``: embed the vendored file if there is one, in the
+                                    first such output of this process only (unless ``$MOTIONLAB_WEB_EMBED`` is ``0``)
     motions, colors, names, spacing, max_frames : as for :func:`player_data`
 
     Raises
@@ -195,6 +217,8 @@ def player_html(
     payload = json.dumps(data, separators=(",", ":")).replace("</", "<\\/")
     player_id = f"motionlab-player-{hashlib.sha1(payload.encode()).hexdigest()[:10]}-{next(_COUNTER)}"
     library = ""
+    if isinstance(three_js, str) and three_js == "auto":
+        three_js = _auto_three_js()
     if three_js is not None and three_js is not False:
         path = vendored_three_js() if three_js is True else Path(three_js)
         if not path.is_file():
@@ -211,18 +235,35 @@ def player_html(
         f'<span class="motionlab-label" style="min-width:9em"></span></div>\n'
         f'<div style="margin-top:0.2em;color:#444">{_legend(data)}'
         f'<span style="color:#888">drag to orbit, wheel to zoom</span></div>\n'
-        f'<div class="motionlab-message" style="color:#a33"></div>\n'
+        f'<div class="motionlab-message" style="color:#a33">The 3D player has not started: this output\'s script '
+        f"did not run (a notebook reopened from disk is not trusted: run the cell again, or trust the notebook)."
+        f"</div>\n"
         f'<script type="application/json" class="motionlab-data">{payload}</script>\n'
         f"{library}<script>\n{script}</script>\n</div>"
     )
 
 
+def _auto_three_js() -> Path | None:
+    """The vendored three.js for ``three_js="auto"``: once per process, if there is one and
+    ``$MOTIONLAB_WEB_EMBED`` is not ``0``; else None (the page must provide ``window.THREE``)."""
+    if _EMBEDDED["done"] or os.environ.get(EMBED_ENV, "1") == "0":
+        return None
+    try:
+        path = vendored_three_js()
+    except FileNotFoundError:
+        return None
+    _EMBEDDED["done"] = True
+    return path
+
+
 def player(motions: Motion | Sequence[Motion], **options):
-    """The web player as a notebook output (``IPython.display.HTML``); options as for :func:`player_html`.
+    """The web player as a notebook output (``IPython.display.HTML``); options as for :func:`player_html`,
+    with ``three_js="auto"`` unless given (three.js embedded once per kernel when vendored).
 
     In a notebook, ``web.player([source, result], names=["source", "retargeted"], spacing=1.0)``
     shows both skeletons side by side; on the documentation site the stored output plays as is.
     """
     from IPython.display import HTML
 
+    options.setdefault("three_js", "auto")
     return HTML(player_html(motions, **options))

@@ -8,13 +8,17 @@
   if (!root || root.getAttribute("data-started")) return;
   root.setAttribute("data-started", "1");
   var message = root.querySelector(".motionlab-message");
-  var THREE = window.THREE;
-  if (!THREE || !THREE.WebGLRenderer) {
+  // three.js may come from the page (the documentation site), from this output, or from an earlier
+  // output of the same notebook (motionlab.viz.web.player embeds it once per kernel): wait for it.
+  var tries = 0;
+  (function waitForThree() {
+    if (window.THREE && window.THREE.WebGLRenderer) { message.textContent = ""; start(window.THREE); return; }
+    if (++tries < 50) { setTimeout(waitForThree, 100); return; }
     message.textContent = "The 3D player needs three.js, which is not loaded on this page. The documentation " +
-      "site includes it; in JupyterLab call motionlab.viz.web.player(..., three_js=True) after " +
-      "`bash scripts/vendor_three.sh`.";
-    return;
-  }
+      "site includes it; in JupyterLab run `bash scripts/vendor_three.sh` once, then run the notebook again " +
+      "(motionlab.viz.web.player embeds the file in the first player's output).";
+  })();
+  function start(THREE) {
   var data = JSON.parse(root.querySelector("script.motionlab-data").textContent);
   var canvas = root.querySelector("canvas");
   var renderer;
@@ -134,7 +138,7 @@
     }
     if (state.dirty) {
       var centre = pose(state.t);
-      view.target.set(centre.x, data.height * 0.5, centre.z);
+      view.target.set(centre.x, data.middle !== undefined ? data.middle : data.height * 0.5, centre.z);
       var ce = Math.cos(view.elevation);
       camera.position.set(
         view.target.x + view.distance * ce * Math.sin(view.azimuth),
@@ -151,4 +155,5 @@
   setPlaying(data.autoplay);
   root.setAttribute("data-ready", "1");
   requestAnimationFrame(frame);
+  }
 })();

@@ -22,7 +22,9 @@ What it does:
 6. opens every notebook page that has a web player (``motionlab.viz.web``) again, from ``file://``
    with every non-file request blocked: the player must start (three.js loaded, a WebGL context on
    its canvas); the check presses play and requires the canvas to change between a first
-   screenshot and one taken 0.5, 0.87 or 1.16 s after it, kept in ``--out/players/``. Every notebook that shows motion
+   screenshot and one taken 0.5, 0.87 or 1.16 s after it, kept in ``--out/players/``, and in every
+   one of those shots the skeletons must be in view: some figure pixels (saturated colours, not the
+   grey floor and background), none on the canvas edge. Every notebook that shows motion
    (:data:`MOTION_NOTEBOOKS`) must have a working player.
 
 Exit status 0 when every check passed, 1 otherwise.
@@ -123,6 +125,41 @@ def _changed_fraction(a: bytes, b: bytes) -> float:
     return float((np.abs(x - y).sum(axis=-1) > 0).mean()) if x.shape == y.shape else 1.0
 
 
+FIGURE_SPREAD = 24
+"""A pixel belongs to a skeleton when its colour channels spread by more than this (0-255): the
+player's background and grid are greys (spread under 16), the skeletons the saturated colours of
+``motionlab.viz.scene.PALETTE``, shaded."""
+
+
+def _figure_box(png: bytes) -> dict:
+    """Where the skeletons are in a canvas screenshot: ``share`` of the pixels that are figure, and
+    whether their bounding box touches an edge of the canvas (``touches``: a figure cut by the view)."""
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    rgb = np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), dtype=np.int16)
+    figure = (rgb.max(axis=-1) - rgb.min(axis=-1)) > FIGURE_SPREAD
+    if not figure.any():
+        return {"share": 0.0, "touches": False}
+    rows, cols = np.flatnonzero(figure.any(axis=1)), np.flatnonzero(figure.any(axis=0))
+    h, w = figure.shape
+    touches = rows[0] <= 1 or rows[-1] >= h - 2 or cols[0] <= 1 or cols[-1] >= w - 2
+    return {"share": round(float(figure.mean()), 4), "touches": bool(touches)}
+
+
+def _in_view(shots: list[bytes]) -> str:
+    """Empty when the skeletons are wholly in view in every shot; else why not."""
+    for k, png in enumerate(shots):
+        box = _figure_box(png)
+        if box["share"] < 0.001:
+            return f"no figure in view in shot {k}"
+        if box["touches"]:
+            return f"the figure leaves the view in shot {k} (it touches the canvas edge)"
+    return ""
+
+
 def _check_player(browser, rel: str, out: Path, timeout_ms: int = 20_000) -> dict:
     """Open ``rel`` from file:// (network blocked), start its first player and watch it move."""
     page = browser.new_page(viewport={"width": 1200, "height": 900})
@@ -148,6 +185,7 @@ def _check_player(browser, rel: str, out: Path, timeout_ms: int = 20_000) -> dic
         (out / "players").mkdir(parents=True, exist_ok=True)
         start, changed = time.monotonic(), 0.0
         first = canvas.screenshot(path=str(out / "players" / f"{stem}_0.png"))
+        shots = [first]
         # Later shots 0.5, 0.87 and 1.16 s after the first began (whatever each shot took): a
         # loop whose length divides one gap shows the same frame in that shot, and no loop of a
         # few frames or more divides all three.
@@ -155,11 +193,15 @@ def _check_player(browser, rel: str, out: Path, timeout_ms: int = 20_000) -> dic
             page.wait_for_timeout(max(0.0, 1000.0 * (gap - (time.monotonic() - start))))
             later = canvas.screenshot(path=str(out / "players" / f"{stem}_{k}.png"))
             changed = max(changed, _changed_fraction(first, later))
+            shots.append(later)
         result["changed"] = round(changed, 4)
         result["errors"] = errors
-        result["ok"] = bool(result["webgl"]) and result["changed"] > 0.001 and not errors
+        result["framing"] = _in_view(shots)  # pixels that change are not enough: the figure must be in view
+        result["ok"] = bool(result["webgl"]) and result["changed"] > 0.001 and not errors and not result["framing"]
         if not result["ok"]:
-            result["why"] = "no WebGL context" if not result["webgl"] else errors[0] if errors else "no motion"
+            result["why"] = (
+                "no WebGL context" if not result["webgl"] else errors[0] if errors else result["framing"] or "no motion"
+            )
     finally:
         page.close()
     return result

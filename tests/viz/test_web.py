@@ -86,3 +86,50 @@ def test_bad_input_is_named(walks):
 def test_player_is_a_notebook_output(walks):
     out = web.player(walks[0], autoplay=True)
     assert "motionlab-player" in out._repr_html_() and _data(out.data)["autoplay"] is True
+
+
+def test_the_camera_frames_the_motion_not_its_rest_pose(walks):
+    a, b = walks
+    data = web.player_data([a, b])
+    extent = max(np.ptp(m.global_positions()[..., 1], axis=-1).max() for m in walks)
+    assert data["height"] == pytest.approx(extent)  # the tallest frame, as the figure moves
+    lowest = min(m.global_positions()[..., 1].min() for m in walks)
+    highest = max(m.global_positions()[..., 1].max() for m in walks)
+    assert data["middle"] == pytest.approx(0.5 * (lowest + highest))
+
+
+def test_a_folded_rest_pose_is_framed_as_the_figure_stands():
+    from tests.conftest import require_data
+
+    root = require_data("bandai_namco")
+    from motionlab.core import bvh
+
+    walk = humanoid.to_canonical(bvh.load(root / "dataset-1/walk/dataset-1_walk_normal_001.bvh"))
+    assert walk.skeleton.height() < 0.2  # Bandai Namco's rest pose is folded up (notebook 01)
+    data = web.player_data(walk)
+    standing = np.ptp(walk.global_positions()[..., 1], axis=-1).max()
+    assert standing > 1.0 and data["height"] == pytest.approx(standing)
+    assert data["distance"] > 2.2 * standing  # far enough back to show the whole walker
+
+
+def test_a_notebook_player_embeds_three_js_once_per_kernel(walks, tmp_path, monkeypatch):
+    lib = tmp_path / "three.js"
+    lib.write_text("var THREE = {marker: 1};")
+    monkeypatch.setenv(web.THREE_JS_ENV, str(lib))
+    monkeypatch.setitem(web._EMBEDDED, "done", False)
+    first, second = web.player(walks[0]).data, web.player(walks[1]).data
+    assert "marker" in first and "marker" not in second  # the second waits for the first's THREE
+    assert "marker" in web.player(walks[0], three_js=True).data  # asked for: embedded every time
+    monkeypatch.setitem(web._EMBEDDED, "done", False)
+    monkeypatch.setenv(web.EMBED_ENV, "0")
+    assert "marker" not in web.player(walks[0]).data  # turned off (stored outputs for the docs site)
+
+
+def test_without_a_vendored_three_js_the_notebook_player_still_renders(walks, tmp_path, monkeypatch):
+    monkeypatch.setenv(web.THREE_JS_ENV, str(tmp_path / "missing.js"))
+    monkeypatch.setitem(web._EMBEDDED, "done", False)
+    if web.Path(web.__file__).resolve().parents[2].joinpath("build", "web", "three.min.js").is_file():
+        pytest.skip("this checkout has a vendored three.js")
+    out = web.player(walks[0]).data
+    assert "motionlab-player" in out and "var THREE" not in out
+    assert "not trusted" in out  # the line shown where no script runs (a reopened notebook)

@@ -1,0 +1,66 @@
+"""Print the experiment exercises' reference values on the notebooks' own inputs (course data,
+quick mode), the numbers quoted in this folder's model answers.
+
+    MOTIONLAB_DATA=/path/to/data MOTIONLAB_QUICK=1 python instructor/answers/reference_values.py
+
+02 and 07 depend on the network and job each notebook runs, and are left to their checks.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+from motionlab import data, retargeting
+from motionlab import exercises as ex
+from motionlab.core import bvh, preprocess
+from motionlab.interpolation import demo
+from motionlab.motion_graphs import clips
+
+
+def main() -> None:
+    warnings.simplefilter("ignore", UserWarning)
+    if not data.has_data("mixamo", "Aj"):
+        raise SystemExit("needs the course data: set MOTIONLAB_DATA")
+    print(f"00 ex1 nlerp_turn      {ex.nlerp_turn.reference():.0f} deg")
+    print(f"00 ex2 euler_order     {ex.euler_order.reference():.1f} deg")
+    running = data.clip_path("mixamo", "Aj", "Running")
+    print(f"00b ex1 reader_order   {ex.reader_order.reference(running):.1f} deg")
+    run = demo.trim_frozen(bvh.load(data.clip_path("mixamo", "Aj", "Run_Arc_Left")))
+    print(
+        f"01 ex1 hips_heading    {ex.hips_heading.reference(preprocess.prepare(run, fps=60).global_positions()):.1f} deg"
+    )
+    source = run
+    target = demo.trim_frozen(bvh.load(data.clip_path("mixamo", "Mousey_m", "Run_Arc_Left"))).skeleton
+    ckpt = retargeting.load_default()
+    for name in ("encoder_start", "contact_weight", "foot_weight", "theta_directions"):
+        print(f"03 {name:19s} {ex.EXPERIMENTS[name].reference(source, target, ckpt):.2f}")
+    from motionlab import synthetic
+    from motionlab.core import humanoid
+
+    walk = synthetic.generate("walk", humanoid.canonical_skeleton(), num_frames=120, fps=30.0, seed=0)
+    print(f"04 ex1 shorter_legs    {ex.shorter_legs.reference(walk):.2f}")
+    styles = ("normal", "elderly", "feminine")
+    root = data.data_root() / "bandai_namco" / "sessions" / "walk"
+    motions = [
+        clips.prepare(bvh.load(p), 30.0).copy(name=p.stem)
+        for s in styles
+        for p in sorted(root.glob(f"dataset-2_walk_{s}_*.bvh"))[:3]
+    ]
+    request = [("walk", s, 150) for s in styles]
+    print(f"05 ex2 style_change    dwell {ex.style_change.reference(motions, request):.0f}")
+    print(f"05 ex3 vanishing_thr.  {ex.vanishing_threshold.reference(motions, 'elderly'):.0f} cm")
+    req = "idle:normal:60,walk:catwalk:120"
+    print(
+        f"05 ex4 transition_clip {ex.transition_clip.reference(clips.mixamo_aj(), req, 'idle_normal_to_walk_catwalk'):.0f} cm"
+    )
+    behaviours, _ = demo.behaviours()
+    walk6, _ = demo.walk_clip()
+    pwalk, _ = demo.paper_walk()
+    print(f"06 ex1 held_out_q      q = {ex.held_out_q.reference(behaviours)}")
+    print(f"06 ex2 walk_spacing    {ex.walk_spacing.reference(pwalk):.0f} frames")
+    print(f"06 ex3 smallest_gap    {ex.smallest_gap.reference(walk6)} frames")
+    print(f"06 ex4 key_frames      {ex.key_frames.reference(behaviours):.2f}")
+
+
+if __name__ == "__main__":
+    main()
