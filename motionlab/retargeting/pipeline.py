@@ -314,7 +314,7 @@ def prepare_pair(source: PreparedSource, target: Skeleton | Motion, root_mode: s
         return PreparedPair(source, tgt, r, root_pos)
     device, dtype = source.x.device, source.x.dtype
     offsets = torch.tensor(tgt.offsets, dtype=dtype, device=device)
-    height = torch.as_tensor(root_pos[:, 1], dtype=dtype)[None]
+    height = torch.as_tensor(root_pos[:, 1], dtype=dtype, device=device)[None]
     root_xz = torch.as_tensor(root_pos[:, [0, 2]], dtype=dtype, device=device)[None]
     return PreparedPair(source, tgt, r, root_pos, offsets, height, root_xz)
 
