@@ -180,7 +180,7 @@ def solve_pairs(
         root_xz=torch.cat([j.root_xz for j in jobs]),
         yaw=torch.cat([j.source.yaw for j in jobs]),
         planted=torch.cat([j.source.planted for j in jobs]),
-        fps=torch.tensor([j.source.motion.fps for j in jobs]),
+        fps=torch.tensor([j.source.motion.fps for j in jobs], dtype=x.dtype, device=x.device),
     )
     out = []
     for p, job, res in zip(pairs, jobs, solved):

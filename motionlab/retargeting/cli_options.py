@@ -11,7 +11,7 @@ import argparse
 
 from motionlab.cli_args import non_negative, non_negative_int, positive, renamed
 
-__all__ = ["ROOT_MODES", "load_checkpoint", "solver_config", "add_solver_args"]
+__all__ = ["ROOT_MODES", "check_device", "load_checkpoint", "solver_config", "add_solver_args"]
 
 ROOT_MODES = ("stride", "hips", "legs", "contacts")
 """``pipeline.ROOT_MODES``, repeated so that ``--help`` does not import torch (a test keeps them equal)."""
@@ -23,9 +23,22 @@ def _error(msg: str):
     return CLIError(msg)
 
 
+def check_device(device: str | None) -> None:
+    """Refuse a ``--device`` this machine does not have (:func:`devices.pick`) before a command does any work."""
+    if device is None:
+        return
+    from motionlab.retargeting import devices
+
+    try:
+        devices.pick(device)
+    except ValueError as e:
+        raise _error(f"--device: {e}") from None
+
+
 def load_checkpoint(path: str | None, device: str | None):
     from motionlab import retargeting
 
+    check_device(device)
     try:
         return retargeting.load(path, device) if path else retargeting.load_default(device)
     except retargeting.CheckpointError as e:

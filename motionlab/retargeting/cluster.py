@@ -47,17 +47,22 @@ def _checkpoint_bytes(checkpoint: Checkpoint) -> bytes:
         return path.read_bytes()
 
 
-class _Worker:
-    """One Ray actor: the checkpoint loaded once, then :func:`solve_pairs` per batch."""
+def _dtype_name(checkpoint: Checkpoint) -> str:
+    return next(name for name, t in ck.DTYPES.items() if t == checkpoint.dtype)
 
-    def __init__(self, blob: bytes, threads: int) -> None:
+
+class _Worker:
+    """One Ray actor: the checkpoint loaded once, on the caller's device type and float type, then
+    :func:`solve_pairs` per batch."""
+
+    def __init__(self, blob: bytes, threads: int, device: str, dtype: str) -> None:
         import torch
 
         torch.set_num_threads(threads)
         with tempfile.TemporaryDirectory() as d:
             path = Path(d) / "net.pt"
             path.write_bytes(blob)
-            self.checkpoint = ck.load(path)
+            self.checkpoint = ck.load(path, device, dtype)
 
     def solve(self, pairs: list[Pair], solver: SolverConfig, root_mode: str) -> list[PairResult]:
         return solve_pairs(self.checkpoint, pairs, solver, root_mode)
@@ -71,7 +76,11 @@ def solve_batches_ray(
     address: str | None = None,
     workers: int = 2,
 ) -> Iterator[list[PairResult]]:
-    """Solve ``batches`` on Ray actors; yields each batch's results as it completes."""
+    """Solve ``batches`` on Ray actors; yields each batch's results as it completes.
+
+    Each actor runs the network on the checkpoint's device type and float type: on a GPU the
+    actors share the caller's GPU (``num_gpus = 1 / workers`` each), on the CPU one core each.
+    Raises ``ImportError`` without Ray and ``ValueError`` for ``workers < 1``."""
     ray = require_ray()
     if workers < 1:
         raise ValueError(f"workers must be >= 1, got {workers}")
@@ -84,9 +93,11 @@ def solve_batches_ray(
             ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False)
         started = True
     try:
-        actor = ray.remote(num_cpus=1)(_Worker)
+        device = checkpoint.device.type  # Ray shows an actor its own GPU(s) as cuda:0
+        gpus = 1.0 / workers if device == "cuda" else 0
+        actor = ray.remote(num_cpus=1, num_gpus=gpus)(_Worker)
         blob = ray.put(_checkpoint_bytes(checkpoint))
-        pool = [actor.remote(blob, 1) for _ in range(workers)]
+        pool = [actor.remote(blob, 1, device, _dtype_name(checkpoint)) for _ in range(workers)]
         pending = {}
         queue = [[replace(p, prepared=None) for p in b] for b in batches]  # workers prepare sources themselves
         free = list(pool)

@@ -391,8 +391,9 @@ def sequence_losses(
 
 
 def _in_model_type(model: RetargetNet, x: torch.Tensor) -> torch.Tensor:
-    """``x`` in the network's float type: every tensor of the iteration follows ``x``."""
-    return torch.as_tensor(x).to(next(model.parameters()).dtype)
+    """``x`` on the network's device and in its float type: every tensor of the iteration follows ``x``."""
+    weight = next(model.parameters())
+    return torch.as_tensor(x, dtype=weight.dtype, device=weight.device)
 
 
 def _check_inputs(x, source, offsets, root_height, cfg) -> None:
@@ -402,7 +403,7 @@ def _check_inputs(x, source, offsets, root_height, cfg) -> None:
             f"expected x (N, T, 70), source (N, T, 22, {last}) for theta={cfg.theta!r} and root_height (N, T), got "
             f"{tuple(x.shape)}, {tuple(source.shape)} and {tuple(root_height.shape)}"
         )
-    shape = tuple(torch.as_tensor(offsets).shape)
+    shape = tuple(offsets.shape) if hasattr(offsets, "shape") else np.shape(offsets)
     if shape not in ((22, 3), (x.shape[0], 22, 3)):
         raise ValueError(f"expected offsets (22, 3) or ({x.shape[0]}, 22, 3), got {shape}")
 
@@ -415,7 +416,8 @@ def _contact_inputs(x, root_height, cfg, root_xz, yaw, planted, fps):
         raise ValueError(
             "the contact term needs B's root path and the frame rate: pass root_xz (N, T, 2), yaw (N, T) and fps with planted"
         )
-    rate = torch.as_tensor(fps, dtype=x.dtype).reshape(-1).expand(x.shape[0]).clone()
+    like = dict(dtype=x.dtype, device=x.device)  # every input on x's device, in x's float type
+    rate = torch.as_tensor(fps, **like).reshape(-1).expand(x.shape[0]).clone()
     if not bool(torch.all(rate > 0)):
         raise ValueError(f"fps must be positive, got {fps}")
     if tuple(planted.shape) != x.shape[:2] + (len(CONTACT_JOINTS),) or tuple(root_xz.shape) != x.shape[:2] + (2,):
@@ -423,9 +425,10 @@ def _contact_inputs(x, root_height, cfg, root_xz, yaw, planted, fps):
             f"expected planted (N, T, 4) and root_xz (N, T, 2) for x {tuple(x.shape)}, got "
             f"{tuple(planted.shape)} and {tuple(root_xz.shape)}"
         )
-    root_xz = torch.as_tensor(root_xz, dtype=x.dtype)
-    root_world = torch.stack([root_xz[..., 0], torch.as_tensor(root_height, dtype=x.dtype), root_xz[..., 1]], dim=-1)
-    return root_world, torch.as_tensor(yaw, dtype=x.dtype), torch.as_tensor(planted, dtype=torch.bool), rate
+    root_xz = torch.as_tensor(root_xz, **like)
+    root_world = torch.stack([root_xz[..., 0], torch.as_tensor(root_height, **like), root_xz[..., 1]], dim=-1)
+    planted = torch.as_tensor(planted, dtype=torch.bool, device=x.device)
+    return root_world, torch.as_tensor(yaw, **like), planted, rate
 
 
 def solve(
@@ -626,7 +629,7 @@ def _losses(p: _Problem, phi0, embedding, smooth, steps: _Steps, active: list):
     ``values[k]`` is ``[L_iter, L_angle, L_foot, L_contact]`` of active group k (means over its rows)."""
     groups, bounds, device, dtype = len(p.sizes), p.bounds, phi0.device, phi0.dtype
     everyone = len(active) == groups
-    rows = None if everyone else torch.cat([torch.arange(bounds[g], bounds[g + 1]) for g in active]).to(device)
+    rows = None if everyone else torch.cat([torch.arange(bounds[g], bounds[g + 1], device=device) for g in active])
     delta = steps.deltas[0] if groups == 1 else torch.cat([steps.deltas[g] for g in active])
     phi = (phi0 if everyone else phi0[rows]) + smooth(delta)
     if p.per_row_offsets and not everyone:
@@ -771,6 +774,6 @@ def _iterate(
             for g in active:
                 track.steps[g] += 1
             bar.update(1)
-            bar.set_postfix(loss=f"{float(group_loss.detach().mean()):.4g}")
+            bar.set_postfix(loss=f"{np.mean([v[0] for v in values]):.4g}")  # values: already on the host
         bar.close()
     return track.results(p.bounds, time.perf_counter() - start)
