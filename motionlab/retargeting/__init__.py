@@ -56,11 +56,12 @@ DEFAULT_CHECKPOINT = Path(__file__).resolve().parent.parent / "assets" / "retarg
 """The shipped checkpoint (trained on ``motionlab.synthetic`` data; see the module docstring)."""
 
 
-def load_default(device=None) -> Checkpoint:
-    """The shipped pretrained network (CUDA when available, else CPU)."""
+def load_default(device=None, dtype: str = "float64") -> Checkpoint:
+    """The shipped pretrained network on ``device`` (default: CUDA when available, else CPU),
+    computing in ``dtype`` (:func:`checkpoint.load`; ``ValueError`` for a device that is not there)."""
     if not DEFAULT_CHECKPOINT.is_file():
         raise FileNotFoundError(
             f"the default retargeting checkpoint {DEFAULT_CHECKPOINT} is missing; re-create it with "
             "`motionlab train --synthetic 300 --seed 0 -o motionlab/assets/retarget_default.pt --force`"
         )
-    return load(DEFAULT_CHECKPOINT, device)
+    return load(DEFAULT_CHECKPOINT, device, dtype)

@@ -117,8 +117,13 @@ def _cmd_retarget(args) -> int:
     if not args.quiet:
         msg = f"wrote {out} ({result.motion.num_frames} frames @ {result.motion.fps:g} fps, method {result.method}"
         if result.method == "full":
-            h = result.history
-            msg += f"; L_iter {h['loss'][0]:.4g} -> {h['loss'][-1]:.4g} in {result.steps} steps ({result.stop_reason})"
+            start, kept = (
+                result.history["loss"][0],
+                result.losses["loss"],
+            )  # the returned iterate's, not the last step's
+            msg += (
+                f"; L_iter {start:.4g} -> {kept:.4g} (step {result.best_step} of {result.steps}, {result.stop_reason})"
+            )
         print(msg + f", {result.seconds:.2f} s)")
     if not check.ok:
         print(f"warning: {out}: {check.describe()}", file=sys.stderr)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 
 from motionlab.cli_args import non_negative, non_negative_int, positive, renamed
+from motionlab.retargeting import terms
 
 __all__ = ["ROOT_MODES", "check_device", "load_checkpoint", "solver_config", "add_solver_args"]
 
@@ -53,7 +54,10 @@ def solver_config(args):
         ("--steps", args.steps, args.steps >= 0, ">= 0"),
         ("--lr", args.lr, args.lr > 0, "> 0"),
         ("--stop-loss", args.stop_loss, args.stop_loss >= 0, ">= 0"),
-        ("--contact-weight", args.contact_weight, args.contact_weight >= 0, ">= 0"),
+        *[
+            (_weight_option(t.name), _weight(args, t.name), _weight(args, t.name) >= 0, ">= 0")
+            for t in terms.registered()
+        ],
         ("--exact-rounds", args.exact_rounds, 0 <= args.exact_rounds <= rounds, f"between 0 and {rounds}"),
     ):
         if not ok:  # also refuses nan
@@ -62,10 +66,18 @@ def solver_config(args):
         max_steps=args.steps,
         lr=args.lr,
         threshold=args.stop_loss,
-        lambda_contact=args.contact_weight,
         init=args.init,
         project_exact=args.exact_rounds,
+        weights={t.name: _weight(args, t.name) for t in terms.registered()},
     )
+
+
+def _weight_option(name: str) -> str:
+    return f"--{name.replace('_', '-')}-weight"
+
+
+def _weight(args, name: str) -> float:
+    return getattr(args, f"{name}_weight")
 
 
 def add_solver_args(p: argparse.ArgumentParser) -> None:
@@ -90,13 +102,14 @@ def add_solver_args(p: argparse.ArgumentParser) -> None:
             help="stop when L_iter drops below this (the paper's threshold; default 2e-3)",
         ),
     )
-    g.add_argument(
-        "--contact-weight",
-        type=non_negative,
-        default=0.5,
-        metavar="W",
-        help="weight of the foot-contact term (motionlab's addition; 0 = the paper's two losses; default 0.5)",
-    )
+    for term in terms.registered():  # one --NAME-weight per registered loss term
+        g.add_argument(
+            _weight_option(term.name),
+            type=non_negative,
+            default=term.weight,
+            metavar="W",
+            help=f"weight of {term.description or term.name} (default {term.weight:g})",
+        )
     g.add_argument(
         "--init",
         choices=("auto", "project", "encoder"),
