@@ -4,9 +4,10 @@ The network is frozen. Starting from ``φ = F_enc(X_A)`` (eq. 9), only the laten
 updated with Adam so that the motion decoded on B's skeleton (eqs. 10–14) keeps A's joint
 angles and keeps its feet above the ground (eq. 15)::
 
-    L_iter = λ_angle · L_angle(A, B') + λ_foot · L_foot(B')  [+ λ_contact · L_contact(B')]
+    L_iter = Σ_k w_k · L_k = λ_angle · L_angle(A, B') + λ_foot · L_foot(B')
+             [+ λ_contact · L_contact(B')] + λ_floor · L_floor(B') [+ any registered term]
 
-with λ_angle = 0.3, λ_foot = 0.5 (paper) and λ_contact = 0.5 (ours, see below), until
+with λ_angle = 0.3, λ_foot = 0.5 (paper), λ_contact = 0.5 and λ_floor = 2.25 (ours), until
 ``L_iter`` drops below ``threshold``, stops improving (``patience`` steps without a relative
 gain of ``min_delta``), or ``max_steps`` is reached. :func:`solve` treats all sequences of a
 batch (e.g. several clips of equal length) as one problem: their losses are averaged, so one
@@ -15,7 +16,15 @@ Adam run moves every latent. :func:`solve_many` runs the same loop on N independ
 :mod:`motionlab.retargeting.expand` solves many (clip, character) pairs at once; each sequence's
 numbers do not depend on the rest of the batch, so its result equals :func:`solve` on it alone.
 
-Three additions of motionlab, each measured in the README's Table 1 (ablation rows):
+**Loss terms are named objects** (:mod:`motionlab.retargeting.terms`, the contract): each has a
+name, a weight and a function of the decoded motion and its inputs; the iteration sums the
+registered terms in order, and the history (``SolverResult.history``: ``loss`` and one list per
+term), the callback, the plots, ``expand``'s manifest and the ``--NAME-weight`` options follow the
+registry. A new term is one function and one :func:`terms.register`; its weight is set with
+``SolverConfig(weights={name: w})`` and its per-sequence inputs passed as ``solve(..., inputs=)``.
+Every tensor follows the network's device and float type (:mod:`motionlab.retargeting.devices`).
+
+Three additions of motionlab, each measured on the results page, docs/results_retargeting.md (ablation rows):
 
 **A Gauss–Newton start (``init="project"``; the default ``"auto"`` uses it).** The encoder
 reproduces A's joint rotations only approximately on clips it was not trained on (12° median,
