@@ -47,8 +47,10 @@ def _checkpoint_bytes(checkpoint: Checkpoint) -> bytes:
         return path.read_bytes()
 
 
-def _dtype_name(checkpoint: Checkpoint) -> str:
-    return next(name for name, t in ck.DTYPES.items() if t == checkpoint.dtype)
+def _placement(checkpoint: Checkpoint) -> tuple[str, str]:
+    """``(device type, float type name)`` of the caller's network: where each actor loads its copy
+    (Ray shows an actor its own GPU(s) as ``cuda:0``)."""
+    return checkpoint.device.type, next(name for name, t in ck.DTYPES.items() if t == checkpoint.dtype)
 
 
 class _Worker:
@@ -93,11 +95,11 @@ def solve_batches_ray(
             ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False)
         started = True
     try:
-        device = checkpoint.device.type  # Ray shows an actor its own GPU(s) as cuda:0
+        device, dtype = _placement(checkpoint)
         gpus = 1.0 / workers if device == "cuda" else 0
         actor = ray.remote(num_cpus=1, num_gpus=gpus)(_Worker)
         blob = ray.put(_checkpoint_bytes(checkpoint))
-        pool = [actor.remote(blob, 1, device, _dtype_name(checkpoint)) for _ in range(workers)]
+        pool = [actor.remote(blob, 1, device, dtype) for _ in range(workers)]
         pending = {}
         queue = [[replace(p, prepared=None) for p in b] for b in batches]  # workers prepare sources themselves
         free = list(pool)

@@ -277,7 +277,7 @@ def test_cuda_expand_equals_the_cpu(clip, tmp_path):
     for d in ("cpu", "cuda"):
         ex.expand([str(tmp_path / "walk.bvh")], chars, tmp_path / d, retargeting.load_default(d), FAST)
     a, b = (bvh.load(tmp_path / d / "long_arms" / "walk.bvh").global_positions() for d in ("cpu", "cuda"))
-    assert 100 * np.abs(a - b).max() < max(CUDA_CM, 1e-4 * 100)  # BVH text keeps 6 decimals (cm)
+    assert 100 * np.abs(a - b).max() < 1e-3  # cm; the BVH text rounds its numbers
 
 
 @pytest.mark.cuda
@@ -307,3 +307,16 @@ def test_cuda_evaluate_equals_the_cpu(clip, tmp_path):
         for k, v in a.items():
             if isinstance(v, float):
                 assert v == pytest.approx(b[k], rel=1e-6, abs=1e-9), k
+
+
+def test_a_ray_worker_loads_the_network_as_the_caller_has_it(tiny_checkpoint):
+    """Ray actors loaded the checkpoint on their own default device and in float64 whatever the caller used."""
+    import dataclasses
+
+    from motionlab.retargeting import cluster
+
+    model32 = type(tiny_checkpoint.model)(tiny_checkpoint.model.config)
+    model32.load_state_dict(tiny_checkpoint.model.state_dict())
+    caller = dataclasses.replace(tiny_checkpoint, model=model32.to(torch.float32))
+    worker = cluster._Worker(cluster._checkpoint_bytes(caller), 1, *cluster._placement(caller))
+    assert (worker.checkpoint.device, worker.checkpoint.dtype) == (caller.device, torch.float32)
