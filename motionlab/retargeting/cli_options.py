@@ -47,6 +47,8 @@ def load_checkpoint(path: str | None, device: str | None):
 
 
 def solver_config(args):
+    import dataclasses
+
     from motionlab.retargeting.solver import SolverConfig
 
     rounds = SolverConfig().project_iters
@@ -68,8 +70,17 @@ def solver_config(args):
         threshold=args.stop_loss,
         init=args.init,
         project_exact=args.exact_rounds,
-        weights={t.name: _weight(args, t.name) for t in terms.registered()},
+        **_weights(args, {f.name for f in dataclasses.fields(SolverConfig)}),
     )
+
+
+def _weights(args, fields: set) -> dict:
+    """The ``--NAME-weight`` values as SolverConfig arguments: ``lambda_NAME`` where that field
+    exists (so an ablation's ``lambda_contact=0`` still applies), else ``weights[NAME]``."""
+    named = {t.name: _weight(args, t.name) for t in terms.registered()}
+    out = {f"lambda_{n}": w for n, w in named.items() if f"lambda_{n}" in fields}
+    out["weights"] = {n: w for n, w in named.items() if f"lambda_{n}" not in fields}
+    return out
 
 
 def _weight_option(name: str) -> str:

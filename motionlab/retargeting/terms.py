@@ -193,7 +193,7 @@ register(
         _contact,
         "m/s",
         ("root_world", "yaw", "planted", "fps"),
-        "L_contact: the source's planted feet stay still (motionlab's addition; 0 = the paper's two losses)",
+        "L_contact: the source's planted feet stay still (motionlab's addition)",
     )
 )
 register(

@@ -165,3 +165,18 @@ def test_expand_writes_the_returned_iterates_losses(ckpt, clip, tmp_path):
                                   ckpt, "full", cfg)  # fmt: skip
     for name in ("loss", "angle", "foot", "floor"):
         assert float(row[name]) == pytest.approx(direct.losses[name], rel=1e-5, abs=1e-12), name
+
+
+def test_the_papers_two_losses_row_switches_every_other_term_off(monkeypatch):
+    """``evaluate``'s ablation row, with the solver settings the command line builds."""
+    from motionlab.retargeting import evaluate
+    from motionlab.retargeting.cli_options import solver_config
+
+    used = {}
+    monkeypatch.setattr(evaluate, "retarget", lambda *args: used.setdefault("cfg", args[4]))
+    cfg = solver_config(build_parser().parse_args(["evaluate", "--floor-weight", "3", "--angle-weight", "0.4"]))
+    assert (cfg.weight("floor"), cfg.weight("angle"), cfg.weight("contact")) == (3.0, 0.4, 0.5)
+    paper = next(r for r in evaluate.ABLATIONS if "paper" in r[0])
+    evaluate._run_row(paper, None, None, None, cfg)
+    weights = {t.name: used["cfg"].weight(t.name) for t in terms.registered()}
+    assert weights == {"angle": 0.4, "foot": 0.5, "contact": 0.0, "floor": 0.0}
