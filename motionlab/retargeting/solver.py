@@ -417,18 +417,10 @@ def sequence_terms(
     return total, dict(zip([t.name for t in terms.registered()], values))
 
 
-def sequence_losses(
-    source: torch.Tensor,
-    generated: Decoded,
-    root_height: torch.Tensor,
-    config: SolverConfig | None = None,
-    root_world: torch.Tensor | None = None,
-    yaw: torch.Tensor | None = None,
-    planted: torch.Tensor | None = None,
-    fps: torch.Tensor | None = None,
-) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
-    """``(L_iter, L_angle, L_foot, L_contact)``, each (N,): :func:`sequence_terms` of the first terms."""
-    total, values = sequence_terms(source, generated, root_height, config, root_world, yaw, planted, fps)
+def sequence_losses(*args, **kwargs) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+    """``(L_iter, L_angle, L_foot, L_contact)``, each (N,): :func:`sequence_terms` (same parameters)
+    reduced to the first three terms' values, as before the term registry."""
+    total, values = sequence_terms(*args, **kwargs)
     return total, values["angle"], values["foot"], values["contact"]
 
 
