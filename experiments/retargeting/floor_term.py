@@ -5,6 +5,10 @@ notebook 07 does, with and without the floor term: the deepest joint of the outp
 plausibility check, the returned iterate's losses and the planted-foot slide::
 
     MOTIONLAB_DATA=/path/to/data python experiments/retargeting/floor_term.py [--steps 20 100]
+    MOTIONLAB_DATA=/path/to/data python experiments/retargeting/floor_term.py --character Mousey_m --steps 100
+
+``--character`` is an ``expand`` preset or a Mixamo character of the course data (its rig from
+its Running clip); ``--clip`` one of Aj's clips.
 """
 
 from __future__ import annotations
@@ -43,13 +47,19 @@ def main() -> None:
     parser.add_argument(
         "--steps", type=int, nargs="+", default=[20, 100], help="solver step limits (notebook 07: 20 quick, 100)"
     )
+    parser.add_argument("--character", default="long_arms", help="preset or Mixamo character (default long_arms)")
+    parser.add_argument("--clip", default="Jumping", help="Aj's clip (default Jumping)")
     args = parser.parse_args()
-    source = bvh.load(data.data_root() / "mixamo" / "Aj" / "Jumping.bvh")
-    target = humanoid.scale_bones(humanoid.canonical_skeleton(), **expand.PRESETS["long_arms"])
+    root = data.data_root() / "mixamo"
+    source = bvh.load(root / "Aj" / f"{args.clip}.bvh")
+    if args.character in expand.PRESETS:
+        target = humanoid.scale_bones(humanoid.canonical_skeleton(), **expand.PRESETS[args.character])
+    else:
+        target = bvh.load(root / args.character / "Running.bvh").skeleton
     ckpt = retargeting.load_default("cpu")
     src_low = humanoid.to_canonical(source).global_positions()[..., 1].min(axis=0)
     print(
-        f"Aj/Jumping -> long_arms {expand.PRESETS['long_arms']}; A's lowest hand "
+        f"Aj/{args.clip} -> {args.character} {expand.PRESETS.get(args.character, '')}; A's lowest hand "
         f"{100 * min(src_low[humanoid.JOINTS.index('LeftHand')], src_low[humanoid.JOINTS.index('RightHand')]):.1f} cm"
     )
     for steps in args.steps:
