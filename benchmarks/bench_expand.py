@@ -8,8 +8,12 @@ Same inputs, same run: source clips × characters, retargeted three ways, each w
 3. ``expand --backend ray`` with a local Ray instance of 2 workers (when Ray is installed).
 
 Throughput is source frames (at the checkpoint's rate) per second of wall time, start-up
-included. The machine's load average is printed before and after (other jobs share the CPU).
-The outputs of all three are compared byte for byte.
+included. For each ``expand`` run it prints the batch count, the time split (load: read and
+prepare the sources; solve: the batches; write: files and manifest) and, on a GPU, the peak GPU
+memory (``torch.cuda.max_memory_allocated``). The machine's load average is printed before and
+after (other jobs share the CPU). The outputs of all three are compared byte for byte.
+``--skip-per-process`` leaves out the slow one-process-per-pair run (then the batched outputs are
+compared with each other).
 
 Usage::
 
@@ -99,12 +103,20 @@ def _per_process(sources, specs, out: Path, args) -> float:
 
 
 def _expand(sources, specs, out: Path, args, backend: str, threads=None):
+    from motionlab import retargeting
     from motionlab.retargeting import expand as ex
-    from motionlab.retargeting.cli_options import load_checkpoint
 
     start = time.perf_counter()
-    ckpt = load_checkpoint(None, args.device)
+    ckpt = retargeting.load_default(args.device, args.dtype)
+    if ckpt.device.type == "cuda":
+        torch.cuda.reset_peak_memory_stats(ckpt.device)
     job = ex.expand(sources, ex.characters(*specs), out, ckpt, backend=backend, workers=2, threads=threads)
+    split = ", ".join(f"{k} {v:.1f} s" for k, v in job.timings.items())
+    memory = ""
+    if ckpt.device.type == "cuda":
+        memory = f", peak GPU memory {torch.cuda.max_memory_allocated(ckpt.device) / 2**20:.0f} MiB"
+    print(f"  {backend}{'' if threads is None else f' ({threads} threads)'} on {ckpt.device}: {job.batches} batches, "
+          f"{job.done} outputs, {job.throughput:.0f} source frames/s in expand; {split}{memory}")  # fmt: skip
     return time.perf_counter() - start, job
 
 
@@ -166,7 +178,15 @@ def main() -> None:
     p.add_argument("--characters", type=int, default=4, help="characters: real ones, then presets (default 4)")
     p.add_argument("--synthetic", action="store_true", help="synthetic clips and characters instead of MOTIONLAB_DATA")
     p.add_argument("--device", help="torch device for all three (default: cuda if available, else cpu)")
+    p.add_argument(
+        "--dtype",
+        choices=("float64", "float32"),
+        default="float64",
+        help="the network's float type in expand (retarget per process: float64)",
+    )
     p.add_argument("--memory", action="store_true", help="only measure memory per batch frame")
+    p.add_argument("--skip-per-process", action="store_true", help="leave out the one-process-per-pair run")
+    p.add_argument("--skip-ray", action="store_true", help="leave out the Ray run")
     p.add_argument("--verify", metavar="OUT", help="only check OUT's outputs against the single-pair path")
     args = p.parse_args()
     if args.memory:
@@ -183,29 +203,31 @@ def main() -> None:
         pairs = len(sources) * len(specs)
         print(f"{len(sources)} clips x {len(specs)} characters = {pairs} pairs, {frames} source frames")
         results = {}
-        t = _per_process(sources, specs, d / "per_process", args)
-        results["one process per pair"] = t
+        if not args.skip_per_process:
+            results["one process per pair"] = _per_process(sources, specs, d / "per_process", args)
         t, job = _expand(sources, specs, d / "local", args, "local")
         results["local batched"] = t
-        print(f"  local: {job.batches} batches, {job.done} outputs")
         if not args.device or args.device == "cpu":
             t, job = _expand(sources, specs, d / "local2", args, "local", threads=2)
             results["local batched, 2 threads"] = t
         try:
+            if args.skip_ray:
+                raise ImportError
             import ray  # noqa: F401
 
             t, job = _expand(sources, specs, d / "ray", args, "ray")
             results["Ray local, 2 workers"] = t
         except ImportError:
-            print('  Ray local: skipped (Ray is not installed: pip install "motionlab[cluster]")')
-        base = frames / results["one process per pair"]
+            print('  Ray local: skipped (--skip-ray, or Ray is not installed: pip install "motionlab[cluster]")')
+        base = frames / next(iter(results.values()))
         for label, t in results.items():
             fps = frames / t
             print(f"{label:<22} {t:8.1f} s  {fps:8.0f} source frames/s  {fps / base:6.1f}x")
+        reference = "per_process" if (d / "per_process").is_dir() else "local"
         for other in ("local", "local2", "ray"):
-            if (d / other).is_dir():
-                s, n = _same(d / "per_process", d / other)
-                print(f"outputs of {other} equal to one-process-per-pair: {s} of {n} files byte for byte")
+            if other != reference and (d / other).is_dir():
+                s, n = _same(d / reference, d / other)
+                print(f"outputs of {other} equal to {reference}: {s} of {n} files byte for byte")
         print(_load())
 
 

@@ -3,6 +3,11 @@
 ``(w, x, y, z)``, Hamilton product, active rotations, BVH (intrinsic) Euler orders, any leading
 batch shape. Everything is differentiable; :func:`normalize` and :func:`slerp` keep gradients
 finite at the identity and at zero-angle interpolation. Tests check each function against NumPy.
+
+Devices and float types: outputs follow the input tensors (every tensor made inside takes the
+device and dtype of an input). An input that is not a tensor (an array, a list, a number) becomes
+a tensor on torch's default device, so pass tensors to compute on a GPU. :data:`IDENTITY` is a
+float32 CPU constant: use ``IDENTITY.to(x)``.
 """
 
 from __future__ import annotations

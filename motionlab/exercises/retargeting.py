@@ -3,8 +3,11 @@
 Most are experiments (:class:`~motionlab.exercises.core.Question`): the student changes one
 parameter of a cell, runs it and types the number it gives; the check reruns the changed
 experiment with the package on the notebook's own inputs (its network, clip and target), so one
-key fits real and synthetic data. Each run is cached per inputs, so a check costs one decode
-(notebook 02) or one latent iteration (notebooks 03 and 07) at most.
+key fits real and synthetic data. Each run is cached under a digest of what it depends on (the
+network's weights, device and float type, the clip's numbers, the settings; a file's bytes), so a
+check costs one decode (notebook 02) or one latent iteration (notebooks 03 and 07) at most, and
+a changed input is never answered from the cache. The caller's network stays where it is (its
+device and float type): the checks compute there.
 
 ``contact_loss`` asks for a function: its cases are small torch tensors drawn from a fixed seed (a
 private generator: the notebook's own random state is left alone). torch is imported only when a
@@ -34,6 +37,53 @@ def _gen(seed: int):
     return torch.Generator().manual_seed(seed)
 
 
+def _feed(h, obj) -> None:
+    """Add ``obj``'s contents to the hash ``h``: tensors and arrays by value (with dtype, shape and
+    device), modules by their state, dataclasses, dicts and sequences item by item, paths by the
+    file's bytes, anything else by ``repr``."""
+    import dataclasses
+    from pathlib import Path
+
+    import torch
+
+    if isinstance(obj, torch.nn.Module):
+        obj = obj.state_dict()
+    if isinstance(obj, torch.Tensor):
+        h.update(f"tensor {obj.dtype} {tuple(obj.shape)} {obj.device}".encode())
+        obj = obj.detach().cpu().numpy()
+    if isinstance(obj, np.ndarray):
+        h.update(f"array {obj.dtype} {obj.shape}".encode())
+        h.update(np.ascontiguousarray(obj).tobytes())
+    elif dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        h.update(type(obj).__name__.encode())
+        for f in dataclasses.fields(obj):
+            _feed(h, f.name)
+            _feed(h, getattr(obj, f.name))
+    elif isinstance(obj, dict):
+        for k in sorted(obj, key=repr):
+            _feed(h, k)
+            _feed(h, obj[k])
+    elif isinstance(obj, (list, tuple)):
+        h.update(f"seq {len(obj)}".encode())
+        for item in obj:
+            _feed(h, item)
+    elif isinstance(obj, Path):
+        h.update(f"file {obj}".encode())
+        h.update(obj.read_bytes())
+    else:
+        h.update(repr(obj).encode())
+
+
+def _key(*inputs) -> str:
+    """A digest of everything a cached run depends on (:func:`_feed`)."""
+    import hashlib
+
+    h = hashlib.sha256()
+    for obj in inputs:
+        _feed(h, obj)
+    return h.hexdigest()
+
+
 # --------------------------------------------------------------------------- notebook 02, experiments
 _DECODED: dict = {}
 
@@ -45,14 +95,15 @@ def _decoded(checkpoint, clip, legs: float):
     from motionlab.core import humanoid, preprocess
     from motionlab.retargeting.features import clip_features
 
-    key = (id(checkpoint), id(clip), legs)
+    key = _key(checkpoint, clip, legs)
     if key not in _DECODED:
         prepared = preprocess.prepare(clip, checkpoint.fps)
         feats = clip_features(prepared)
-        x = torch.as_tensor(checkpoint.stats.normalize(feats.x), dtype=checkpoint.dtype)[None]
-        own = torch.tensor(prepared.skeleton.offsets, dtype=checkpoint.dtype)
-        other = torch.tensor(humanoid.scale_bones(prepared.skeleton, legs=legs).offsets, dtype=checkpoint.dtype)
-        model = checkpoint.model.cpu()
+        where = dict(dtype=checkpoint.dtype, device=checkpoint.device)
+        x = torch.as_tensor(checkpoint.stats.normalize(feats.x), **where)[None]
+        own = torch.tensor(prepared.skeleton.offsets, **where)
+        other = torch.tensor(humanoid.scale_bones(prepared.skeleton, legs=legs).offsets, **where)
+        model = checkpoint.model
         with torch.no_grad():
             phi = model.encode(x)
             _DECODED[key] = (feats, own, model.decode(phi, own), model.decode(phi, other))
@@ -65,7 +116,7 @@ def _q_delta_change(checkpoint, clip, legs: float = 0.7, reduce=np.max, against_
 
     _, _, on_a, on_b = _decoded(checkpoint, clip, legs)
     other = tq.IDENTITY.to(on_a.q_delta) if against_identity else on_b.q_delta
-    per_joint = tq.angle_between(on_a.q_delta, other).mean(dim=(0, 1)).numpy()  # (22,) radians
+    per_joint = tq.angle_between(on_a.q_delta, other).mean(dim=(0, 1)).cpu().numpy()  # (22,) radians
     value = float(reduce(per_joint))
     return float(np.degrees(value)) if degrees else value
 
@@ -103,7 +154,7 @@ def _joint_error_cm(checkpoint, clip, correction: bool = False, centimetres: boo
 
     feats, offsets, on_a, _ = _decoded(checkpoint, clip, 0.7)
     positions = on_a.positions if correction else RetargetNet.forward_kinematics(on_a.q, offsets)
-    err = np.linalg.norm(positions[0].numpy() - feats.positions, axis=-1).mean()
+    err = np.linalg.norm(positions[0].cpu().numpy() - feats.positions, axis=-1).mean()
     return float(100 * err if centimetres else err)
 
 
@@ -133,15 +184,15 @@ def _contact_cases():
     g = _gen(300)
 
     def walk(*shape):  # positions that move a few centimetres per frame, metres
-        return torch.cumsum(0.02 * torch.randn(*shape, 4, 3, generator=g), dim=-3)
+        return torch.cumsum(0.02 * torch.randn(*shape, 4, 3, generator=g, dtype=torch.float32, device="cpu"), dim=-3)
 
     def labels(*shape):
-        return torch.rand(*shape, 4, generator=g) < 0.6
+        return torch.rand(*shape, 4, generator=g, dtype=torch.float32, device="cpu") < 0.6
 
     return [
         (walk(2, 30), labels(2, 30), 60.0),
         (walk(25), labels(25), 30.0),  # no batch dimension, another frame rate
-        (walk(1, 12), torch.zeros(1, 12, 4, dtype=torch.bool), 60.0),  # never planted: 0
+        (walk(1, 12), torch.zeros(1, 12, 4, dtype=torch.bool, device="cpu"), 60.0),  # never planted: 0
     ]
 
 
@@ -212,7 +263,7 @@ def _measure(source, target, checkpoint, what: str, **settings) -> float:
     from motionlab.retargeting import pipeline, plots
     from motionlab.retargeting.solver import SolverConfig
 
-    key = (id(source), id(target), id(checkpoint), tuple(sorted(settings.items())))
+    key = _key(source, target, checkpoint, settings)
     if key not in _RUNS:
         run = retargeting.retarget(source, target, checkpoint, "full", SolverConfig(**settings))
         src = preprocess.prepare(source, checkpoint.fps)
@@ -319,10 +370,12 @@ _PLAUSIBILITY: dict = {}
 
 def _arms_plausibility(clip_path, checkpoint, solver, arms: float = 1.3):
     """The plausibility of ``clip_path`` retargeted onto the canonical character with arms × ``arms``."""
+    from pathlib import Path
+
     from motionlab.core import bvh, humanoid
     from motionlab.retargeting.pipeline import retarget
 
-    key = (str(clip_path), id(checkpoint), repr(solver), arms)
+    key = _key(Path(clip_path), checkpoint, solver, arms)
     if key not in _PLAUSIBILITY:
         target = humanoid.scale_bones(humanoid.canonical_skeleton(), arms=arms)
         result = retarget(bvh.load(clip_path), target, checkpoint, solver=solver)

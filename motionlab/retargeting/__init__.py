@@ -5,7 +5,9 @@ proportions by optimising the network's latent code (weights frozen) so that joi
 match the source and the feet stay above the ground.
 
 * :mod:`.model` — F_enc, F_qlinear, F_skel, F_Δ, Hamilton correction and FK;
-* :mod:`.losses` — L_recon, L_angle, L_foot;
+* :mod:`.losses` — L_recon, L_angle, L_foot, L_contact, L_floor; :mod:`.terms` — the latent
+  iteration's loss terms as named objects (the registry a new term joins);
+* :mod:`.devices` — the default torch device and its checks;
 * :mod:`.train` — training on one character; :mod:`.checkpoint` — save / load;
 * :mod:`.solver` — the latent iteration; :mod:`.baselines` — copy-rotation;
 * :mod:`.pipeline` — a Motion onto a target skeleton, end to end;
@@ -56,16 +58,17 @@ DEFAULT_CHECKPOINT = Path(__file__).resolve().parent.parent / "assets" / "retarg
 """The shipped checkpoint (trained on ``motionlab.synthetic`` data; see the module docstring)."""
 
 
-def load_default(device=None) -> Checkpoint:
-    """The shipped pretrained network (CUDA when available, else CPU).
+def load_default(device=None, dtype: str = "float64") -> Checkpoint:
+    """The shipped pretrained network on ``device`` (default: CUDA when available, else CPU),
+    computing in ``dtype`` (:func:`checkpoint.load`).
 
     Raises
     ------
-    FileNotFoundError when the shipped checkpoint is missing.
+    FileNotFoundError when the shipped checkpoint is missing; ValueError for a device that is not there.
     """
     if not DEFAULT_CHECKPOINT.is_file():
         raise FileNotFoundError(
             f"the default retargeting checkpoint {DEFAULT_CHECKPOINT} is missing; re-create it with "
             "`motionlab train --synthetic 300 --seed 0 -o motionlab/assets/retarget_default.pt --force`"
         )
-    return load(DEFAULT_CHECKPOINT, device)
+    return load(DEFAULT_CHECKPOINT, device, dtype)

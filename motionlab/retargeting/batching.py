@@ -184,11 +184,12 @@ def solve_pairs(
         root_xz=torch.cat([j.root_xz for j in jobs]),
         yaw=torch.cat([j.source.yaw for j in jobs]),
         planted=torch.cat([j.source.planted for j in jobs]),
-        fps=torch.tensor([j.source.motion.fps for j in jobs]),
+        fps=torch.tensor([j.source.motion.fps for j in jobs], dtype=x.dtype, device=x.device),
+        inputs={"floor": torch.cat([j.floor for j in jobs])},
     )
     out = []
     for p, job, res in zip(pairs, jobs, solved):
-        r = finish(job, res.local_rot[0], "full", res.history, res.stop_reason, res.steps, res.seconds)
+        r = finish(job, res.local_rot[0], "full", res.history, res.stop_reason, res.steps, res.seconds, res.best_step)
         out.append(PairResult(p.clip, p.character, r, len(pairs), 0.0))
     share = (time.perf_counter() - start) / len(pairs)
     for o in out:

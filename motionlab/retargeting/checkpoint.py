@@ -22,6 +22,7 @@ import torch
 from motionlab.core import files
 from motionlab.core.preprocess import NormStats
 from motionlab.core.skeleton import Skeleton
+from motionlab.retargeting import devices
 from motionlab.retargeting.model import ModelConfig, RetargetNet
 
 __all__ = ["FORMAT", "FORMAT_VERSION", "DTYPES", "CheckpointError", "Checkpoint", "save", "load"]
@@ -151,16 +152,18 @@ def save(path: str | os.PathLike, checkpoint: Checkpoint, overwrite: bool = True
 
 def load(path: str | os.PathLike, device: str | torch.device | None = None, dtype: str = "float64") -> Checkpoint:
     """Read a checkpoint written by :func:`save`; the network is in ``eval()`` mode on ``device``
-    (default: CUDA when available, else CPU) and computes in ``dtype`` (a key of :data:`DTYPES`,
-    whatever type its weights were stored in).
+    (default: CUDA when available, else CPU; :func:`motionlab.retargeting.devices.pick`) and computes
+    in ``dtype`` (a key of :data:`DTYPES`, whatever type its weights were stored in).
 
     Raises
     ------
     FileNotFoundError when there is no file; CheckpointError naming ``path`` when it is not
-    a readable checkpoint of this format version; ValueError for an unknown ``dtype``.
+    a readable checkpoint of this format version; ValueError for an unknown ``dtype`` or a
+    ``device`` this machine does not have.
     """
     if dtype not in DTYPES:
         raise ValueError(f"dtype must be one of {tuple(DTYPES)}, got {dtype!r}")
+    devices.pick(device)  # a device that is not there fails before the file is read
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"checkpoint {path} not found")
@@ -192,7 +195,5 @@ def load(path: str | os.PathLike, device: str | torch.device | None = None, dtyp
     except (KeyError, TypeError, RuntimeError, ValueError) as e:
         raise CheckpointError(f"{path}: damaged retargeting checkpoint ({type(e).__name__}: {e})") from None
     _check_contents(path, ckpt)
-    if device is None:
-        device = "cuda" if torch.cuda.is_available() else "cpu"
-    model.to(device).eval()
+    model.to(devices.pick(device)).eval()
     return ckpt

@@ -62,6 +62,7 @@ def _cmd_retarget(args) -> int:
     from motionlab.core import bvh, files, gltf, humanoid, rest_pose
     from motionlab.retargeting.pipeline import retarget
 
+    cli_options.check_device(args.device)
     out = Path(args.output)
     if out.suffix.lower() not in (".bvh", gltf.SUFFIX):
         raise _error(f"output {out} must end in .bvh or {gltf.SUFFIX} (glTF 2.0)")
@@ -116,8 +117,13 @@ def _cmd_retarget(args) -> int:
     if not args.quiet:
         msg = f"wrote {out} ({result.motion.num_frames} frames @ {result.motion.fps:g} fps, method {result.method}"
         if result.method == "full":
-            h = result.history
-            msg += f"; L_iter {h['loss'][0]:.4g} -> {h['loss'][-1]:.4g} in {result.steps} steps ({result.stop_reason})"
+            start, kept = (
+                result.history["loss"][0],
+                result.losses["loss"],
+            )  # the returned iterate's, not the last step's
+            msg += (
+                f"; L_iter {start:.4g} -> {kept:.4g} (step {result.best_step} of {result.steps}, {result.stop_reason})"
+            )
         print(msg + f", {result.seconds:.2f} s)")
     if not check.ok:
         print(f"warning: {out}: {check.describe()}", file=sys.stderr)
@@ -134,6 +140,7 @@ def _cmd_train(args) -> int:
     from motionlab.retargeting.model import ModelConfig
     from motionlab.retargeting.train import TrainConfig, train, training_set
 
+    cli_options.check_device(args.device)
     (out,) = check_outputs([("-o", args.output)], args.force, inputs=[("clip", c) for c in args.clips])
     if not 0.0 <= args.pose_augment <= 0.5:  # also refuses nan; skeleton augmentation takes the other half
         raise _error(f"--pose-augment must be between 0 and 0.5, got {args.pose_augment}")
@@ -242,6 +249,7 @@ def _cmd_evaluate(args) -> int:
     from motionlab import data as mdata
     from motionlab.retargeting.evaluate import Evaluation, evaluate, rows_with_root
 
+    cli_options.check_device(args.device)
     folder = Path(args.data) if args.data else mdata.data_root() / "mixamo"
     check_outputs([("--csv", args.csv)], args.force)  # refuse before hours of work, not after
     if not folder.is_dir():

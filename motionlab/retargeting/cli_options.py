@@ -10,8 +10,9 @@ from __future__ import annotations
 import argparse
 
 from motionlab.cli_args import non_negative, non_negative_int, positive, renamed
+from motionlab.retargeting import terms
 
-__all__ = ["ROOT_MODES", "load_checkpoint", "solver_config", "add_solver_args"]
+__all__ = ["ROOT_MODES", "check_device", "load_checkpoint", "solver_config", "add_solver_args"]
 
 ROOT_MODES = ("stride", "hips", "legs", "contacts")
 """``pipeline.ROOT_MODES``, repeated so that ``--help`` does not import torch (a test keeps them equal)."""
@@ -23,6 +24,18 @@ def _error(msg: str):
     return CLIError(msg)
 
 
+def check_device(device: str | None) -> None:
+    """Refuse a ``--device`` this machine does not have (:func:`devices.pick`) before a command does any work."""
+    if device is None:
+        return
+    from motionlab.retargeting import devices
+
+    try:
+        devices.pick(device)
+    except ValueError as e:
+        raise _error(f"--device: {e}") from None
+
+
 def load_checkpoint(path: str | None, device: str | None):
     """The network of the checkpoint at ``path`` (the shipped one when ``path`` is None) on ``device``.
 
@@ -32,6 +45,7 @@ def load_checkpoint(path: str | None, device: str | None):
     """
     from motionlab import retargeting
 
+    check_device(device)
     try:
         return retargeting.load(path, device) if path else retargeting.load_default(device)
     except retargeting.CheckpointError as e:
@@ -45,6 +59,8 @@ def solver_config(args):
     ------
     CLIError naming the option whose value is out of range.
     """
+    import dataclasses
+
     from motionlab.retargeting.solver import SolverConfig
 
     rounds = SolverConfig().project_iters
@@ -52,7 +68,10 @@ def solver_config(args):
         ("--steps", args.steps, args.steps >= 0, ">= 0"),
         ("--lr", args.lr, args.lr > 0, "> 0"),
         ("--stop-loss", args.stop_loss, args.stop_loss >= 0, ">= 0"),
-        ("--contact-weight", args.contact_weight, args.contact_weight >= 0, ">= 0"),
+        *[
+            (_weight_option(t.name), _weight(args, t.name), _weight(args, t.name) >= 0, ">= 0")
+            for t in terms.registered()
+        ],
         ("--exact-rounds", args.exact_rounds, 0 <= args.exact_rounds <= rounds, f"between 0 and {rounds}"),
     ):
         if not ok:  # also refuses nan
@@ -61,10 +80,27 @@ def solver_config(args):
         max_steps=args.steps,
         lr=args.lr,
         threshold=args.stop_loss,
-        lambda_contact=args.contact_weight,
         init=args.init,
         project_exact=args.exact_rounds,
+        **_weights(args, {f.name for f in dataclasses.fields(SolverConfig)}),
     )
+
+
+def _weights(args, fields: set) -> dict:
+    """The ``--NAME-weight`` values as SolverConfig arguments: ``lambda_NAME`` where that field
+    exists (so an ablation's ``lambda_contact=0`` still applies), else ``weights[NAME]``."""
+    named = {t.name: _weight(args, t.name) for t in terms.registered()}
+    out = {f"lambda_{n}": w for n, w in named.items() if f"lambda_{n}" in fields}
+    out["weights"] = {n: w for n, w in named.items() if f"lambda_{n}" not in fields}
+    return out
+
+
+def _weight_option(name: str) -> str:
+    return f"--{name.replace('_', '-')}-weight"
+
+
+def _weight(args, name: str) -> float:
+    return getattr(args, f"{name}_weight")
 
 
 def add_solver_args(p: argparse.ArgumentParser) -> None:
@@ -89,13 +125,14 @@ def add_solver_args(p: argparse.ArgumentParser) -> None:
             help="stop when L_iter drops below this (the paper's threshold; default 2e-3)",
         ),
     )
-    g.add_argument(
-        "--contact-weight",
-        type=non_negative,
-        default=0.5,
-        metavar="W",
-        help="weight of the foot-contact term (motionlab's addition; 0 = the paper's two losses; default 0.5)",
-    )
+    for term in terms.registered():  # one --NAME-weight per registered loss term
+        g.add_argument(
+            _weight_option(term.name),
+            type=non_negative,
+            default=term.weight,
+            metavar="W",
+            help=f"weight of {term.description or term.name} (default {term.weight:g})",
+        )
     g.add_argument(
         "--init",
         choices=("auto", "project", "encoder"),

@@ -52,17 +52,24 @@ def _checkpoint_bytes(checkpoint: Checkpoint) -> bytes:
         return path.read_bytes()
 
 
-class _Worker:
-    """One Ray actor: the checkpoint loaded once, then :func:`solve_pairs` per batch."""
+def _placement(checkpoint: Checkpoint) -> tuple[str, str]:
+    """``(device type, float type name)`` of the caller's network: where each actor loads its copy
+    (Ray shows an actor its own GPU(s) as ``cuda:0``)."""
+    return checkpoint.device.type, next(name for name, t in ck.DTYPES.items() if t == checkpoint.dtype)
 
-    def __init__(self, blob: bytes, threads: int) -> None:
+
+class _Worker:
+    """One Ray actor: the checkpoint loaded once, on the caller's device type and float type, then
+    :func:`solve_pairs` per batch."""
+
+    def __init__(self, blob: bytes, threads: int, device: str, dtype: str) -> None:
         import torch
 
         torch.set_num_threads(threads)
         with tempfile.TemporaryDirectory() as d:
             path = Path(d) / "net.pt"
             path.write_bytes(blob)
-            self.checkpoint = ck.load(path)
+            self.checkpoint = ck.load(path, device, dtype)
 
     def solve(self, pairs: list[Pair], solver: SolverConfig, root_mode: str) -> list[PairResult]:
         return solve_pairs(self.checkpoint, pairs, solver, root_mode)
@@ -78,9 +85,12 @@ def solve_batches_ray(
 ) -> Iterator[list[PairResult]]:
     """Solve ``batches`` on Ray actors; yields each batch's results as it completes.
 
+    Each actor runs the network on the checkpoint's device type and float type: on a GPU the
+    actors share the caller's GPU (``num_gpus = 1 / workers`` each), on the CPU one core each.
+
     Raises
     ------
-    ValueError when ``workers`` < 1.
+    ImportError without Ray; ValueError when ``workers`` < 1.
     """
     ray = require_ray()
     if workers < 1:
@@ -94,9 +104,11 @@ def solve_batches_ray(
             ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False)
         started = True
     try:
-        actor = ray.remote(num_cpus=1)(_Worker)
+        device, dtype = _placement(checkpoint)
+        gpus = 1.0 / workers if device == "cuda" else 0
+        actor = ray.remote(num_cpus=1, num_gpus=gpus)(_Worker)
         blob = ray.put(_checkpoint_bytes(checkpoint))
-        pool = [actor.remote(blob, 1) for _ in range(workers)]
+        pool = [actor.remote(blob, 1, device, dtype) for _ in range(workers)]
         pending = {}
         queue = [[replace(p, prepared=None) for p in b] for b in batches]  # workers prepare sources themselves
         free = list(pool)

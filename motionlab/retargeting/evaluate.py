@@ -51,6 +51,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from motionlab.core import humanoid, metrics, preprocess
+from motionlab.retargeting import terms
 from motionlab.retargeting.checkpoint import Checkpoint
 from motionlab.retargeting.pipeline import retarget, source_contacts
 from motionlab.retargeting.solver import SolverConfig
@@ -87,12 +88,13 @@ ROWS: tuple[tuple[str, str, str], ...] = (
 (everything scaled by thigh + shin); the others share the pipeline's default root trajectory."""
 
 ABLATIONS: tuple[tuple, ...] = (
-    ("full, paper's two losses", "full", "stride", {"lambda_contact": 0.0}),
+    ("full, paper's two losses", "full", "stride", {"paper_terms": True}),
     ("full, encoder start", "full", "stride", {"init": "encoder", "lr": 0.1}),
     ("full, without q_delta", "full", "stride", {"correction": False}),
 )
 """The full method with one addition switched off: ``(label, method, root_mode, options)``, where
-``options`` are :class:`SolverConfig` fields, or ``correction=False`` (q_Δ replaced by the identity)."""
+``options`` are :class:`SolverConfig` fields, ``correction=False`` (q_Δ replaced by the identity)
+or ``paper_terms=True`` (every loss term but the paper's two weighted 0: :data:`terms.PAPER_TERMS`)."""
 
 
 def rows_with_root(root_mode: str, ablations: bool = False) -> tuple[tuple, ...]:
@@ -327,6 +329,9 @@ def _run_row(row: tuple, source, target, checkpoint: Checkpoint | None, solver: 
     _, method, root_mode = row[:3]
     options = dict(row[3]) if len(row) > 3 else {}
     correction = options.pop("correction", True)
+    if options.pop("paper_terms", False):
+        off = {t.name: 0.0 for t in terms.registered() if t.name not in terms.PAPER_TERMS}
+        options["weights"] = {**(solver or SolverConfig()).weights, **off}
     cfg = dataclasses.replace(solver or SolverConfig(), **options)
     model = checkpoint.model if checkpoint is not None else None
     if model is not None:

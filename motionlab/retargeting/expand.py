@@ -58,6 +58,7 @@ import numpy as np
 from motionlab.core import bvh, gltf, humanoid, metrics, rest_pose
 from motionlab.core.skeleton import Skeleton
 from motionlab.core.threads import batch_threads, torch_threads
+from motionlab.retargeting import terms
 from motionlab.retargeting.batching import Pair, PairResult, batch_frames, plan_batches, quality, solve_pairs
 from motionlab.retargeting.checkpoint import Checkpoint
 from motionlab.retargeting.pipeline import at_rate, prepare_source
@@ -67,6 +68,7 @@ __all__ = [
     "PRESETS",
     "MANIFEST",
     "COLUMNS",
+    "columns",
     "FORMATS",
     "Character",
     "characters",
@@ -90,17 +92,38 @@ PRESETS: dict[str, dict[str, float]] = {
 (:func:`humanoid.canonical_skeleton`, 1.75 m). ``NAME:legs=1.2,arms=0.9`` makes a custom one."""
 
 MANIFEST = "manifest.csv"
-COLUMNS = (
-    "clip", "character", "status", "output", "source", "character_file", "frames", "steps", "stop_reason",
-    "loss", "angle", "foot", "contact", "penetration_cm", "skating_cm_s", "source_skating_cm_s", "seconds", "batch_size",
+_HEAD = ("clip", "character", "status", "output", "source", "character_file", "frames", "steps", "stop_reason", "loss")
+_TAIL = (
+    "penetration_cm", "skating_cm_s", "source_skating_cm_s", "seconds", "batch_size",
     "flag", "error", "fps", "source_sha256", "character_sha256", "options_sha256",
 )  # fmt: skip
-"""Manifest columns: ``status`` is ``ok`` or ``error``; ``loss``/``angle``/``foot``/``contact`` the
-final (best) L_iter, L_angle, L_foot (metres), L_contact (m/s); ``seconds`` the pair's share of its batch's wall time;
+
+
+def columns() -> tuple[str, ...]:
+    """The manifest's columns: :data:`COLUMNS` with one column per registered loss term (:mod:`.terms`) after ``loss``."""
+    return _HEAD + tuple(t.name for t in terms.registered()) + _TAIL
+
+
+COLUMNS = columns()
+"""Manifest columns (with the built-in loss terms; :func:`columns` follows the registry): ``status``
+is ``ok`` or ``error``; ``loss`` the returned (best) iterate's L_iter, then each term's value there
+(``angle`` L_angle, ``foot`` L_foot in metres, ``contact`` L_contact in m/s, ``floor`` L_floor in
+metres, …); ``seconds`` the pair's share of its batch's wall time;
 ``flag`` lists the quality thresholds exceeded (``penetration``, ``skating``) and the failed
 plausibility tests (``implausible_foot``, ``_floor``, ``_hips``, ``_bones``), empty if none; ``fps`` the
 output's frame rate; the ``*_sha256`` columns key resumption (module docstring)."""
 _OLD_COLUMNS = COLUMNS[: COLUMNS.index("fps")]  # manifests written before the content keys: all redone
+
+
+def _without_terms(names) -> tuple:
+    """Column names with the loss-term columns (between ``loss`` and ``penetration_cm``) left out:
+    manifests written with other registered terms are still this format (their options key differs)."""
+    names = tuple(names)
+    if "loss" not in names or _TAIL[0] not in names:
+        return names
+    return names[: names.index("loss") + 1] + names[names.index(_TAIL[0]) :]
+
+
 FORMATS = ("bvh", "glb")
 """Output formats of :func:`expand`: BVH text or binary glTF 2.0 (:mod:`motionlab.core.gltf`)."""
 
@@ -204,7 +227,8 @@ def _sha256(path) -> str:
 
 def options_digest(checkpoint: Checkpoint, solver: SolverConfig, root_mode: str, fps: float | None) -> str:
     """SHA-256 of everything besides source and character that changes an output: the checkpoint's
-    weights, normalisation and frame rate, the solver settings, the root rule and the output rate."""
+    weights, normalisation and frame rate, the solver settings, the registered loss terms and their
+    weights, the root rule and the output rate."""
     h = hashlib.sha256()
     for name, tensor in sorted(checkpoint.model.state_dict().items()):
         h.update(name.encode())
@@ -212,6 +236,7 @@ def options_digest(checkpoint: Checkpoint, solver: SolverConfig, root_mode: str,
     h.update(np.asarray(checkpoint.stats.mean, dtype=np.float64).tobytes())
     h.update(np.asarray(checkpoint.stats.std, dtype=np.float64).tobytes())
     settings = {"solver": dataclasses.asdict(solver), "root": root_mode, "fps": fps, "ckpt_fps": checkpoint.fps}
+    settings["terms"] = [[t.name, solver.weight(t.name)] for t in terms.registered()]  # what L_iter sums
     h.update(json.dumps(settings, sort_keys=True, default=str).encode())
     return h.hexdigest()
 
@@ -295,11 +320,10 @@ def read_manifest(out: str | Path) -> list[dict]:
         return []
     with open(path, newline="", encoding="utf-8") as f:
         reader = csv.DictReader(f)
-        if tuple(reader.fieldnames or ()) not in (COLUMNS, _OLD_COLUMNS):
-            raise ValueError(
-                f"{path} is not an expand manifest (columns {reader.fieldnames}, expected {list(COLUMNS)})"
-            )
-        return [{k: r.get(k, "") for k in COLUMNS} for r in reader]
+        cols = columns()
+        if _without_terms(reader.fieldnames or ()) not in (_without_terms(cols), _without_terms(_OLD_COLUMNS)):
+            raise ValueError(f"{path} is not an expand manifest (columns {reader.fieldnames}, expected {list(cols)})")
+        return [{k: r.get(k, "") for k in cols} for r in reader]
 
 
 def _umask_mode() -> int:
@@ -331,10 +355,11 @@ def _write_atomic(path: Path, text: str) -> None:
 
 def _write_manifest(out: Path, rows: list[dict]) -> None:
     buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=COLUMNS, lineterminator="\n")
+    cols = columns()
+    w = csv.DictWriter(buf, fieldnames=cols, lineterminator="\n")
     w.writeheader()
     for r in sorted(rows, key=lambda r: (r["character"], r["clip"])):
-        w.writerow({k: r.get(k, "") for k in COLUMNS})
+        w.writerow({k: r.get(k, "") for k in cols})
     _write_atomic(out / MANIFEST, buf.getvalue())
 
 
@@ -361,6 +386,9 @@ class ExpandResult:
                             ``character changed``, ``options changed``, ``file missing``)
     resampled : list of str   one line per source whose frame rate changed on the way
     implausible : int       outputs of this run that failed a plausibility test
+    timings : dict          wall time, seconds: ``load`` (plan, read and prepare the sources),
+                            ``solve`` (the batches: pairs prepared, the latent iteration, outputs
+                            finished and checked), ``write`` (files and manifest)
     """
 
     out: Path
@@ -374,6 +402,7 @@ class ExpandResult:
     redone: dict = field(default_factory=dict)
     resampled: list = field(default_factory=list)
     implausible: int = 0
+    timings: dict = field(default_factory=lambda: {"load": 0.0, "solve": 0.0, "write": 0.0})
 
     @property
     def throughput(self) -> float:
@@ -418,7 +447,7 @@ def _row(pr: PairResult, src: _Source, char: Character, limits, suffix: str, out
         flags.append("skating")
     flags += [f"implausible_{t}" for t in res.plausibility.failed]
     source = src.path
-    best = int(np.argmin(h["loss"]))
+    best = res.best_step  # the returned iterate's losses, not the last step's
     return {
         "clip": pr.clip,
         "character": pr.character,
@@ -430,9 +459,7 @@ def _row(pr: PairResult, src: _Source, char: Character, limits, suffix: str, out
         "steps": str(res.steps),
         "stop_reason": res.stop_reason,
         "loss": _fmt(h["loss"][best]),
-        "angle": _fmt(h["angle"][best]),
-        "foot": _fmt(h["foot"][best]),
-        "contact": _fmt(h["contact"][best]) if h.get("contact") else "",
+        **{t.name: _fmt(h[t.name][best]) if h.get(t.name) else "" for t in terms.registered()},
         "penetration_cm": _fmt(q["penetration_cm"]),
         "skating_cm_s": _fmt(q["skating_cm_s"]),
         "source_skating_cm_s": _fmt(src.skating),
@@ -611,6 +638,7 @@ def _expand(
     options = options_digest(checkpoint, solver, root_mode, fps)
     todo = _plan(clips, targets, out, known, force, suffix, options, result, rows)
     pairs, sources_by_clip = _load_pairs(todo, checkpoint, solver, rows, result, suffix)
+    result.timings["load"] = time.perf_counter() - start
     for src in sources_by_clip.values():
         rates = (src.fps, checkpoint.fps, fps or src.fps)
         if max(rates) - min(rates) > 1e-4 * max(rates):
@@ -630,13 +658,18 @@ def _expand(
     from tqdm.auto import tqdm
 
     bar = tqdm(total=len(batches), desc="expand", unit="batch", disable=not progress)
+    clock = time.perf_counter()
     for index, solved in enumerate(stream):
+        result.timings["solve"] += time.perf_counter() - clock
+        clock = time.perf_counter()
         new = _write_batch(solved, sources_by_clip, chars, limits, suffix, options, fps, out, rows, result)
+        result.timings["write"] += time.perf_counter() - clock
         result.done += len(new)
         result.batches += 1
         bar.update(1)
         if on_batch is not None:
             on_batch(index, new)
+        clock = time.perf_counter()
     bar.close()
     result.rows = sorted(rows.values(), key=lambda r: (r["character"], r["clip"]))
     result.seconds = time.perf_counter() - start

@@ -30,6 +30,7 @@ def _cmd_expand(args) -> int:
     from motionlab.cli import CLIError
     from motionlab.retargeting import expand as ex
 
+    cli_options.check_device(args.device)
     if args.backend == "ray":
         from motionlab.retargeting.cluster import INSTALL_HINT
 

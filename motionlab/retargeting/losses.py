@@ -9,7 +9,11 @@ loss                   formula                                                  
 ``foot_loss``          1/(4T) Σ_t Σ_{i ∈ feet} max(−y_i,t, 0)                       metres
 ``rotation_loss``      mean over frames and joints of 1 − ⟨q, q̂⟩²                   unitless
 ``contact_loss``       mean over planted frame pairs of fps·‖x_t+1 − x_t‖₂ (feet)   m/s
+``floor_loss``         1/(18T) Σ_t Σ_{j ∉ feet} max(f_t,j − y_t,j, 0), f ≤ 0        metres
 =====================  ===========================================================  ==========
+
+The iteration's terms (L_angle, L_foot, L_contact, L_floor) are registered, with their weights,
+in :mod:`motionlab.retargeting.terms`; the λ constants here are theirs.
 
 **Our choice of θ (the paper leaves it open): the joint angles themselves**, i.e. each joint's
 local rotation as a unit quaternion (the root's in the heading frame), compared up to sign:
@@ -34,6 +38,10 @@ even when every joint position is right.
 ``contact_loss`` is *our addition* to the iteration: on the frames where A's foot is planted
 (:mod:`motionlab.retargeting.contacts`), B's foot joint should not move in the world.
 
+``floor_loss`` is *our addition* too: L_foot only sees the feet, so a hand, knee or head may go
+under the floor; L_floor keeps every joint at or above it, or no deeper than the source's own
+joint went (scaled to B: :func:`motionlab.retargeting.pipeline.prepare_pair`).
+
 Paper: Wang, Li, Xie and Jia 2023, eq. (8) (L_recon) and eqs. (15)–(17) (the iteration's losses, §2.2). Taught in ``notebooks/03_latent_iteration.ipynb``.
 """
 
@@ -42,6 +50,7 @@ from __future__ import annotations
 import torch
 
 from motionlab.core import fk_torch, humanoid
+from motionlab.retargeting.contacts import CONTACT_JOINTS
 
 __all__ = [
     "LAMBDA_RECON",
@@ -55,7 +64,10 @@ __all__ = [
     "foot_loss",
     "rotation_loss",
     "contact_loss",
+    "feet_in_world",
+    "floor_loss",
     "LAMBDA_CONTACT",
+    "LAMBDA_FLOOR",
 ]
 
 LAMBDA_RECON = 0.5
@@ -67,8 +79,15 @@ LAMBDA_FOOT = 0.5
 LAMBDA_CONTACT = 0.5
 """Weight of the contact term (our addition), the same number as λ_foot; the term is a speed
 (m/s), so a planted foot sliding at 2 cm/s costs as much as a foot 2 cm below the ground."""
+LAMBDA_FLOOR = LAMBDA_FOOT * 18 / 4
+"""Weight of the floor term (our addition): λ_foot × 18 / 4. L_foot is a mean over the 4 foot
+joints, L_floor over the other 18, so a joint under the floor costs what a foot under the ground
+costs in the paper's L_foot."""
 FOOT_JOINTS: tuple[int, ...] = tuple(humanoid.JOINTS.index(n) for n in humanoid.FEET)
 """Indices of LeftFoot, RightFoot, LeftToeBase, RightToeBase in the canonical skeleton."""
+
+
+_OTHER_JOINTS: tuple[int, ...] = tuple(j for j in range(len(humanoid.JOINTS)) if j not in FOOT_JOINTS)
 
 
 def _same_shape(a: torch.Tensor, b: torch.Tensor, what: str) -> None:
@@ -186,6 +205,42 @@ def contact_loss(feet: torch.Tensor, planted: torch.Tensor, fps: float | torch.T
         raise ValueError(
             f"contact_loss: expected feet (..., T, F, 3) and planted (..., T, F), got {tuple(feet.shape)} and {tuple(planted.shape)}"
         )
-    both = (planted[..., 1:, :] & planted[..., :-1, :]).to(feet.dtype)
+    both = (planted[..., 1:, :] & planted[..., :-1, :]).to(dtype=feet.dtype, device=feet.device)
     step = _length(feet[..., 1:, :, :] - feet[..., :-1, :, :])
     return fps * (step * both).sum() / both.sum().clamp_min(1.0)
+
+
+def feet_in_world(positions: torch.Tensor, root_pos: torch.Tensor, yaw: torch.Tensor) -> torch.Tensor:
+    """World positions (..., T, 4, 3) of the contact joints (:data:`contacts.CONTACT_JOINTS`).
+
+    ``positions`` (..., T, 22, 3) are root-relative in the heading frame (the decoder's output),
+    ``root_pos`` (..., T, 3) the world root path and ``yaw`` (..., T) the heading, radians: a point
+    ``p`` of the heading frame is ``R_y(yaw) p + root`` in the world.
+    """
+    feet = positions[..., list(CONTACT_JOINTS), :]
+    c, s = torch.cos(yaw)[..., None], torch.sin(yaw)[..., None]
+    x, y, z = feet.unbind(-1)
+    return torch.stack([c * x + s * z, y, -s * x + c * z], dim=-1) + root_pos[..., None, :]
+
+
+def floor_loss(heights: torch.Tensor, allowed: torch.Tensor | None = None) -> torch.Tensor:
+    """L_floor: mean over frames and the 18 joints other than the feet of ``max(allowed − y, 0)``, metres.
+
+    The four foot joints are L_foot's (:func:`foot_loss`); this term sees every other joint.
+
+    Parameters
+    ----------
+    heights : Tensor (..., T, 22)    every joint's height above the floor, metres
+    allowed : Tensor (..., T, 22) or None   the lowest height each joint may reach (<= 0: the
+        source's own depth there, scaled); None: 0, the floor itself
+
+    Exactly 0, with a zero gradient, where every joint is above its allowed height.
+    """
+    if heights.shape[-1] != len(humanoid.JOINTS):
+        raise ValueError(f"floor_loss: expected heights (..., T, 22), got {tuple(heights.shape)}")
+    if allowed is not None and allowed.shape != heights.shape:
+        raise ValueError(
+            f"floor_loss: expected allowed {tuple(heights.shape)} like heights, got {tuple(allowed.shape)}"
+        )
+    depth = -heights if allowed is None else allowed - heights
+    return torch.relu(depth[..., list(_OTHER_JOINTS)]).mean()

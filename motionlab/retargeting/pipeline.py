@@ -96,9 +96,11 @@ class RetargetResult:
     positions : ndarray (T, 22, 3)   world joint positions (FK of ``motion``), metres
     method : str              one of :data:`METHODS`
     root_scale : (float, float)  ``(r_xz, r_y)`` that scaled A's root trajectory
-    history : dict            solver history (``loss``, ``angle``, ``foot`` per step); empty otherwise
+    history : dict            solver history (``loss`` and each loss term per step); empty otherwise
     stop_reason : str         why the solver stopped ("" without iteration)
     steps : int               solver steps
+    best_step : int           the step whose iterate is the result (the lowest L_iter; Adam may
+                              overshoot after it): :attr:`losses` are the values there
     seconds : float           wall time of the method itself (network + solver), seconds
     plausibility : Plausibility or None   the output's plausibility tests (:mod:`.plausibility`)
     resampled : str           how the frame rate changed on the way ("" when it did not)
@@ -114,6 +116,14 @@ class RetargetResult:
     seconds: float = 0.0
     plausibility: plausibility.Plausibility | None = None
     resampled: str = ""
+    best_step: int = 0
+
+    @property
+    def losses(self) -> dict[str, float]:
+        """L_iter (``loss``) and each term's value at the returned iterate (step ``best_step``);
+        empty without iteration. The numbers to report: the history's last entry may be an
+        overshoot that was not kept."""
+        return {k: float(v[self.best_step]) for k, v in self.history.items() if len(v) > self.best_step}
 
 
 def hip_height(skeleton: Skeleton) -> float:
@@ -275,6 +285,9 @@ class PreparedPair:
     offsets : Tensor (22, 3) or None   B's bone offsets on the checkpoint's device
     root_height : Tensor (1, T) or None   B's root height, metres
     root_xz : Tensor (1, T, 2) or None    B's root on the ground plane, metres (contact term)
+    floor : Tensor (1, T, 22) or None     the lowest height each joint of B may reach (L_floor,
+        :mod:`.terms`): A's own joint heights scaled by ``r_y`` where A's joint is under the
+        floor, else 0; metres
     """
 
     source: PreparedSource
@@ -284,6 +297,7 @@ class PreparedPair:
     offsets: torch.Tensor | None = None
     root_height: torch.Tensor | None = None
     root_xz: torch.Tensor | None = None
+    floor: torch.Tensor | None = None
 
 
 def prepare_source(
@@ -323,9 +337,11 @@ def prepare_pair(source: PreparedSource, target: Skeleton | Motion, root_mode: s
         return PreparedPair(source, tgt, r, root_pos)
     device, dtype = source.x.device, source.x.dtype
     offsets = torch.tensor(tgt.offsets, dtype=dtype, device=device)
-    height = torch.as_tensor(root_pos[:, 1], dtype=dtype)[None]
+    height = torch.as_tensor(root_pos[:, 1], dtype=dtype, device=device)[None]
     root_xz = torch.as_tensor(root_pos[:, [0, 2]], dtype=dtype, device=device)[None]
-    return PreparedPair(source, tgt, r, root_pos, offsets, height, root_xz)
+    floor = np.minimum(0.0, r[1] * src.global_positions()[..., 1])  # A's depth under the floor, scaled
+    floor = torch.as_tensor(floor, dtype=dtype, device=device)[None]
+    return PreparedPair(source, tgt, r, root_pos, offsets, height, root_xz, floor)
 
 
 def finish(
@@ -336,8 +352,10 @@ def finish(
     stop_reason: str = "",
     steps: int = 0,
     seconds: float = 0.0,
+    best_step: int = 0,
 ) -> RetargetResult:
-    """B's Motion from the network's heading-frame rotations (T, 22, 4) (``None`` for "copy")."""
+    """B's Motion from the network's heading-frame rotations (T, 22, 4) (``None`` for "copy");
+    ``best_step`` the solver step whose iterate ``heading_rot`` is."""
     src = pair.source
     if method == "copy":
         local_rot = src.motion.local_rot.copy()
@@ -348,7 +366,9 @@ def finish(
     positions = motion.global_positions()
     planted = None if src.planted is None else src.planted[0].cpu().numpy()
     check = plausibility.check(positions, pair.target, src.motion, planted)
-    return RetargetResult(motion, positions, method, pair.root_scale, history or {}, stop_reason, steps, seconds, check)
+    return RetargetResult(
+        motion, positions, method, pair.root_scale, history or {}, stop_reason, steps, seconds, check, "", best_step
+    )
 
 
 def _same_rate(a: float, b: float) -> bool:
@@ -392,6 +412,7 @@ def solve_pair(checkpoint, pair: PreparedPair, solver: SolverConfig | None = Non
         yaw=src.yaw,
         planted=src.planted,
         fps=src.motion.fps,
+        inputs={"floor": pair.floor},
     )
 
 
@@ -450,13 +471,19 @@ def retarget(
     solver = solver or SolverConfig()
     pair = prepare_pair(prepare_source(source, checkpoint, method, solver), target, root_mode)
     history: dict = {}
-    reason, steps, heading_rot = "", 0, None
+    reason, steps, heading_rot, best = "", 0, None, 0
     start = time.perf_counter()
     if method == "network":
         with torch.no_grad(), threads.torch_threads(threads.threads_for(pair.source.x.shape[1])):
             heading_rot = checkpoint.model(pair.source.x, pair.offsets).local_rot[0].cpu().numpy()
     elif method == "full":
         res = solve_pair(checkpoint, pair, solver, callback=callback, progress=progress)
-        heading_rot, history, reason, steps = res.local_rot[0], res.history, res.stop_reason, res.steps
-    result = finish(pair, heading_rot, method, history, reason, steps, time.perf_counter() - start)
+        heading_rot, history, reason, steps, best = (
+            res.local_rot[0],
+            res.history,
+            res.stop_reason,
+            res.steps,
+            res.best_step,
+        )
+    result = finish(pair, heading_rot, method, history, reason, steps, time.perf_counter() - start, best)
     return at_rate(result, fps or source.fps, source.fps)

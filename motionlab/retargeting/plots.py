@@ -317,20 +317,28 @@ def plot_reconstruction(true_pos, pred_pos, joints: Sequence[str], fps: float | 
 
 
 # ----------------------------------------------------------------------------- latent iteration
+_TITLES = {
+    "contact": "contact loss: planted feet's speed (cm/s)",
+    "floor": "floor loss: mean depth of the other joints below their limit (cm)",
+}
+_CENTI = {"m": "cm", "m/s": "cm/s"}
+
+
 def plot_iteration(history: Mapping[str, Sequence[float]], axes=None, title: str = "", config=None):
     """The latent iteration's losses over its steps, labelled from the terms that were actually used.
 
     Parameters
     ----------
     history : a solver history (:attr:`SolverResult.history`): ``loss`` (L_iter), ``angle``
-        (L_angle), ``foot`` (L_foot, metres) and, optionally, ``contact`` (L_contact, m/s)
-    axes : two Axes, or three when the contact term is shown; None: a new figure
+        (L_angle), ``foot`` (L_foot, metres) and one list per other registered loss term
+        (:mod:`motionlab.retargeting.terms`: ``contact`` in m/s, ``floor`` in metres, …)
+    axes : two Axes, plus one per other term shown; None: a new figure
     title : suptitle
     config : the :class:`~motionlab.retargeting.solver.SolverConfig` of the run (default: the
         defaults). Its weights write the L_iter legend; its ``init`` names step 0 (the
         Gauss–Newton start for ``"project"``/``"auto"``, ``φ = F_enc(X_A)`` for ``"encoder"``).
-        L_contact is in the legend, and gets its own panel, when its weight is positive and the
-        history holds a nonzero value (the solver was given contact labels).
+        A term other than L_angle and L_foot is in the legend, and gets its own panel, when its
+        weight is positive and the history holds a nonzero value of it.
 
     Returns
     -------
@@ -340,34 +348,41 @@ def plot_iteration(history: Mapping[str, Sequence[float]], axes=None, title: str
     ------
     ValueError when the history lacks ``'loss'``, ``'angle'`` or ``'foot'``.
     """
+    from motionlab.retargeting import terms
     from motionlab.retargeting.solver import SolverConfig
 
     for k in ("loss", "angle", "foot"):
         if k not in history or not len(history[k]):
             raise ValueError(f"plot_iteration needs a solver history with 'loss', 'angle' and 'foot'; {k!r} is missing")
     cfg = config or SolverConfig()
-    contact = np.asarray(history.get("contact", []), dtype=float)
-    with_contact = cfg.lambda_contact > 0 and contact.size > 0 and bool(np.any(contact != 0))
-    terms = [f"{cfg.lambda_angle:g} L_{{angle}}", f"{cfg.lambda_foot:g} L_{{foot}}"]
-    if with_contact:
-        terms.append(f"{cfg.lambda_contact:g} L_{{contact}}")
+    registered = [t for t in terms.registered() if t.name in history]
+    shown = [
+        t
+        for t in registered
+        if t.name not in ("angle", "foot") and cfg.weight(t.name) > 0 and np.any(np.asarray(history[t.name]) != 0)
+    ]
+    legend = [f"{cfg.weight(t.name):g} L_{{{t.name}}}" for t in registered if t.name in ("angle", "foot")]
+    legend += [f"{cfg.weight(t.name):g} L_{{{t.name}}}" for t in shown]
     uses_encoder = cfg.init == "encoder" or (cfg.init == "auto" and cfg.theta != "rotations")
     start = "$\\varphi = F_{enc}(X_A)$" if uses_encoder else "the Gauss–Newton start"
     if axes is None:
-        _, axes = _plt().subplots(1, 3 if with_contact else 2, figsize=(15 if with_contact else 11, 3.2))
+        _, axes = _plt().subplots(1, 2 + len(shown), figsize=(11 + 4 * len(shown), 3.2))
     steps = np.arange(len(history["loss"]))
     ax = axes[0]
     ax.plot(steps, history["angle"], color="C0", label="$L_{angle}$")
-    ax.plot(steps, history["loss"], color="0.4", ls=":", label="$L_{iter} = " + " + ".join(terms) + "$")
+    ax.plot(steps, history["loss"], color="0.4", ls=":", label="$L_{iter} = " + " + ".join(legend) + "$")
     ax.set_title("joint-angle loss (unitless)", fontsize=10)
     ax.legend(fontsize=8)
     ax = axes[1]
     ax.plot(steps, 100 * np.asarray(history["foot"]), color="C3", label="$L_{foot}$")
     ax.set_title("foot loss: mean depth below the ground (cm)", fontsize=10)
-    if with_contact:
-        ax = axes[2]
-        ax.plot(steps, 100 * contact, color="C2", label="$L_{contact}$")
-        ax.set_title("contact loss: planted feet's speed (cm/s)", fontsize=10)
+    for k, (ax, term) in enumerate(zip(axes[2:], shown)):
+        scale = 100 if term.unit in _CENTI else 1
+        unit = _CENTI.get(term.unit, term.unit)
+        ax.plot(
+            steps, scale * np.asarray(history[term.name], dtype=float), color=f"C{2 + k}", label=f"$L_{{{term.name}}}$"
+        )
+        ax.set_title(_TITLES.get(term.name, f"{term.name} loss" + (f" ({unit})" if unit else "")), fontsize=10)
     for ax in axes:
         ax.set_xlabel(f"iteration step (0 = {start})")
         ax.grid(alpha=0.3)

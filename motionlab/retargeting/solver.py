@@ -4,9 +4,10 @@ The network is frozen. Starting from ``φ = F_enc(X_A)`` (eq. 9), only the laten
 updated with Adam so that the motion decoded on B's skeleton (eqs. 10–14) keeps A's joint
 angles and keeps its feet above the ground (eq. 15)::
 
-    L_iter = λ_angle · L_angle(A, B') + λ_foot · L_foot(B')  [+ λ_contact · L_contact(B')]
+    L_iter = Σ_k w_k · L_k = λ_angle · L_angle(A, B') + λ_foot · L_foot(B')
+             [+ λ_contact · L_contact(B')] + λ_floor · L_floor(B') [+ any registered term]
 
-with λ_angle = 0.3, λ_foot = 0.5 (paper) and λ_contact = 0.5 (ours, see below), until
+with λ_angle = 0.3, λ_foot = 0.5 (paper), λ_contact = 0.5 and λ_floor = 2.25 (ours), until
 ``L_iter`` drops below ``threshold``, stops improving (``patience`` steps without a relative
 gain of ``min_delta``), or ``max_steps`` is reached. :func:`solve` treats all sequences of a
 batch (e.g. several clips of equal length) as one problem: their losses are averaged, so one
@@ -15,7 +16,15 @@ Adam run moves every latent. :func:`solve_many` runs the same loop on N independ
 :mod:`motionlab.retargeting.expand` solves many (clip, character) pairs at once; each sequence's
 numbers do not depend on the rest of the batch, so its result equals :func:`solve` on it alone.
 
-Three additions of motionlab, each measured in the README's Table 1 (ablation rows):
+**Loss terms are named objects** (:mod:`motionlab.retargeting.terms`, the contract): each has a
+name, a weight and a function of the decoded motion and its inputs; the iteration sums the
+registered terms in order, and the history (``SolverResult.history``: ``loss`` and one list per
+term), the callback, the plots, ``expand``'s manifest and the ``--NAME-weight`` options follow the
+registry. A new term is one function and one :func:`terms.register`; its weight is set with
+``SolverConfig(weights={name: w})`` and its per-sequence inputs passed as ``solve(..., inputs=)``.
+Every tensor follows the network's device and float type (:mod:`motionlab.retargeting.devices`).
+
+Three additions of motionlab, each measured on the results page, docs/results_retargeting.md (ablation rows):
 
 **A Gauss–Newton start (``init="project"``; the default ``"auto"`` uses it).** The encoder
 reproduces A's joint rotations only approximately on clips it was not trained on (12° median,
@@ -69,9 +78,10 @@ import torch
 from tqdm.auto import tqdm
 
 from motionlab.core import threads
-from motionlab.retargeting import losses
+from motionlab.retargeting import losses, terms
 from motionlab.retargeting.contacts import CONTACT_JOINTS
 from motionlab.retargeting.model import NUM_JOINTS, Decoded, RetargetNet
+from motionlab.retargeting.terms import TermInputs
 
 __all__ = [
     "SolverConfig",
@@ -80,11 +90,15 @@ __all__ = [
     "smoother",
     "iteration_loss",
     "sequence_losses",
+    "sequence_terms",
     "project_latent",
     "world_feet",
     "solve",
     "solve_many",
 ]
+
+_LAMBDAS = {"angle": "lambda_angle", "foot": "lambda_foot", "contact": "lambda_contact"}
+"""The terms whose weights are also :class:`SolverConfig` fields (the paper's two and L_contact)."""
 
 INITS = ("auto", "project", "encoder")
 """How the iteration starts: least-squares projection onto A's rotations, or ``F_enc(X_A)``;
@@ -127,6 +141,8 @@ class SolverConfig:
     theta : str            ``"rotations"`` (joint rotations, default) or ``"directions"``
                            (unit bone directions from positions)
     smooth_sigma : float   σ (frames) of the Gaussian that smooths latent updates over time; 0: off
+    weights : dict         weight of a registered loss term by name (:mod:`.terms`), overriding
+                           the ``lambda_*`` fields and the term's default (:meth:`weight`)
     """
 
     max_steps: int = 100
@@ -143,8 +159,21 @@ class SolverConfig:
     smooth_sigma: float = 3.0
     smooth_projection: bool = True
     project_exact: int = 4
+    weights: dict = field(default_factory=dict)
+
+    def weight(self, name: str) -> float:
+        """The weight of loss term ``name``: ``weights[name]``, else the ``lambda_*`` field
+        (angle, foot, contact), else the registered term's default (``KeyError`` if none)."""
+        if name in self.weights:
+            return float(self.weights[name])
+        if name in _LAMBDAS:
+            return getattr(self, _LAMBDAS[name])
+        return terms.get(name).weight
 
     def __post_init__(self) -> None:
+        bad = {k: v for k, v in self.weights.items() if not (isinstance(k, str) and v >= 0)}
+        if bad:
+            raise ValueError(f"weights must map term names to numbers >= 0, got {bad}")
         if self.init not in INITS:
             raise ValueError(f"init must be one of {INITS}, got {self.init!r}")
         if self.init == "project" and self.theta != "rotations":
@@ -176,10 +205,11 @@ class SolverResult:
     local_rot : ndarray (N, T, 22, 4)   final local rotations (root in the heading frame)
     positions : ndarray (N, T, 22, 3)   FK on the target skeleton, root at the origin, metres
     phi : Tensor (N, T, D)              the optimised latent
-    history : dict of lists             per evaluated step: ``loss`` (L_iter), ``angle`` (L_angle),
+    history : dict of lists             per evaluated step: ``loss`` (L_iter), then one list per
+                                        registered term (:mod:`.terms`): ``angle`` (L_angle),
                                         ``foot`` (L_foot, metres), ``contact`` (L_contact, m/s;
-                                        0 without contact labels); entry 0 is the
-                                        starting point (after the projection, if any)
+                                        0 without contact labels), ``floor`` (L_floor, metres)…;
+                                        entry 0 is the starting point (after the projection, if any)
     stop_reason : str                   ``"threshold"``, ``"plateau"`` or ``"max_steps"``
     best_step : int                     the step whose latent is returned: the lowest ``L_iter``
                                         seen (Adam may overshoot after it)
@@ -235,6 +265,25 @@ def smoother(sigma: float, channels: int, dtype=torch.float64, device="cpu") -> 
     return _smoother(sigma, channels, dtype, device)
 
 
+def _summed(cfg: SolverConfig, decoded: Decoded, inputs: TermInputs, given: dict | None = None):
+    """``(L_iter, [value of each registered term])`` for one problem: ``Σ weight · value`` over the
+    terms whose inputs are there (in registration order); the others are 0. ``given`` holds values
+    computed by the caller (by term name)."""
+    total, values = None, []
+    for term in terms.registered():
+        if given and term.name in given:
+            value = given[term.name]
+        elif all(inputs.has(n) for n in term.needs):
+            value = term.function(decoded, inputs)
+        else:
+            values.append(None)
+            continue
+        w = cfg.weight(term.name)
+        total = w * value if total is None else total + w * value
+        values.append(value)
+    return total, [torch.zeros_like(total) if v is None else v for v in values]
+
+
 def iteration_loss(
     source: torch.Tensor,
     generated: Decoded,
@@ -242,36 +291,27 @@ def iteration_loss(
     config: SolverConfig | None = None,
     contact: torch.Tensor | None = None,
 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """``(L_iter, L_angle, L_foot)`` (eqs. 15–17).
+    """``(L_iter, L_angle, L_foot)`` (eqs. 15–17, and motionlab's terms).
 
     ``source`` is A's local rotations (N, T, 22, 4) for ``theta="rotations"`` or A's root-relative
     heading-frame positions (N, T, 22, 3) for ``"directions"``; ``generated`` the decoder's output
     on B; ``root_height`` (N, T) B's root height above the ground, metres. ``contact``, when
     given, is L_contact (:func:`losses.contact_loss`); ``λ_contact · contact`` is then part of L_iter.
+    L_iter sums every registered term (:mod:`.terms`) these inputs allow, L_floor with the floor
+    itself as the limit; :func:`sequence_terms` gives each term's value.
     """
     cfg = config or SolverConfig()
-    if cfg.theta == "rotations":
-        angle = losses.angle_loss(source, generated.local_rot)
-    else:
-        angle = losses.direction_loss(source, generated.positions)
-    foot = losses.foot_loss(generated.positions[..., 1] + root_height[..., None])
-    total = cfg.lambda_angle * angle + cfg.lambda_foot * foot
-    if contact is not None:
-        total = total + cfg.lambda_contact * contact
-    return total, angle, foot
+    given = {"contact": contact} if contact is not None else None
+    total, values = _summed(cfg, generated, TermInputs(source, cfg.theta, root_height), given)
+    names = [t.name for t in terms.registered()]
+    return total, values[names.index("angle")], values[names.index("foot")]
 
 
 def world_feet(positions: torch.Tensor, root_pos: torch.Tensor, yaw: torch.Tensor) -> torch.Tensor:
-    """World positions (N, T, 4, 3) of the contact joints (:data:`contacts.CONTACT_JOINTS`).
-
-    ``positions`` (N, T, 22, 3) are root-relative in the heading frame (the decoder's output),
-    ``root_pos`` (N, T, 3) the world root path and ``yaw`` (N, T) the heading, radians: a point
-    ``p`` of the heading frame is ``R_y(yaw) p + root`` in the world.
-    """
-    feet = positions[..., list(CONTACT_JOINTS), :]
-    c, s = torch.cos(yaw)[..., None], torch.sin(yaw)[..., None]
-    x, y, z = feet.unbind(-1)
-    return torch.stack([c * x + s * z, y, -s * x + c * z], dim=-1) + root_pos[..., None, :]
+    """World positions (N, T, 4, 3) of the contact joints (:data:`contacts.CONTACT_JOINTS`):
+    :func:`losses.feet_in_world`. ``positions`` (N, T, 22, 3) root-relative in the heading frame,
+    ``root_pos`` (N, T, 3) the world root path, ``yaw`` (N, T) the heading, radians."""
+    return losses.feet_in_world(positions, root_pos, yaw)
 
 
 def project_latent(
@@ -341,7 +381,7 @@ def project_latent(
     return flat.reshape(N, T, D)
 
 
-def sequence_losses(
+def sequence_terms(
     source: torch.Tensor,
     generated: Decoded,
     root_height: torch.Tensor,
@@ -350,49 +390,44 @@ def sequence_losses(
     yaw: torch.Tensor | None = None,
     planted: torch.Tensor | None = None,
     fps: torch.Tensor | None = None,
-) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
-    """:func:`iteration_loss` of every sequence on its own: ``(L_iter, L_angle, L_foot, L_contact)``, each (N,).
+    extra: dict | None = None,
+) -> tuple[torch.Tensor, dict[str, torch.Tensor]]:
+    """``(L_iter (N,), {term name: value (N,)})``: every sequence on its own, every registered term.
 
-    The same function, mapped over the batch axis with ``torch.func.vmap``, so entry ``i`` is
-    what :func:`iteration_loss` gives for sequence ``i`` alone (inputs as there, (N, T, ...)).
-    With ``root_world`` (N, T, 3), ``yaw`` (N, T), ``planted`` (N, T, 4) and ``fps`` (N,) the contact term is
-    included (:func:`losses.contact_loss` on :func:`world_feet`); otherwise L_contact is 0.
+    Each registered term (:mod:`.terms`) is mapped over the batch axis with ``torch.func.vmap``,
+    so entry ``i`` is what sequence ``i`` gives alone. Inputs as :func:`iteration_loss`, (N, T, ...);
+    with ``root_world`` (N, T, 3), ``yaw`` (N, T), ``planted`` (N, T, 4) and ``fps`` (N,) the
+    contact term is evaluated (otherwise it is 0); ``extra`` holds other terms' inputs (N, T, ...).
     """
     cfg = config or SolverConfig()
-    if planted is None:
+    given = {"root_world": root_world, "yaw": yaw, "planted": planted}
+    rows = {k: v for k, v in given.items() if v is not None and planted is not None}
+    rate = {"fps": fps} if planted is not None else {}
 
-        def one(src, rot, pos, q, q_delta, height):
-            out = Decoded(rot[None], pos[None], q[None], q_delta[None])
-            total, angle, foot = iteration_loss(src[None], out, height[None], cfg)
-            return total, angle, foot, torch.zeros_like(total)
+    def one(src, out, height, row, rate, more):
+        decoded = Decoded(*(t[None] for t in out))
+        inputs = TermInputs(
+            src[None], cfg.theta, height[None], **{k: v[None] for k, v in row.items()}, **rate,
+            extra={k: v[None] for k, v in more.items()},
+        )  # fmt: skip
+        return _summed(cfg, decoded, inputs)
 
-        return torch.func.vmap(one)(
-            source, generated.local_rot, generated.positions, generated.q, generated.q_delta, root_height
-        )
+    out = (generated.local_rot, generated.positions, generated.q, generated.q_delta)
+    total, values = torch.func.vmap(one)(source, out, root_height, rows, rate, dict(extra or {}))
+    return total, dict(zip([t.name for t in terms.registered()], values))
 
-    def one_contact(src, rot, pos, q, q_delta, height, root, heading, feet_planted, rate):
-        out = Decoded(rot[None], pos[None], q[None], q_delta[None])
-        contact = losses.contact_loss(world_feet(pos[None], root[None], heading[None]), feet_planted[None], rate)
-        total, angle, foot = iteration_loss(src[None], out, height[None], cfg, contact)
-        return total, angle, foot, contact
 
-    return torch.func.vmap(one_contact)(
-        source,
-        generated.local_rot,
-        generated.positions,
-        generated.q,
-        generated.q_delta,
-        root_height,
-        root_world,
-        yaw,
-        planted,
-        fps,
-    )
+def sequence_losses(*args, **kwargs) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+    """``(L_iter, L_angle, L_foot, L_contact)``, each (N,): :func:`sequence_terms` (same parameters)
+    reduced to the first three terms' values, as before the term registry."""
+    total, values = sequence_terms(*args, **kwargs)
+    return total, values["angle"], values["foot"], values["contact"]
 
 
 def _in_model_type(model: RetargetNet, x: torch.Tensor) -> torch.Tensor:
-    """``x`` in the network's float type: every tensor of the iteration follows ``x``."""
-    return torch.as_tensor(x).to(next(model.parameters()).dtype)
+    """``x`` on the network's device and in its float type: every tensor of the iteration follows ``x``."""
+    weight = next(model.parameters())
+    return torch.as_tensor(x, dtype=weight.dtype, device=weight.device)
 
 
 def _check_inputs(x, source, offsets, root_height, cfg) -> None:
@@ -402,20 +437,21 @@ def _check_inputs(x, source, offsets, root_height, cfg) -> None:
             f"expected x (N, T, 70), source (N, T, 22, {last}) for theta={cfg.theta!r} and root_height (N, T), got "
             f"{tuple(x.shape)}, {tuple(source.shape)} and {tuple(root_height.shape)}"
         )
-    shape = tuple(torch.as_tensor(offsets).shape)
+    shape = tuple(offsets.shape) if hasattr(offsets, "shape") else np.shape(offsets)
     if shape not in ((22, 3), (x.shape[0], 22, 3)):
         raise ValueError(f"expected offsets (22, 3) or ({x.shape[0]}, 22, 3), got {shape}")
 
 
 def _contact_inputs(x, root_height, cfg, root_xz, yaw, planted, fps):
     """``(root_world (N, T, 3), yaw (N, T), planted (N, T, 4), fps (N,))`` for the contact term, or None when it is off."""
-    if planted is None or cfg.lambda_contact <= 0:
+    if planted is None or cfg.weight("contact") <= 0:
         return None
     if root_xz is None or yaw is None or fps is None:
         raise ValueError(
             "the contact term needs B's root path and the frame rate: pass root_xz (N, T, 2), yaw (N, T) and fps with planted"
         )
-    rate = torch.as_tensor(fps, dtype=x.dtype).reshape(-1).expand(x.shape[0]).clone()
+    like = dict(dtype=x.dtype, device=x.device)  # every input on x's device, in x's float type
+    rate = torch.as_tensor(fps, **like).reshape(-1).expand(x.shape[0]).clone()
     if not bool(torch.all(rate > 0)):
         raise ValueError(f"fps must be positive, got {fps}")
     if tuple(planted.shape) != x.shape[:2] + (len(CONTACT_JOINTS),) or tuple(root_xz.shape) != x.shape[:2] + (2,):
@@ -423,9 +459,25 @@ def _contact_inputs(x, root_height, cfg, root_xz, yaw, planted, fps):
             f"expected planted (N, T, 4) and root_xz (N, T, 2) for x {tuple(x.shape)}, got "
             f"{tuple(planted.shape)} and {tuple(root_xz.shape)}"
         )
-    root_xz = torch.as_tensor(root_xz, dtype=x.dtype)
-    root_world = torch.stack([root_xz[..., 0], torch.as_tensor(root_height, dtype=x.dtype), root_xz[..., 1]], dim=-1)
-    return root_world, torch.as_tensor(yaw, dtype=x.dtype), torch.as_tensor(planted, dtype=torch.bool), rate
+    root_xz = torch.as_tensor(root_xz, **like)
+    root_world = torch.stack([root_xz[..., 0], torch.as_tensor(root_height, **like), root_xz[..., 1]], dim=-1)
+    planted = torch.as_tensor(planted, dtype=torch.bool, device=x.device)
+    return root_world, torch.as_tensor(yaw, **like), planted, rate
+
+
+def _extra_inputs(x: torch.Tensor, inputs: dict | None, cfg: SolverConfig) -> dict:
+    """Other terms' inputs on ``x``'s device and float type, checked (N, T, ...); the weights' names checked."""
+    names = [t.name for t in terms.registered()]
+    unknown = sorted(set(cfg.weights) - set(names))
+    if unknown:
+        raise ValueError(f"SolverConfig.weights names {unknown}, which are not registered loss terms: {names}")
+    out = {}
+    for key, value in (inputs or {}).items():
+        value = torch.as_tensor(value, dtype=x.dtype, device=x.device)
+        if tuple(value.shape[:2]) != tuple(x.shape[:2]):
+            raise ValueError(f"input {key!r}: expected ({x.shape[0]}, {x.shape[1]}, ...), got {tuple(value.shape)}")
+        out[key] = value
+    return out
 
 
 def solve(
@@ -441,6 +493,7 @@ def solve(
     yaw: torch.Tensor | None = None,
     planted: torch.Tensor | None = None,
     fps: float | torch.Tensor | None = None,
+    inputs: dict | None = None,
 ) -> SolverResult:
     """Optimise the latent of a frozen network for skeleton ``offsets``.
 
@@ -458,7 +511,7 @@ def solve(
     offsets : Tensor (22, 3) or (N, 22, 3)   B's bone offsets, metres
     root_height : Tensor (N, T)           B's root height above the ground, metres
     config : SolverConfig
-    callback : called as ``callback(step, {"loss", "angle", "foot", "contact"})`` after each evaluation
+    callback : called as ``callback(step, {"loss": L_iter, term name: value, ...})`` after each evaluation
     progress : tqdm bar with the loss
     root_xz : Tensor (N, T, 2), optional  B's root position on the ground plane (x, z), metres
     yaw : Tensor (N, T), optional         A's (= B's) heading, radians
@@ -466,17 +519,29 @@ def solve(
         (:func:`motionlab.retargeting.contacts.detect_contacts`); with ``root_xz`` and ``yaw``
         they switch on the contact term (weight ``config.lambda_contact``)
     fps : float or Tensor (N,), optional  frame rate of the sequences (needed by the contact term)
+    inputs : dict of Tensor (N, T, ...), optional   per-sequence inputs of registered terms
+        (:attr:`terms.TermInputs.extra`), e.g. ``"floor"`` (N, T, 22): the lowest height each
+        joint of B may reach, metres (without it L_floor keeps every joint above the floor)
 
     Returns
     -------
     SolverResult
+
+    Raises
+    ------
+    ValueError
+        inputs of the wrong shape, contact labels without the root path or frame rate, a
+        non-positive frame rate, or a weight for a term that is not registered.
     """
     cfg = config or SolverConfig()
     x = _in_model_type(model, x)
     _check_inputs(x, source, offsets, root_height, cfg)
     contact = _contact_inputs(x, root_height, cfg, root_xz, yaw, planted, fps)
+    extra = _extra_inputs(x, inputs, cfg)
     with threads.torch_threads(threads.threads_for(x.shape[0] * x.shape[1])):
-        return _iterate(model, x, source, offsets, root_height, cfg, [x.shape[0]], callback, progress, contact)[0]
+        return _iterate(model, x, source, offsets, root_height, cfg, [x.shape[0]], callback, progress, contact, extra)[
+            0
+        ]
 
 
 def solve_many(
@@ -491,6 +556,7 @@ def solve_many(
     yaw: torch.Tensor | None = None,
     planted: torch.Tensor | None = None,
     fps: float | torch.Tensor | None = None,
+    inputs: dict | None = None,
 ) -> list[SolverResult]:
     """Solve N independent problems (one per sequence) in one batched latent iteration.
 
@@ -509,8 +575,9 @@ def solve_many(
     x = _in_model_type(model, x)
     _check_inputs(x, source, offsets, root_height, cfg)
     contact = _contact_inputs(x, root_height, cfg, root_xz, yaw, planted, fps)
+    extra = _extra_inputs(x, inputs, cfg)
     with threads.torch_threads(threads.threads_for(x.shape[0] * x.shape[1])):
-        return _iterate(model, x, source, offsets, root_height, cfg, [1] * x.shape[0], None, progress, contact)
+        return _iterate(model, x, source, offsets, root_height, cfg, [1] * x.shape[0], None, progress, contact, extra)
 
 
 @contextmanager
@@ -534,7 +601,8 @@ class _Problem:
     """The fixed inputs of one batched latent iteration, on the network's device and float type.
 
     ``bounds`` (groups + 1,): row ranges of the groups; ``group_of_row`` (N,): each row's group;
-    ``contact``: ``(root_world, yaw, planted, fps)`` of :func:`_contact_inputs`, or None.
+    ``contact``: ``(root_world, yaw, planted, fps)`` of :func:`_contact_inputs`, or None;
+    ``extra``: other terms' inputs (N, T, ...) by name.
     """
 
     model: RetargetNet
@@ -546,13 +614,14 @@ class _Problem:
     bounds: np.ndarray
     group_of_row: torch.Tensor
     cfg: SolverConfig
+    extra: dict = field(default_factory=dict)
 
     @property
     def per_row_offsets(self) -> bool:
         return self.offsets.ndim == 3
 
 
-def _problem(model, x, source, offsets, root_height, cfg, sizes, contact) -> tuple[_Problem, torch.Tensor]:
+def _problem(model, x, source, offsets, root_height, cfg, sizes, contact, extra) -> tuple[_Problem, torch.Tensor]:
     """Move every input onto the network's device (``x`` and ``source`` in ``x``'s float type)."""
     device = next(model.parameters()).device
     x, src = x.to(device), source.to(device=device, dtype=x.dtype)
@@ -562,7 +631,8 @@ def _problem(model, x, source, offsets, root_height, cfg, sizes, contact) -> tup
     if contact is not None:
         contact = tuple(t.to(device) for t in contact)
     bounds = np.cumsum([0] + list(sizes))
-    return _Problem(model, src, offsets, root_height, contact, list(sizes), bounds, group_of_row, cfg), x
+    extra = {k: v.to(device=device, dtype=x.dtype) for k, v in (extra or {}).items()}
+    return _Problem(model, src, offsets, root_height, contact, list(sizes), bounds, group_of_row, cfg, extra), x
 
 
 def _start(p: _Problem, x: torch.Tensor):
@@ -623,10 +693,10 @@ def _steps(phi0: torch.Tensor, bounds: np.ndarray, lr: float) -> _Steps:
 
 def _losses(p: _Problem, phi0, embedding, smooth, steps: _Steps, active: list):
     """Decode the active groups' latents; ``(out, phi, group_loss (active,), values)`` where
-    ``values[k]`` is ``[L_iter, L_angle, L_foot, L_contact]`` of active group k (means over its rows)."""
+    ``values[k]`` is ``[L_iter, each registered term's value]`` of active group k (means over its rows)."""
     groups, bounds, device, dtype = len(p.sizes), p.bounds, phi0.device, phi0.dtype
     everyone = len(active) == groups
-    rows = None if everyone else torch.cat([torch.arange(bounds[g], bounds[g + 1]) for g in active]).to(device)
+    rows = None if everyone else torch.cat([torch.arange(bounds[g], bounds[g + 1], device=device) for g in active])
     delta = steps.deltas[0] if groups == 1 else torch.cat([steps.deltas[g] for g in active])
     phi = (phi0 if everyone else phi0[rows]) + smooth(delta)
     if p.per_row_offsets and not everyone:
@@ -639,13 +709,14 @@ def _losses(p: _Problem, phi0, embedding, smooth, steps: _Steps, active: list):
         extra = dict(
             zip(("root_world", "yaw", "planted", "fps"), p.contact if everyone else [c[rows] for c in p.contact])
         )
-    loss, angle, foot, touch = sequence_losses(s, out, h, p.cfg, **extra)  # (rows,): each sequence on its own
+    more = p.extra if everyone else {k: v[rows] for k, v in p.extra.items()}
+    loss, by_term = sequence_terms(s, out, h, p.cfg, **extra, extra=more)  # (rows,): each sequence on its own
     owner = p.group_of_row if everyone else p.group_of_row[rows]
     which = owner if everyone else torch.searchsorted(torch.as_tensor(active, device=device), owner)
     count = torch.zeros(len(active), dtype=dtype, device=device).index_add_(0, which, torch.ones_like(loss))
     parts = [
         torch.zeros(len(active), dtype=dtype, device=device).index_add_(0, which, v) / count
-        for v in (loss, angle, foot, touch)
+        for v in (loss, *by_term.values())
     ]
     return out, phi, parts[0], torch.stack([q.detach() for q in parts], 1).tolist()
 
@@ -655,6 +726,7 @@ class _Track:
     """Per group: the loss history, the plateau rule's state, the stop reason and the best iterate
     (rows ``bounds[g]:bounds[g + 1]`` of ``best_rot``, ``best_pos``, ``best_phi``)."""
 
+    keys: tuple
     histories: list
     best: list
     since_best: list
@@ -669,8 +741,10 @@ class _Track:
     @classmethod
     def new(cls, phi0: torch.Tensor, groups: int) -> _Track:
         shape = phi0.shape[:2]
+        keys = ("loss",) + tuple(t.name for t in terms.registered())
         return cls(
-            [{"loss": [], "angle": [], "foot": [], "contact": []} for _ in range(groups)],
+            keys,
+            [{k: [] for k in keys} for _ in range(groups)],
             [float("inf")] * groups,  # best loss that counted as an improvement (plateau rule)
             [0] * groups,
             ["max_steps"] * groups,
@@ -687,12 +761,11 @@ class _Track:
         ``active`` of the groups that stop here."""
         cfg, stopped, row = p.cfg, [], 0
         for k, g in enumerate(active):
-            value, a_value, f_value, c_value = values[k]
-            n = p.sizes[g]
-            for key, v in zip(("loss", "angle", "foot", "contact"), values[k]):
+            value, n = values[k][0], p.sizes[g]
+            for key, v in zip(self.keys, values[k]):
                 self.histories[g][key].append(v)
             if callback is not None:
-                callback(self.steps[g], {"loss": value, "angle": a_value, "foot": f_value, "contact": c_value})
+                callback(self.steps[g], dict(zip(self.keys, values[k])))
             if value < self.best_value[g]:  # Adam can overshoot: keep the best iterate seen, not the last
                 self.best_value[g], self.best_step[g] = value, self.steps[g]
                 b0, b1 = p.bounds[g], p.bounds[g + 1]
@@ -749,12 +822,12 @@ def _adam_step(steps: _Steps, group_loss: torch.Tensor, active: list, stopped: l
 
 
 def _iterate(
-    model, x, source, offsets, root_height, cfg, sizes, callback, progress, contact=None
+    model, x, source, offsets, root_height, cfg, sizes, callback, progress, contact=None, extra=None
 ) -> list[SolverResult]:
     """The latent iteration for consecutive groups of sequences (``sizes`` rows each), each group
     an independent problem: group loss = mean of its sequences' losses, own step size and stop.
     ``contact``: ``(root_world, yaw, planted)`` of :func:`_contact_inputs`, or None."""
-    p, x = _problem(model, x, source, offsets, root_height, cfg, sizes, contact)
+    p, x = _problem(model, x, source, offsets, root_height, cfg, sizes, contact, extra)
     start = time.perf_counter()
     with _frozen(model):
         phi0, embedding, smooth = _start(p, x)
@@ -771,6 +844,6 @@ def _iterate(
             for g in active:
                 track.steps[g] += 1
             bar.update(1)
-            bar.set_postfix(loss=f"{float(group_loss.detach().mean()):.4g}")
+            bar.set_postfix(loss=f"{np.mean([v[0] for v in values]):.4g}")  # values: already on the host
         bar.close()
     return track.results(p.bounds, time.perf_counter() - start)

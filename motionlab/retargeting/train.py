@@ -40,7 +40,7 @@ from motionlab.core import quat_torch as tq
 from motionlab.core.motion import Motion
 from motionlab.core.preprocess import NormStats
 from motionlab.core.skeleton import Skeleton
-from motionlab.retargeting import losses
+from motionlab.retargeting import devices, losses
 from motionlab.retargeting.checkpoint import DTYPES, Checkpoint
 from motionlab.retargeting.features import clip_features
 from motionlab.retargeting.model import NUM_JOINTS, ModelConfig, RetargetNet
@@ -55,6 +55,10 @@ __all__ = [
     "train",
     "pick_device",
 ]
+
+_DRAWS = {"dtype": torch.float32, "device": "cpu"}
+"""Random draws (skeleton and pose augmentation) come from a CPU generator in float32, then move to
+the training device: one seed gives the same batches on every device."""
 
 _SWAP = [
     humanoid.JOINTS.index(n.replace("Left", "#").replace("Right", "Left").replace("#", "Right"))
@@ -83,10 +87,9 @@ def mirrored(motion: Motion) -> Motion:
 
 
 def pick_device(device: str | torch.device | None = None) -> torch.device:
-    """``device`` if given, else CUDA when available, else the CPU."""
-    if device is not None:
-        return torch.device(device)
-    return torch.device("cuda" if torch.cuda.is_available() else "cpu")
+    """:func:`motionlab.retargeting.devices.pick`: ``device`` checked, else CUDA when available, else
+    the CPU. Raises ``ValueError`` for a device this machine does not have."""
+    return devices.pick(device)
 
 
 @dataclass
@@ -243,11 +246,11 @@ def random_offsets(base: torch.Tensor, batch: int, cfg: TrainConfig, generator: 
     groups, idx = _group_index()
     log_s = math.log(cfg.scale_range)
     log_o = math.log(cfg.overall_range)
-    g = (torch.rand(batch, len(groups), generator=generator) * 2 - 1) * log_s
-    overall = (torch.rand(batch, 1, generator=generator) * 2 - 1) * log_o
-    per_joint = torch.zeros(batch, len(humanoid.JOINTS))
-    mask = torch.as_tensor(idx >= 0)
-    per_joint[:, mask] = g[:, torch.as_tensor(idx[idx >= 0])]
+    g = (torch.rand(batch, len(groups), generator=generator, **_DRAWS) * 2 - 1) * log_s
+    overall = (torch.rand(batch, 1, generator=generator, **_DRAWS) * 2 - 1) * log_o
+    per_joint = torch.zeros(batch, len(humanoid.JOINTS), **_DRAWS)
+    mask = torch.as_tensor(idx >= 0, device="cpu")
+    per_joint[:, mask] = g[:, torch.as_tensor(idx[idx >= 0], device="cpu")]
     factor = torch.exp(per_joint + overall)
     return base[None] * factor[..., None].to(base)
 
@@ -255,9 +258,9 @@ def random_offsets(base: torch.Tensor, batch: int, cfg: TrainConfig, generator: 
 def random_turns(batch: int, cfg: TrainConfig, generator: torch.Generator) -> torch.Tensor:
     """``batch`` sets (batch, 22, 4) of random rotations, uniform axis, angle uniform in
     [0, ``cfg.pose_noise``]; the root's is the identity."""
-    axis = torch.randn(batch, len(humanoid.JOINTS), 3, generator=generator)
+    axis = torch.randn(batch, len(humanoid.JOINTS), 3, generator=generator, **_DRAWS)
     axis = axis / axis.norm(dim=-1, keepdim=True).clamp_min(1e-9)
-    angle = torch.rand(batch, len(humanoid.JOINTS), generator=generator) * cfg.pose_noise
+    angle = torch.rand(batch, len(humanoid.JOINTS), generator=generator, **_DRAWS) * cfg.pose_noise
     angle[:, 0] = 0.0
     return torch.cat([torch.cos(angle / 2)[..., None], torch.sin(angle / 2)[..., None] * axis], dim=-1)
 
@@ -303,12 +306,13 @@ class _Windows:
 
 
 def _windows(data: TrainingSet, dtype: torch.dtype, device: torch.device) -> _Windows:
-    mean = torch.as_tensor(data.stats.mean, dtype=dtype)
-    std = torch.as_tensor(data.stats.std, dtype=dtype)
-    x_all = ((torch.from_numpy(data.x).to(dtype) - mean) / std).to(device)
-    pos_all = torch.from_numpy(data.positions).to(device=device, dtype=dtype)
-    rot_all = torch.from_numpy(data.local_rot).to(device=device, dtype=dtype)
-    base = torch.tensor(data.skeleton.offsets, dtype=dtype)
+    cpu = dict(dtype=dtype, device="cpu")
+    mean = torch.as_tensor(data.stats.mean, **cpu)
+    std = torch.as_tensor(data.stats.std, **cpu)
+    x_all = ((torch.as_tensor(data.x, device="cpu").to(dtype) - mean) / std).to(device)
+    pos_all = torch.as_tensor(data.positions, device=device).to(dtype)
+    rot_all = torch.as_tensor(data.local_rot, device=device).to(dtype)
+    base = torch.tensor(data.skeleton.offsets, **cpu)
     base[0] = 0.0
     return _Windows(x_all, pos_all, rot_all, base, mean, std)
 
@@ -320,7 +324,7 @@ def _batch(w: _Windows, cfg: TrainConfig, gen: torch.Generator):
     device, dtype = w.x.device, w.x.dtype
     n_aug = int(round(cfg.augment * cfg.batch_size))
     n_pose = min(int(round(cfg.pose_augment * cfg.batch_size)), cfg.batch_size - n_aug)
-    idx = torch.randint(len(w), (cfg.batch_size,), generator=gen)
+    idx = torch.randint(len(w), (cfg.batch_size,), generator=gen, device="cpu").to(device)
     offsets = w.base[None].repeat(cfg.batch_size, 1, 1)
     if n_aug:
         offsets[:n_aug] = random_offsets(w.base, n_aug, cfg, gen)
@@ -362,13 +366,15 @@ def train(
     history : list of the ``record`` dicts
     """
     cfg = config or TrainConfig()
+    device = pick_device(cfg.device)  # a device that is not there fails before any work
     if not isinstance(data, TrainingSet):
         data = training_set(data, progress=progress)
-    device = pick_device(cfg.device)
     torch.manual_seed(cfg.seed)
     gen = torch.Generator().manual_seed(cfg.seed)
     dtype = DTYPES[cfg.dtype]
-    model = RetargetNet(model_config).to(device=device, dtype=dtype)
+    with torch.device("cpu"):  # initial weights drawn on the CPU: one seed, one network on every device
+        model = RetargetNet(model_config)
+    model = model.to(device=device, dtype=dtype)
     model.train()
     windows = _windows(data, dtype, device)
     opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
@@ -381,18 +387,22 @@ def train(
         x, rot, target, offsets = _batch(windows, cfg, gen)
         out = model(x, offsets)
         recon = losses.recon_loss(out.positions, target, cfg.recon_weight)
-        rot_l = losses.rotation_loss(out.local_rot, rot) if cfg.rot_weight > 0 else torch.zeros((), device=device)
+        rot_l = (
+            losses.rotation_loss(out.local_rot, rot)
+            if cfg.rot_weight > 0
+            else torch.zeros((), dtype=dtype, device=device)
+        )
         loss = recon + cfg.rot_weight * rot_l
         opt.zero_grad(set_to_none=True)
         loss.backward()
         opt.step()
         sched.step()
-        value = loss.item()
-        running = value if running is None else 0.95 * running + 0.05 * value
+        with torch.no_grad():  # on the device: no host sync but at the logged steps
+            running = loss.detach() if running is None else 0.95 * running + 0.05 * loss.detach()
         if step % cfg.log_every == 0 or step == cfg.steps:
             record = {
                 "step": step,
-                "loss": value,
+                "loss": loss.item(),
                 "recon": recon.item(),
                 "rot": rot_l.item(),
                 "lr": opt.param_groups[0]["lr"],
@@ -400,7 +410,7 @@ def train(
             }
             history.append(record)
             err_cm = 100 * 3 * record["recon"] / cfg.recon_weight if cfg.recon_weight else float("nan")
-            bar.set_postfix(loss=f"{running:.4g}", err_cm=f"{err_cm:.2f}")
+            bar.set_postfix(loss=f"{float(running):.4g}", err_cm=f"{err_cm:.2f}")
             if callback is not None:
                 callback(step, record)
     model.eval()

@@ -14,6 +14,7 @@ import pytest
 
 from motionlab import cli
 from motionlab.cli_args import DeprecatedAlias, HelpFormatter
+from motionlab.retargeting import terms
 
 
 def _commands() -> dict[str, argparse.ArgumentParser]:
@@ -64,7 +65,10 @@ VOCABULARY = {
     "--unit-scale": ("unit_scale", "positive", "BVH units to metres (view)"),
     "--steps": ("steps", "non_negative_int", "step limit of the latent iteration"),
     "--lr": ("lr", "positive", "Adam step of the latent iteration"),
-    "--contact-weight": ("contact_weight", "non_negative", "weight of the latent iteration's foot-contact term"),
+    **{  # one per registered loss term of the latent iteration (motionlab.retargeting.terms)
+        f"--{t.name.replace('_', '-')}-weight": (f"{t.name}_weight", "non_negative", f"weight of the term L_{t.name}")
+        for t in terms.registered()
+    },
     "--init": ("init", "text", "start of the latent iteration"),
     "--exact-rounds": ("exact_rounds", "non_negative_int", "exact Gauss-Newton rounds of the latent start"),
     "--train-steps": ("train_steps", "positive_int", "Adam steps of training"),

@@ -1,0 +1,61 @@
+"""Which torch device the retargeting network runs on: the one home of the default and its checks.
+
+The default is CUDA when ``torch.cuda.is_available()``, else the CPU. A device that is named
+(``--device``, ``TrainConfig.device``, :func:`motionlab.retargeting.load`) must exist on this
+machine: :func:`pick` refuses a name torch does not know and a CUDA (or MPS) device this torch
+cannot use, with a :class:`ValueError` saying which devices there are, instead of a torch
+traceback at the first tensor.
+
+Every tensor of the retargeting code follows its inputs: the network's weights decide the
+device and float type, and each tensor made from other data names them (``device=``, ``dtype=``)
+explicitly. ``tests/retargeting/test_devices.py`` checks that rule on the CPU.
+"""
+
+from __future__ import annotations
+
+import torch
+
+__all__ = ["pick", "available"]
+
+
+def available() -> list[str]:
+    """The device names usable here: ``"cpu"``, then ``"cuda"``, ``"cuda:0"``… and ``"mps"`` where present."""
+    names = ["cpu"]
+    if torch.cuda.is_available():
+        names += ["cuda"] + [f"cuda:{i}" for i in range(torch.cuda.device_count())]
+    mps = getattr(torch.backends, "mps", None)
+    if mps is not None and mps.is_available():
+        names.append("mps")
+    return names
+
+
+def pick(device: str | torch.device | None = None) -> torch.device:
+    """``device`` checked, or the default (CUDA when available, else the CPU).
+
+    Raises
+    ------
+    ValueError
+        ``device`` is not a torch device name, or names a CUDA / MPS device this machine or this
+        build of torch does not have (the message lists the devices there are).
+    """
+    if device is None:
+        return torch.device("cuda" if torch.cuda.is_available() else "cpu")
+    try:
+        dev = torch.device(device)
+    except (RuntimeError, TypeError):
+        raise ValueError(f"device {device!r} is not a torch device; expected one of {available()}") from None
+    if dev.type == "cuda":
+        if not torch.cuda.is_available():
+            build = "a CPU-only build" if torch.version.cuda is None else f"built for CUDA {torch.version.cuda}"
+            raise ValueError(
+                f"device {device!r}: this machine has no usable CUDA GPU (torch {torch.__version__}, {build}); use cpu"
+            )
+        if dev.index is not None and dev.index >= torch.cuda.device_count():
+            raise ValueError(f"device {device!r}: there are {torch.cuda.device_count()} CUDA GPU(s); use {available()}")
+    elif dev.type == "mps":
+        mps = getattr(torch.backends, "mps", None)
+        if mps is None or not mps.is_available():
+            raise ValueError(f"device {device!r}: MPS is not available here; expected one of {available()}")
+    elif dev.type != "cpu":
+        raise ValueError(f"device {device!r}: motionlab runs on {available()}, not on {dev.type}")
+    return dev

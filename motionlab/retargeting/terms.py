@@ -1,0 +1,208 @@
+"""The loss terms of the latent iteration, as named objects in one registry.
+
+Contract
+--------
+A term is a :class:`Term`: a ``name`` (a Python identifier), a default ``weight`` (>= 0), and a
+``function(decoded, inputs) -> Tensor`` giving the term's value for ONE sequence: ``decoded`` is
+the decoder's output on B (:class:`~motionlab.retargeting.model.Decoded`, tensors (1, T, 22, ·))
+and ``inputs`` a :class:`TermInputs` of the same sequence. The function returns a 0-d tensor,
+differentiable in ``decoded``; it must work under ``torch.func.vmap`` (no ``.item()``, no
+branching on tensor values), since :func:`motionlab.retargeting.solver.solve_many` maps it over
+the sequences of a batch. ``needs`` names the inputs it cannot do without (``"planted"``…); where
+one is missing the term is not evaluated and its value is 0.
+
+The iteration (:mod:`motionlab.retargeting.solver`) sums ``weight × value`` over the registered
+terms, in registration order: ``L_iter = Σ_k w_k · L_k``. A term's weight comes from
+``SolverConfig.weights[name]`` when given, else (for the three terms the paper and motionlab
+started with) ``SolverConfig.lambda_angle`` / ``lambda_foot`` / ``lambda_contact``, else
+``Term.weight``. Everything else follows the registry: the solver's history and callback (one
+entry per term name, beside ``"loss"`` = L_iter), :func:`motionlab.retargeting.plots.plot_iteration`,
+``expand``'s manifest columns (one per term, after ``loss``), ``options_sha256`` and the
+``--NAME-weight`` options of ``retarget``, ``evaluate`` and ``expand``.
+
+Adding a term is one function and one :func:`register` call (``tests/retargeting/test_terms.py``
+does it from outside the package). Per-sequence data a term needs beyond the built-in inputs
+travel in ``TermInputs.extra`` (``solve(..., inputs={"name": tensor (N, T, ...)})``).
+
+The built-in terms, in order:
+
+============  =======================================================================  ======  ======
+name          value                                                                    unit    weight
+============  =======================================================================  ======  ======
+``angle``     L_angle (eq. 16): A's joint angles vs B's (:func:`losses.angle_loss`)    —       0.3
+``foot``      L_foot (eq. 17): the feet below the ground (:func:`losses.foot_loss`)     m       0.5
+``contact``   L_contact (motionlab): speed of A's planted feet on B                    m/s     0.5
+``floor``     L_floor (motionlab): the other 18 joints below the floor, beyond the     m       2.25
+              source's own depth scaled to B (:func:`losses.floor_loss`)
+============  =======================================================================  ======  ======
+
+L_floor's weight is λ_foot × 18 / 4: L_foot is a mean over the 4 foot joints, L_floor over the
+other 18, so a joint under the floor costs exactly what a foot under the ground costs in the
+paper's L_foot (the feet stay L_foot's alone). Where no joint goes under its allowed depth L_floor and its gradient are exactly 0, so
+the iteration's numbers are those without it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from motionlab.retargeting import losses
+
+__all__ = [
+    "Term",
+    "TermInputs",
+    "register",
+    "unregister",
+    "registered",
+    "get",
+    "PAPER_TERMS",
+]
+
+PAPER_TERMS = ("angle", "foot")
+"""The two terms of the paper (eqs. 15–17); the others are motionlab's additions."""
+
+
+@dataclass(frozen=True)
+class TermInputs:
+    """What a term sees of one sequence besides the decoded motion (tensors with a leading 1).
+
+    Attributes
+    ----------
+    source : Tensor (1, T, 22, 4) or (1, T, 22, 3)   θ(A): A's local rotations (``theta="rotations"``)
+        or A's root-relative heading-frame positions (``"directions"``)
+    theta : str                    ``"rotations"`` or ``"directions"``
+    root_height : Tensor (1, T)    B's root height above the ground, metres
+    root_world : Tensor (1, T, 3) or None   B's root in the world (contact inputs), metres
+    yaw : Tensor (1, T) or None    A's (= B's) heading, radians
+    planted : Tensor (1, T, 4) of bool or None   A's foot contacts
+    fps : Tensor () or None        frame rate
+    extra : dict of Tensor         per-sequence inputs of other terms, e.g. ``"floor"`` (1, T, 22):
+                                   the lowest height each joint of B may reach, metres (<= 0)
+    """
+
+    source: Any
+    theta: str
+    root_height: Any
+    root_world: Any = None
+    yaw: Any = None
+    planted: Any = None
+    fps: Any = None
+    extra: dict = field(default_factory=dict)
+
+    def has(self, name: str) -> bool:
+        """Whether input ``name`` (a field or a key of ``extra``) is given."""
+        if name in self.extra:
+            return True
+        return getattr(self, name, None) is not None
+
+
+@dataclass(frozen=True)
+class Term:
+    """A loss term of the latent iteration (module docstring: the contract).
+
+    Attributes
+    ----------
+    name : str           identifier: history key, manifest column, ``--NAME-weight`` option
+    weight : float       default weight (>= 0)
+    function : callable  ``function(decoded, inputs: TermInputs) -> Tensor ()``
+    unit : str           unit of the value ("" for none), for reports
+    needs : tuple of str inputs the term cannot be evaluated without (fields or ``extra`` keys)
+    description : str    one line for ``--help`` and the docs
+    """
+
+    name: str
+    weight: float
+    function: Callable
+    unit: str = ""
+    needs: tuple[str, ...] = ()
+    description: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.name.isidentifier() or self.name == "loss":
+            raise ValueError(f"a term's name must be a Python identifier other than 'loss', got {self.name!r}")
+        if not self.weight >= 0:
+            raise ValueError(f"term {self.name!r}: weight must be >= 0, got {self.weight}")
+        if not callable(self.function):
+            raise ValueError(f"term {self.name!r}: function must be callable")
+
+
+_REGISTRY: dict[str, Term] = {}
+
+
+def register(term: Term, replace: bool = False) -> Term:
+    """Add ``term`` to the iteration (after the terms already there); returns it.
+
+    Raises ``ValueError`` when a term of that name is registered and ``replace`` is False.
+    """
+    if not isinstance(term, Term):
+        raise ValueError(f"expected a Term, got {type(term).__name__}")
+    if term.name in _REGISTRY and not replace:
+        raise ValueError(f"a loss term named {term.name!r} is already registered (replace=True replaces it)")
+    _REGISTRY[term.name] = term
+    return term
+
+
+def unregister(name: str) -> Term:
+    """Remove the term ``name`` and return it; ``KeyError`` naming the registered terms if there is none."""
+    if name not in _REGISTRY:
+        raise KeyError(f"no loss term {name!r}; registered: {list(_REGISTRY)}")
+    return _REGISTRY.pop(name)
+
+
+def registered() -> tuple[Term, ...]:
+    """The registered terms, in the order the iteration sums them."""
+    return tuple(_REGISTRY.values())
+
+
+def get(name: str) -> Term:
+    """The registered term ``name``; ``KeyError`` naming the registered terms if there is none."""
+    if name not in _REGISTRY:
+        raise KeyError(f"no loss term {name!r}; registered: {list(_REGISTRY)}")
+    return _REGISTRY[name]
+
+
+# ---------------------------------------------------------------------------- built-in terms
+def _angle(decoded, inputs: TermInputs):
+    if inputs.theta == "rotations":
+        return losses.angle_loss(inputs.source, decoded.local_rot)
+    return losses.direction_loss(inputs.source, decoded.positions)
+
+
+def _foot(decoded, inputs: TermInputs):
+    return losses.foot_loss(decoded.positions[..., 1] + inputs.root_height[..., None])
+
+
+def _contact(decoded, inputs: TermInputs):
+    feet = losses.feet_in_world(decoded.positions, inputs.root_world, inputs.yaw)
+    return losses.contact_loss(feet, inputs.planted, inputs.fps)
+
+
+def _floor(decoded, inputs: TermInputs):
+    heights = decoded.positions[..., 1] + inputs.root_height[..., None]
+    return losses.floor_loss(heights, inputs.extra.get("floor"))
+
+
+register(Term("angle", losses.LAMBDA_ANGLE, _angle, "", (), "L_angle: the source's joint angles kept (paper, eq. 16)"))
+register(Term("foot", losses.LAMBDA_FOOT, _foot, "m", (), "L_foot: feet above the ground (paper, eq. 17)"))
+register(
+    Term(
+        "contact",
+        losses.LAMBDA_CONTACT,
+        _contact,
+        "m/s",
+        ("root_world", "yaw", "planted", "fps"),
+        "L_contact: the source's planted feet stay still (motionlab's addition)",
+    )
+)
+register(
+    Term(
+        "floor",
+        losses.LAMBDA_FLOOR,
+        _floor,
+        "m",
+        (),
+        "L_floor: every joint at or above the floor, or no deeper than the source's own (motionlab's addition)",
+    )
+)
