@@ -11,8 +11,6 @@ import functools
 import re
 from pathlib import Path
 
-import pytest
-
 PACKAGE = Path(__file__).resolve().parents[1] / "motionlab"
 
 RAISES = re.compile(r"\b[Rr]aises\b")
@@ -23,13 +21,6 @@ CITES_RESULTS = re.compile(r"\bREADME\b(?!\.md)")
 belong to the docs pages, under the command that prints them, and a docstring states the
 contract instead. A path to a README file (``$MOTIONLAB_DATA/README.md``) and a paper's table
 ("Table 1 of paper A") are not flagged."""
-
-PENDING = {
-    ("retargeting/solver.py", "<module>"): "cites",
-    ("retargeting/solver.py", "SolverConfig"): "cites",
-}
-"""Flagged in ``retargeting/solver.py``, whose rewrite (issue 44 item 1) is under way on
-another branch; the test below fails once an entry is fixed, so that it is removed here."""
 
 
 @functools.cache
@@ -85,23 +76,17 @@ def _citations() -> list[tuple[str, str, int]]:
 
 
 def test_every_public_function_that_raises_says_so():
-    missing = [m for m in _undocumented_raises() if (m[0], m[1]) not in PENDING]
+    missing = [m for m in _undocumented_raises()]
     assert not missing, "public functions that raise without a 'Raises' in their docstring:\n" + "\n".join(
         f"  motionlab/{f}:{line} {name}" for f, name, line in missing
     )
 
 
 def test_no_docstring_cites_a_results_page():
-    found = [c for c in _citations() if (c[0], c[1]) not in PENDING]
+    found = [c for c in _citations()]
     assert not found, "docstrings citing the README for results:\n" + "\n".join(
         f"  motionlab/{f}:{line} {name}" for f, name, line in found
     )
-
-
-@pytest.mark.parametrize(("where", "kind"), sorted(PENDING.items()))
-def test_pending_entries_are_still_flagged(where, kind):
-    flagged = _citations() if kind == "cites" else _undocumented_raises()
-    assert where in {(f, name) for f, name, _ in flagged}, f"{where} is fixed: remove it from PENDING"
 
 
 def test_the_checks_can_fail():

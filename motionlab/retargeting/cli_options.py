@@ -25,7 +25,12 @@ def _error(msg: str):
 
 
 def check_device(device: str | None) -> None:
-    """Refuse a ``--device`` this machine does not have (:func:`devices.pick`) before a command does any work."""
+    """Refuse a ``--device`` this machine does not have (:func:`devices.pick`) before a command does any work.
+
+    Raises
+    ------
+    CLIError naming ``--device`` and the devices this machine has.
+    """
     if device is None:
         return
     from motionlab.retargeting import devices

@@ -235,6 +235,10 @@ def floor_loss(heights: torch.Tensor, allowed: torch.Tensor | None = None) -> to
         source's own depth there, scaled); None: 0, the floor itself
 
     Exactly 0, with a zero gradient, where every joint is above its allowed height.
+
+    Raises
+    ------
+    ValueError unless ``heights`` has 22 joints on its last axis.
     """
     if heights.shape[-1] != len(humanoid.JOINTS):
         raise ValueError(f"floor_loss: expected heights (..., T, 22), got {tuple(heights.shape)}")

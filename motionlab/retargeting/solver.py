@@ -24,33 +24,29 @@ registry. A new term is one function and one :func:`terms.register`; its weight 
 ``SolverConfig(weights={name: w})`` and its per-sequence inputs passed as ``solve(..., inputs=)``.
 Every tensor follows the network's device and float type (:mod:`motionlab.retargeting.devices`).
 
-Three additions of motionlab, each measured on the results page, docs/results_retargeting.md (ablation rows):
+Three further additions of motionlab (their ablations are on docs/results_retargeting.md):
 
 **A Gauss–Newton start (``init="project"``; the default ``"auto"`` uses it).** The encoder
-reproduces A's joint rotations only approximately on clips it was not trained on (12° median,
-upper body, on Aj's held-back clips: ``benchmarks/bench_retarget.py``), and Adam on the angle loss closes that gap slowly. ``F_qlinear`` is linear (eq. 10):
-``q = unit(W φ + b)`` with ``W`` of shape (88, D), D ≥ 88, so the latent that makes ``q ⊗ q_Δ``
-equal A's rotations can be found by least squares, one frame at a time.
-This is a Gauss–Newton step on the angle term (:func:`project_latent`; ``q_Δ`` depends on φ,
-hence ``project_iters`` rounds, each step smoothed over time like the Adam updates below). It
-starts the iteration from ``L_angle ≈ 0``: the decoder then says what the source says, and
-Adam only has to trade that against the foot terms. ``init="encoder"`` starts from ``F_enc(X_A)`` as the paper does.
+reproduces A's joint rotations only approximately on clips it was not trained on, and Adam on the
+angle loss closes that gap slowly. ``F_qlinear`` is linear (eq. 10): ``q = unit(W φ + b)`` with
+``W`` of shape (88, D), D ≥ 88, so the latent that makes ``q ⊗ q_Δ`` equal A's rotations can be
+found by least squares, one frame at a time. This is a Gauss–Newton step on the angle term
+(:func:`project_latent`; ``q_Δ`` depends on φ, hence ``project_iters`` rounds, each step smoothed
+over time like the Adam updates below). It starts the iteration from ``L_angle ≈ 0``: the decoder
+then says what the source says, and Adam only has to trade that against the foot terms.
+``init="encoder"`` starts from ``F_enc(X_A)`` as the paper does.
 
 **Foot contacts (``lambda_contact``).** Where A's foot is planted
 (:mod:`motionlab.retargeting.contacts`), B's foot should stay still in the world;
 :func:`losses.contact_loss` measures how fast it moves (m/s). This needs B's world
 positions, so :func:`solve` takes B's root trajectory, heading and the frame rate. The term is
-a speed so that its weight does not depend on the frame rate; a first version measured metres
-per *frame*, which at 60 fps weighed it 60× less: L_iter then fell below the paper's threshold
-after about 5 Adam steps, and planted feet kept sliding (the ``slide`` column of
-``motionlab evaluate``; ``--contact-weight 0.0083`` = 0.5 / 60 reproduces that first version).
+a speed (m/s, not m/frame) so that its weight does not depend on the frame rate.
 
 **Smooth latent updates (``smooth_sigma``).** The decoder works frame by frame, so per-frame
-Adam steps on φ add frame-to-frame jitter (on the Mixamo data the mean acceleration tripled,
-0.30 → 0.91 cm/frame²). We therefore write ``φ = φ₀ + G_σ * δ``, where ``G_σ`` is a fixed
-Gaussian filter along time (σ = ``smooth_sigma`` frames) and optimise the free offset ``δ``:
-still only the latent moves and the loss is unchanged, but every update is temporally smooth.
-``smooth_sigma=0`` optimises φ directly, as the paper states.
+Adam steps on φ add frame-to-frame jitter. We therefore write ``φ = φ₀ + G_σ * δ``, where ``G_σ``
+is a fixed Gaussian filter along time (σ = ``smooth_sigma`` frames) and optimise the free offset
+``δ``: still only the latent moves and the loss is unchanged, but every update is temporally
+smooth. ``smooth_sigma=0`` optimises φ directly, as the paper states.
 
 **The same iterates on every CPU (``step_grid``).** The start and every Adam iterate are rounded
 to a grid a four-thousandth of a step fine, so that last-bit differences between CPUs' kernels
@@ -131,13 +127,8 @@ class SolverConfig:
     smooth_projection : bool  smooth each Gauss–Newton step over time with G_σ (below), so the
                            start latent is as smooth in time as the encoder's
     project_exact : int    of the ``project_iters`` rounds, how many last ones are not smoothed
-                           (they remove what the smoothed rounds leave of A's fastest details).
-                           4: with 2, the start left a residual that, where the iteration stops
-                           at once (the synthetic demo), gave more skating than copying A's
-                           rotations (0.225 vs 0.223 m/s); 4 reproduces them. On 5 of the 10
-                           Mixamo animations 2, 3 and 4 score the same to 0.5 % in pose MSE/h²
-                           (``motionlab evaluate --exact-rounds K``); the other 5 confirm it
-                           (README, Table 1)
+                           (they remove what the smoothed rounds leave of A's fastest details;
+                           ``motionlab evaluate --exact-rounds K`` compares values)
     theta : str            ``"rotations"`` (joint rotations, default) or ``"directions"``
                            (unit bone directions from positions)
     smooth_sigma : float   σ (frames) of the Gaussian that smooths latent updates over time; 0: off

@@ -145,7 +145,12 @@ def register(term: Term, replace: bool = False) -> Term:
 
 
 def unregister(name: str) -> Term:
-    """Remove the term ``name`` and return it; ``KeyError`` naming the registered terms if there is none."""
+    """Remove the term ``name`` and return it.
+
+    Raises
+    ------
+    KeyError naming the registered terms if there is none called ``name``.
+    """
     if name not in _REGISTRY:
         raise KeyError(f"no loss term {name!r}; registered: {list(_REGISTRY)}")
     return _REGISTRY.pop(name)
@@ -157,7 +162,12 @@ def registered() -> tuple[Term, ...]:
 
 
 def get(name: str) -> Term:
-    """The registered term ``name``; ``KeyError`` naming the registered terms if there is none."""
+    """The registered term ``name``.
+
+    Raises
+    ------
+    KeyError naming the registered terms if there is none called ``name``.
+    """
     if name not in _REGISTRY:
         raise KeyError(f"no loss term {name!r}; registered: {list(_REGISTRY)}")
     return _REGISTRY[name]
