@@ -151,8 +151,11 @@ def _preset(spec: str) -> tuple[str, dict[str, float]]:
     return name, factors
 
 
-def characters(*specs: str, presets: Iterable[str] = ()) -> list[Character]:
+def characters(*specs: str, presets: Iterable[str] = (), rest_from=None) -> list[Character]:
     """Target characters from ``FILE.bvh``, ``NAME=FILE.bvh`` and preset names.
+
+    ``rest_from``: a Motion whose standing pose serves every file on its rig
+    (:func:`rest_pose.on_reference`, ``--rest-from``).
 
     A file's character is named after its stem; stems shared by several files are made unique
     with the parent folder (``Kaya/Jumping.bvh`` → ``Kaya_Jumping``). A file that cannot be read
@@ -176,7 +179,8 @@ def characters(*specs: str, presets: Iterable[str] = ()) -> list[Character]:
     for name, p in entries:
         digest = _sha256(p)
         try:
-            sk = rest_pose.standing_skeleton(bvh.load(p), f"character file {p}")[0]
+            rig = rest_pose.on_reference(bvh.load(p), rest_from, f"character file {p}")
+            sk = rest_pose.standing_skeleton(rig, f"character file {p}")[0]
             out.append(Character(name, sk, str(p), digest=digest))
         except _ERRORS as err:
             out.append(Character(name, None, str(p), _why(err, "character", p), digest))
@@ -511,6 +515,7 @@ def expand(
     threads: int | None = None,
     output_format: str = "bvh",
     fps: float | None = None,
+    rest_from=None,
 ) -> ExpandResult:
     """Retarget every source clip onto every character; see the module docstring.
 
@@ -535,6 +540,8 @@ def expand(
         the outputs' format and file suffix. A rerun in another format redoes every pair.
     fps : frame rate of every output (default: each source's own); the network runs at the
         checkpoint's rate
+    rest_from : a Motion whose standing pose serves every source on its rig
+        (:func:`rest_pose.on_reference`, ``--rest-from``; pass the same to :func:`characters`)
 
     Returns
     -------
@@ -547,7 +554,7 @@ def expand(
     with torch_threads(batch_threads(checkpoint.device, threads)):
         return _expand(
             sources, targets, out, checkpoint, solver, root_mode, force, max_frames, backend, address, workers,
-            max_penetration_cm, skate_ratio, progress, on_batch, "." + output_format, fps,
+            max_penetration_cm, skate_ratio, progress, on_batch, "." + output_format, fps, rest_from,
         )  # fmt: skip
 
 
@@ -587,7 +594,7 @@ def _plan(clips, targets, out, known, force, suffix, options, result, rows):
 
 def _expand(
     sources, targets, out, checkpoint, solver, root_mode, force, max_frames, backend, address, workers,
-    max_penetration_cm, skate_ratio, progress, on_batch, suffix, fps,
+    max_penetration_cm, skate_ratio, progress, on_batch, suffix, fps, rest_from=None,
 ) -> ExpandResult:  # fmt: skip
     start = time.perf_counter()
     out = Path(out)
@@ -606,7 +613,7 @@ def _expand(
     rows: dict[tuple[str, str], dict] = {}
     options = options_digest(checkpoint, solver, root_mode, fps)
     todo = _plan(clips, targets, out, known, force, suffix, options, result, rows)
-    pairs, sources_by_clip = _load_pairs(todo, checkpoint, solver, rows, result, suffix)
+    pairs, sources_by_clip = _load_pairs(todo, checkpoint, solver, rows, result, suffix, rest_from)
     for src in sources_by_clip.values():
         rates = (src.fps, checkpoint.fps, fps or src.fps)
         if max(rates) - min(rates) > 1e-4 * max(rates):
@@ -670,7 +677,7 @@ def _write_batch(solved, sources_by_clip, chars, limits, suffix, options, fps, o
     return new
 
 
-def _load_pairs(todo, checkpoint, solver, rows, result, suffix):
+def _load_pairs(todo, checkpoint, solver, rows, result, suffix, rest_from=None):
     """Read each source once; a clip or character that fails becomes ``error`` rows."""
     pairs: list[Pair] = []
     sources_by_clip: dict[str, _Source] = {}
@@ -680,7 +687,7 @@ def _load_pairs(todo, checkpoint, solver, rows, result, suffix):
     feet = [humanoid.JOINTS.index(f) for f in humanoid.FEET]
     for clip, (path, chars, digest) in by_clip.items():
         try:
-            motion = bvh.load(path)
+            motion = rest_pose.on_reference(bvh.load(path), rest_from, str(path))
             prepared = prepare_source(motion, checkpoint, "full", solver)
         except _ERRORS as err:
             for c in chars:
