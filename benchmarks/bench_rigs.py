@@ -2,6 +2,7 @@
 
     MOTIONLAB_DATA=/path/to/data python benchmarks/bench_rigs.py [--seconds 3] [--pair bandai mixamo]
     MOTIONLAB_DATA=/path/to/data python benchmarks/bench_rigs.py --methods [--source-fps 60] [--pair xia cmu]
+    MOTIONLAB_DATA=/path/to/data python benchmarks/bench_rigs.py --flags
 
 Prints, per (source, target) pair: the hip height ratio (B's median hip height over B's standing
 hip height, and the same for A on A), the median foot height in A's contact frames (cm and /
@@ -9,7 +10,11 @@ B's leg length), foot skating (cm/s, B and A) and the output frame rate
 (:mod:`motionlab.retargeting.rig_matrix`). Without MOTIONLAB_DATA only the synthetic character runs.
 With ``--methods``: the planted-foot slide of each pair under the three methods (copy rotations,
 the network alone, the full latent iteration), beside the source's own; ``--source-fps`` resamples
-every source clip first.
+every source clip first. With ``--flags``: held-out clips (every dataset-2 walk-turn take, a Xia
+walk and a CMU walk not in the matrix) retargeted by the full method onto three Mixamo characters, with
+``expand``'s skating flag before this change (foot joints below 5 cm, against twice the source's
+own, scaled) and now (planted-foot slide on the source's stance frames,
+:attr:`motionlab.retargeting.plausibility.Plausibility.skating`).
 """
 
 from __future__ import annotations
@@ -18,7 +23,7 @@ import argparse
 import time
 
 from motionlab import data, retargeting
-from motionlab.core import humanoid, metrics
+from motionlab.core import bvh, humanoid, metrics, preprocess
 from motionlab.retargeting import rig_matrix
 from motionlab.retargeting.pipeline import retarget, source_contacts
 
@@ -44,13 +49,48 @@ def method_slides(clips, checkpoint, pairs=None) -> None:
             print(f"{a:<10} {b:<10} " + " ".join(f"{v:>8.1f}" for v in slides) + f" {own:>9.1f}")
 
 
+HELD_OUT = ("bandai_namco/dataset-2/walk-turn-left/*.bvh", "bandai_namco/dataset-2/walk-turn-right/*.bvh",
+            "xia/walk/*_01_001.bvh", "cmu/131/131_02.bvh")  # fmt: skip
+"""Clips never used to set a threshold: the issue's false alarm (walk-turn takes) and CMU-skeleton walks."""
+CHARACTERS = ("Aj", "Kaya", "Goblin_m")
+
+
+def skating_flags(root, checkpoint, skate_ratio: float = 2.0) -> None:
+    """Print, per held-out clip and Mixamo character, the old and the new skating measure and flag."""
+    feet = [humanoid.JOINTS.index(f) for f in humanoid.FEET]
+    print(f"{'source':<42} {'target':<9} {'old cm/s':>8} {'limit':>6} {'flag':>5} {'slide cm/s':>10} "
+          f"{'limit':>6} {'(source)':>8} {'flag':>5}")  # fmt: skip
+    for pattern in HELD_OUT:
+        for path in sorted(root.glob(pattern))[:2]:
+            source = bvh.load(path)
+            src = preprocess.prepare(source, None, stand=True)
+            old_src = 100 * metrics.foot_skating(src.global_positions(), feet, src.fps)
+            for name in CHARACTERS:
+                target = root / "mixamo" / name / "Running.bvh"
+                res = retarget(source, bvh.load(target), checkpoint)
+                check = res.plausibility
+                old = 100 * metrics.foot_skating(res.positions, feet, res.motion.fps)
+                old_limit = skate_ratio * old_src * res.root_scale[0]
+                cm = 100.0  # Mixamo targets are in metres
+                new_flag = check.skating and check.slide > skate_ratio * check.source_slide * res.root_scale[0]
+                print(f"{path.stem:<42} {name:<9} {old:>8.1f} {old_limit:>6.1f} {str(old > old_limit):>5} "
+                      f"{cm * check.slide:>10.1f} {cm * check.slide_limit:>6.1f} {cm * check.source_slide * res.root_scale[0]:>8.1f} "
+                      f"{str(new_flag):>5}")  # fmt: skip
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=3.0, help="seconds of each family's clip (default 3)")
     ap.add_argument("--pair", nargs=2, action="append", metavar=("SOURCE", "TARGET"), help="only these pairs")
     ap.add_argument("--methods", action="store_true", help="slide per method (copy, network, full) instead")
     ap.add_argument("--source-fps", type=float, help="with --methods: resample every source clip to this rate")
+    ap.add_argument("--flags", action="store_true", help="old and new skating flag on held-out clips instead")
     args = ap.parse_args()
+    if args.flags:
+        start = time.perf_counter()
+        skating_flags(data.data_root(), retargeting.load_default())
+        print(f"{time.perf_counter() - start:.0f} s")
+        return
     root = data.data_root() if data.has_data() else None
     clips = rig_matrix.family_clips(root, args.seconds)
     start = time.perf_counter()

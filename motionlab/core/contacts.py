@@ -24,10 +24,12 @@ A foot joint is **planted** in frame ``t`` when, on A,
 
 * it is low: its height is at most its *contact height* plus ``height_tol × h`` (``h``: A's
   22-joint rest height, so the rule does not depend on the character's size or the file's
-  unit). A joint's contact height is its rest height above the lowest rest joint, plus the
-  clearance of the lowest joint when it touches the ground, estimated as the least
-  ``y − rest height`` any foot joint reaches in the clip (joints sit inside the foot, a few
-  centimetres above the sole); and
+  unit). A joint's contact height is its rest height above the lowest rest joint (the rig's
+  own geometry), plus that joint's own clearance when it touches the ground, estimated as the
+  least ``y − rest height`` the joint reaches in the clip (the source's own foot heights; never
+  below 0): joints sit inside the foot, a few centimetres above the sole, and a rig's standing
+  foot need not be the performer's (CMU's rest foot lies nearly flat, its planted ankle does
+  not, so one clearance for all four joints, the lowest's, left CMU's ankles never low); and
 * it is slow: its speed is below ``speed_tol × h`` per second,
 
 and the label is kept only for runs of at least ``min_frames`` consecutive frames (a
@@ -147,7 +149,7 @@ def detect_contacts(
     if not (height > 0 and fps > 0):
         raise ValueError(f"height and fps must be positive, got {height} and {fps}")
     feet = pos[:, list(CONTACT_JOINTS)]
-    clearance = max(float((feet[..., 1] - rest).min()), 0.0)
+    clearance = np.maximum((feet[..., 1] - rest).min(axis=0), 0.0)  # (4,): each joint's own
     labels = low_and_slow(feet, rest + clearance, height_tol * height, speed_tol * height, fps)
     return runs_at_least(labels, min_frames)
 

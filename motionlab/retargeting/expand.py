@@ -22,11 +22,13 @@ with ``output_format="glb"``) plus ``OUT/manifest.csv``, one row per (clip, char
   only replaced with ``force=True``. A clip that cannot be read or mapped is recorded as an
   ``error`` row with its message, and the job goes on.
 * **Quality flags.** A row is flagged when its mean foot penetration exceeds
-  ``max_penetration_cm`` (default 1 cm: about a shoe sole) or its foot skating exceeds
-  ``skate_ratio`` (default 2) times the source clip's own skating scaled by the root's ground
+  ``max_penetration_cm`` (default 1 cm: about a shoe sole) or, ``skating``, when its planted
+  feet slide: on the frames where the source's feet are planted, B's feet move faster than the
+  contact detector's speed limit on B (:attr:`plausibility.Plausibility.skating`) and faster
+  than ``skate_ratio`` (default 2) times the source's own planted feet scaled by the root's ground
   ratio ``r_xz`` (a longer-legged character moves its feet faster by that ratio; sliding beyond
-  twice that is new sliding the retargeting added). Both rules are set by these principles, not
-  fitted to any clip. Every output also goes through the plausibility tests of
+  twice that is new sliding the retargeting added). A low swinging foot is not a planted one.
+  Both rules are set by these principles, not fitted to any clip. Every output also goes through the plausibility tests of
   :mod:`motionlab.retargeting.plausibility` (feet on the floor, hip height, bone lengths); a
   failed test adds ``implausible_<test>`` to ``flag``.
 * **Frame rate.** Outputs are at each source's frame rate unless ``fps`` is given; the network
@@ -418,7 +420,8 @@ def _row(pr: PairResult, src: _Source, char: Character, limits, suffix: str, out
     flags = []
     if q["penetration_cm"] > limits[0]:
         flags.append("penetration")
-    if q["skating_cm_s"] > limits[1] * src.skating * res.root_scale[0] and q["skating_cm_s"] > 0:
+    check = res.plausibility  # planted-foot slide on A's stance frames (plausibility.Plausibility.skating)
+    if check.skating and check.slide > limits[1] * check.source_slide * res.root_scale[0]:
         flags.append("skating")
     flags += [f"implausible_{t}" for t in res.plausibility.failed]
     source = src.path

@@ -135,7 +135,8 @@ def register(subparsers) -> None:
             "--skate-ratio",
             type=positive,
             default=2.0,
-            help="flag when skating exceeds this times the source's own (scaled by the root ratio; default 2)",
+            help="flag skating when the planted feet slide faster than the contact speed limit and this times the "
+            "source's own planted feet (scaled by the root ratio; default 2)",
         )
         p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
         cli_options.add_rest_from(p)
