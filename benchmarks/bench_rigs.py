@@ -25,28 +25,27 @@ import time
 from motionlab import data, retargeting
 from motionlab.core import bvh, humanoid, metrics, preprocess
 from motionlab.retargeting import rig_matrix
-from motionlab.retargeting.pipeline import retarget, source_contacts
+from motionlab.retargeting.pipeline import retarget
 
 METHODS = ("copy", "network", "full")
 
 
 def method_slides(clips, checkpoint, pairs=None) -> None:
-    """Print B's planted-foot slide (cm/s, on A's contact frames) per pair and method, and A's own."""
-    feet = [humanoid.JOINTS.index(f) for f in humanoid.FEET]
-    print(f"{'source':<10} {'target':<10} " + " ".join(f"{m:>8}" for m in METHODS) + f" {'(source)':>9}")
+    """Print B's planted-foot slide (cm/s, on A's contact frames, at the network's rate: the skating
+    flag's measure, :attr:`motionlab.retargeting.plausibility.Plausibility.slide`) per pair and
+    method, and A's own."""
+    print(f"{'source':<10} {'target':<10} " + " ".join(f"{m:>8}" for m in METHODS) + f" {'(source)':>9} flagged")
     for a in clips:
         for b in clips:
             if a == b or (pairs is not None and (a, b) not in pairs):
                 continue
-            src = humanoid.to_canonical(clips[a])
-            planted = source_contacts(src)
-            slides = []
-            for method in METHODS:
-                res = retarget(clips[a], clips[b], checkpoint, method=method)
-                n = min(len(planted), len(res.positions))
-                slides.append(100 * metrics.planted_slide(res.positions[:n], feet, planted[:n], res.motion.fps))
-            own = 100 * metrics.planted_slide(src.global_positions(), feet, planted, src.fps)
-            print(f"{a:<10} {b:<10} " + " ".join(f"{v:>8.1f}" for v in slides) + f" {own:>9.1f}")
+            checks = [retarget(clips[a], clips[b], checkpoint, method=m).plausibility for m in METHODS]
+            flagged = ",".join(m for m, c in zip(METHODS, checks) if c.skating) or "-"
+            print(
+                f"{a:<10} {b:<10} "
+                + " ".join(f"{100 * c.slide:>8.1f}" for c in checks)
+                + f" {100 * checks[0].source_slide:>9.1f} {flagged}"
+            )
 
 
 HELD_OUT = ("bandai_namco/dataset-2/walk-turn-left/*.bvh", "bandai_namco/dataset-2/walk-turn-right/*.bvh",
