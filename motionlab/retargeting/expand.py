@@ -208,9 +208,12 @@ def _sha256(path) -> str:
     return h.hexdigest()
 
 
-def options_digest(checkpoint: Checkpoint, solver: SolverConfig, root_mode: str, fps: float | None) -> str:
+def options_digest(
+    checkpoint: Checkpoint, solver: SolverConfig, root_mode: str, fps: float | None, rest_from=None
+) -> str:
     """SHA-256 of everything besides source and character that changes an output: the checkpoint's
-    weights, normalisation and frame rate, the solver settings, the root rule and the output rate."""
+    weights, normalisation and frame rate, the solver settings, the root rule, the output rate and
+    the ``rest_from`` motion (its rest offsets and rotations; nothing when None)."""
     h = hashlib.sha256()
     for name, tensor in sorted(checkpoint.model.state_dict().items()):
         h.update(name.encode())
@@ -219,6 +222,9 @@ def options_digest(checkpoint: Checkpoint, solver: SolverConfig, root_mode: str,
     h.update(np.asarray(checkpoint.stats.std, dtype=np.float64).tobytes())
     settings = {"solver": dataclasses.asdict(solver), "root": root_mode, "fps": fps, "ckpt_fps": checkpoint.fps}
     h.update(json.dumps(settings, sort_keys=True, default=str).encode())
+    if rest_from is not None:
+        h.update(np.asarray(rest_from.skeleton.offsets, dtype=np.float64).tobytes())
+        h.update(np.asarray(rest_from.local_rot, dtype=np.float64).tobytes())
     return h.hexdigest()
 
 
@@ -614,7 +620,7 @@ def _expand(
         _clean_temporaries(out / c.name)
     result = ExpandResult(out)
     rows: dict[tuple[str, str], dict] = {}
-    options = options_digest(checkpoint, solver, root_mode, fps)
+    options = options_digest(checkpoint, solver, root_mode, fps, rest_from)
     todo = _plan(clips, targets, out, known, force, suffix, options, result, rows)
     pairs, sources_by_clip = _load_pairs(todo, checkpoint, solver, rows, result, suffix, rest_from)
     for src in sources_by_clip.values():

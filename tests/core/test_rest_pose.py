@@ -159,3 +159,15 @@ def test_retarget_takes_the_standing_pose_from_rest_from(tmp_path, capsys):
     out = tmp_path / "b.bvh"
     main([*args, "-o", str(out), "-q", "--keep-implausible", "--rest-from", str(tmp_path / "walk.bvh")])
     assert out.is_file()
+
+
+def test_expand_takes_the_standing_pose_from_rest_from(tmp_path):
+    from motionlab.retargeting import expand
+
+    walk = _lying(_walk(30))
+    crawl = walk.copy(local_rot=np.tile(quat.normalize(walk.local_rot[:1] * 0 + [1.0, 0, 0, 0]), (30, 1, 1)))
+    bvh.save(tmp_path / "crawl.bvh", crawl)
+    (bad,) = expand.characters(str(tmp_path / "crawl.bvh"))
+    assert bad.skeleton is None and "--rest-from" in bad.error
+    (good,) = expand.characters(str(tmp_path / "crawl.bvh"), rest_from=walk)
+    np.testing.assert_allclose(good.skeleton.offsets, rest_pose.standing(walk)[0].skeleton.offsets, atol=1e-6)
