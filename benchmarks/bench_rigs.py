@@ -3,6 +3,7 @@
     MOTIONLAB_DATA=/path/to/data python benchmarks/bench_rigs.py [--seconds 3] [--pair bandai mixamo]
     MOTIONLAB_DATA=/path/to/data python benchmarks/bench_rigs.py --methods [--source-fps 60] [--pair xia cmu]
     MOTIONLAB_DATA=/path/to/data python benchmarks/bench_rigs.py --flags
+    MOTIONLAB_DATA=/path/to/data python benchmarks/bench_rigs.py --methods --gn-damping 1e-5
 
 Prints, per (source, target) pair: the hip height ratio (B's median hip height over B's standing
 hip height, and the same for A on A), the median foot height in A's contact frames (cm and /
@@ -10,7 +11,9 @@ B's leg length), foot skating (cm/s, B and A) and the output frame rate
 (:mod:`motionlab.retargeting.rig_matrix`). Without MOTIONLAB_DATA only the synthetic character runs.
 With ``--methods``: the planted-foot slide of each pair under the three methods (copy rotations,
 the network alone, the full latent iteration), beside the source's own; ``--source-fps`` resamples
-every source clip first. With ``--flags``: held-out clips (every dataset-2 walk-turn take, a Xia
+every source clip first; ``--gn-damping`` runs the study of ``docs/rigs.md`` with the Gauss–Newton
+start's relative damping (:func:`motionlab.retargeting.solver.project_latent`, 1e-3 in the solver)
+set to another value. With ``--flags``: held-out clips (every dataset-2 walk-turn take, a Xia
 walk and a CMU walk not in the matrix) retargeted by the full method onto three Mixamo characters, with
 ``expand``'s skating flag before this change (foot joints below 5 cm, against twice the source's
 own, scaled) and now (planted-foot slide on the source's stance frames,
@@ -84,7 +87,13 @@ def main() -> None:
     ap.add_argument("--methods", action="store_true", help="slide per method (copy, network, full) instead")
     ap.add_argument("--source-fps", type=float, help="with --methods: resample every source clip to this rate")
     ap.add_argument("--flags", action="store_true", help="old and new skating flag on held-out clips instead")
+    ap.add_argument("--gn-damping", type=float, help="with --methods: the Gauss-Newton start's relative damping")
     args = ap.parse_args()
+    if args.gn_damping is not None:  # a study: the solver's projection with another damping
+        from motionlab.retargeting import solver
+
+        project = solver.project_latent
+        solver.project_latent = lambda *a, **k: project(*a, **{**k, "damping": args.gn_damping})
     if args.flags:
         start = time.perf_counter()
         skating_flags(data.data_root(), retargeting.load_default())
