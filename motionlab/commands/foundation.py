@@ -50,7 +50,7 @@ def _info(args) -> int:
         print(f"humanoid  does not map: {e.reason}")
     else:
         try:
-            stand, pose = rest_pose.standing(humanoid.to_canonical(m), args.file)
+            stand, pose = rest_pose.standing(humanoid.to_canonical(m), args.file, humanoid.family(sk))
             print(f"rest      {pose.describe()}; standing height {stand.skeleton.height():.4f} m")
         except rest_pose.RestPoseError as e:
             print(f"rest      {e}")

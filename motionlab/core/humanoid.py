@@ -37,6 +37,8 @@ __all__ = [
     "PARENTS",
     "FEET",
     "PROFILES",
+    "STANDING",
+    "family",
     "RigMappingError",
     "RigMapping",
     "strip_prefix",
@@ -132,6 +134,27 @@ PROFILES: dict[str, dict[str, str | None]] = {
     ),
 }  # fmt: skip
 """Rig profiles: canonical joint → rig joint name (``None``: a zero-length joint the rig lacks)."""
+
+STANDING: dict[str, str] = {
+    "mixamo": "rest",  # a T-pose at rest
+    "cmu": "rest",  # an A-stance at rest: arms down, legs spread 20 deg
+    "cmu_max": "rest",
+    "bandai_namco": "tpose",  # every bone along its parent's x axis at rest: the body lies flat
+}
+"""How each rig profile's canonical standing pose is found (:mod:`motionlab.core.rest_pose`):
+``"rest"``, the rest offsets stand (a rig of a known family whose offsets do not falls back to its
+motion's most upright frame); ``"tpose"``, the rest offsets carry the bone lengths only, and the
+standing pose is every bone along the T-pose's direction (:func:`canonical_skeleton`), whatever the take.
+A profile missing here (a custom mapping) counts as ``"rest"``."""
+
+
+def family(skeleton: Skeleton, profile=None) -> str | None:
+    """Name of the rig profile that maps ``skeleton`` (see :func:`find_mapping`); ``None`` for a
+    skeleton that already is the canonical humanoid (its family is unknown). Raises
+    :class:`RigMappingError` as :func:`find_mapping` does."""
+    if is_canonical(skeleton):
+        return None
+    return find_mapping(skeleton, profile).profile
 
 
 @dataclass(frozen=True)

@@ -23,6 +23,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from motionlab.core import contacts
+
 __all__ = [
     "mse",
     "mpjpe",
@@ -97,12 +99,11 @@ def foot_penetration(pos, feet, ground: float = 0.0) -> float:
 
 def foot_contacts(pos, feet, fps: float, height_threshold: float = 0.05, speed_threshold: float = 0.5) -> np.ndarray:
     """Boolean ground-contact labels (..., T, F) for the ``feet`` joints: below
-    ``height_threshold`` (position unit) and slower than ``speed_threshold`` (units/s).
+    ``height_threshold`` (position unit) and slower than ``speed_threshold`` (units/s) —
+    :func:`motionlab.core.contacts.low_and_slow` with contact height 0.
     """
     pos = _pos(pos)
-    p = pos[..., list(feet), :]
-    vel = np.gradient(p, axis=-3) * fps if p.shape[-3] > 1 else np.zeros_like(p)
-    return (p[..., 1] < height_threshold) & (np.linalg.norm(vel, axis=-1) < speed_threshold)
+    return contacts.low_and_slow(pos[..., list(feet), :], 0.0, height_threshold, speed_threshold, fps)
 
 
 def foot_skating(pos, feet, fps: float, height_threshold: float = 0.05) -> float:

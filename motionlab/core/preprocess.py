@@ -44,12 +44,12 @@ def prepare(motion: Motion, fps: float | None = 60.0, profile=None, stand: bool 
     """Reduce a motion to the 22-joint humanoid and resample it to ``fps`` (``None``: keep).
 
     ``stand=True`` also brings the rig to its canonical standing rest pose
-    (:func:`motionlab.core.rest_pose.standing`; world positions unchanged), as retargeting
+    (:func:`motionlab.core.rest_pose.standing` with the rig's profile; world positions unchanged), as retargeting
     does, and raises :class:`~motionlab.core.rest_pose.RestPoseError` when there is none.
     """
     out = humanoid.to_canonical(motion, profile)
     if stand:
-        out = rest_pose.standing(out)[0]
+        out = rest_pose.standing(out, family=humanoid.family(motion.skeleton, profile))[0]
     if fps is not None:
         out = out.resample(fps)
     bad = ~np.isfinite(out.local_rot).all(axis=(1, 2)) | ~np.isfinite(out.root_pos).all(axis=1)

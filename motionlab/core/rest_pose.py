@@ -7,12 +7,18 @@ height 6.5 cm). Anything that measures a skeleton (hip height, leg chain, the ro
 network's offsets) or compares joint rotations across rigs needs one convention. The
 **canonical standing pose** is built in two stages, on the 22 canonical joints:
 
-1. **A standing pose.** From the rest offsets when they describe one (``source="rest"``): thigh,
-   shin and the Hips→Neck spine within :data:`TOLERANCE_DEG` of straight down / up.
-   Otherwise from the motion (``source="motion"``): the frame of most upright stance, the one
-   whose worst angle of thighs and shins to straight down and of the spine to straight up is
-   least, turned to face +Z. When the rest offsets fail and there is no motion, or no frame is
-   upright within the tolerance, :class:`RestPoseError` names the joint and what was expected.
+1. **A standing pose.** A rig whose profile's rule (:data:`humanoid.STANDING`) is ``"tpose"``
+   (Bandai Namco: its rest offsets carry bone lengths only) stands by that rule on any take
+   (``source="profile"``): every bone along the T-pose's direction with the rig's own length,
+   the joint frames (each bone's twist) from the take's most upright frame, so every take of the
+   rig gets the same standing skeleton. Otherwise from the rest offsets when they describe one
+   (``source="rest"``): thigh, shin and the Hips→Neck spine within :data:`TOLERANCE_DEG` of
+   straight down / up. Otherwise from the motion (``source="motion"``): the frame of most upright
+   stance, the one whose worst angle of thighs and shins to straight down and of the spine to
+   straight up is least, turned to face +Z. Or from another take of the same rig
+   (``reference=``, ``source="file"``, the command line's ``--rest-from FILE.bvh``). When the
+   rest offsets fail and there is no motion, or no frame is upright within the tolerance,
+   :class:`RestPoseError` names the joint, what was expected and :data:`REST_FROM_HINT`.
 2. **The T-pose's bone directions** (:func:`motionlab.core.humanoid.canonical_skeleton`) for
    each bone of the legs, spine and arms (:data:`STRAIGHTENED`) that points more than
    :data:`TOLERANCE_DEG` away from them; bones within it keep the rig's own direction, so
@@ -32,7 +38,7 @@ shows it on every pair of the shared data's rig families.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -44,8 +50,11 @@ __all__ = [
     "TOLERANCE_DEG",
     "SPREAD_DEG",
     "STRAIGHTENED",
+    "REST_FROM_HINT",
     "RestPoseError",
     "StandingPose",
+    "same_rig",
+    "on_reference",
     "standing",
     "standing_skeleton",
 ]
@@ -80,20 +89,35 @@ class StandingPose:
 
     Attributes
     ----------
-    source : str          ``"rest"`` (the rest offsets stand) or ``"motion"`` (a frame of the motion)
+    source : str          ``"rest"`` (the rest offsets stand), ``"motion"`` (a frame of the motion),
+                          ``"profile"`` (the rig profile's rule, :data:`humanoid.STANDING`) or
+                          ``"file"`` (another take of the rig, ``reference``)
     frame : int           the frame used (``-1`` for ``"rest"``)
     straightened : tuple of str   canonical joints whose incoming bone was turned onto the T-pose
-    worst_deg : float     the standing pose's worst leg/spine angle to vertical, degrees
+    worst_deg : float     the standing pose's worst leg/spine angle to vertical, degrees (before turning)
+    family : str          the rig profile (``""`` when unknown)
+    reference : str       name of the reference motion (``source="file"``)
     """
 
     source: str
     frame: int
     straightened: tuple[str, ...]
     worst_deg: float
+    family: str = ""
+    reference: str = ""
 
     def describe(self) -> str:
         """One line for ``motionlab info``: which pose was used and what was turned."""
-        where = "the rest offsets" if self.source == "rest" else f"frame {self.frame} of the motion (most upright)"
+        where = {
+            "rest": "the rest offsets",
+            "motion": f"frame {self.frame} of the motion (most upright)",
+            "profile": f"the {self.family!r} rig profile (rest offsets lie flat: every bone along the T-pose, "
+            f"joint frames from frame {self.frame})",
+            "file": f"the file {self.reference or 'given'} (same rig)",
+        }[self.source]
+        if self.source in ("profile", "file"):
+            turned = f"; {len(self.straightened)} bones turned onto the T-pose" if self.straightened else ""
+            return f"standing pose from {where}{turned}"
         turned = f"; turned onto the T-pose: {', '.join(self.straightened)}" if self.straightened else ""
         return f"standing pose from {where}, legs/spine within {self.worst_deg:.0f} deg of vertical{turned}"
 
@@ -117,24 +141,52 @@ def _uprightness(pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return angles.max(axis=-1), angles.argmax(axis=-1)
 
 
-def _straighten(offsets: np.ndarray, legs_down: bool) -> tuple[np.ndarray, tuple[str, ...]]:
+_LEAD = {"Hips": ("Spine", "LeftUpLeg", "RightUpLeg"), "Spine2": ("Neck", "LeftShoulder", "RightShoulder")}
+"""Branching joints: the child whose bone the turn lays on the T-pose's, and the left and right
+children whose difference it turns into the T-pose's left-right plane."""
+
+
+def _two_vector_turn(lead: np.ndarray, across: np.ndarray, lead_goal: np.ndarray, across_goal: np.ndarray):
+    """The rotation (4,) taking ``lead`` onto ``lead_goal``'s direction and ``across`` (perpendicular
+    part) into the half-plane of ``across_goal``."""
+
+    def frame(a, b):
+        e1 = a / np.linalg.norm(a)
+        e2 = b - (b @ e1) * e1
+        e2 /= np.linalg.norm(e2)
+        return np.stack([e1, e2, np.cross(e1, e2)], axis=1)
+
+    return quat.normalize(quat.from_matrix(frame(lead_goal, across_goal) @ frame(lead, across).T))
+
+
+def _straighten(offsets: np.ndarray, legs_down: bool, every: bool = False) -> tuple[np.ndarray, tuple[str, ...]]:
     """Per-joint rotations (22, 4) turning bones onto the T-pose (module docstring, stage 2), and
-    the names of the joints whose incoming bone turned; ``legs_down``: thighs and shins straight down."""
+    the names of the joints whose incoming bone turned; ``legs_down``: thighs and shins straight down;
+    ``every``: every bone onto the T-pose's direction (a branching joint turns by its :data:`_LEAD`
+    child's bone, its other children follow rigidly)."""
     ref = humanoid.canonical_skeleton().offsets.copy()
     turn = np.tile(quat.IDENTITY, (len(_J), 1))
     names = []
-    for name in STRAIGHTENED:
-        c = _J.index(name)
+    for c in range(1, len(_J)):
+        name, p = _J[c], humanoid.PARENTS[c]
         o, goal = offsets[c], ref[c]
-        if np.linalg.norm(o) == 0:
+        if np.linalg.norm(o) == 0 or (name not in STRAIGHTENED and not every):
             continue
-        if name in _LEGS and not legs_down and _angle(o, ref[c]) <= TOLERANCE_DEG:
-            spread = np.degrees(np.arctan2(abs(o[0]), -o[1]))
-            goal = o * np.array([0.0, 1.0, 1.0]) if spread > SPREAD_DEG else o
-        elif not (name in _LEGS and legs_down) and _angle(o, ref[c]) <= TOLERANCE_DEG:
-            goal = o
-        if goal is not o:
-            turn[humanoid.PARENTS[c]] = quat.between(o, goal)
+        if every and _J[p] in _LEAD:
+            lead, left, right = (_J.index(n) for n in _LEAD[_J[p]])
+            if c == lead:
+                across = offsets[left] - offsets[right]
+                turn[p] = _two_vector_turn(o, across, goal, ref[left] - ref[right])
+                names.append(name)
+            continue
+        if not every and _angle(o, ref[c]) <= TOLERANCE_DEG:
+            if name in _LEGS and not legs_down:
+                spread = np.degrees(np.arctan2(abs(o[0]), -o[1]))
+                goal = o * np.array([0.0, 1.0, 1.0]) if spread > SPREAD_DEG else o
+            elif name not in _LEGS:
+                goal = o
+        if goal is not o and _angle(o, goal) > 1e-9:
+            turn[p] = quat.between(o, goal)
             names.append(name)
     for c in range(1, len(_J)):  # leaves (head, hands, toes) turn with their parent's bone
         if c not in humanoid.PARENTS:
@@ -161,29 +213,75 @@ def _apply(motion: Motion, turn: np.ndarray) -> Motion:
     return Motion(skeleton, quat.normalize(local), motion.root_pos.copy(), motion.fps, local_pos, motion.name)
 
 
-def _standing_turn(motion: Motion, what: str) -> tuple[np.ndarray, int, float]:
-    """Rotations (22, 4) that make the most upright frame the rest pose, its index and worst angle."""
+REST_FROM_HINT = (
+    "take the standing pose from another take of the same rig that stands: --rest-from FILE.bvh "
+    "(retarget, expand), rest_pose.standing(..., reference=) in Python"
+)
+"""How the refusal tells the user to give the standing pose of an unknown rig."""
+
+
+def _standing_turn(motion: Motion, what: str, check: bool = True) -> tuple[np.ndarray, int, float]:
+    """Rotations (22, 4) that make the most upright frame the rest pose, its index and worst angle;
+    ``check``: raise :class:`RestPoseError` when that frame is not within :data:`TOLERANCE_DEG`."""
     g_rot, g_pos = motion.fk()
     score, which = _uprightness(g_pos)
     t = int(np.argmin(score))
-    if not score[t] <= TOLERANCE_DEG:
+    if check and not score[t] <= TOLERANCE_DEG:
         raise RestPoseError(
             f"{what}: no standing pose: the rest offsets do not stand and in no frame are thighs and shins within "
             f"{TOLERANCE_DEG:g} deg of straight down and Hips->Neck of straight up (most upright: frame {t}, where "
-            f"{_WHAT[which[t]]} is {score[t]:.0f} deg off)"
+            f"{_WHAT[which[t]]} is {score[t]:.0f} deg off); {REST_FROM_HINT}"
         )
 
     yaw = humanoid.heading(g_pos[t])
     return quat.mul(quat.from_yaw(-yaw)[None], g_rot[t]), t, float(score[t])
 
 
-def standing(motion: Motion, what: str | None = None) -> tuple[Motion, StandingPose]:
+def _turned_offsets(offsets: np.ndarray, turn: np.ndarray) -> np.ndarray:
+    """Rest offsets (22, 3) with each joint's child offsets turned by ``turn`` (22, 4), as :func:`_apply`."""
+    out = offsets.copy()
+    out[1:] = quat.rotate(turn[humanoid.PARENTS[1:]], offsets[1:])
+    return out
+
+
+def _pose_turn(motion: Motion, what: str, family: str | None) -> tuple[np.ndarray, StandingPose]:
+    """Per-joint rotations (22, 4) from the rest pose to the canonical standing pose, and how it was found."""
+    offsets = motion.skeleton.offsets
+    if humanoid.STANDING.get(family or "", "rest") == "tpose":
+        # the profile's rule: bone lengths from the rest offsets, every bone along the T-pose; the joint
+        # frames (twist about each bone) from the most upright frame of this take, whatever its pose
+        first, frame, worst = _standing_turn(motion, what, check=False)
+        second, names = _straighten(_turned_offsets(offsets, first), legs_down=True, every=True)
+        return quat.mul(second, first), StandingPose("profile", frame, names, worst, family or "")
+    worst = float(_uprightness(motion.skeleton.rest_positions())[0])
+    first, source, frame = np.tile(quat.IDENTITY, (len(_J), 1)), "rest", -1
+    if not worst <= TOLERANCE_DEG:
+        first, frame, worst = _standing_turn(motion, what)
+        source = "motion"
+    second, names = _straighten(_turned_offsets(offsets, first), legs_down=source == "motion")
+    return quat.mul(second, first), StandingPose(source, frame, names, worst, family or "")
+
+
+def same_rig(a: Skeleton, b: Skeleton, tolerance: float = 0.01) -> bool:
+    """True when two canonical skeletons have the same rest offsets (each within ``tolerance`` × the
+    larger leg length, :func:`humanoid.leg_length`): one rig, so one standing pose serves both."""
+    scale = max(humanoid.leg_length(a), humanoid.leg_length(b))
+    return bool(np.abs(a.offsets[1:] - b.offsets[1:]).max() <= tolerance * scale)
+
+
+def standing(
+    motion: Motion, what: str | None = None, family: str | None = None, reference: Motion | None = None
+) -> tuple[Motion, StandingPose]:
     """The motion on its rig's canonical standing rest pose (module docstring).
 
     Parameters
     ----------
     motion : Motion on the 22 canonical joints (:func:`humanoid.to_canonical`), T frames
     what : how errors name the motion (default: its name)
+    family : the rig profile it was mapped with (:func:`humanoid.family`); a profile whose rule
+        in :data:`humanoid.STANDING` is ``"tpose"`` stands from its rest offsets on any take
+    reference : another canonical Motion on the same rig (:func:`same_rig`) whose standing pose
+        is used instead of this motion's own (``--rest-from``); the pose's ``source`` is ``"file"``
 
     Returns
     -------
@@ -192,40 +290,64 @@ def standing(motion: Motion, what: str | None = None) -> tuple[Motion, StandingP
 
     Raises
     ------
-    RestPoseError when neither the rest offsets nor any frame stand (see module docstring).
+    RestPoseError when neither the rest offsets nor any frame stand (see module docstring), naming
+    :data:`REST_FROM_HINT`, or when ``reference`` is on another rig.
     ValueError when ``motion`` is not canonical.
     """
     if not humanoid.is_canonical(motion.skeleton):
         raise ValueError("standing() needs a 22-joint canonical motion; call humanoid.to_canonical first")
     what = what or motion.name or "motion"
-    worst = float(_uprightness(motion.skeleton.rest_positions())[0])
-    source, frame = "rest", -1
-    if not worst <= TOLERANCE_DEG:
-        turn, frame, worst = _standing_turn(motion, what)
-        motion, source = _apply(motion, turn), "motion"
-    turn, names = _straighten(motion.skeleton.offsets, legs_down=source == "motion")
-    if names:
-        motion = _apply(motion, turn)
-    return motion, StandingPose(source, frame, names, worst)
+    if reference is not None:
+        if not humanoid.is_canonical(reference.skeleton) or not same_rig(reference.skeleton, motion.skeleton):
+            raise RestPoseError(f"{what}: the standing pose's file {reference.name or ''} is on another rig")
+        turn, pose = _pose_turn(reference, reference.name or "reference", family)
+        pose = replace(pose, source="file", reference=reference.name or "")
+    else:
+        turn, pose = _pose_turn(motion, what, family)
+    if pose.source == "rest" and not pose.straightened:
+        return motion, pose
+    return _apply(motion, turn), pose
 
 
-def standing_skeleton(rig: Skeleton | Motion, what: str = "skeleton") -> tuple[Skeleton, StandingPose]:
+def standing_skeleton(
+    rig: Skeleton | Motion, what: str = "skeleton", reference: Motion | None = None
+) -> tuple[Skeleton, StandingPose]:
     """A rig's canonical 22-joint skeleton in its standing rest pose (offsets in metres).
 
-    ``rig`` is a Skeleton (its rest offsets must stand) or a Motion on it (a frame of the
-    motion is used when they do not). Raises :class:`RestPoseError` (naming ``what``, the
-    joint and what was expected) and :class:`humanoid.RigMappingError`.
+    ``rig`` is a Skeleton or a Motion on it (a frame of the motion is used when the rest offsets
+    do not stand and its profile has no rule, :data:`humanoid.STANDING`); ``reference`` as in
+    :func:`standing`. Raises :class:`RestPoseError` (naming ``what``, the joint and what was
+    expected) and :class:`humanoid.RigMappingError`.
     """
+    sk = rig.skeleton if isinstance(rig, Motion) else rig
+    family = humanoid.family(sk)
     if isinstance(rig, Motion):
         motion = humanoid.to_canonical(rig)
     else:
         sk = humanoid.to_canonical_skeleton(rig)
         motion = Motion(sk, np.tile(quat.IDENTITY, (1, len(_J), 1)), sk.offsets[None, 0].copy(), 30.0)
         worst, which = _uprightness(sk.rest_positions())
-        if not worst <= TOLERANCE_DEG:
+        rule = humanoid.STANDING.get(family or "", "rest")
+        if not worst <= TOLERANCE_DEG and rule != "tpose" and reference is None:
             raise RestPoseError(
                 f"{what}: the rest offsets are not a standing pose ({_WHAT[int(which)]} is {float(worst):.0f} deg "
-                f"off, at most {TOLERANCE_DEG:g} expected) and no motion was given to find one"
+                f"off, at most {TOLERANCE_DEG:g} expected) and no motion was given to find one; {REST_FROM_HINT}"
             )
-    out, pose = standing(motion, what)
+    out, pose = standing(motion, what, family, reference)
     return out.skeleton, pose
+
+
+def on_reference(rig: Motion, reference: Motion | None, what: str = "motion") -> Motion:
+    """``rig`` (a Motion on any mappable rig) on the 22 canonical joints in ``reference``'s standing
+    pose when both are on one rig (:func:`same_rig`); ``rig`` itself otherwise or without a reference.
+
+    ``reference`` is a Motion on any mappable rig (``--rest-from FILE.bvh``); the result's rest
+    offsets stand, so retargeting uses them as they are. Raises :class:`RestPoseError` when the
+    reference has no standing pose and :class:`humanoid.RigMappingError`.
+    """
+    if reference is None:
+        return rig
+    motion, ref = humanoid.to_canonical(rig), humanoid.to_canonical(reference)
+    if not same_rig(motion.skeleton, ref.skeleton):
+        return rig
+    return standing(motion, what, humanoid.family(rig.skeleton), reference=ref)[0]

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from motionlab.core import contacts as _contacts
 from motionlab.core.motion import Motion
 
 __all__ = ["Cycles", "Spans", "contacts", "strikes", "cycles_from_ankles", "segment_cycles", "FOOT_JOINTS"]
@@ -94,8 +95,7 @@ def contacts(pos, fps: float, feet=(0, 1), height: float = 0.06, speed: float = 
     if p.shape[0] < 2:
         return np.zeros(p.shape[:2], dtype=bool)
     ground = np.percentile(p[:, :, 1], 5, axis=0)
-    vel = np.gradient(p[:, :, [0, 2]], axis=0) * float(fps)
-    return (p[:, :, 1] - ground < height) & (np.linalg.norm(vel, axis=-1) < speed)
+    return _contacts.low_and_slow(p, ground, height, speed, float(fps), horizontal=True)
 
 
 def strikes(contact: np.ndarray, min_frames: int = 3) -> np.ndarray:

@@ -77,7 +77,10 @@ def _cmd_retarget(args) -> int:
     except humanoid.RigMappingError as e:
         raise rig_error(e, "source", args.source) from None
     base = _load_bvh(args.target, "target") if args.target else source
+    reference = cli_options.rest_from(args)
     try:
+        source = rest_pose.on_reference(source, reference, args.source)
+        base = rest_pose.on_reference(base, reference, args.target or args.source)
         target = rest_pose.standing_skeleton(base, f"target file {args.target or args.source}")[0]
     except humanoid.RigMappingError as e:
         raise rig_error(e, "target", args.target) from None
@@ -330,6 +333,7 @@ def _add_retarget(subparsers) -> None:
             )
         p.add_argument("--scale", type=positive, default=1.0, metavar="F", help="scale the whole target by F")
         p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
+        cli_options.add_rest_from(p)
         cli_args.add_force(p, "overwrite existing output files")
         cli_args.add_rate_and_plausibility_args(p)
         cli_args.add_quiet(p)

@@ -12,7 +12,15 @@ import argparse
 from motionlab.cli_args import non_negative, non_negative_int, positive, renamed
 from motionlab.retargeting import terms
 
-__all__ = ["ROOT_MODES", "check_device", "load_checkpoint", "solver_config", "add_solver_args"]
+__all__ = [
+    "ROOT_MODES",
+    "check_device",
+    "load_checkpoint",
+    "solver_config",
+    "add_solver_args",
+    "add_rest_from",
+    "rest_from",
+]
 
 ROOT_MODES = ("stride", "hips", "legs", "contacts")
 """``pipeline.ROOT_MODES``, repeated so that ``--help`` does not import torch (a test keeps them equal)."""
@@ -152,3 +160,31 @@ def add_solver_args(p: argparse.ArgumentParser) -> None:
         metavar="K",
         help="of the projection's 8 Gauss-Newton rounds, how many last ones are not smoothed over time (default 4)",
     )
+
+
+def add_rest_from(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--rest-from",
+        metavar="FILE.bvh",
+        help="take the standing pose of every source or target on FILE's rig from FILE (another take of the rig "
+        "that stands), for a rig whose rest offsets lie flat and whose profile has no rule",
+    )
+
+
+def rest_from(args):
+    """The ``--rest-from`` motion, checked (it must have a standing pose), or None.
+
+    Raises
+    ------
+    CLIError naming ``--rest-from`` when the file cannot be read or does not stand.
+    """
+    if not args.rest_from:
+        return None
+    from motionlab.core import bvh, files, humanoid, rest_pose
+
+    try:
+        reference = bvh.load(files.check_input(args.rest_from, "--rest-from"))
+        rest_pose.standing(humanoid.to_canonical(reference), f"--rest-from {args.rest_from}")
+    except ValueError as e:  # also RigMappingError, RestPoseError, BVH errors
+        raise _error(f"--rest-from {args.rest_from}: {e}") from None
+    return reference

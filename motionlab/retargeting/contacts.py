@@ -1,129 +1,26 @@
-"""Foot contacts of the source, for the contact term of the latent iteration (our addition).
+"""Foot contacts of the source for the contact term: :mod:`motionlab.core.contacts`, the package's
+one foot-contact detector, re-exported here where the retargeting code and notebook 03 name it."""
 
-Paper A's iteration keeps the feet *above* the ground (``L_foot``) but says nothing about feet
-that should stay *still*: a foot planted by the performer may slide on the new character, and
-per-frame latent updates make it slide more. motionlab therefore labels the frames where each
-foot joint of A is planted and asks B's foot to keep still on those frames
-(:func:`motionlab.retargeting.losses.contact_loss`).
+from motionlab.core.contacts import (
+    CONTACT_JOINTS,
+    HEIGHT_TOL,
+    MIN_FRAMES,
+    SPEED_TOL,
+    detect_contacts,
+    low_and_slow,
+    of_motion,
+    rest_heights,
+    runs_at_least,
+)
 
-A foot joint is **planted** in frame ``t`` when, on A,
-
-* it is low: its height is at most its *contact height* plus ``height_tol × h`` (``h``: A's
-  22-joint rest height, so the rule does not depend on the character's size or the file's
-  unit). A joint's contact height is its rest height above the lowest rest joint, plus the
-  clearance of the lowest joint when it touches the ground, estimated as the least
-  ``y − rest height`` any foot joint reaches in the clip (joints sit inside the foot, a few
-  centimetres above the sole); and
-* it is slow: its speed is below ``speed_tol × h`` per second,
-
-and the label is kept only for runs of at least ``min_frames`` consecutive frames (a
-one-frame touch is not a plant). The labels are frame indices, so they carry over to any
-target: scaling to B happens because B's own foot positions are what the loss keeps still.
-
-Defaults, chosen on motionlab's synthetic clips, whose contacts are known because the generator
-plants the feet by IK (:func:`motionlab.synthetic.generate` with ``return_contacts=True``), never
-on the evaluation clips: a 3 %·h height tolerance and an 8 %·h/s speed limit (≈ 0.11 m/s for a
-1.42 m performer; slower limits miss real, slightly jittery plants, faster ones add heel-off
-frames). Over walk, run, jump and squat × 3 seeds their precision is 0.98 and recall 0.99
-(``tests/retargeting/test_contacts.py`` checks ≥ 0.95 for both).
-
-Taught in ``notebooks/03_latent_iteration.ipynb``.
-"""
-
-from __future__ import annotations
-
-import numpy as np
-
-from motionlab.core import humanoid
-
-__all__ = ["CONTACT_JOINTS", "HEIGHT_TOL", "SPEED_TOL", "MIN_FRAMES", "detect_contacts", "rest_heights", "of_motion"]
-
-CONTACT_JOINTS: tuple[int, ...] = tuple(humanoid.JOINTS.index(n) for n in humanoid.FEET)
-"""LeftFoot, RightFoot, LeftToeBase, RightToeBase: the joints whose contacts are detected."""
-HEIGHT_TOL = 0.03
-"""Height above the joint's rest height, as a fraction of the character's height."""
-SPEED_TOL = 0.08
-"""Speed limit, as a fraction of the character's height per second."""
-MIN_FRAMES = 3
-"""Shortest run of frames that counts as a plant."""
-
-
-def _runs_at_least(mask: np.ndarray, n: int) -> np.ndarray:
-    """Keep only runs of ``True`` at least ``n`` frames long, along axis 0 of a (T, F) mask."""
-    if n <= 1:
-        return mask
-    T = mask.shape[0]
-    padded = np.concatenate([np.zeros((1,) + mask.shape[1:], bool), mask, np.zeros((1,) + mask.shape[1:], bool)])
-    edges = np.diff(padded.astype(np.int8), axis=0)  # +1 at a run's start, -1 one past its end
-    out = np.zeros_like(mask)
-    for f in range(mask.shape[1]):  # a loop over the 4 feet, not over frames
-        starts = np.flatnonzero(edges[:, f] == 1)
-        stops = np.flatnonzero(edges[:, f] == -1)
-        keep = (stops - starts) >= n
-        counts = np.zeros(T + 1, np.int64)
-        np.add.at(counts, starts[keep], 1)
-        np.add.at(counts, stops[keep], -1)
-        out[:, f] = np.cumsum(counts)[:T] > 0
-    return out
-
-
-def detect_contacts(
-    positions: np.ndarray,
-    rest_heights: np.ndarray,
-    height: float,
-    fps: float,
-    height_tol: float = HEIGHT_TOL,
-    speed_tol: float = SPEED_TOL,
-    min_frames: int = MIN_FRAMES,
-) -> np.ndarray:
-    """Planted-foot labels of a motion (module docstring).
-
-    Parameters
-    ----------
-    positions : ndarray (T, 22, 3)   world joint positions of the canonical skeleton, metres, Y up
-    rest_heights : ndarray (4,)      rest-pose height above the lowest joint of each contact joint
-                                     (:data:`CONTACT_JOINTS` order), metres
-    height : float                   the character's 22-joint rest height, metres
-    fps : float                      frames per second
-    height_tol, speed_tol : float    fractions of ``height`` (metres and metres/second)
-    min_frames : int                 shortest plant, frames
-
-    Returns
-    -------
-    ndarray of bool, shape (T, 4), in :data:`CONTACT_JOINTS` order
-
-    Raises
-    ------
-    ValueError unless the positions are (T, 22, 3), the rest heights (4,), and ``height``
-    and ``fps`` positive.
-    """
-    pos = np.asarray(positions, dtype=np.float64)
-    if pos.ndim != 3 or pos.shape[1:] != (len(humanoid.JOINTS), 3):
-        raise ValueError(f"expected canonical world positions (T, 22, 3), got {pos.shape}")
-    rest = np.asarray(rest_heights, dtype=np.float64)
-    if rest.shape != (len(CONTACT_JOINTS),):
-        raise ValueError(f"expected 4 rest heights (LeftFoot, RightFoot, LeftToeBase, RightToeBase), got {rest.shape}")
-    if not (height > 0 and fps > 0):
-        raise ValueError(f"height and fps must be positive, got {height} and {fps}")
-    feet = pos[:, list(CONTACT_JOINTS)]
-    above_rest = feet[..., 1] - rest
-    clearance = max(float(above_rest.min()), 0.0)
-    low = above_rest <= clearance + height_tol * height
-    if len(pos) > 1:
-        speed = np.linalg.norm(np.gradient(feet, axis=0), axis=-1) * fps
-    else:
-        speed = np.zeros(feet.shape[:2])
-    return _runs_at_least(low & (speed < speed_tol * height), min_frames)
-
-
-def rest_heights(skeleton) -> np.ndarray:
-    """Rest-pose heights (4,) of the contact joints above the skeleton's lowest rest joint, metres."""
-    rest = skeleton.rest_positions()
-    return rest[list(CONTACT_JOINTS), 1] - rest[:, 1].min()
-
-
-def of_motion(motion) -> np.ndarray:
-    """Planted feet (T, 4) of a motion on the canonical 22-joint humanoid (:func:`detect_contacts`
-    with the skeleton's own rest heights and height)."""
-    sk = motion.skeleton
-    return detect_contacts(motion.global_positions(), rest_heights(sk), sk.height(), motion.fps)
+__all__ = [
+    "CONTACT_JOINTS",
+    "HEIGHT_TOL",
+    "SPEED_TOL",
+    "MIN_FRAMES",
+    "low_and_slow",
+    "runs_at_least",
+    "detect_contacts",
+    "rest_heights",
+    "of_motion",
+]

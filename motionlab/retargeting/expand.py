@@ -22,11 +22,13 @@ with ``output_format="glb"``) plus ``OUT/manifest.csv``, one row per (clip, char
   only replaced with ``force=True``. A clip that cannot be read or mapped is recorded as an
   ``error`` row with its message, and the job goes on.
 * **Quality flags.** A row is flagged when its mean foot penetration exceeds
-  ``max_penetration_cm`` (default 1 cm: about a shoe sole) or its foot skating exceeds
-  ``skate_ratio`` (default 2) times the source clip's own skating scaled by the root's ground
+  ``max_penetration_cm`` (default 1 cm: about a shoe sole) or, ``skating``, when its planted
+  feet slide: on the frames where the source's feet are planted, B's feet move faster than the
+  contact detector's speed limit on B (:attr:`plausibility.Plausibility.skating`) and faster
+  than ``skate_ratio`` (default 2) times the source's own planted feet scaled by the root's ground
   ratio ``r_xz`` (a longer-legged character moves its feet faster by that ratio; sliding beyond
-  twice that is new sliding the retargeting added). Both rules are set by these principles, not
-  fitted to any clip. Every output also goes through the plausibility tests of
+  twice that is new sliding the retargeting added). A low swinging foot is not a planted one.
+  Both rules are set by these principles, not fitted to any clip. Every output also goes through the plausibility tests of
   :mod:`motionlab.retargeting.plausibility` (feet on the floor, hip height, bone lengths); a
   failed test adds ``implausible_<test>`` to ``flag``.
 * **Frame rate.** Outputs are at each source's frame rate unless ``fps`` is given; the network
@@ -174,8 +176,11 @@ def _preset(spec: str) -> tuple[str, dict[str, float]]:
     return name, factors
 
 
-def characters(*specs: str, presets: Iterable[str] = ()) -> list[Character]:
+def characters(*specs: str, presets: Iterable[str] = (), rest_from=None) -> list[Character]:
     """Target characters from ``FILE.bvh``, ``NAME=FILE.bvh`` and preset names.
+
+    ``rest_from``: a Motion whose standing pose serves every file on its rig
+    (:func:`rest_pose.on_reference`, ``--rest-from``).
 
     A file's character is named after its stem; stems shared by several files are made unique
     with the parent folder (``Kaya/Jumping.bvh`` → ``Kaya_Jumping``). A file that cannot be read
@@ -199,7 +204,8 @@ def characters(*specs: str, presets: Iterable[str] = ()) -> list[Character]:
     for name, p in entries:
         digest = _sha256(p)
         try:
-            sk = rest_pose.standing_skeleton(bvh.load(p), f"character file {p}")[0]
+            rig = rest_pose.on_reference(bvh.load(p), rest_from, f"character file {p}")
+            sk = rest_pose.standing_skeleton(rig, f"character file {p}")[0]
             out.append(Character(name, sk, str(p), digest=digest))
         except _ERRORS as err:
             out.append(Character(name, None, str(p), _why(err, "character", p), digest))
@@ -225,10 +231,13 @@ def _sha256(path) -> str:
     return h.hexdigest()
 
 
-def options_digest(checkpoint: Checkpoint, solver: SolverConfig, root_mode: str, fps: float | None) -> str:
+def options_digest(
+    checkpoint: Checkpoint, solver: SolverConfig, root_mode: str, fps: float | None, rest_from=None
+) -> str:
     """SHA-256 of everything besides source and character that changes an output: the checkpoint's
     weights, normalisation and frame rate, the solver settings, the registered loss terms and their
-    weights, the root rule and the output rate."""
+    weights, the root rule, the output rate and the ``rest_from`` motion (its rest offsets and
+    rotations; nothing when None)."""
     h = hashlib.sha256()
     for name, tensor in sorted(checkpoint.model.state_dict().items()):
         h.update(name.encode())
@@ -238,6 +247,9 @@ def options_digest(checkpoint: Checkpoint, solver: SolverConfig, root_mode: str,
     settings = {"solver": dataclasses.asdict(solver), "root": root_mode, "fps": fps, "ckpt_fps": checkpoint.fps}
     settings["terms"] = [[t.name, solver.weight(t.name)] for t in terms.registered()]  # what L_iter sums
     h.update(json.dumps(settings, sort_keys=True, default=str).encode())
+    if rest_from is not None:
+        h.update(np.asarray(rest_from.skeleton.offsets, dtype=np.float64).tobytes())
+        h.update(np.asarray(rest_from.local_rot, dtype=np.float64).tobytes())
     return h.hexdigest()
 
 
@@ -443,7 +455,8 @@ def _row(pr: PairResult, src: _Source, char: Character, limits, suffix: str, out
     flags = []
     if q["penetration_cm"] > limits[0]:
         flags.append("penetration")
-    if q["skating_cm_s"] > limits[1] * src.skating * res.root_scale[0] and q["skating_cm_s"] > 0:
+    check = res.plausibility  # planted-foot slide on A's stance frames (plausibility.Plausibility.skating)
+    if check.skating and check.slide > limits[1] * check.source_slide * res.root_scale[0]:
         flags.append("skating")
     flags += [f"implausible_{t}" for t in res.plausibility.failed]
     source = src.path
@@ -538,6 +551,7 @@ def expand(
     threads: int | None = None,
     output_format: str = "bvh",
     fps: float | None = None,
+    rest_from=None,
 ) -> ExpandResult:
     """Retarget every source clip onto every character; see the module docstring.
 
@@ -562,6 +576,8 @@ def expand(
         the outputs' format and file suffix. A rerun in another format redoes every pair.
     fps : frame rate of every output (default: each source's own); the network runs at the
         checkpoint's rate
+    rest_from : a Motion whose standing pose serves every source on its rig
+        (:func:`rest_pose.on_reference`, ``--rest-from``; pass the same to :func:`characters`)
 
     Returns
     -------
@@ -578,7 +594,7 @@ def expand(
     with torch_threads(batch_threads(checkpoint.device, threads)):
         return _expand(
             sources, targets, out, checkpoint, solver, root_mode, force, max_frames, backend, address, workers,
-            max_penetration_cm, skate_ratio, progress, on_batch, "." + output_format, fps,
+            max_penetration_cm, skate_ratio, progress, on_batch, "." + output_format, fps, rest_from,
         )  # fmt: skip
 
 
@@ -618,7 +634,7 @@ def _plan(clips, targets, out, known, force, suffix, options, result, rows):
 
 def _expand(
     sources, targets, out, checkpoint, solver, root_mode, force, max_frames, backend, address, workers,
-    max_penetration_cm, skate_ratio, progress, on_batch, suffix, fps,
+    max_penetration_cm, skate_ratio, progress, on_batch, suffix, fps, rest_from=None,
 ) -> ExpandResult:  # fmt: skip
     start = time.perf_counter()
     out = Path(out)
@@ -635,9 +651,9 @@ def _expand(
         _clean_temporaries(out / c.name)
     result = ExpandResult(out)
     rows: dict[tuple[str, str], dict] = {}
-    options = options_digest(checkpoint, solver, root_mode, fps)
+    options = options_digest(checkpoint, solver, root_mode, fps, rest_from)
     todo = _plan(clips, targets, out, known, force, suffix, options, result, rows)
-    pairs, sources_by_clip = _load_pairs(todo, checkpoint, solver, rows, result, suffix)
+    pairs, sources_by_clip = _load_pairs(todo, checkpoint, solver, rows, result, suffix, rest_from)
     result.timings["load"] = time.perf_counter() - start
     for src in sources_by_clip.values():
         rates = (src.fps, checkpoint.fps, fps or src.fps)
@@ -707,7 +723,7 @@ def _write_batch(solved, sources_by_clip, chars, limits, suffix, options, fps, o
     return new
 
 
-def _load_pairs(todo, checkpoint, solver, rows, result, suffix):
+def _load_pairs(todo, checkpoint, solver, rows, result, suffix, rest_from=None):
     """Read each source once; a clip or character that fails becomes ``error`` rows."""
     pairs: list[Pair] = []
     sources_by_clip: dict[str, _Source] = {}
@@ -717,7 +733,7 @@ def _load_pairs(todo, checkpoint, solver, rows, result, suffix):
     feet = [humanoid.JOINTS.index(f) for f in humanoid.FEET]
     for clip, (path, chars, digest) in by_clip.items():
         try:
-            motion = bvh.load(path)
+            motion = rest_pose.on_reference(bvh.load(path), rest_from, str(path))
             prepared = prepare_source(motion, checkpoint, "full", solver)
         except _ERRORS as err:
             for c in chars:

@@ -42,7 +42,8 @@ def _cmd_expand(args) -> int:
         raise CLIError("give target characters: --characters FILE.bvh ... and/or --preset NAME ...")
     check_output_folder("-o", args.output)  # before any work
     try:
-        targets = ex.characters(*args.characters, presets=args.preset)
+        reference = cli_options.rest_from(args)
+        targets = ex.characters(*args.characters, presets=args.preset, rest_from=reference)
         ex.check_output_layout(args.output, ex.find_sources(args.sources), targets, "." + args.format)
     except ValueError as e:
         raise CLIError(str(e)) from None
@@ -65,6 +66,7 @@ def _cmd_expand(args) -> int:
         threads=args.threads or None,
         output_format=args.format,
         fps=args.fps,
+        rest_from=reference,
     )
     for line in job.resampled:  # always shown, also under -q
         print(line, file=sys.stderr)
@@ -134,9 +136,11 @@ def register(subparsers) -> None:
             "--skate-ratio",
             type=positive,
             default=2.0,
-            help="flag when skating exceeds this times the source's own (scaled by the root ratio; default 2)",
+            help="flag skating when the planted feet slide faster than the contact speed limit and this times the "
+            "source's own planted feet (scaled by the root ratio; default 2)",
         )
         p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
+        cli_options.add_rest_from(p)
         cli_args.add_force(p, "redo every pair and replace existing outputs")
         cli_args.add_rate_and_plausibility_args(p)
         cli_args.add_quiet(p)

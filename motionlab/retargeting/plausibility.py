@@ -25,6 +25,14 @@ A retargeted clip of B is **plausible** when, with ``leg`` = B's thigh + shin
 The thresholds are fractions of the target's own leg length or standing height, set by these
 principles, never fitted to clips, so they hold for any size or file unit. A clip without
 planted frames skips the foot test.
+
+Beside the tests, a **skating** flag (:attr:`Plausibility.skating`, ``expand``'s ``skating``):
+the planted-foot slide, the mean horizontal speed of B's foot joints on the frames where A's are
+planted (:func:`motionlab.core.metrics.planted_slide`, as ``bench_rigs --methods`` prints it), is
+more than :data:`SLIDE_TOL` × B's 22-joint height per second, the speed under which the contact
+detector (:mod:`motionlab.core.contacts`) counts a foot as planted: B's feet then move, on
+average, faster than any foot the detector would call planted on B. A low swinging foot does not
+count (it is not planted on A), a planted foot that floats does. It is a flag, not a failed test.
 """
 
 from __future__ import annotations
@@ -33,11 +41,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from motionlab.core import humanoid
+from motionlab.core import contacts, humanoid, metrics
 from motionlab.core.motion import Motion
-from motionlab.retargeting import contacts
 
-__all__ = ["FOOT_TOL", "HIP_TOL", "BONE_TOL", "Plausibility", "check"]
+__all__ = ["FOOT_TOL", "HIP_TOL", "BONE_TOL", "SLIDE_TOL", "Plausibility", "check"]
 
 FOOT_TOL = 0.10
 """Foot height in contact frames and depth under the floor allowed, as a fraction of B's leg length."""
@@ -45,6 +52,9 @@ HIP_TOL = 0.20
 """Allowed difference of the median hip height, as a fraction of the standing hip height (B's vs A's)."""
 BONE_TOL = 0.01
 """Allowed relative deviation of a bone's length from B's rest length."""
+SLIDE_TOL = contacts.SPEED_TOL
+"""Planted-foot slide above which a clip is flagged ``skating``, in B's heights per second: the
+contact detector's own speed limit (:data:`motionlab.core.contacts.SPEED_TOL`)."""
 
 
 @dataclass(frozen=True)
@@ -61,6 +71,9 @@ class Plausibility:
     source_hip_ratio : float   the same for A on A
     bone_error : float      largest relative bone-length deviation
     failed : tuple of str   names of the failed tests: ``foot``, ``floor``, ``hips``, ``bones``
+    slide : float           B's planted-foot slide on A's contact frames, position unit per second
+    source_slide : float    the same for A on A
+    slide_limit : float     :data:`SLIDE_TOL` × B's height, per second (``skating`` above it)
     """
 
     foot_height: float
@@ -71,11 +84,19 @@ class Plausibility:
     source_hip_ratio: float
     bone_error: float
     failed: tuple[str, ...]
+    slide: float = 0.0
+    source_slide: float = 0.0
+    slide_limit: float = float("inf")
 
     @property
     def ok(self) -> bool:
         """True when every test passed."""
         return not self.failed
+
+    @property
+    def skating(self) -> bool:
+        """True when B's planted feet slide faster than :attr:`slide_limit` (module docstring)."""
+        return self.slide > self.slide_limit
 
     def describe(self) -> str:
         """One line: the measures and, when some failed, which."""
@@ -83,7 +104,8 @@ class Plausibility:
         return (
             f"{verdict}: hip height {self.hip_ratio:.2f} of standing (source {self.source_hip_ratio:.2f}), "
             f"foot in contact {self.foot_height:+.3f} leg (source {self.source_foot_height:+.3f}), lowest joint {self.lowest:+.3f} leg (source {self.source_lowest:+.3f}), "
-            f"bone lengths within {100 * self.bone_error:.2g} %"
+            f"bone lengths within {100 * self.bone_error:.2g} %, planted-foot slide {self.slide / self.slide_limit:.2f} "
+            f"of the contact speed limit{' (SKATING)' if self.skating else ''}"
         )
 
 
@@ -110,6 +132,7 @@ def check(positions: np.ndarray, target, source: Motion, planted: np.ndarray | N
     target : Skeleton                B's canonical skeleton in its standing rest pose
     source : Motion                  A on the canonical 22 joints in its standing rest pose, T frames
     planted : ndarray (T, 4) of bool, optional   A's planted foot joints (default: detected on ``source``)
+    (``positions`` are at ``source.fps``: the slide is per second of it)
 
     Returns
     -------
@@ -144,4 +167,9 @@ def check(positions: np.ndarray, target, source: Motion, planted: np.ndarray | N
         failed.append("hips")
     if not bone_error <= BONE_TOL:
         failed.append("bones")
-    return Plausibility(foot, src_foot, lowest, src_lowest, hip, src_hip, bone_error, tuple(failed))
+    slide = metrics.planted_slide(positions, contacts.CONTACT_JOINTS, planted, source.fps)
+    src_slide = metrics.planted_slide(src_pos, contacts.CONTACT_JOINTS, planted, source.fps)
+    limit = SLIDE_TOL * target.height()
+    return Plausibility(
+        foot, src_foot, lowest, src_lowest, hip, src_hip, bone_error, tuple(failed), slide, src_slide, limit
+    )

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from motionlab.core import bvh, humanoid, metrics
+from motionlab.core import bvh, humanoid
 from motionlab.core.motion import Motion
 
 __all__ = ["FAMILY_CLIPS", "family_clips", "pair_matrix", "table"]
@@ -60,13 +60,12 @@ def pair_matrix(clips: dict[str, Motion], checkpoint, solver=None, pairs=None) -
     vertical root scale B / A, standing hip heights), ``hip_ratio`` (B's median hip height / B's
     standing hip height), ``source_hip_ratio``, ``foot_cm`` (median height of planted feet above
     contact height, cm), ``foot_leg`` (the same / B's leg length), ``source_foot_leg`` (A's, / A's
-    leg length), ``lowest_leg``, ``skating_cm_s`` (B's planted-foot speed on A's contact frames,
-    :func:`metrics.planted_slide`), ``source_skating_cm_s`` (A's own), ``fps`` (output) and
-    ``source_fps``.
+    leg length), ``lowest_leg``, ``skating_cm_s`` (B's planted-foot slide on A's contact frames at
+    the network's rate, :attr:`plausibility.Plausibility.slide`, × 100), ``source_skating_cm_s``
+    (A's own), ``skating`` (the plausibility check's skating flag), ``fps`` (output) and ``source_fps``.
     """
-    from motionlab.retargeting.pipeline import retarget, source_contacts
+    from motionlab.retargeting.pipeline import retarget
 
-    feet = [humanoid.JOINTS.index(f) for f in humanoid.FEET]
     rows = []
     names = list(clips)
     for a in names:
@@ -76,15 +75,13 @@ def pair_matrix(clips: dict[str, Motion], checkpoint, solver=None, pairs=None) -
             res = retarget(clips[a], clips[b], checkpoint, solver=solver)
             p = res.plausibility
             leg = humanoid.leg_length(res.motion.skeleton)
-            src = humanoid.to_canonical(clips[a])
-            src_pos, planted = src.global_positions(), source_contacts(src)
-            n = min(len(planted), len(res.positions))
             rows.append(
                 {
                     "source": a,
                     "target": b,
                     "ok": p.ok,
                     "failed": "+".join(p.failed),
+                    "skating": p.skating,
                     "root_scale_y": res.root_scale[1],
                     "hip_ratio": p.hip_ratio,
                     "source_hip_ratio": p.source_hip_ratio,
@@ -92,8 +89,8 @@ def pair_matrix(clips: dict[str, Motion], checkpoint, solver=None, pairs=None) -
                     "source_foot_leg": p.source_foot_height,
                     "foot_cm": 100 * p.foot_height * leg,
                     "lowest_leg": p.lowest,
-                    "skating_cm_s": 100 * metrics.planted_slide(res.positions[:n], feet, planted[:n], res.motion.fps),
-                    "source_skating_cm_s": 100 * metrics.planted_slide(src_pos, feet, planted, src.fps),
+                    "skating_cm_s": 100 * p.slide,
+                    "source_skating_cm_s": 100 * p.source_slide,
                     "fps": res.motion.fps,
                     "source_fps": clips[a].fps,
                 }
@@ -112,6 +109,6 @@ def table(rows: list[dict]) -> str:
         lines.append(
             f"{r['source']:<10} {r['target']:<10} {r['root_scale_y']:>6.3f} {r['hip_ratio']:>9.2f} {r['source_hip_ratio']:>8.2f} "
             f"{r['foot_cm']:>8.1f} {r['foot_leg']:>+8.3f} {r['source_foot_leg']:>+8.3f} {r['skating_cm_s']:>10.1f} {r['source_skating_cm_s']:>8.1f} "
-            f"{r['fps']:>5.0f}  {'ok' if r['ok'] else 'IMPLAUSIBLE ' + r['failed']}"
+            f"{r['fps']:>5.0f}  {'ok' if r['ok'] else 'IMPLAUSIBLE ' + r['failed']}{', skating' if r['skating'] else ''}"
         )
     return "\n".join(lines)

@@ -23,7 +23,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from motionlab.core import humanoid, metrics, quat
+from motionlab.core import contacts as _contacts
+from motionlab.core import humanoid, quat
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
 from motionlab.viz import backend
@@ -84,7 +85,7 @@ def contact_labels(
 
     A foot joint counts as touching when its height is below its own standing height (rest pose,
     relative to the lowest joint) plus 2 % of the body height, and it moves slower than 0.3 body
-    heights per second (see :func:`motionlab.core.metrics.foot_contacts`).
+    heights per second (:func:`motionlab.core.contacts.low_and_slow`, the package's contact rule).
 
     Parameters
     ----------
@@ -106,9 +107,9 @@ def contact_labels(
         return labels
     rest_y = skeleton.rest_positions()[:, 1]
     height = max(skeleton.height(), 1e-6)
-    for j in feet:
-        threshold = rest_y[j] - rest_y.min() + 0.02 * height
-        labels[:, j] = metrics.foot_contacts(positions[:, [j]], [0], fps, threshold, 0.3 * height)[:, 0]
+    labels[:, feet] = _contacts.low_and_slow(
+        positions[:, feet], rest_y[feet] - rest_y.min(), 0.02 * height, 0.3 * height, fps
+    )
     return labels
 
 

@@ -58,6 +58,7 @@ VOCABULARY = {
     "--num-characters": ("num_characters", "positive_int", "how many synthetic characters (demo)"),
     "--root": ("root", "text", "root trajectory rule of retargeting (stride, hips, legs, contacts)"),
     "--gap-root": ("root", "text", "root path across a filled gap (fill-gaps)"),
+    "--rest-from": ("rest_from", "text", "a take of the same rig whose standing pose serves that rig's files"),
     "--stop-loss": ("stop_loss", "non_negative", "the latent iteration stops when L_iter drops below it"),
     "--distance-threshold": ("threshold", "positive", "largest frame distance of a motion-graph transition"),
     "--delta": ("delta", "text", "Δ, the dropped-frame factor of fill-gaps"),

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from motionlab import synthetic
-from motionlab.core import bvh, humanoid, quat, rest_pose
+from motionlab.core import bvh, humanoid, preprocess, quat, rest_pose
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
 from motionlab.retargeting import pipeline
@@ -89,7 +89,7 @@ def test_bandai_namco_stands_like_a_mixamo_character():
     root = require_data("bandai_namco")
     motion = bvh.load(root / "dataset-1" / "walk" / "dataset-1_walk_normal_001.bvh")
     sk, pose = rest_pose.standing_skeleton(motion, "bandai")
-    assert pose.source == "motion"
+    assert pose.source == "profile" and pose.family == "bandai_namco"
     leg = humanoid.leg_length(sk)
     assert 1.0 < pipeline.hip_height(sk) / leg < 1.3  # hips above straight legs plus the foot
     aj = require_data("mixamo", "Aj", "Running.bvh")
@@ -106,3 +106,68 @@ def test_info_says_which_pose_it_used(tmp_path, capsys):
     assert "rest      standing pose from the rest offsets" in capsys.readouterr().out
     assert main(["info", str(tmp_path / "lying.bvh")]) == 0
     assert "standing pose from frame" in capsys.readouterr().out
+
+
+def test_every_bandai_take_stands_in_the_one_pose_of_its_rig():
+    """Issue 41 item 4: a run whose no frame stands was refused; the rig profile's rule (bone lengths
+    from the rest offsets, every bone along the T-pose) gives every take of the rig one standing pose."""
+    root = require_data("bandai_namco")
+    run = bvh.load(root / "dataset-2" / "run" / "dataset-2_run_normal_001.bvh")
+    walk = bvh.load(root / "dataset-1" / "walk" / "dataset-1_walk_normal_001.bvh")
+    with pytest.raises(rest_pose.RestPoseError, match="--rest-from"):  # without the profile's rule: refused
+        rest_pose.standing(humanoid.to_canonical(run))
+    out, pose = rest_pose.standing(humanoid.to_canonical(run), family="bandai_namco")
+    assert pose.source == "profile"
+    np.testing.assert_allclose(out.global_positions(), humanoid.to_canonical(run).global_positions(), atol=1e-6)
+    sk_run = preprocess.prepare(run, None, stand=True).skeleton
+    sk_walk = rest_pose.standing_skeleton(walk)[0]
+    np.testing.assert_allclose(sk_run.offsets[1:], sk_walk.offsets[1:], atol=1e-6)  # one pose whatever the take
+    assert pipeline.hip_height(sk_run) == pytest.approx(pipeline.hip_height(sk_walk), abs=1e-6)
+    np.testing.assert_allclose(sk_run.bone_lengths(), humanoid.to_canonical_skeleton(run.skeleton).bone_lengths())
+
+
+def test_an_unknown_rig_stands_from_another_file():
+    """A rig with no profile rule whose take never stands takes the pose from another take (--rest-from)."""
+    walk = _lying(_walk(30))
+    crawl = walk.copy(local_rot=np.tile(quat.normalize(walk.local_rot[:1] * 0 + [1.0, 0, 0, 0]), (30, 1, 1)))
+    with pytest.raises(rest_pose.RestPoseError, match="--rest-from FILE.bvh"):
+        rest_pose.standing(crawl, "crawl.bvh")
+    out, pose = rest_pose.standing(crawl, "crawl.bvh", reference=walk)
+    assert pose.source == "file"
+    np.testing.assert_allclose(out.skeleton.offsets, rest_pose.standing(walk)[0].skeleton.offsets, atol=1e-12)
+    np.testing.assert_allclose(out.global_positions(), crawl.global_positions(), atol=1e-9)
+    other = _lying(
+        _repose(_walk(30), np.tile([1.0, 0, 0, 0], (22, 1))).copy(
+            skeleton=humanoid.scale_bones(humanoid.canonical_skeleton(), legs=1.3)
+        )
+    )
+    with pytest.raises(rest_pose.RestPoseError, match="another rig"):
+        rest_pose.standing(crawl, "crawl.bvh", reference=other)
+    assert rest_pose.on_reference(crawl, other) is crawl  # another rig's file is not this rig's pose
+
+
+def test_retarget_takes_the_standing_pose_from_rest_from(tmp_path, capsys):
+    from motionlab.cli import main
+
+    walk = _lying(_walk(30))
+    crawl = walk.copy(local_rot=np.tile(quat.normalize(walk.local_rot[:1] * 0 + [1.0, 0, 0, 0]), (30, 1, 1)))
+    for name, m in (("walk.bvh", walk), ("crawl.bvh", crawl), ("tpose.bvh", _walk(10))):
+        bvh.save(tmp_path / name, m)
+    args = ["retarget", str(tmp_path / "crawl.bvh"), "--target", str(tmp_path / "tpose.bvh"), "--method", "copy"]
+    assert main([*args, "-o", str(tmp_path / "a.bvh"), "-q"]) != 0
+    assert "--rest-from FILE.bvh" in capsys.readouterr().err
+    out = tmp_path / "b.bvh"
+    main([*args, "-o", str(out), "-q", "--keep-implausible", "--rest-from", str(tmp_path / "walk.bvh")])
+    assert out.is_file()
+
+
+def test_expand_takes_the_standing_pose_from_rest_from(tmp_path):
+    from motionlab.retargeting import expand
+
+    walk = _lying(_walk(30))
+    crawl = walk.copy(local_rot=np.tile(quat.normalize(walk.local_rot[:1] * 0 + [1.0, 0, 0, 0]), (30, 1, 1)))
+    bvh.save(tmp_path / "crawl.bvh", crawl)
+    (bad,) = expand.characters(str(tmp_path / "crawl.bvh"))
+    assert bad.skeleton is None and "--rest-from" in bad.error
+    (good,) = expand.characters(str(tmp_path / "crawl.bvh"), rest_from=walk)
+    np.testing.assert_allclose(good.skeleton.offsets, rest_pose.standing(walk)[0].skeleton.offsets, atol=1e-6)

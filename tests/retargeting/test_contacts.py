@@ -194,3 +194,36 @@ def test_full_method_beats_copy_on_a_real_clip_pair():
             pose[method] += metrics.mse(p - p[:, :1], g - g[:, :1])
     assert err["full"] < err["copy"]
     assert pose["full"] < pose["copy"]
+
+
+def test_each_foot_joint_has_its_own_clearance_on_cmu_rigs():
+    """Issue 41 item 2: CMU's rest foot lies nearly flat, its planted ankle stands higher; with one
+    clearance for all four joints (the lowest's) CMU's ankles were never planted."""
+    root = require_data("cmu")
+    m = preprocess.prepare(bvh.load(root / "131" / "131_01.bvh"), None, stand=True)
+    labels = contacts.of_motion(m)
+    assert labels[:, :2].mean(axis=0).min() > 0.1  # ankles (was 0.00 and 0.03)
+
+
+def test_every_contact_detector_uses_the_one_rule():
+    """metrics.foot_contacts, motion_graphs.cycles.contacts and viz.scene.contact_labels give the
+    labels of core.contacts.low_and_slow with the thresholds they state."""
+    from motionlab.core import contacts as core_contacts
+    from motionlab.core import metrics
+    from motionlab.motion_graphs import cycles
+    from motionlab.viz import scene
+
+    walk = synthetic.generate("walk", humanoid.canonical_skeleton(), num_frames=90, fps=60, seed=2)
+    pos = walk.global_positions()
+    feet = list(contacts.CONTACT_JOINTS)
+    rule = core_contacts.low_and_slow
+    assert np.array_equal(metrics.foot_contacts(pos, feet, 60.0), rule(pos[:, feet], 0.0, 0.05, 0.5, 60.0))
+    ground = np.percentile(pos[:, feet[:2], 1], 5, axis=0)
+    assert np.array_equal(
+        cycles.contacts(pos, 60.0, feet[:2]), rule(pos[:, feet[:2]], ground, 0.06, 0.6, 60.0, horizontal=True)
+    )
+    rest = walk.skeleton.rest_positions()[:, 1]
+    h = walk.skeleton.height()
+    got = scene.contact_labels(walk.skeleton, pos, 60.0)[:, feet]
+    assert np.array_equal(got, rule(pos[:, feet], rest[feet] - rest.min(), 0.02 * h, 0.3 * h, 60.0))
+    assert got.any() and (~got).any()

@@ -58,3 +58,39 @@ def test_frames_must_match(walked):
     with pytest.raises(ValueError, match="frames"):
         plausibility.check(res.positions[:-1], res.motion.skeleton, src)
     assert np.isfinite(res.plausibility.hip_ratio)
+
+
+def test_skating_is_planted_feet_sliding_not_low_feet_moving(walked):
+    """Issue 41: the skating flag measures B's feet on A's stance frames (planted-foot slide): a
+    planted foot that slides is flagged, a foot that moves fast while A's is in the air is not."""
+    from motionlab.core import contacts
+
+    res, src = walked
+    planted = contacts.of_motion(src)
+    assert planted.any() and not res.plausibility.skating
+    t = np.arange(len(res.positions)) / src.fps
+    limit = plausibility.SLIDE_TOL * res.motion.skeleton.height()  # per second
+    feet = list(contacts.CONTACT_JOINTS)
+    swing = res.positions.copy()
+    swing[..., feet, 0] += np.where(planted, 0.0, 10 * limit * t[:, None])  # fast, but only when A's foot is up
+    swung = plausibility.check(swing, res.motion.skeleton, src, planted)
+    assert swung.slide == pytest.approx(res.plausibility.slide) and not swung.skating
+    slid = res.positions.copy()
+    slid[..., 0] += 2 * limit * t[:, None]  # the whole body drifts at twice the limit
+    flagged = plausibility.check(slid, res.motion.skeleton, src, planted)
+    assert flagged.skating and flagged.slide > limit and flagged.ok  # a flag, not a failed test
+    assert "SKATING" in flagged.describe()
+
+
+def test_held_out_walk_turn_on_a_mixamo_character_is_not_flagged():
+    """The issue's false alarm: a Bandai Namco walk-turn take on Kaya was flagged skating (its feet
+    below 5 cm moved at 55-59 cm/s); on the source's stance frames they move a few cm/s."""
+    from motionlab.core import bvh
+    from tests.conftest import require_data
+
+    root = require_data("bandai_namco")
+    kaya = require_data("mixamo", "Kaya", "Running.bvh")
+    take = bvh.load(root / "dataset-2" / "walk-turn-right" / "dataset-2_walk-turn-right_normal_001.bvh")
+    res = retarget(take, bvh.load(kaya), retargeting.load_default("cpu"))
+    assert not res.plausibility.skating
+    assert res.plausibility.slide < 0.5 * res.plausibility.slide_limit
