@@ -338,10 +338,9 @@ def _link_takes(graph: MotionGraph, cmp: _Compare, arr: _Arranged, cuts: _Cuts, 
                                          clips[a].num_frames, False)  # fmt: skip
             found["transition"].append((src, dst, cost[which]))
         # takes connect stance to stance: every take's ports with every other take's
-        found["transition"].append(
-            _stance_links.link_within(graph, _stance_links.port_features(graph, ks, port_masks, cmp.feats),
-                                      opt.threshold, opt.min_loop, opt.window)
-        )  # fmt: skip
+        port = _stance_links.port_features(graph, ks, port_masks, cmp.feats)
+        cmp.comparisons += 0 if port[0] is None else len(port[1]) ** 2
+        found["transition"].append(_stance_links.link_within(graph, port, opt.threshold, opt.min_loop, opt.window))
         for kind, parts in found.items():
             if parts:
                 graph.add_edges(*(np.concatenate(p) for p in zip(*parts)), kind)
