@@ -1,4 +1,4 @@
-"""``motionlab demo``, the README's main command, end to end on one character."""
+"""``motionlab demo``, the README's main command, end to end on one random character and the long-shins case."""
 
 from __future__ import annotations
 
