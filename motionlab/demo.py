@@ -2,14 +2,25 @@
 
 1. make a synthetic performance (idle → walk → run → jump → walk → squat) on the character the
    shipped network was trained on;
-2. make new characters with other proportions (longer legs, short arms, …);
+2. make new characters with other proportions (longer legs, short arms, …), and one more,
+   :func:`long_shins`: the source character with its shins alone lengthened;
 3. retarget the performance onto each of them three ways — copying local rotations, the network
    without iteration, and the full latent iteration — with the shipped pretrained network;
-4. write everything as BVH to the output folder, a figure of foot heights, and print a table.
+4. write everything as BVH to the output folder, a figure of the long-shins case's feet, and print
+   a table.
 
 Because the motion is procedural, the generator can also perform the same segments directly on
 each new character; that *procedural reference* gives an error to compare against (it is one
 plausible answer, not the only one).
+
+Why the extra character: the random characters scale every bone of a leg alike, and the root rule
+(``synthetic.ROOT_MODE``) scales the root by the same factor, so copied rotations put the feet
+exactly where the generator does and the full method has nothing to fix. Copying is exact only
+for such a uniform leg chain; the smallest change that breaks it is the *ratio* of its bones, so
+the demo lengthens one bone (the shins) by the character sampler's largest leg factor
+(``characters.RANGES["legs"][1]``, not tuned to the result). There, copied rotations slide the
+planted feet; the table shows what the full method changes (planted-foot slide, lowest joint,
+plausibility, :mod:`motionlab.retargeting.plausibility`).
 """
 
 from __future__ import annotations
@@ -21,8 +32,9 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from motionlab.core import bvh, files, humanoid, metrics
+from motionlab.core.skeleton import Skeleton
 
-__all__ = ["run_demo", "SEGMENTS", "MARKER"]
+__all__ = ["run_demo", "long_shins", "SEGMENTS", "MARKER", "METHODS"]
 
 MARKER = ".motionlab-demo"
 """File the demo leaves in its output folder: a folder holding it belongs to the demo, and a
@@ -31,15 +43,52 @@ re-run replaces the demo's own files there without ``force``."""
 SEGMENTS = [("idle", 40), ("walk", 140), ("run", 110), ("jump", 70), ("walk", 80), ("squat", 100)]
 """The demo performance: (behaviour, frames at 60 fps)."""
 
+METHODS = ("copy", "network", "full")
+"""The three ways the demo retargets (:func:`motionlab.retargeting.retarget`'s ``method``)."""
 
-def _row(name: str, pos: np.ndarray, ref: np.ndarray, fps: float, height: float, seconds: float) -> dict:
+CASE = "long shins"
+"""The table's name for the :func:`long_shins` character."""
+
+
+def long_shins(skeleton: Skeleton, factor: float | None = None) -> Skeleton:
+    """``skeleton`` with both shins (knee to ankle) alone lengthened by ``factor`` (default: the
+    character sampler's largest leg factor, ``characters.RANGES["legs"][1]``), its lowest joint
+    kept on the ground; thighs and feet unchanged, so the leg's bone ratio changes.
+
+    Raises
+    ------
+    ValueError when ``skeleton`` is not the canonical 22-joint humanoid or ``factor`` is not > 0.
+    """
+    from motionlab.synthetic import characters
+
+    factor = characters.RANGES["legs"][1] if factor is None else float(factor)
+    if not humanoid.is_canonical(skeleton):
+        raise ValueError("long_shins: expected the canonical 22-joint humanoid skeleton")
+    if not (np.isfinite(factor) and factor > 0):
+        raise ValueError(f"long_shins: factor must be a positive number, got {factor}")
+    offsets = skeleton.offsets.copy()
+    for shin_end in ("LeftFoot", "RightFoot"):  # a joint's offset is the bone from its parent (the knee)
+        offsets[skeleton.index(shin_end)] *= factor
+    stretched = Skeleton(skeleton.names, skeleton.parents, offsets, skeleton.end_sites)
+    offsets[0, 1] += skeleton.rest_positions()[:, 1].min() - stretched.rest_positions()[:, 1].min()
+    return Skeleton(skeleton.names, skeleton.parents, offsets, skeleton.end_sites)
+
+
+def _row(name: str, result, ref: np.ndarray, planted: np.ndarray, fps: float, height: float, seconds: float) -> dict:
+    """One table row: the error against the procedural reference, the planted feet's slide (A's
+    contact frames), the lowest joint, feet below the ground, smoothness and the plausibility verdict."""
     feet = [humanoid.JOINTS.index(j) for j in humanoid.FEET]
+    n = min(len(result.positions), len(ref), len(planted))
+    pos = result.positions[:n]
+    p = result.plausibility
     return {
         "method": name,
-        "mpjpe_cm": 100 * metrics.mpjpe(pos, ref),
+        "mpjpe_cm": 100 * metrics.mpjpe(pos, ref[:n]),
+        "slide_cms": 100 * metrics.planted_slide(pos, feet, planted[:n], fps),
+        "lowest_cm": 100 * float(pos[..., 1].min()),
         "pen_pct": 100 * metrics.foot_penetration(pos, feet) / height,
-        "skate": metrics.foot_skating(pos, feet, fps),
         "smooth": 100 * metrics.smoothness(pos),
+        "plausible": "yes" if p is None or p.ok else "no: " + ", ".join(p.failed),
         "seconds": seconds,
     }
 
@@ -61,11 +110,12 @@ def _claim(out_dir: Path, planned: list[Path], force: bool) -> None:
     )
 
 
-def _character_rows(i, target, performance, checkpoint, seed: int, out_dir: Path, curves: dict) -> list[dict]:
+def _character_rows(label, target, performance, planted, checkpoint, seed, out_dir: Path, curves) -> list[dict]:
     """Retarget the performance onto ``target`` by each method: one table row per method.
 
-    Writes the full method's result as ``character_{i}.bvh``; for character 0, stores each
-    method's lowest toe height per frame (T,) in ``curves``.
+    ``label``: the character's number, or :data:`CASE`. Writes the full method's result as
+    ``character_{label}.bvh`` (``long_shins.bvh`` for the case); when ``curves`` is a dict, stores
+    each method's feet there (:func:`_foot_curves`).
     """
     from motionlab import synthetic
     from motionlab.retargeting import retarget
@@ -73,67 +123,91 @@ def _character_rows(i, target, performance, checkpoint, seed: int, out_dir: Path
     reference = synthetic.sequence(SEGMENTS, target, fps=60, seed=seed).global_positions()
     height = target.height()
     rows = []
-    for method in ("copy", "network", "full"):
-        t0 = time.perf_counter()
+    for method in METHODS:
         # the procedural reference scales strides by thigh + shin: scale the root the same way
+        t0 = time.perf_counter()
         result = retarget(performance, target, checkpoint, method, root_mode=synthetic.ROOT_MODE)
-        seconds = time.perf_counter() - t0
-        n = min(len(result.positions), len(reference))
-        row = _row(method, result.positions[:n], reference[:n], performance.fps, height, seconds)
-        row["character"] = f"{i} ({height:.2f} m, legs {humanoid.leg_length(target) / height:.2f}·h)"
+        row = _row(method, result, reference, planted, performance.fps, height, time.perf_counter() - t0)
+        legs = f"legs {humanoid.leg_length(target) / height:.2f}·h"
+        row["character"] = f"{label} ({height:.2f} m, {legs})" if label != CASE else f"{CASE} ({legs})"
         rows.append(row)
         if method == "full":
-            result.motion.name = f"character_{i}"
-            bvh.save(out_dir / f"character_{i}.bvh", result.motion, overwrite=True)
-        if i == 0:
-            feet = [humanoid.JOINTS.index(j) for j in ("LeftToeBase", "RightToeBase")]
-            curves[method] = result.positions[:, feet, 1].min(axis=1)
+            name = f"character_{label}" if label != CASE else "long_shins"
+            result.motion.name = name
+            bvh.save(out_dir / f"{name}.bvh", result.motion, overwrite=True)
+        if curves is not None:
+            curves[method] = _foot_curves(result.positions, planted, performance.fps)
     return rows
 
 
+def _foot_curves(pos: np.ndarray, planted: np.ndarray, fps: float) -> tuple[np.ndarray, np.ndarray]:
+    """Per frame: the lowest toe height (m) and the fastest planted foot joint's horizontal speed
+    (m/s; ``nan`` where A plants no foot)."""
+    toes = [humanoid.JOINTS.index(j) for j in ("LeftToeBase", "RightToeBase")]
+    feet = [humanoid.JOINTS.index(j) for j in humanoid.FEET]
+    n = min(len(pos), len(planted))
+    speed = np.linalg.norm(np.diff(pos[:n, feet][..., [0, 2]], axis=0), axis=-1) * fps  # (n-1, 4)
+    both = planted[1:n] & planted[: n - 1]
+    fastest = np.where(both.any(axis=1), np.where(both, speed, 0.0).max(axis=1), np.nan)
+    return pos[:, toes, 1].min(axis=1), fastest
+
+
+_COLUMNS = (
+    ("mpjpe_cm", "MPJPE vs procedural ref (cm)", ".2f"),
+    ("slide_cms", "planted-foot slide (cm/s)", ".2f"),
+    ("lowest_cm", "lowest joint (cm, < 0: under the floor)", ".2f"),
+    ("pen_pct", "feet below ground (% height)", ".3f"),
+    ("smooth", "smoothness (cm/frame²)", ".3f"),
+    ("plausible", "plausible", "s"),
+    ("seconds", "time (s)", ".2f"),
+)
+
+
 def _table(rows: list[dict]) -> str:
-    """The demo's Markdown tables: one row per character and method, then the means per method."""
-    header = "| character | method | MPJPE vs procedural ref (cm) | feet below ground (% height) | foot skating (m/s) | smoothness (cm/frame²) | time (s) |"
-    lines = [header, "|---|---|---|---|---|---|---|"]
-    for r in rows:
-        lines.append(
-            f"| {r['character']} | {r['method']} | {r['mpjpe_cm']:.2f} | {r['pen_pct']:.3f} | {r['skate']:.3f} | "
-            f"{r['smooth']:.3f} | {r['seconds']:.2f} |"
-        )
-    means = {}
-    for method in ("copy", "network", "full"):
-        sel = [r for r in rows if r["method"] == method]
-        means[method] = {
-            k: float(np.mean([r[k] for r in sel])) for k in ("mpjpe_cm", "pen_pct", "skate", "smooth", "seconds")
-        }
-    lines += [
-        "",
-        "| mean over characters | MPJPE (cm) | below ground (% h) | skating (m/s) | smoothness | time (s) |",
-        "|---|---|---|---|---|---|",
-    ]
-    for method, m in means.items():
-        lines.append(
-            f"| {method} | {m['mpjpe_cm']:.2f} | {m['pen_pct']:.3f} | {m['skate']:.3f} | {m['smooth']:.3f} | {m['seconds']:.2f} |"
-        )
+    """The demo's Markdown tables: one row per character and method; then per method the mean
+    over the random characters (plausible: how many of them) and the long-shins case; then what
+    the full method changed on the case."""
+    head = lambda first: "| " + " | ".join([first, "method"] + [t for _, t, _ in _COLUMNS]) + " |"  # noqa: E731
+    rule = "|" + "---|" * (len(_COLUMNS) + 2)
+    cells = lambda r: " | ".join(format(r[k], f) for k, _, f in _COLUMNS)  # noqa: E731
+    lines = [head("character"), rule] + [f"| {r['character']} | {r['method']} | {cells(r)} |" for r in rows]
+    lines += ["", head("summary"), rule]
+    random = [r for r in rows if not r["character"].startswith(CASE)]
+    n = len(random) // len(METHODS)
+    for method in METHODS:
+        sel = [r for r in random if r["method"] == method]
+        mean = {k: float(np.mean([r[k] for r in sel])) for k, _, f in _COLUMNS if f != "s"}
+        mean["lowest_cm"] = min(r["lowest_cm"] for r in sel)  # the lowest of all, not a mean
+        mean["plausible"] = f"{sum(r['plausible'] == 'yes' for r in sel)}/{len(sel)}"
+        lines.append(f"| mean over {n} random character{'s' * (n != 1)} | {method} | {cells(mean)} |")
+    case = {r["method"]: r for r in rows if r["character"].startswith(CASE)}
+    lines += [f"| {CASE} | {m} | {cells(case[m])} |" for m in METHODS if m in case]
+    lines += ["", "(random characters: lowest joint is the lowest of them all; plausible counts those that passed)"]
+    if {"copy", "full"} <= set(case):
+        c, f = case["copy"], case["full"]
+        lines += ["", f"On {CASE}, copied rotations slide the planted feet at {c['slide_cms']:.2f} cm/s; the full method "
+                      f"keeps them at {f['slide_cms']:.2f} cm/s (lowest joint {c['lowest_cm']:.2f} -> {f['lowest_cm']:.2f} cm)."]  # fmt: skip
     return "\n".join(lines)
 
 
 def _plot_foot_heights(curves: dict, fps: float, path: Path) -> None:
-    """Save character 0's lowest toe height per frame, one line per method, as a PNG."""
+    """Save the long-shins case's lowest toe height and planted-foot speed per frame, one line per
+    method, as a PNG."""
     import matplotlib
 
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(9, 3))
-    t = np.arange(len(next(iter(curves.values())))) / fps
-    for method, y in curves.items():
-        ax.plot(t[: len(y)], 100 * y, label=method, lw=1.2)
+    fig, (ax, bx) = plt.subplots(2, 1, figsize=(9, 5), sharex=True)
+    for method, (low, speed) in curves.items():
+        ax.plot(np.arange(len(low)) / fps, 100 * low, label=method, lw=1.2)
+        bx.plot(np.arange(1, len(speed) + 1) / fps, 100 * speed, label=method, lw=1.0)
     ax.axhline(0, color="k", lw=0.8)
-    ax.set_xlabel("time (s)")
     ax.set_ylabel("lowest toe height (cm)")
-    ax.set_title("character 0: lowest toe height per frame (below 0 = through the floor)")
+    ax.set_title(f"{CASE}: lowest toe height (below 0 = through the floor) and planted feet's speed")
     ax.legend()
+    bx.set_xlabel("time (s)")
+    bx.set_ylabel("fastest planted foot (cm/s)")
     fig.tight_layout()
     files.atomic_write(path, lambda f: fig.savefig(f, format="png", dpi=110), True, binary=True)
     plt.close(fig)
@@ -149,7 +223,7 @@ def run_demo(out_dir: str | Path = "outputs/demo", characters: int = 4, seed: in
     from motionlab.retargeting import load_default
 
     out_dir = Path(out_dir)
-    planned = [out_dir / "source.bvh", out_dir / "foot_heights.png", out_dir / "summary.md"]
+    planned = [out_dir / "source.bvh", out_dir / "foot_heights.png", out_dir / "summary.md", out_dir / "long_shins.bvh"]
     planned += [out_dir / f"character_{i}.bvh" for i in range(characters)]
     _claim(out_dir, planned, force)
 
@@ -164,10 +238,14 @@ def run_demo(out_dir: str | Path = "outputs/demo", characters: int = 4, seed: in
         f"({' → '.join(s for s, _ in SEGMENTS)})"
     )
 
-    targets = synthetic.character_set(characters, seed=seed + 1)
+    from motionlab.retargeting.pipeline import source_contacts
+
+    planted = source_contacts(performance)  # A's planted feet (T, 4), the frames the slide is measured on
+    targets = [*enumerate(synthetic.character_set(characters, seed=seed + 1)), (CASE, long_shins(source_skeleton))]
     rows, curves = [], {}
-    for i, target in enumerate(tqdm(targets, desc="characters")):
-        rows += _character_rows(i, target, performance, checkpoint, seed, out_dir, curves)
+    for label, target in tqdm(targets, desc="characters"):
+        rows += _character_rows(label, target, performance, planted, checkpoint, seed, out_dir,
+                                curves if label == CASE else None)  # fmt: skip
     table = _table(rows)
     files.atomic_write(out_dir / "summary.md", lambda f: f.write("# motionlab demo\n\n" + table + "\n"), True)
     print()

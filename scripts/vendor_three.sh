@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # three.js for the web player (motionlab.viz.web), from npm, bundled into ONE classic script that
 # defines window.THREE: build/web/three.min.js. A classic script (not an ES module) is what a page
-# opened from file:// may load. scripts/build_docs.sh copies it into the site; in JupyterLab,
-# motionlab.viz.web.player(..., three_js=True) embeds it. Needs node + npm and the npm registry
+# opened from file:// may load. scripts/build_docs.sh copies it into the site; in JupyterLab and
+# VS Code, motionlab.viz.web.player embeds it by itself (three_js="auto", the default there: in the
+# first player of a kernel; MOTIONLAB_WEB_EMBED=0 turns that off). Needs node + npm and the npm registry
 # (once: the file is kept and reused while the versions below stay the same).
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -48,6 +48,9 @@ between neighbours S1–M1, M1–M2, …, M4–S2. Which style pairs are bridged
   both directions;
 * frames of intermediate and transition clips that lie on no recorded route are removed.
 
+``prune=False`` skips all three (every frame and every candidate edge stays; the table still
+records the routes), so the pruning's effect can be measured on its own.
+
 Conditions met on the way (a take pruned, a forced pair, a missing link, an unused transition
 clip) are collected in ``info["conditions"]`` and counted once in the build report
 (:mod:`.report`).
@@ -163,6 +166,7 @@ class _Options:
     neighbours: int
     rep_cycles: int
     progress: bool
+    prune: bool = True
 
 
 @dataclass
@@ -334,17 +338,17 @@ def _link_takes(graph: MotionGraph, cmp: _Compare, arr: _Arranged, cuts: _Cuts, 
                                          clips[a].num_frames, False)  # fmt: skip
             found["transition"].append((src, dst, cost[which]))
         # takes connect stance to stance: every take's ports with every other take's
-        found["transition"].append(
-            _stance_links.link_within(graph, _stance_links.port_features(graph, ks, port_masks, cmp.feats),
-                                      opt.threshold, opt.min_loop, opt.window)
-        )  # fmt: skip
+        port = _stance_links.port_features(graph, ks, port_masks, cmp.feats)
+        cmp.comparisons += 0 if port[0] is None else len(port[1]) ** 2
+        found["transition"].append(_stance_links.link_within(graph, port, opt.threshold, opt.min_loop, opt.window))
         for kind, parts in found.items():
             if parts:
                 graph.add_edges(*(np.concatenate(p) for p in zip(*parts)), kind)
         for c in ks:
             if c != cuts.rep[key]:
                 cmp.cache.pop(c, None)
-        _prune_pool(graph, cmp, ks, opt, notes)
+        if opt.prune:
+            _prune_pool(graph, cmp, ks, opt, notes)
         ports[key] = _stance_links.port_features(graph, ks, port_masks, cmp.feats)
     graph.drop_dead_edges()
     return ports
@@ -459,7 +463,7 @@ def _link_styles(graph, cmp, spaces, cuts, pool_start, opt: _Options, notes: _No
         for direction, edges, seq in (("forward", fwd, chain), ("backward", list(reversed(bwd)), chain[::-1])):
             sa, sz = (s1, s2) if direction == "forward" else (s2, s1)
             routes, kept = _bridge_routes(graph, seq, edges, opt.dwell, pool_start((b, sa)), pool_start((b, sz)))
-            for src, dst, cost in kept:
+            for src, dst, cost in kept if opt.prune else edges:  # unpruned: invalid paths' first edges too
                 graph.add_edges(src, dst, cost, "bridge")
             for r in routes:
                 for clip, f0, f1 in r["pieces"]:
@@ -580,6 +584,7 @@ def build_structured(
     neighbours: int = NEIGHBOURS,
     rep_cycles: int = REP_CYCLES,
     progress: bool = False,
+    prune: bool = True,
 ) -> MotionGraph:
     """Build the structured motion graph (see the module docstring).
 
@@ -601,7 +606,7 @@ def build_structured(
     dwell : fewest frames a style route spends in each intermediate motion (default fps/5)
     neighbours : each take is compared with itself and the next ``neighbours`` takes of its style
     rep_cycles : whole cycles of each representative take that the interpolation space blends
-    progress : show a tqdm bar per stage
+    progress : show a tqdm bar per stage; prune : ``False`` skips every pruning step (for paper B's ablation)
 
     Returns
     -------
@@ -619,9 +624,9 @@ def build_structured(
         raise GraphError(f"got {len(labels)} labels for {len(motions)} clips")
     opt = _Options(float(threshold), window, int(round(fps / 2)) if min_loop is None else int(min_loop),
                    tuple(weights), style_pairs, reference_style, force,
-                   max(1, int(round(fps / 5)) if dwell is None else int(dwell)), neighbours, rep_cycles, progress)  # fmt: skip
-    notes, seconds = _Notes(), {}
-    arr = _arrange(motions, labels)
+                   max(1, int(round(fps / 5)) if dwell is None else int(dwell)), neighbours, rep_cycles, progress,
+                   prune)  # fmt: skip
+    notes, seconds, arr = _Notes(), {}, _arrange(motions, labels)
     with _timer(seconds, "cycles_seconds"):
         cuts = _cut_takes(arr, notes, progress)
     with _timer(seconds, "registration_seconds"):
@@ -639,7 +644,7 @@ def build_structured(
         _link_transition_clips(graph, cmp, arr, pool_start, opt, notes, table, on_route)
     with _timer(seconds, "stance_seconds"):
         cmp.comparisons += _link_stances(graph, arr, table, ports, pool_start, opt)
-    _finish(graph, table, on_route)
+    _finish(graph, table, on_route if opt.prune else None)
     graph.info = _info(opt, cmp.comparisons, len(motions), seconds, len(extra), notes)
     graph.info["build_seconds"] = time.perf_counter() - t0
     return graph
@@ -650,7 +655,7 @@ def _info(opt: _Options, comparisons: int, n_input: int, seconds: dict, n_extra:
     return dict(
         kind="structured", threshold=opt.threshold, window=opt.window, min_loop=opt.min_loop, dwell=opt.dwell,
         style_pairs=opt.style_pairs, weights=list(opt.weights), neighbours=opt.neighbours,
-        rep_cycles=opt.rep_cycles, comparisons=comparisons, input_clips=n_input, **seconds,
+        rep_cycles=opt.rep_cycles, prune=opt.prune, comparisons=comparisons, input_clips=n_input, **seconds,
         intermediates=n_extra, conditions=notes.lines,
     )  # fmt: skip
 
@@ -669,9 +674,10 @@ def _pool_start(graph: MotionGraph, arr: _Arranged, key: Key) -> int:
     return graph.clips[arr.pools[key][0]].start
 
 
-def _finish(graph: MotionGraph, table: dict, on_route: np.ndarray) -> None:
-    """Intermediate and transition frames live only on recorded routes; dead and repeated edges go."""
-    for c in graph.clips:
+def _finish(graph: MotionGraph, table: dict, on_route: np.ndarray | None) -> None:
+    """Intermediate and transition frames live only on recorded routes (all of them when ``on_route``
+    is ``None``: no pruning); dead and repeated edges go."""
+    for c in graph.clips if on_route is not None else ():
         if c.kind in ("intermediate", "transition"):
             graph.alive[c.start : c.stop] &= on_route[c.start : c.stop]
     graph.drop_dead_edges()
@@ -827,11 +833,19 @@ def build_wcmg(
 
     Transition clips are left out (a wcMG has no notion of them). For the connectivity
     comparison of paper B's experiments.
+
+    Raises
+    ------
+    GraphError when two basic clips share one behaviour and style (takes): a wcMG has one clip per style.
     """
     from motionlab.motion_graphs.graph import build_standard
 
     t0 = time.perf_counter()
     labels = [parse_name(m.name, name_map) for m in motions]
+    keys = [lab.key for lab in labels if lab.kind == "basic"]
+    if len(set(keys)) < len(keys):
+        twice = sorted({f"{b}_{s}" for b, s in keys if keys.count((b, s)) > 1})
+        raise GraphError(f"build_wcmg takes one clip per style; several clips of {', '.join(twice)}")
     basics = {lab.key: m for lab, m in zip(labels, motions) if lab.kind == "basic"}
     by_behaviour: dict[str, list[str]] = {}
     for b, s in basics:

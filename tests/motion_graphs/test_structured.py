@@ -124,3 +124,29 @@ def test_ring_pairs_grow_linearly():
     assert len(pairs) == 40 * 3
     # the ring joins every take to the next: one connected cycle
     assert all((k, k + 1) in pairs for k in range(39)) and (0, 39) in pairs
+
+
+def test_prune_false_keeps_every_frame_and_edge(library, sgraph):
+    """``prune=False`` (paper B's ablation) skips every pruning step: the same frames and the
+    pruned graph's edges plus the ones pruning removed; dead ends (the clips' last frames) remain."""
+    raw = structured.build_structured(library, THRESHOLD, prune=False)
+    assert raw.info["prune"] is False and sgraph.info["prune"] is True
+    assert raw.num_frames == sgraph.num_frames and raw.num_alive == raw.num_frames > sgraph.num_alive
+    assert raw.dead_ends().size > 0 == sgraph.dead_ends().size
+    key = lambda g: set(zip(g.src.tolist(), g.dst.tolist()))  # noqa: E731
+    assert key(sgraph) < key(raw)  # pruning only removes edges
+    assert {(tuple(x["from"]), tuple(x["to"])) for x in raw.table["links"]} == {
+        (tuple(x["from"]), tuple(x["to"])) for x in sgraph.table["links"]
+    }
+
+
+def test_wcmg_refuses_several_takes_of_a_style(library):
+    """A wcMG has one clip per style: several takes of one style are refused by name, not
+    silently reduced to the last take."""
+    import pytest
+
+    walk = next(m for m in library if m.name == "walk_normal")
+    with pytest.raises(graph.GraphError, match="walk_normal"):
+        structured.build_wcmg([walk.copy(name="walk_normal_001"), walk.copy(name="walk_normal_002")], THRESHOLD)
+    g = structured.build_wcmg([m for m in library if m.name in ("walk_normal", "walk_happy")], THRESHOLD)
+    assert g.info["kind"] == "wcmg" and g.info["intermediates"] == 4
