@@ -19,11 +19,21 @@ from __future__ import annotations
 import contextlib
 import os
 import re
+import stat
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
-__all__ = ["TMP_SUFFIX", "check_input", "check_output", "atomic_write", "atomic_write_all", "remove_stale"]
+__all__ = [
+    "TMP_SUFFIX",
+    "check_input",
+    "check_output",
+    "check_replaceable",
+    "exists_message",
+    "atomic_write",
+    "atomic_write_all",
+    "remove_stale",
+]
 
 TMP_SUFFIX = ".motionlab-tmp"
 """Ending of every temporary file a motionlab writer creates."""
@@ -47,25 +57,69 @@ def check_input(path: str | os.PathLike, what: str = "input") -> Path:
     return path
 
 
+def _kind(path: Path) -> str | None:
+    """What ``path`` is when it is not a plain file or folder to write (a link, a named pipe, ...)."""
+    if path.is_symlink():
+        return f"a symbolic link (to {os.readlink(path)})"
+    try:
+        mode = path.stat().st_mode
+    except OSError:
+        return None
+    for test, name in ((stat.S_ISFIFO, "a named pipe"), (stat.S_ISCHR, "a character device"),
+                       (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket")):  # fmt: skip
+        if test(mode):
+            return name
+    return None
+
+
+def check_replaceable(path: str | os.PathLike, what: str = "output") -> None:
+    """Refuse, even with ``overwrite``, a destination that a write would not replace as a file:
+    a symbolic link (the write would replace the link, not what it points to), a named pipe, a
+    device or a socket, or a name ending in a path separator (a folder's name).
+
+    Raises
+    ------
+    FileExistsError
+        saying what ``path`` is.
+    IsADirectoryError
+        ``path`` ends in a separator (``newdir/``).
+    """
+    text = os.fspath(path)
+    if text.endswith(("/", os.sep)):
+        raise IsADirectoryError(f"{what} {text} ends in {text[-1]!r}, so it names a folder; expected a file name")
+    kind = _kind(Path(path))
+    if kind is not None:
+        raise FileExistsError(
+            f"{what} {text} is {kind}, not a file; motionlab replaces only plain files, --force or not"
+        )
+
+
+def exists_message(what: str, path) -> str:
+    """The one wording of the refusal to replace an existing file."""
+    return f"{what} {path} exists; add --force to replace it (overwrite=True in Python), or choose another name"
+
+
 def check_output(path: str | os.PathLike, overwrite: bool = False, what: str = "output") -> Path:
     """``path`` as a Path after checking that a file can be written there.
 
     Raises
     ------
     IsADirectoryError
-        ``path`` is a folder.
+        ``path`` is a folder, or ends in a path separator.
     FileExistsError
-        ``path`` exists and ``overwrite`` is False.
+        ``path`` exists and ``overwrite`` is False, or is a link, named pipe, device or socket
+        (:func:`check_replaceable`).
     FileNotFoundError
         The folder ``path`` would go in does not exist.
     PermissionError
         That folder is not writable.
     """
+    check_replaceable(path, what)
     path = Path(path)
     if path.is_dir():
         raise IsADirectoryError(f"{what} {path} is a folder; expected a file name")
     if path.exists() and not overwrite:
-        raise FileExistsError(f"{what} {path} exists; pass --force (overwrite=True) to replace it")
+        raise FileExistsError(exists_message(what, path))
     folder = path.parent
     if not folder.is_dir():
         raise FileNotFoundError(f"folder {folder} for the {what} {path.name} does not exist")

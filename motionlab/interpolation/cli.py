@@ -44,7 +44,7 @@ __all__ = ["register", "run_fill_gaps"]
 def register(subparsers) -> None:
     with cli_args.command(subparsers, "fill-gaps", run_fill_gaps) as p:
         p.add_argument("input", help="BVH file with dropped frames")
-        cli_args.add_output(p, "where to write the filled BVH file")
+        cli_args.add_output(p, "where to write the filled motion: .bvh, or .glb for binary glTF 2.0")
         p.add_argument("--method", choices=("stride", "slerp", "hermite", "graph"), default="stride",
                        help="stride: the strides on both sides continued (default; slerp where the motion does not "
                        "repeat); slerp: SLERP; hermite: velocity-matched; graph: key-pose guided (needs --action)")  # fmt: skip
@@ -204,10 +204,13 @@ def _times_gaps(path: str, src: Path, motion) -> list[tuple[int, int]]:
     return missing
 
 
-def _copy(src: Path, dst: Path, force: bool) -> None:
-    """Copy ``src`` to ``dst`` byte for byte, atomically."""
-    from motionlab.core import files
+def _copy(src: Path, dst: Path, motion, force: bool) -> None:
+    """Copy ``src`` to ``dst`` byte for byte, atomically (a ``.glb`` output: ``motion`` written as glTF)."""
+    from motionlab.core import files, motion_files
 
+    if dst.suffix.lower() != ".bvh":
+        motion_files.save(dst, motion, overwrite=force, unit=motion_files.file_unit(motion.skeleton), what="-o file")
+        return
     data = src.read_bytes()
     files.atomic_write(dst, lambda f: f.write(data), overwrite=force, binary=True, what="-o file")
 
@@ -233,6 +236,7 @@ def _check_args(args: argparse.Namespace):
     src = files.check_input(args.input)
     inputs = [("input", src), ("--times", args.times)] + [("--takes", t) for t in args.takes]
     inputs += [("--action", a.split("=", 1)[1]) for a in args.action if "=" in a]
+    cli_args.motion_output("-o", args.output)
     (dst,) = check_outputs([("-o", args.output)], args.force, inputs=inputs)
     return delta, src, dst
 
@@ -244,7 +248,7 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
     of frames and fill them.
     """
     from motionlab.cli import CLIError
-    from motionlab.core import bvh
+    from motionlab.core import bvh, motion_files
     from motionlab.interpolation import detect, gaps
 
     delta, src, dst = _check_args(args)
@@ -270,7 +274,7 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
     )
     if not missing:
         bar.close()
-        _copy(src, dst, args.force)
+        _copy(src, dst, motion, args.force)
         print(f"{nothing}; wrote an unchanged copy")
         if not args.quiet:
             print(f"wrote {dst} ({motion.num_frames} frames)")
@@ -282,7 +286,7 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
     except ValueError as e:
         raise CLIError(str(e)) from None
     bar.start("write")
-    bvh.save(dst, filled, overwrite=args.force)
+    motion_files.save(dst, filled, overwrite=args.force, unit=motion_files.file_unit(motion.skeleton))
     bar.close()
     if not report:
         print(f"{nothing}; wrote an unchanged copy")

@@ -55,22 +55,23 @@ def _cmd_retarget(args) -> int:
     """retarget a BVH clip onto another character (latent iteration)
 
     Generate TARGET's version of SOURCE.bvh. The target character is defined by the rest skeleton of --target (its
-    motion is ignored) and/or --scale-* factors; the output is a BVH on the 22-joint canonical skeleton (BVH, or
-    glTF 2.0 when OUTPUT ends in .glb).
+    motion is ignored) and/or --scale-* factors; the output is the motion on the 22-joint canonical skeleton,
+    written as BVH (OUTPUT ending in .bvh) or binary glTF 2.0 (.glb).
     """
     from motionlab.cli import rig_error
-    from motionlab.core import bvh, files, gltf, humanoid, rest_pose
+    from motionlab.core import files, humanoid, motion_files, rest_pose
     from motionlab.retargeting.pipeline import retarget
 
     out = Path(args.output)
-    if out.suffix.lower() not in (".bvh", gltf.SUFFIX):
-        raise _error(f"output {out} must end in .bvh or {gltf.SUFFIX} (glTF 2.0)")
+    suffix = cli_args.motion_output("-o", args.output)
     npz = Path(args.npz) if args.npz else None
     if npz is not None and npz.suffix.lower() != ".npz":  # np.savez would silently add '.npz' to another name
         raise _error(f"--npz {npz} must end in .npz")
     inputs = [("source", args.source), ("--target", args.target), ("--checkpoint", args.checkpoint)]
     check_outputs([("-o", out), ("--npz", npz)], args.force, inputs=inputs)  # before any work
     source = _load_bvh(args.source, "source")
+    if args.fps is not None:
+        cli_args.check_size(f"--fps {args.fps:g} over {source.duration:g} s", source.duration * args.fps + 1, 22)
     try:
         humanoid.find_mapping(source.skeleton)
     except humanoid.RigMappingError as e:
@@ -99,9 +100,8 @@ def _cmd_retarget(args) -> int:
         fps=args.fps,
     )
     check = _check_result(args, result)
-    binary = out.suffix.lower() == gltf.SUFFIX
-    data = (gltf.dumps if binary else bvh.dumps)(result.motion)  # any error shows before a file is written
-    outputs = [(out, lambda f: f.write(data), binary, "output")]
+    data = motion_files.encode(result.motion, suffix, motion_files.file_unit(base.skeleton))  # errors before writing
+    outputs = [(out, lambda f: f.write(data), True, "output")]
     if npz is not None:  # both files or neither
         arrays = dict(
             local_rot=result.motion.local_rot,
@@ -190,6 +190,20 @@ def _animations(args, folder: Path) -> list[str]:
     return list(DEFAULT_ANIMATIONS)
 
 
+def _check_characters_and_animations(args, folder: Path, animations: list[str]) -> None:
+    """Before any training: every character folder exists, and every animation has the source's clip and
+    at least one target's (a pair without its clips is skipped; an animation without any pair is refused)."""
+    for option, name in [("--source", args.source)] + [("--targets", t) for t in args.targets]:
+        if not (folder / name).is_dir():
+            have = sorted(p.name for p in folder.iterdir() if p.is_dir())
+            raise _error(f"{option} {name}: no folder {folder / name} (characters in {folder}: {', '.join(have)})")
+    for anim in animations:
+        if not (folder / args.source / f"{anim}.bvh").is_file():
+            raise _error(f"--animations {anim}: the source has no clip {folder / args.source / (anim + '.bvh')}")
+        if not any((folder / t / f"{anim}.bvh").is_file() for t in args.targets):
+            raise _error(f"--animations {anim}: none of the targets {', '.join(args.targets)} has {anim}.bvh")
+
+
 def _fold_checkpoint(args, folder: Path, fpath: Path, left_out: list[str]):
     """The network of one fold: loaded from ``fpath``, or trained on the source's clips but ``left_out`` and saved there."""
     from motionlab.core import bvh
@@ -250,6 +264,7 @@ def _cmd_evaluate(args) -> int:
         raise _error(f"--folds must be >= 1, got {args.folds}")
     path = Path(args.checkpoint) if args.checkpoint else Path(tempfile.gettempdir()) / f"motionlab_{args.source}.pt"
     animations = _animations(args, folder)
+    _check_characters_and_animations(args, folder, animations)
     if args.folds > len(animations):
         raise _error(f"--folds {args.folds} is more than the {len(animations)} animations evaluated")
     # leave animations out: fold k is evaluated by a network trained without the fold's animations
@@ -318,9 +333,15 @@ def _add_retarget(subparsers) -> None:
         )
         for name in ("legs", "arms", "spine", "neck"):
             p.add_argument(
-                f"--scale-{name}", type=positive, default=1.0, metavar="F", help=f"scale the target's {name} bones by F"
+                f"--scale-{name}",
+                type=cli_args.factor,
+                default=1.0,
+                metavar="F",
+                help=f"scale the target's {name} bones by F (0.1 to 10)",
             )
-        p.add_argument("--scale", type=positive, default=1.0, metavar="F", help="scale the whole target by F")
+        p.add_argument(
+            "--scale", type=cli_args.factor, default=1.0, metavar="F", help="scale the whole target by F (0.1 to 10)"
+        )
         p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
         cli_args.add_force(p, "overwrite existing output files")
         cli_args.add_rate_and_plausibility_args(p)
@@ -339,7 +360,11 @@ def _add_train(subparsers) -> None:
             help="train on N built-in synthetic clips instead",
         )
         cli_args.add_output(p, "checkpoint file to write (.pt)")
-        p.add_argument("--train-steps", type=positive_int, default=1500, help="Adam steps (default 1500)")
+        cli_args.renamed(
+            p,
+            "--steps",
+            p.add_argument("--train-steps", type=positive_int, default=1500, help="Adam steps (default 1500)"),
+        )
         p.add_argument("--batch-size", type=positive_int, default=32, help="windows per Adam step")
         p.add_argument(
             "--pose-augment",
@@ -348,10 +373,14 @@ def _add_train(subparsers) -> None:
             metavar="F",
             help="fraction of each batch with joints turned at random (up to 0.3 rad; 0..0.5, default 0 = off)",
         )
-        p.add_argument("--train-lr", type=positive, default=2e-3, help="Adam learning rate of the training")
+        cli_args.renamed(
+            p,
+            "--lr",
+            p.add_argument("--train-lr", type=positive, default=2e-3, help="Adam learning rate of the training"),
+        )
         p.add_argument("--latent", type=positive_int, default=128, help="latent channels D per frame")
         p.add_argument("--hidden", type=positive_int, default=96, help="hidden channels")
-        p.add_argument("--seed", type=int, default=0, help="random seed")
+        p.add_argument("--seed", type=cli_args.seed, default=0, help="random seed")
         p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
         cli_args.add_force(p, "overwrite an existing checkpoint")
 
@@ -390,7 +419,7 @@ def _add_evaluate(subparsers) -> None:
             default=1500,
             help="Adam steps when the network is trained (default 1500)",
         )
-        p.add_argument("--seed", type=int, default=0, help="random seed")
+        p.add_argument("--seed", type=cli_args.seed, default=0, help="random seed")
         p.add_argument("--csv", help="write the per-clip records to this CSV")
         cli_args.add_force(p, "overwrite an existing --csv file")
         p.add_argument(

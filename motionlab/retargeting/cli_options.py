@@ -24,8 +24,28 @@ def _error(msg: str):
 
 
 def load_checkpoint(path: str | None, device: str | None):
-    from motionlab import retargeting
+    """The ``--checkpoint`` network (default: the shipped one) on ``device``.
 
+    Raises
+    ------
+    CLIError
+        the file is missing or not a checkpoint written by ``motionlab train``.
+    """
+    import zipfile
+
+    from motionlab import retargeting
+    from motionlab.core import files
+
+    if path:
+        try:
+            files.check_input(path, "--checkpoint")
+        except OSError as e:
+            raise _error(str(e)) from None
+        if not zipfile.is_zipfile(path):  # torch.save writes a zip archive; text or BVH is refused here
+            raise _error(
+                f"--checkpoint {path} is not a network checkpoint (a .pt file written by `motionlab train`, "
+                "which is a zip archive)"
+            )
     try:
         return retargeting.load(path, device) if path else retargeting.load_default(device)
     except retargeting.CheckpointError as e:

@@ -40,6 +40,7 @@ Taught in ``notebooks/07_expanding_a_database.ipynb``.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import dataclasses
 import glob
@@ -329,13 +330,38 @@ def _write_atomic(path: Path, text: str) -> None:
         raise
 
 
+@contextlib.contextmanager
+def _folder_lock(out: Path):
+    """Hold an exclusive lock on the folder ``out`` (``flock`` on the folder itself, so no lock file
+    is left in it); where ``flock`` does not exist (Windows), no lock."""
+    try:
+        import fcntl
+    except ImportError:
+        yield
+        return
+    fd = os.open(out, os.O_RDONLY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # closing releases the lock
+
+
 def _write_manifest(out: Path, rows: list[dict]) -> None:
-    buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=COLUMNS, lineterminator="\n")
-    w.writeheader()
-    for r in sorted(rows, key=lambda r: (r["character"], r["clip"])):
-        w.writerow({k: r.get(k, "") for k in COLUMNS})
-    _write_atomic(out / MANIFEST, buf.getvalue())
+    """Write ``rows`` as the manifest, merged by ``(character, clip)`` with the rows on disk for
+    pairs not among ``rows`` (another run's, written meanwhile), under a lock on the folder: two runs
+    into one folder keep both runs' rows. A kept row is checked again when a run reuses it."""
+    mine = {(r["character"], r["clip"]): r for r in rows}
+    with _folder_lock(out):
+        merged = dict(mine)
+        for r in read_manifest(out):
+            merged.setdefault((r["character"], r["clip"]), r)
+        buf = io.StringIO()
+        w = csv.DictWriter(buf, fieldnames=COLUMNS, lineterminator="\n")
+        w.writeheader()
+        for key in sorted(merged):
+            w.writerow({k: merged[key].get(k, "") for k in COLUMNS})
+        _write_atomic(out / MANIFEST, buf.getvalue())
 
 
 def _fmt(v: float) -> str:

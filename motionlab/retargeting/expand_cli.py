@@ -124,7 +124,11 @@ def register(subparsers) -> None:
         p.add_argument("--address", help="Ray cluster address (default: $RAY_ADDRESS, else a local Ray instance)")
         p.add_argument("--workers", type=positive_int, default=2, help="Ray actors (default 2)")
         p.add_argument(
-            "--threads", type=non_negative_int, default=0, help="torch threads (default: 1 on the CPU, see expand())"
+            "--threads",
+            type=non_negative_int,
+            default=0,
+            help="torch threads during the job (default 0: 1 on the CPU, which keeps a long job fast when the "
+            "machine turns busy; torch's own count on a GPU)",
         )
         p.add_argument(
             "--max-penetration", type=non_negative, default=1.0, metavar="CM", help="flag above this (default 1 cm)"

@@ -63,6 +63,7 @@ RANDOM = st.one_of(
     st.integers(-10, 10**6).map(str),
     st.text("abcxyz019:,._=-", max_size=12),  # no "/": a path never leaves the sandbox
 )
+FLOAT_TYPES = ("float", "positive", "non_negative", "in_range", "frame_rate", "factor")
 GOOD_INTS = st.sampled_from(["1", "2", "3", "10"])
 GOOD_FLOATS = st.sampled_from(["0.5", "1", "0.03", "30", "1.2"])
 
@@ -74,9 +75,9 @@ def _values(action: argparse.Action):
         good = st.sampled_from(list(action.choices))
     elif action.dest in ("output", "out", "report", "csv", "npz"):
         good = st.sampled_from(OUTPUTS)
-    elif getattr(action.type, "__name__", "") in ("int", "positive_int", "non_negative_int"):
+    elif getattr(action.type, "__name__", "") in ("int", "positive_int", "non_negative_int", "seed"):
         good = GOOD_INTS
-    elif getattr(action.type, "__name__", "") in ("float", "positive", "non_negative"):
+    elif getattr(action.type, "__name__", "") in FLOAT_TYPES:
         good = GOOD_FLOATS
     else:
         good = st.sampled_from(NAMES)

@@ -116,7 +116,7 @@ def test_refusing_writes_nothing(walk, tmp_path):
     assert list(tmp_path.iterdir()) == []
     path = gltf.save(tmp_path / "walk.glb", walk)
     before = path.read_bytes()
-    with pytest.raises(FileExistsError, match="exists; pass --force"):
+    with pytest.raises(FileExistsError, match="exists; add --force"):
         gltf.save(path, walk[:10])
     assert path.read_bytes() == before and [p.name for p in tmp_path.iterdir()] == ["walk.glb"]
     gltf.save(path, walk[:10], overwrite=True)
