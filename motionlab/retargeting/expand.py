@@ -56,7 +56,7 @@ from pathlib import Path
 
 import numpy as np
 
-from motionlab.core import bvh, gltf, humanoid, metrics, rest_pose
+from motionlab.core import bvh, humanoid, metrics, motion_files, rest_pose
 from motionlab.core.skeleton import Skeleton
 from motionlab.core.threads import batch_threads, torch_threads
 from motionlab.retargeting.batching import Pair, PairResult, batch_frames, plan_batches, quality, solve_pairs
@@ -125,6 +125,8 @@ class Character:
     origin : str                    the BVH path or ``preset:NAME``
     error : str                     why the character cannot be used ("" if it can)
     digest : str                    SHA-256 of the file's bytes, or of a preset's factors
+    unit : float                    metres per length unit of the file (:func:`motion_files.file_unit`):
+                                    a ``.glb`` output is written in metres from it
     """
 
     name: str
@@ -132,6 +134,7 @@ class Character:
     origin: str
     error: str = ""
     digest: str = ""
+    unit: float = motion_files.CM
 
 
 def _preset(spec: str) -> tuple[str, dict[str, float]]:
@@ -177,8 +180,9 @@ def characters(*specs: str, presets: Iterable[str] = ()) -> list[Character]:
     for name, p in entries:
         digest = _sha256(p)
         try:
-            sk = rest_pose.standing_skeleton(bvh.load(p), f"character file {p}")[0]
-            out.append(Character(name, sk, str(p), digest=digest))
+            rig = bvh.load(p)
+            sk = rest_pose.standing_skeleton(rig, f"character file {p}")[0]
+            out.append(Character(name, sk, str(p), digest=digest, unit=motion_files.file_unit(rig.skeleton)))
         except _ERRORS as err:
             out.append(Character(name, None, str(p), _why(err, "character", p), digest))
     for spec in presets:
@@ -678,7 +682,7 @@ def _write_batch(solved, sources_by_clip, chars, limits, suffix, options, fps, o
             file = out / row["output"]
             file.parent.mkdir(parents=True, exist_ok=True)
             fd, tmp = tempfile.mkstemp(dir=file.parent, prefix=f".{file.name}.", suffix=".tmp")
-            data = gltf.dumps(motion) if suffix == gltf.SUFFIX else bvh.dumps(motion).encode("utf-8")
+            data = motion_files.encode(motion, suffix, chars[pr.character].unit)
             with os.fdopen(fd, "wb") as f:
                 f.write(data)
             os.chmod(tmp, _MODE)

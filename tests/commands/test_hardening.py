@@ -568,3 +568,14 @@ def test_graph_build_counts_recorded_frames_apart_from_made_ones(tmp_path, capsy
     g = io.load(tmp_path / "g.mlgraph")
     recorded = sum(c.num_frames for c in g.clips if c.kind != "intermediate")
     assert code == 0 and f"of {recorded} recorded frames alive" in out
+
+
+def test_expand_writes_a_cmu_character_in_metres_in_gltf():
+    """A CMU-skeleton character's outputs carry its file's unit, which the .glb writer turns into metres."""
+    from motionlab.core import motion_files
+    from motionlab.retargeting import expand as ex
+    from tests.conftest import require_data
+
+    (cmu,) = ex.characters(str(require_data("cmu", "131", "131_01.bvh")))
+    (mixamo,) = ex.characters(str(require_data("mixamo", "Kaya", "Running.bvh")))
+    assert (cmu.unit, mixamo.unit) == (motion_files.ASF_UNIT, motion_files.CM)
