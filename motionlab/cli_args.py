@@ -32,6 +32,7 @@ from motionlab.core import files
 
 __all__ = [
     "CLIError",
+    "rig_error",
     "positive",
     "non_negative",
     "positive_int",
@@ -151,7 +152,7 @@ def check_size(what: str, frames: float, joints: int) -> None:
     ``what`` names the options that asked for it (``--seconds 1e9 at --fps 60``)."""
     gigabytes = frames * joints * 7 * 8 / 1e9
     if not gigabytes <= MAX_OUTPUT_GB:
-        raise _error(
+        raise CLIError(
             f"{what} asks for {frames:.3g} frames of {joints} joints ({gigabytes:.3g} GB of poses); "
             f"at most {MAX_OUTPUT_GB:g} GB is made ({MAX_OUTPUT_GB * 1e9 / (joints * 56):.3g} frames): "
             "ask for fewer frames"
@@ -164,7 +165,7 @@ def check_replaceable(option: str, given) -> None:
     try:
         files.check_replaceable(given, option)
     except OSError as e:
-        raise _error(str(e)) from None
+        raise CLIError(str(e)) from None
 
 
 def motion_output(option: str, given) -> str:
@@ -174,11 +175,11 @@ def motion_output(option: str, given) -> str:
 
     check_replaceable(option, given)
     if Path(given).is_dir():
-        raise _error(f"{option} {given} is a folder; expected the name of a file to write")
+        raise CLIError(f"{option} {given} is a folder; expected the name of a file to write")
     try:
         return motion_files.output_suffix(given, option)
     except ValueError as e:
-        raise _error(str(e)) from None
+        raise CLIError(str(e)) from None
 
 
 class CLIError(Exception):
@@ -188,14 +189,16 @@ class CLIError(Exception):
     """
 
 
-def _error(message: str) -> Exception:
-    return CLIError(message)
+def rig_error(error, role: str, path) -> CLIError:
+    """A :class:`CLIError` saying which file (``role``: source, target, input) does not map onto the
+    humanoid (a :class:`~motionlab.core.humanoid.RigMappingError` ``error``)."""
+    return CLIError(error.for_file(role, path))
 
 
 def _check_writable(option: str, path: Path, folder: Path) -> None:
     """Refuse ``path`` when the existing ``folder`` it goes into cannot be written."""
     if not os.access(folder, os.W_OK | os.X_OK):
-        raise _error(
+        raise CLIError(
             f"{option} {path}: cannot write into the folder {folder.resolve()} (permission denied); "
             "choose a folder you can write to"
         )
@@ -204,9 +207,9 @@ def _check_writable(option: str, path: Path, folder: Path) -> None:
 def _check_folder(option: str, path: Path, folder: Path) -> None:
     """``folder`` (where ``path`` goes) exists and takes new files."""
     if folder.exists() and not folder.is_dir():
-        raise _error(f"{option} {path}: {folder} is a file, not a folder; choose a file name in a folder")
+        raise CLIError(f"{option} {path}: {folder} is a file, not a folder; choose a file name in a folder")
     if not folder.is_dir():
-        raise _error(f"{option} {path}: the folder {folder} does not exist; create it or choose another folder")
+        raise CLIError(f"{option} {path}: the folder {folder} does not exist; create it or choose another folder")
     _check_writable(option, path, folder)
 
 
@@ -246,13 +249,13 @@ def check_outputs(
         path = Path(given)
         key = path.resolve()
         if key in seen:
-            raise _error(f"{seen[key]} and {option} both name {path}; give each output its own file")
+            raise CLIError(f"{seen[key]} and {option} both name {path}; give each output its own file")
         if key in read:
-            raise _error(f"{option} {path} is the {read[key]} file; write the output to another file")
+            raise CLIError(f"{option} {path} is the {read[key]} file; write the output to another file")
         if path.is_dir():
-            raise _error(f"{option} {path} is a folder; expected the name of a file to write")
+            raise CLIError(f"{option} {path} is a folder; expected the name of a file to write")
         if path.exists() and not force:
-            raise _error(files.exists_message(option, path))
+            raise CLIError(files.exists_message(option, path))
         _check_folder(option, path, path.parent)
         seen[key] = option
         checked.append(path)
@@ -269,12 +272,12 @@ def check_output_folder(option: str, given: str | os.PathLike) -> Path:
     """
     path = Path(given)
     if path.exists() and not path.is_dir():
-        raise _error(f"{option} {path} is a file; expected a folder (it is made if it does not exist)")
+        raise CLIError(f"{option} {path} is a file; expected a folder (it is made if it does not exist)")
     folder = path
     while not folder.exists():
         folder = folder.parent
     if not folder.is_dir():
-        raise _error(f"{option} {path}: {folder} is a file, so the folder cannot be made; choose another folder")
+        raise CLIError(f"{option} {path}: {folder} is a file, so the folder cannot be made; choose another folder")
     _check_writable(option, path, folder)
     return path
 

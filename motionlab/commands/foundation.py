@@ -8,15 +8,9 @@ import io
 from pathlib import Path
 
 from motionlab import cli_args
-from motionlab.cli_args import check_output_folder, check_outputs, positive, positive_int
+from motionlab.cli_args import check_output_folder, check_outputs, positive, positive_int, rig_error
 
 __all__ = ["register", "positive"]
-
-
-def _rig_error(error, role, path):
-    from motionlab.cli import rig_error
-
-    return rig_error(error, role, path)
 
 
 def _load(path: str, what: str = "input"):
@@ -92,7 +86,7 @@ def _convert(args) -> int:
         try:
             m = humanoid.to_canonical(m)
         except humanoid.RigMappingError as e:
-            raise _rig_error(e, "input", args.input) from None
+            raise rig_error(e, "input", args.input) from None
     if args.fps is not None:
         m = m.resample(args.fps)
     motion_files.save(out, m, overwrite=args.force, unit=unit)

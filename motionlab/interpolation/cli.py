@@ -36,7 +36,7 @@ import argparse
 from pathlib import Path
 
 from motionlab import cli_args
-from motionlab.cli_args import Stages
+from motionlab.cli_args import CLIError, Stages
 
 __all__ = ["register", "run_fill_gaps"]
 
@@ -74,7 +74,6 @@ def register(subparsers) -> None:
 
 
 def _graph(actions: list[str], allow: list[str], src: Path, motion):
-    from motionlab.cli import CLIError
     from motionlab.core import bvh
     from motionlab.interpolation.action_graph import ActionGraph, GraphError
 
@@ -104,7 +103,6 @@ def _graph(actions: list[str], allow: list[str], src: Path, motion):
 def _takes(paths: list[str], src: Path, motion):
     """:class:`~.recorded.RecordedTakes` of the ``--takes`` files (none of them the input), each on
     the input ``motion``'s skeleton and frame rate."""
-    from motionlab.cli import CLIError
     from motionlab.core import bvh
     from motionlab.interpolation.recorded import RecordedTakes
 
@@ -141,7 +139,6 @@ def _takes(paths: list[str], src: Path, motion):
 
 def _check_rig(what: str, clip, src: Path, motion) -> None:
     """Refuse a clip (``what``: the option and file that named it) on another rig than the input."""
-    from motionlab.cli import CLIError
 
     if tuple(clip.skeleton.names) != tuple(motion.skeleton.names):
         sk, mine = clip.skeleton, motion.skeleton
@@ -153,7 +150,6 @@ def _check_rig(what: str, clip, src: Path, motion) -> None:
 
 def _check_rate(path: Path, take, src: Path, motion) -> None:
     """Refuse a ``--takes`` file at another frame rate than the input."""
-    from motionlab.cli import CLIError
 
     if abs(take.fps - motion.fps) > 1e-6 * motion.fps:
         raise CLIError(
@@ -174,7 +170,6 @@ def _times_gaps(path: str, src: Path, motion) -> list[tuple[int, int]]:
     input's Frame Time (times in another unit than seconds are refused, never filled)."""
     import numpy as np
 
-    from motionlab.cli import CLIError
     from motionlab.interpolation import gaps
 
     try:
@@ -217,7 +212,6 @@ def _copy(src: Path, dst: Path, motion, force: bool) -> None:
 
 def _check_args(args: argparse.Namespace):
     """``(delta, src, dst)`` after checking the options and every output before any work."""
-    from motionlab.cli import CLIError
     from motionlab.cli_args import check_outputs
     from motionlab.core import files
     from motionlab.interpolation import detect
@@ -247,7 +241,6 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
     Detect frames missing from a BVH stream (distance D > Δ between consecutive frames), insert the estimated number
     of frames and fill them.
     """
-    from motionlab.cli import CLIError
     from motionlab.core import bvh, motion_files
     from motionlab.interpolation import detect, gaps
 

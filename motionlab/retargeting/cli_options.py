@@ -9,18 +9,10 @@ from __future__ import annotations
 
 import argparse
 
-from motionlab.cli_args import non_negative, non_negative_int, positive, renamed
+from motionlab.cli_args import CLIError, non_negative, non_negative_int, positive, renamed
+from motionlab.retargeting.pipeline import METHODS, ROOT_MODES  # the choices come from the library
 
-__all__ = ["ROOT_MODES", "load_checkpoint", "solver_config", "add_solver_args"]
-
-ROOT_MODES = ("stride", "hips", "legs", "contacts")
-"""``pipeline.ROOT_MODES``, repeated so that ``--help`` does not import torch (a test keeps them equal)."""
-
-
-def _error(msg: str):
-    from motionlab.cli import CLIError
-
-    return CLIError(msg)
+__all__ = ["METHODS", "ROOT_MODES", "load_checkpoint", "solver_config", "add_solver_args"]
 
 
 def load_checkpoint(path: str | None, device: str | None):
@@ -40,16 +32,16 @@ def load_checkpoint(path: str | None, device: str | None):
         try:
             files.check_input(path, "--checkpoint")
         except OSError as e:
-            raise _error(str(e)) from None
+            raise CLIError(str(e)) from None
         if not zipfile.is_zipfile(path):  # torch.save writes a zip archive; text or BVH is refused here
-            raise _error(
+            raise CLIError(
                 f"--checkpoint {path} is not a network checkpoint (a .pt file written by `motionlab train`, "
                 "which is a zip archive)"
             )
     try:
         return retargeting.load(path, device) if path else retargeting.load_default(device)
     except retargeting.CheckpointError as e:
-        raise _error(str(e)) from None
+        raise CLIError(str(e)) from None
 
 
 def solver_config(args):
@@ -64,7 +56,7 @@ def solver_config(args):
         ("--exact-rounds", args.exact_rounds, 0 <= args.exact_rounds <= rounds, f"between 0 and {rounds}"),
     ):
         if not ok:  # also refuses nan
-            raise _error(f"{option} must be {expected}, got {value}")
+            raise CLIError(f"{option} must be {expected}, got {value}")
     return SolverConfig(
         max_steps=args.steps,
         lr=args.lr,

@@ -224,9 +224,7 @@ def options_digest(checkpoint: Checkpoint, solver: SolverConfig, root_mode: str,
 def _why(err: Exception, role: str, path) -> str:
     """What went wrong with the ``role`` (character, source) file ``path``, in words a command-line user can act on."""
     if isinstance(err, humanoid.RigMappingError):  # its Python hint (profile=...) has no command-line form
-        from motionlab.cli import rig_error
-
-        return f"{type(err).__name__}: {rig_error(err, role, path)}"
+        return f"{type(err).__name__}: {err.for_file(role, path)}"
     return f"{type(err).__name__}: {err}"
 
 

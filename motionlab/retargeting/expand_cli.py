@@ -13,7 +13,7 @@ import argparse
 import sys
 
 from motionlab import cli_args
-from motionlab.cli_args import check_output_folder, non_negative, non_negative_int, positive, positive_int
+from motionlab.cli_args import CLIError, check_output_folder, non_negative, non_negative_int, positive, positive_int
 from motionlab.retargeting import cli_options
 from motionlab.retargeting.cli_options import ROOT_MODES
 
@@ -27,7 +27,6 @@ def _cmd_expand(args) -> int:
     with --format glb) with OUT/manifest.csv (one row per output). Rerunning the same command redoes only what is
     missing. Exit status 1 when some pair failed (see the manifest's error column).
     """
-    from motionlab.cli import CLIError
     from motionlab.retargeting import expand as ex
 
     if args.backend == "ray":

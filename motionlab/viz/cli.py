@@ -17,15 +17,9 @@ import time
 from pathlib import Path
 
 from motionlab import cli_args
-from motionlab.cli_args import check_outputs, non_negative_int, positive, positive_int
+from motionlab.cli_args import CLIError, check_outputs, non_negative_int, positive, positive_int, rig_error
 
 __all__ = ["register"]
-
-
-def _error(message: str):
-    from motionlab.cli import CLIError
-
-    return CLIError(message)
 
 
 MAX_SIZE = 4096
@@ -93,23 +87,23 @@ def _cmd_view(args) -> int:
     source = files.check_input(args.file, "BVH")
     out = Path(args.output) if args.output else None
     if out is None and not backend.has_display():  # never write into the current folder unasked
-        raise _error(f"no display found to open a window for {source}; write a movie instead with -o {source.stem}.mp4")
+        raise CLIError(
+            f"no display found to open a window for {source}; write a movie instead with -o {source.stem}.mp4"
+        )
     if out is not None:
         if out.suffix.lower() not in MOVIE_SUFFIXES:
-            raise _error(f"-o must end in .mp4 or .gif, got {str(out)!r}")
+            raise CLIError(f"-o must end in .mp4 or .gif, got {str(out)!r}")
         check_outputs([("-o", args.output)], args.force, inputs=[("input", source)])
     try:
         motion = bvh.load(source, scale=args.unit_scale)
     except bvh.BVHError as e:
-        raise _error(str(e)) from None
+        raise CLIError(str(e)) from None
     if args.canonical:
         from motionlab.core import humanoid
 
         try:
             motion = humanoid.to_canonical(motion)
         except humanoid.RigMappingError as e:
-            from motionlab.cli import rig_error
-
             raise rig_error(e, "input", source) from None
     if args.start or args.stop is not None:
         motion = _frames(motion, args.start, args.stop, source)
@@ -122,7 +116,7 @@ def _cmd_view(args) -> int:
     try:
         backend.import_pyvista()
     except backend.RenderingUnavailable as e:
-        raise _error(str(e)) from None
+        raise CLIError(str(e)) from None
     start = time.perf_counter()
     kwargs = {"stride": args.stride} if args.stride else {}
     save_movie(motion, out, overwrite=args.force, off_screen=True, anti_aliasing=args.smooth, **kwargs, **options)
@@ -139,10 +133,10 @@ def _cmd_view(args) -> int:
 def _frames(motion, start: int, stop: int | None, source: Path):
     """Frames ``start`` up to ``stop`` (``None``: the end) of ``motion``, or a CLIError naming the options."""
     if start >= motion.num_frames:
-        raise _error(f"--start {start} is past the last frame of {source} ({motion.num_frames} frames: 0 to "
+        raise CLIError(f"--start {start} is past the last frame of {source} ({motion.num_frames} frames: 0 to "
                      f"{motion.num_frames - 1})")  # fmt: skip
     if stop is not None and stop <= start:
-        raise _error(f"--stop {stop} must be after --start {start}")
+        raise CLIError(f"--stop {stop} must be after --start {start}")
     return motion[start:stop]
 
 
