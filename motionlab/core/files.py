@@ -32,7 +32,9 @@ __all__ = [
     "exists_message",
     "atomic_write",
     "atomic_write_all",
+    "atomic_write_file",
     "remove_stale",
+    "remove_stale_in",
 ]
 
 TMP_SUFFIX = ".motionlab-tmp"
@@ -141,10 +143,20 @@ def _alive(pid: int) -> bool:
 def remove_stale(path: str | os.PathLike) -> list[Path]:
     """Remove temporary files left beside ``path`` by writers that no longer run; returns them."""
     path = Path(path)
-    pattern = re.compile(rf"\.{re.escape(path.name)}\.(\d+)\.[^.]+{re.escape(TMP_SUFFIX)}\Z")
+    name = re.escape(path.name)
+    return _remove_stale(path.parent, rf"\.{name}\.(\d+)\.[^.]+{re.escape(TMP_SUFFIX)}(?:{re.escape(path.suffix)})?\Z")
+
+
+def remove_stale_in(folder: str | os.PathLike) -> list[Path]:
+    """Remove every temporary file in ``folder`` left by a motionlab writer that no longer runs."""
+    return _remove_stale(Path(folder), rf"\..+\.(\d+)\.[^.]+{re.escape(TMP_SUFFIX)}(?:\.[^.]+)?\Z")
+
+
+def _remove_stale(folder: Path, regex: str) -> list[Path]:
+    pattern = re.compile(regex)
     removed = []
     try:
-        entries = list(path.parent.iterdir())
+        entries = list(folder.iterdir())
     except OSError:
         return removed
     for entry in entries:
@@ -162,8 +174,8 @@ def atomic_write_all(outputs: list[tuple], overwrite: bool = False) -> list[Path
     """Write several files as one: every temporary file is complete before the first rename.
 
     ``outputs`` holds ``(path, write, binary, what)`` tuples as for :func:`atomic_write`. If
-    any ``write`` fails, no destination is touched; the renames at the end cannot fail short
-    of a system failure.
+    any ``write`` fails, no destination is touched; the renames at the end, in the order of
+    ``outputs``, cannot fail short of a system failure.
     """
     checked = [(check_output(path, overwrite, what), write, binary, what) for path, write, binary, what in outputs]
     temps: list[str] = []
@@ -188,25 +200,45 @@ def _removed_on_error(temps: list[str]):
         raise
 
 
-def _write_temporary(path: Path, write: Callable, binary: bool, what: str) -> str:
-    """A complete temporary file beside ``path`` holding what ``write(f)`` wrote, with ``path``'s mode."""
-    if path.exists():
-        mode = path.stat().st_mode & 0o777
-    else:
-        umask = os.umask(0)
-        os.umask(umask)
-        mode = 0o666 & ~umask
+def _umask() -> int:
+    """The process umask, read without changing it where Linux shows it (``/proc/self/status``)."""
     try:
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.{os.getpid()}.", suffix=TMP_SUFFIX)
+        with open("/proc/self/status", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    umask = os.umask(0o022)  # elsewhere: read by setting, then set back at once
+    os.umask(umask)
+    return umask
+
+
+def _mode(path: Path) -> int:
+    """Permissions for ``path``'s new contents: the old file's, or what ``open`` gives a new file."""
+    return path.stat().st_mode & 0o777 if path.exists() else 0o666 & ~_umask()
+
+
+def _write_temporary(path: Path, write: Callable, binary: bool, what: str, by_name: bool = False) -> str:
+    """A complete temporary file beside ``path`` holding what ``write(f)`` wrote (``by_name``:
+    ``write(tmp_path)``, ``tmp_path`` ending in ``path``'s suffix), with ``path``'s mode, on disk."""
+    mode = _mode(path)
+    suffix = TMP_SUFFIX + (path.suffix if by_name else "")
+    try:
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.{os.getpid()}.", suffix=suffix)
     except OSError as e:  # the folder refuses new files: say which output, not the temporary name
         raise type(e)(f"cannot write the {what} {path}: {(e.strerror or str(e)).lower()}") from None
     with _removed_on_error([tmp]):
-        if binary:
-            with os.fdopen(fd, "wb") as f:
-                write(f)
+        if by_name:
+            os.close(fd)
+            write(Path(tmp))
         else:
-            with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
+            with os.fdopen(
+                fd, "wb" if binary else "w", **({} if binary else {"encoding": "utf-8", "newline": "\n"})
+            ) as f:
                 write(f)
+                f.flush()
+                os.fsync(f.fileno())
         os.chmod(tmp, mode)
     return tmp
 
@@ -230,6 +262,25 @@ def atomic_write(
     path = check_output(path, overwrite, what)
     remove_stale(path)
     tmp = _write_temporary(path, write, binary, what)
+    with _removed_on_error([tmp]):
+        os.replace(tmp, path)
+    return path
+
+
+def atomic_write_file(
+    path: str | os.PathLike, fill: Callable[[Path], None], overwrite: bool = False, what: str = "output"
+) -> Path:
+    """:func:`atomic_write` for writers that need a file name (a movie encoder, an image library):
+    ``fill(tmp)`` writes the temporary file ``tmp``, a Path beside ``path`` ending in its suffix.
+
+    Raises
+    ------
+    OSError
+        as :func:`check_output` says for ``path``; whatever ``fill`` raises (``path`` unchanged).
+    """
+    path = check_output(path, overwrite, what)
+    remove_stale(path)
+    tmp = _write_temporary(path, fill, True, what, by_name=True)
     with _removed_on_error([tmp]):
         os.replace(tmp, path)
     return path
