@@ -48,12 +48,17 @@ def check_input(path: str | os.PathLike, what: str = "input") -> Path:
     ------
     FileNotFoundError, IsADirectoryError, PermissionError
         With a message naming ``what`` and the path.
+    OSError
+        ``path`` is a named pipe, a device or a socket (a link to a file is read).
     """
     path = Path(path)
     if path.is_dir():
         raise IsADirectoryError(f"{what} {path} is a folder; expected a file")
     if not path.exists():
         raise FileNotFoundError(f"{what} file {path} not found")
+    kind = _kind(path.resolve())
+    if kind is not None:  # reading a named pipe or a device can wait forever, or never end
+        raise OSError(f"{what} {path} is {kind}, not a file; expected a file")
     if not os.access(path, os.R_OK):
         raise PermissionError(f"{what} file {path} is not readable (permission denied)")
     return path

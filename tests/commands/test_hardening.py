@@ -579,3 +579,9 @@ def test_expand_writes_a_cmu_character_in_metres_in_gltf():
     (cmu,) = ex.characters(str(require_data("cmu", "131", "131_01.bvh")))
     (mixamo,) = ex.characters(str(require_data("mixamo", "Kaya", "Running.bvh")))
     assert (cmu.unit, mixamo.unit) == (motion_files.ASF_UNIT, motion_files.CM)
+
+
+def test_an_input_that_is_a_named_pipe_is_refused_not_waited_on(tmp_path, capsys):
+    os.mkfifo(tmp_path / "pipe.bvh")
+    code, _, err = _run(capsys, "convert", tmp_path / "pipe.bvh", "-o", tmp_path / "x.bvh")
+    assert code == 2 and "named pipe" in err and not (tmp_path / "x.bvh").exists()
