@@ -128,10 +128,36 @@ def _load_clips(args: argparse.Namespace) -> list:
         motions = clips.synthetic_library(fps=args.fps)
         print(f"using {len(motions)} synthetic clips (no real data)")
         return motions
+    _check_folder_size(args.folder, args.fps)
     try:
         return clips.load_folder(args.folder, args.fps, name_map, progress=not args.quiet)
     except NamingError as e:
         raise CLIError(str(e)) from None
+
+
+def _header_seconds(path: Path) -> float:
+    """A BVH file's length in seconds from its ``Frames:`` and ``Frame Time:`` lines (0 when unreadable)."""
+    frames = None
+    try:
+        with open(path, encoding="utf-8", errors="replace") as f:
+            for line in f:
+                key, _, value = line.strip().partition(":")
+                if key == "Frames":
+                    frames = float(value)
+                elif key == "Frame Time" and frames is not None:
+                    return frames * float(value)
+    except (OSError, ValueError):
+        pass
+    return 0.0
+
+
+def _check_folder_size(folder: str, fps: float) -> None:
+    """Refuse, before loading, a folder whose clips at ``--fps`` would be more frames than
+    :func:`motionlab.cli_args.check_size` allows (read from the files' headers)."""
+    folder_path = Path(folder)
+    if folder_path.is_dir():
+        seconds = sum(_header_seconds(p) for p in folder_path.rglob("*.bvh"))
+        cli_args.check_size(f"--fps {fps:g} over the {seconds:.0f} s of clips in {folder}", seconds * fps, 22)
 
 
 def _build_graph(args: argparse.Namespace, motions: list):

@@ -585,3 +585,15 @@ def test_an_input_that_is_a_named_pipe_is_refused_not_waited_on(tmp_path, capsys
     os.mkfifo(tmp_path / "pipe.bvh")
     code, _, err = _run(capsys, "convert", tmp_path / "pipe.bvh", "-o", tmp_path / "x.bvh")
     assert code == 2 and "named pipe" in err and not (tmp_path / "x.bvh").exists()
+
+
+def test_graph_build_refuses_a_folder_too_long_at_the_frame_rate_before_loading(tmp_path, capsys, monkeypatch):
+    def no_loading(*args, **kwargs):
+        raise AssertionError("loaded before checking the size")
+
+    monkeypatch.setattr("motionlab.motion_graphs.clips.load_folder", no_loading)
+    (tmp_path / "clips").mkdir()
+    header = "HIERARCHY\nROOT Hips\n{\n}\nMOTION\nFrames: 100000000\nFrame Time: 0.0333333\n"
+    (tmp_path / "clips" / "walk_normal.bvh").write_text(header)
+    code, _, err = _run(capsys, "graph-build", tmp_path / "clips", "-o", tmp_path / "g.mlgraph", "--fps", "1000")
+    assert code == 2 and "--fps 1000" in err and "at most" in err and not (tmp_path / "g.mlgraph").exists()
