@@ -11,7 +11,7 @@ import argparse
 import importlib
 import sys
 
-from motionlab.cli_args import CLIError, HelpFormatter, RawDescriptionHelpFormatter
+from motionlab.cli_args import CLIError, HelpFormatter, RawDescriptionHelpFormatter, rig_error
 
 __all__ = ["main", "build_parser", "CLIError", "rig_error"]
 
@@ -22,16 +22,6 @@ _PARTS = (
     "motionlab.interpolation.cli",
     "motionlab.viz.cli",
 )
-
-
-def rig_error(error, role: str, path) -> Exception:
-    """A CLIError saying which file (``role``: source, target, input) does not map onto the humanoid."""
-    from motionlab.core.humanoid import PROFILES
-
-    return CLIError(
-        f"{role} file {path}: {error.reason} Its joint names must follow one of the rig profiles "
-        f"{', '.join(PROFILES)}; `motionlab info {path} --joints` lists its joints."
-    )
 
 
 def build_parser() -> argparse.ArgumentParser:

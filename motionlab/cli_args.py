@@ -28,12 +28,22 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+from motionlab.core import files
+
 __all__ = [
     "CLIError",
+    "rig_error",
     "positive",
     "non_negative",
     "positive_int",
     "non_negative_int",
+    "in_range",
+    "frame_rate",
+    "factor",
+    "seed",
+    "check_size",
+    "motion_output",
+    "check_replaceable",
     "check_outputs",
     "check_output_folder",
     "HelpFormatter",
@@ -115,6 +125,103 @@ def non_negative_int(text: str) -> int:
     return value
 
 
+def in_range(low: float, high: float, what: str = "a number", name: str = "in_range"):
+    """argparse type named ``name``: a finite number from ``low`` to ``high`` (the message states the range)."""
+
+    def check(text: str) -> float:
+        value = _number(text)
+        if not (math.isfinite(value) and low <= value <= high):
+            raise argparse.ArgumentTypeError(f"expected {what} from {low:g} to {high:g}, got {text!r}")
+        return value
+
+    check.__name__ = name
+    return check
+
+
+FPS_RANGE = (1.0, 1000.0)
+"""Frame rates a command accepts: motion capture records at 24 to 480 fps; above 1000 fps a clip
+only grows, below 1 fps it is no longer motion."""
+
+frame_rate = in_range(*FPS_RANGE, "a frame rate in fps", "frame_rate")
+"""argparse type of every ``--fps``."""
+
+FACTOR_RANGE = (0.1, 10.0)
+"""Bone-length factors a command accepts: a tenth to ten times the bone (a human figure stays one)."""
+
+factor = in_range(*FACTOR_RANGE, "a length factor", "factor")
+"""argparse type of every ``--scale*``, ``--legs``, ``--arms`` factor."""
+
+SEED_MAX = 2**32 - 1
+
+
+def seed(text: str) -> int:
+    """argparse type of every ``--seed``: a whole number from 0 to 2**32 - 1 (what NumPy's generators take).
+
+    Raises
+    ------
+    argparse.ArgumentTypeError for anything else.
+    """
+    value = _whole(text)
+    if not 0 <= value <= SEED_MAX:
+        raise argparse.ArgumentTypeError(f"expected a whole number from 0 to {SEED_MAX}, got {text!r}")
+    return value
+
+
+MAX_OUTPUT_GB = 2.0
+"""A command refuses, before any work, an output whose poses would take more than this many GB
+of memory (``frames x joints x 7`` float64 numbers: a rotation and a position per joint)."""
+
+
+def check_size(what: str, frames: float, joints: int) -> None:
+    """Refuse a motion of ``frames`` frames of ``joints`` joints beyond :data:`MAX_OUTPUT_GB`;
+    ``what`` names the options that asked for it (``--seconds 1e9 at --fps 60``).
+
+    Raises
+    ------
+    CLIError naming ``what``, the size asked for and the limit.
+    """
+    gigabytes = frames * joints * 7 * 8 / 1e9
+    if not gigabytes <= MAX_OUTPUT_GB:
+        raise CLIError(
+            f"{what} asks for {frames:.3g} frames of {joints} joints ({gigabytes:.3g} GB of poses); "
+            f"at most {MAX_OUTPUT_GB:g} GB is made ({MAX_OUTPUT_GB * 1e9 / (joints * 56):.3g} frames): "
+            "ask for fewer frames"
+        )
+
+
+def check_replaceable(option: str, given) -> None:
+    """A :class:`CLIError` for an output name that is no file to write, ``--force`` or not: a name
+    ending in ``/``, a symbolic link, a named pipe, a device (:func:`motionlab.core.files.check_replaceable`).
+
+    Raises
+    ------
+    CLIError naming ``option`` and what the path is.
+    """
+    try:
+        files.check_replaceable(given, option)
+    except OSError as e:
+        raise CLIError(str(e)) from None
+
+
+def motion_output(option: str, given) -> str:
+    """The suffix (``.bvh``, ``.glb``) of a motion output, or a :class:`CLIError` saying which are
+    written (:func:`motionlab.core.motion_files.output_suffix`); first :func:`check_replaceable`.
+
+    Raises
+    ------
+    CLIError for a name that is no file to write, a folder, or a suffix that is not written.
+    """
+    from motionlab.core import motion_files
+
+    check_replaceable(option, given)
+    if Path(given).is_dir():
+        raise CLIError(f"{option} {given} is a folder; expected the name of a file to write")
+    try:
+        return motion_files.output_suffix(given, option)
+    except ValueError as e:
+        raise CLIError(str(e)) from None
+
+
 class CLIError(Exception):
     """A user-facing error: printed as ``motionlab: error: …`` with exit status 2, no traceback.
 
@@ -122,14 +229,16 @@ class CLIError(Exception):
     """
 
 
-def _error(message: str) -> Exception:
-    return CLIError(message)
+def rig_error(error, role: str, path) -> CLIError:
+    """A :class:`CLIError` saying which file (``role``: source, target, input) does not map onto the
+    humanoid (a :class:`~motionlab.core.humanoid.RigMappingError` ``error``)."""
+    return CLIError(error.for_file(role, path))
 
 
 def _check_writable(option: str, path: Path, folder: Path) -> None:
     """Refuse ``path`` when the existing ``folder`` it goes into cannot be written."""
     if not os.access(folder, os.W_OK | os.X_OK):
-        raise _error(
+        raise CLIError(
             f"{option} {path}: cannot write into the folder {folder.resolve()} (permission denied); "
             "choose a folder you can write to"
         )
@@ -138,9 +247,9 @@ def _check_writable(option: str, path: Path, folder: Path) -> None:
 def _check_folder(option: str, path: Path, folder: Path) -> None:
     """``folder`` (where ``path`` goes) exists and takes new files."""
     if folder.exists() and not folder.is_dir():
-        raise _error(f"{option} {path}: {folder} is a file, not a folder; choose a file name in a folder")
+        raise CLIError(f"{option} {path}: {folder} is a file, not a folder; choose a file name in a folder")
     if not folder.is_dir():
-        raise _error(f"{option} {path}: the folder {folder} does not exist; create it or choose another folder")
+        raise CLIError(f"{option} {path}: the folder {folder} does not exist; create it or choose another folder")
     _check_writable(option, path, folder)
 
 
@@ -165,8 +274,9 @@ def check_outputs(
     Raises
     ------
     CLIError
-        An output is a folder, exists without ``force``, lies in a missing or unwritable folder,
-        is named by two options, or is an input file; the message names the option.
+        An output is a folder (or a name ending in ``/``), exists without ``force``, is a link, a
+        named pipe or a device (``force`` or not), lies in a missing or unwritable folder, is named
+        by two options, or is an input file; the message names the option.
     """
     seen: dict[Path, str] = {}
     read = {Path(p).resolve(): what for what, p in inputs if p is not None}
@@ -175,16 +285,17 @@ def check_outputs(
         if given is None:
             checked.append(None)
             continue
+        check_replaceable(option, given)
         path = Path(given)
         key = path.resolve()
         if key in seen:
-            raise _error(f"{seen[key]} and {option} both name {path}; give each output its own file")
+            raise CLIError(f"{seen[key]} and {option} both name {path}; give each output its own file")
         if key in read:
-            raise _error(f"{option} {path} is the {read[key]} file; write the output to another file")
+            raise CLIError(f"{option} {path} is the {read[key]} file; write the output to another file")
         if path.is_dir():
-            raise _error(f"{option} {path} is a folder; expected the name of a file to write")
+            raise CLIError(f"{option} {path} is a folder; expected the name of a file to write")
         if path.exists() and not force:
-            raise _error(f"{option} {path} exists; add --force to replace it, or choose another file name")
+            raise CLIError(files.exists_message(option, path))
         _check_folder(option, path, path.parent)
         seen[key] = option
         checked.append(path)
@@ -201,12 +312,12 @@ def check_output_folder(option: str, given: str | os.PathLike) -> Path:
     """
     path = Path(given)
     if path.exists() and not path.is_dir():
-        raise _error(f"{option} {path} is a file; expected a folder (it is made if it does not exist)")
+        raise CLIError(f"{option} {path} is a file; expected a folder (it is made if it does not exist)")
     folder = path
     while not folder.exists():
         folder = folder.parent
     if not folder.is_dir():
-        raise _error(f"{option} {path}: {folder} is a file, so the folder cannot be made; choose another folder")
+        raise CLIError(f"{option} {path}: {folder} is a file, so the folder cannot be made; choose another folder")
     _check_writable(option, path, folder)
     return path
 
@@ -338,7 +449,7 @@ def add_rate_and_plausibility_args(p: argparse.ArgumentParser) -> None:
     """``--fps`` (output frame rate) and ``--keep-implausible``, shared by ``retarget`` and ``expand``."""
     p.add_argument(
         "--fps",
-        type=positive,
+        type=frame_rate,
         metavar="FPS",
         help="frame rate of the output (default: the source's; a resample is always reported)",
     )

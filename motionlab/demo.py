@@ -102,7 +102,7 @@ def _claim(out_dir: Path, planned: list[Path], force: bool) -> None:
     if clash and not owned and not force:
         raise FileExistsError(
             f"{clash[0]} exists (and {len(clash) - 1} more) in {out_dir}, which an earlier demo did not write; "
-            "pass --force to overwrite, or choose another --out"
+            "add --force to replace them (force=True in Python), or choose another -o folder"
         )
     out_dir.mkdir(parents=True, exist_ok=True)
     files.atomic_write(

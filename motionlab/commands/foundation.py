@@ -8,15 +8,9 @@ import io
 from pathlib import Path
 
 from motionlab import cli_args
-from motionlab.cli_args import check_output_folder, check_outputs, positive, positive_int
+from motionlab.cli_args import check_output_folder, check_outputs, positive, positive_int, rig_error
 
 __all__ = ["register", "positive"]
-
-
-def _rig_error(error, role, path):
-    from motionlab.cli import rig_error
-
-    return rig_error(error, role, path)
 
 
 def _load(path: str, what: str = "input"):
@@ -25,13 +19,23 @@ def _load(path: str, what: str = "input"):
     return bvh.load(files.check_input(path, what))
 
 
+def _rest_line(m, path) -> None:
+    from motionlab.core import humanoid, rest_pose
+
+    try:
+        stand, pose = rest_pose.standing(humanoid.to_canonical(m), path, humanoid.family(m.skeleton))
+        print(f"rest      {pose.describe()}; standing height {stand.skeleton.height():.4f} m")
+    except rest_pose.RestPoseError as e:
+        print(f"rest      {e}")
+
+
 def _info(args) -> int:
     """describe a BVH file: skeleton, frames, fps, 22-joint mapping
 
     Print a BVH file's skeleton, frame count, frame rate, rest height and whether (and by which rig profile) it maps
     onto the canonical 22-joint humanoid.
     """
-    from motionlab.core import humanoid, rest_pose
+    from motionlab.core import humanoid
 
     m = _load(args.file)
     sk = m.skeleton
@@ -49,11 +53,10 @@ def _info(args) -> int:
     except humanoid.RigMappingError as e:
         print(f"humanoid  does not map: {e.reason}")
     else:
-        try:
-            stand, pose = rest_pose.standing(humanoid.to_canonical(m), args.file, humanoid.family(sk))
-            print(f"rest      {pose.describe()}; standing height {stand.skeleton.height():.4f} m")
-        except rest_pose.RestPoseError as e:
-            print(f"rest      {e}")
+        if m.num_frames == 0:
+            print("rest      no frames to read the standing pose from")
+        else:
+            _rest_line(m, args.file)
     if args.joints:
         depth = sk.depth()
         for j, name in enumerate(sk.names):
@@ -66,39 +69,48 @@ def _convert(args) -> int:
     """reduce a BVH file to the 22-joint humanoid and/or resample it; write BVH or glTF (.glb)
 
     Read a BVH file, optionally reduce it to the canonical 22 joints (--canonical) and resample it (--fps), and
-    write it as BVH or, when OUTPUT ends in .glb, as binary glTF 2.0 (docs/gltf.md).
+    write it as BVH (OUTPUT ending in .bvh, in the input's length unit) or binary glTF 2.0 (.glb, in metres;
+    docs/gltf.md).
     """
-    from motionlab.core import bvh, gltf, humanoid
+    from motionlab.core import humanoid, motion_files
 
+    cli_args.motion_output("-o", args.output)
     (out,) = check_outputs([("-o", args.output)], args.force, inputs=[("input", args.input)])
     m = _load(args.input)
+    unit = motion_files.file_unit(m.skeleton)
+    if args.fps is not None:
+        cli_args.check_size(
+            f"--fps {args.fps:g} over {m.duration:g} s", m.duration * args.fps + 1, m.skeleton.num_joints
+        )
     if args.canonical:
         try:
             m = humanoid.to_canonical(m)
         except humanoid.RigMappingError as e:
-            raise _rig_error(e, "input", args.input) from None
+            raise rig_error(e, "input", args.input) from None
     if args.fps is not None:
         m = m.resample(args.fps)
-    (gltf.save if out.suffix.lower() == gltf.SUFFIX else bvh.save)(out, m, overwrite=args.force)
+    motion_files.save(out, m, overwrite=args.force, unit=unit)
     if not args.quiet:
         print(f"wrote {out}: {m.num_frames} frames at {m.fps:g} fps, {m.skeleton.num_joints} joints")
     return 0
 
 
 def _synth(args) -> int:
-    """write synthetic motion (idle, walk, run, jump, squat or mix) as BVH
+    """write synthetic motion (idle, walk, run, jump, squat or mix) as BVH or glTF (.glb)
 
     Generate procedural humanoid motion on a character of the given height and limb proportions and write it as BVH
-    (mix: idle -> walk -> run -> jump -> walk -> squat).
+    or, when OUTPUT ends in .glb, binary glTF 2.0 (mix: idle -> walk -> run -> jump -> walk -> squat).
     """
     from motionlab import synthetic
-    from motionlab.core import bvh, humanoid
+    from motionlab.core import humanoid, motion_files
 
+    cli_args.motion_output("-o", args.output)
     (out,) = check_outputs([("-o", args.output)], args.force)
+    joints = len(humanoid.JOINTS)
     if args.behaviour != "mix" and int(args.seconds * args.fps) < 1:
-        from motionlab.cli import CLIError
-
-        raise CLIError(f"--seconds {args.seconds:g} at --fps {args.fps:g} is less than one frame")
+        raise cli_args.CLIError(f"--seconds {args.seconds:g} at --fps {args.fps:g} is less than one frame")
+    if args.behaviour != "mix":
+        cli_args.check_size(f"--seconds {args.seconds:g} at --fps {args.fps:g}", args.seconds * args.fps, joints)
     skeleton = humanoid.canonical_skeleton(args.height)
     skeleton = humanoid.scale_bones(skeleton, legs=args.legs, arms=args.arms)
     if args.behaviour == "mix":
@@ -109,7 +121,7 @@ def _synth(args) -> int:
             args.behaviour, skeleton, num_frames=int(args.seconds * args.fps), fps=args.fps, seed=args.seed
         )
     motion.name = args.behaviour
-    bvh.save(out, motion, overwrite=args.force)
+    motion_files.save(out, motion, overwrite=args.force, unit=motion_files.CM)
     if not args.quiet:
         print(f"wrote {out}: {motion.num_frames} frames of {args.behaviour} at {motion.fps:g} fps")
     return 0
@@ -140,20 +152,27 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     with cli_args.command(sub, "convert", _convert) as p:
         p.add_argument("input", help="input .bvh")
-        cli_args.add_output(p, "output file: .glb writes glTF 2.0 (Blender, web viewers, engines), any other name BVH")
+        cli_args.add_output(p, "output file: .bvh writes BVH, .glb binary glTF 2.0 (Blender, web viewers, engines)")
         p.add_argument("--canonical", action="store_true", help="reduce to the canonical 22 joints")
-        p.add_argument("--fps", type=positive, default=None, help="resample to this frame rate (frames per second)")
+        p.add_argument(
+            "--fps", type=cli_args.frame_rate, default=None, help="resample to this frame rate (frames per second)"
+        )
         cli_args.add_force(p, "overwrite the output if it exists")
 
     with cli_args.command(sub, "synth", _synth) as p:
         p.add_argument("behaviour", choices=["idle", "walk", "run", "jump", "squat", "mix"], help="what the body does")
-        cli_args.add_output(p, "output .bvh")
+        cli_args.add_output(p, "output file: .bvh or .glb (binary glTF 2.0)")
         p.add_argument("--seconds", type=positive, default=4.0, help="length in seconds (ignored for mix)")
-        p.add_argument("--fps", type=positive, default=60.0, help="frame rate (frames per second)")
-        p.add_argument("--height", type=positive, default=1.75, help="character height, metres")
-        p.add_argument("--legs", type=positive, default=1.0, help="leg length factor")
-        p.add_argument("--arms", type=positive, default=1.0, help="arm length factor")
-        p.add_argument("--seed", type=int, default=0, help="random seed")
+        p.add_argument("--fps", type=cli_args.frame_rate, default=60.0, help="frame rate (frames per second)")
+        p.add_argument(
+            "--height",
+            type=cli_args.in_range(0.3, 3.0, "a height in metres"),
+            default=1.75,
+            help="character height, metres",
+        )
+        p.add_argument("--legs", type=cli_args.factor, default=1.0, help="leg length factor")
+        p.add_argument("--arms", type=cli_args.factor, default=1.0, help="arm length factor")
+        p.add_argument("--seed", type=cli_args.seed, default=0, help="random seed")
         cli_args.add_force(p, "overwrite the output if it exists")
 
     with cli_args.command(sub, "demo", _demo) as p:
@@ -165,7 +184,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                 "--num-characters", type=positive_int, default=4, help="how many new characters (1 or more)"
             ),
         )
-        p.add_argument("--seed", type=int, default=0, help="random seed")
+        p.add_argument("--seed", type=cli_args.seed, default=0, help="random seed")
         cli_args.add_force(
             p, "replace files in an output folder that an earlier demo did not write (a demo folder is always re-used)"
         )

@@ -19,11 +19,23 @@ from __future__ import annotations
 import contextlib
 import os
 import re
+import stat
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
-__all__ = ["TMP_SUFFIX", "check_input", "check_output", "atomic_write", "atomic_write_all", "remove_stale"]
+__all__ = [
+    "TMP_SUFFIX",
+    "check_input",
+    "check_output",
+    "check_replaceable",
+    "exists_message",
+    "atomic_write",
+    "atomic_write_all",
+    "atomic_write_file",
+    "remove_stale",
+    "remove_stale_in",
+]
 
 TMP_SUFFIX = ".motionlab-tmp"
 """Ending of every temporary file a motionlab writer creates."""
@@ -36,15 +48,62 @@ def check_input(path: str | os.PathLike, what: str = "input") -> Path:
     ------
     FileNotFoundError, IsADirectoryError, PermissionError
         With a message naming ``what`` and the path.
+    OSError
+        ``path`` is a named pipe, a device or a socket (a link to a file is read).
     """
     path = Path(path)
     if path.is_dir():
         raise IsADirectoryError(f"{what} {path} is a folder; expected a file")
     if not path.exists():
         raise FileNotFoundError(f"{what} file {path} not found")
+    kind = _kind(path.resolve())
+    if kind is not None:  # reading a named pipe or a device can wait forever, or never end
+        raise OSError(f"{what} {path} is {kind}, not a file; expected a file")
     if not os.access(path, os.R_OK):
         raise PermissionError(f"{what} file {path} is not readable (permission denied)")
     return path
+
+
+def _kind(path: Path) -> str | None:
+    """What ``path`` is when it is not a plain file or folder to write (a link, a named pipe, ...)."""
+    if path.is_symlink():
+        return f"a symbolic link (to {os.readlink(path)})"
+    try:
+        mode = path.stat().st_mode
+    except OSError:
+        return None
+    for test, name in ((stat.S_ISFIFO, "a named pipe"), (stat.S_ISCHR, "a character device"),
+                       (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket")):  # fmt: skip
+        if test(mode):
+            return name
+    return None
+
+
+def check_replaceable(path: str | os.PathLike, what: str = "output") -> None:
+    """Refuse, even with ``overwrite``, a destination that a write would not replace as a file:
+    a symbolic link (the write would replace the link, not what it points to), a named pipe, a
+    device or a socket, or a name ending in a path separator (a folder's name).
+
+    Raises
+    ------
+    FileExistsError
+        saying what ``path`` is.
+    IsADirectoryError
+        ``path`` ends in a separator (``newdir/``).
+    """
+    text = os.fspath(path)
+    if text.endswith(("/", os.sep)):
+        raise IsADirectoryError(f"{what} {text} ends in {text[-1]!r}, so it names a folder; expected a file name")
+    kind = _kind(Path(path))
+    if kind is not None:
+        raise FileExistsError(
+            f"{what} {text} is {kind}, not a file; motionlab replaces only plain files, --force or not"
+        )
+
+
+def exists_message(what: str, path) -> str:
+    """The one wording of the refusal to replace an existing file."""
+    return f"{what} {path} exists; add --force to replace it (overwrite=True in Python), or choose another name"
 
 
 def check_output(path: str | os.PathLike, overwrite: bool = False, what: str = "output") -> Path:
@@ -53,19 +112,21 @@ def check_output(path: str | os.PathLike, overwrite: bool = False, what: str = "
     Raises
     ------
     IsADirectoryError
-        ``path`` is a folder.
+        ``path`` is a folder, or ends in a path separator.
     FileExistsError
-        ``path`` exists and ``overwrite`` is False.
+        ``path`` exists and ``overwrite`` is False, or is a link, named pipe, device or socket
+        (:func:`check_replaceable`).
     FileNotFoundError
         The folder ``path`` would go in does not exist.
     PermissionError
         That folder is not writable.
     """
+    check_replaceable(path, what)
     path = Path(path)
     if path.is_dir():
         raise IsADirectoryError(f"{what} {path} is a folder; expected a file name")
     if path.exists() and not overwrite:
-        raise FileExistsError(f"{what} {path} exists; pass --force (overwrite=True) to replace it")
+        raise FileExistsError(exists_message(what, path))
     folder = path.parent
     if not folder.is_dir():
         raise FileNotFoundError(f"folder {folder} for the {what} {path.name} does not exist")
@@ -87,10 +148,20 @@ def _alive(pid: int) -> bool:
 def remove_stale(path: str | os.PathLike) -> list[Path]:
     """Remove temporary files left beside ``path`` by writers that no longer run; returns them."""
     path = Path(path)
-    pattern = re.compile(rf"\.{re.escape(path.name)}\.(\d+)\.[^.]+{re.escape(TMP_SUFFIX)}\Z")
+    name = re.escape(path.name)
+    return _remove_stale(path.parent, rf"\.{name}\.(\d+)\.[^.]+{re.escape(TMP_SUFFIX)}(?:{re.escape(path.suffix)})?\Z")
+
+
+def remove_stale_in(folder: str | os.PathLike) -> list[Path]:
+    """Remove every temporary file in ``folder`` left by a motionlab writer that no longer runs."""
+    return _remove_stale(Path(folder), rf"\..+\.(\d+)\.[^.]+{re.escape(TMP_SUFFIX)}(?:\.[^.]+)?\Z")
+
+
+def _remove_stale(folder: Path, regex: str) -> list[Path]:
+    pattern = re.compile(regex)
     removed = []
     try:
-        entries = list(path.parent.iterdir())
+        entries = list(folder.iterdir())
     except OSError:
         return removed
     for entry in entries:
@@ -108,8 +179,8 @@ def atomic_write_all(outputs: list[tuple], overwrite: bool = False) -> list[Path
     """Write several files as one: every temporary file is complete before the first rename.
 
     ``outputs`` holds ``(path, write, binary, what)`` tuples as for :func:`atomic_write`. If
-    any ``write`` fails, no destination is touched; the renames at the end cannot fail short
-    of a system failure.
+    any ``write`` fails, no destination is touched; the renames at the end, in the order of
+    ``outputs``, cannot fail short of a system failure.
     """
     checked = [(check_output(path, overwrite, what), write, binary, what) for path, write, binary, what in outputs]
     temps: list[str] = []
@@ -134,25 +205,45 @@ def _removed_on_error(temps: list[str]):
         raise
 
 
-def _write_temporary(path: Path, write: Callable, binary: bool, what: str) -> str:
-    """A complete temporary file beside ``path`` holding what ``write(f)`` wrote, with ``path``'s mode."""
-    if path.exists():
-        mode = path.stat().st_mode & 0o777
-    else:
-        umask = os.umask(0)
-        os.umask(umask)
-        mode = 0o666 & ~umask
+def _umask() -> int:
+    """The process umask, read without changing it where Linux shows it (``/proc/self/status``)."""
     try:
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.{os.getpid()}.", suffix=TMP_SUFFIX)
+        with open("/proc/self/status", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    umask = os.umask(0o022)  # elsewhere: read by setting, then set back at once
+    os.umask(umask)
+    return umask
+
+
+def _mode(path: Path) -> int:
+    """Permissions for ``path``'s new contents: the old file's, or what ``open`` gives a new file."""
+    return path.stat().st_mode & 0o777 if path.exists() else 0o666 & ~_umask()
+
+
+def _write_temporary(path: Path, write: Callable, binary: bool, what: str, by_name: bool = False) -> str:
+    """A complete temporary file beside ``path`` holding what ``write(f)`` wrote (``by_name``:
+    ``write(tmp_path)``, ``tmp_path`` ending in ``path``'s suffix), with ``path``'s mode, on disk."""
+    mode = _mode(path)
+    suffix = TMP_SUFFIX + (path.suffix if by_name else "")
+    try:
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.{os.getpid()}.", suffix=suffix)
     except OSError as e:  # the folder refuses new files: say which output, not the temporary name
         raise type(e)(f"cannot write the {what} {path}: {(e.strerror or str(e)).lower()}") from None
     with _removed_on_error([tmp]):
-        if binary:
-            with os.fdopen(fd, "wb") as f:
-                write(f)
+        if by_name:
+            os.close(fd)
+            write(Path(tmp))
         else:
-            with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
+            with os.fdopen(
+                fd, "wb" if binary else "w", **({} if binary else {"encoding": "utf-8", "newline": "\n"})
+            ) as f:
                 write(f)
+                f.flush()
+                os.fsync(f.fileno())
         os.chmod(tmp, mode)
     return tmp
 
@@ -176,6 +267,25 @@ def atomic_write(
     path = check_output(path, overwrite, what)
     remove_stale(path)
     tmp = _write_temporary(path, write, binary, what)
+    with _removed_on_error([tmp]):
+        os.replace(tmp, path)
+    return path
+
+
+def atomic_write_file(
+    path: str | os.PathLike, fill: Callable[[Path], None], overwrite: bool = False, what: str = "output"
+) -> Path:
+    """:func:`atomic_write` for writers that need a file name (a movie encoder, an image library):
+    ``fill(tmp)`` writes the temporary file ``tmp``, a Path beside ``path`` ending in its suffix.
+
+    Raises
+    ------
+    OSError
+        as :func:`check_output` says for ``path``; whatever ``fill`` raises (``path`` unchanged).
+    """
+    path = check_output(path, overwrite, what)
+    remove_stale(path)
+    tmp = _write_temporary(path, fill, True, what, by_name=True)
     with _removed_on_error([tmp]):
         os.replace(tmp, path)
     return path

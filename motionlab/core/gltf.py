@@ -101,12 +101,37 @@ def _check_motion(motion: Motion) -> None:
     if motion.local_pos is not None and not np.all(np.isfinite(motion.local_pos)):
         frame = int(np.argwhere(~np.isfinite(motion.local_pos))[0, 0])
         raise ValueError(f"motion {motion.name!r}: local_pos is not finite at frame {frame}")
+    _check_float32(motion)
     norms = np.linalg.norm(motion.local_rot, axis=-1)
     if np.any(norms < 1e-8):
         frame, joint = (int(v) for v in np.argwhere(norms < 1e-8)[0])
         raise ValueError(
             f"motion {motion.name!r}: local_rot of joint {motion.skeleton.names[joint]!r} at frame {frame} "
             "is a zero quaternion, not a rotation"
+        )
+
+
+_FLOAT32_MAX = float(np.finfo(np.float32).max)
+
+
+def _check_float32(motion: Motion) -> None:
+    """Refuse what float32 accessors cannot hold: lengths beyond float32, or a last key time beyond it."""
+    sk = motion.skeleton
+    for label, values in (("root_pos", motion.root_pos), ("local_pos", motion.local_pos), ("offsets", sk.offsets)):
+        if values is None:
+            continue
+        big = np.abs(values) > _FLOAT32_MAX / 1e3  # room for the mesh and bind matrices built from them
+        if np.any(big):
+            where = tuple(int(v) for v in np.argwhere(big)[0])
+            raise ValueError(
+                f"motion {motion.name!r}: {label} holds {float(values[where]):g} at {where}, beyond what glTF's "
+                f"float32 numbers hold (|v| < {_FLOAT32_MAX / 1e3:.3g} m)"
+            )
+    last = (motion.num_frames - 1) / motion.fps
+    if not (np.isfinite(motion.fps) and last < _FLOAT32_MAX):
+        raise ValueError(
+            f"motion {motion.name!r}: {motion.num_frames} frames at {motion.fps:g} fps end at {last:g} s, "
+            "beyond what glTF's float32 key times hold"
         )
 
 
@@ -259,11 +284,17 @@ def dumps(motion: Motion) -> bytes:
     TypeError
         ``motion`` is not a :class:`~motionlab.core.motion.Motion`.
     ValueError
-        The motion has no frames, or holds non-finite values or zero quaternions.
+        The motion has no frames, holds non-finite values, values or key times beyond float32, or
+        zero quaternions.
     """
     _check_motion(motion)
     doc, data = _document(motion)
-    text = json.dumps(doc, separators=(",", ":")).encode("utf-8")
+    try:
+        text = json.dumps(doc, separators=(",", ":"), allow_nan=False).encode("utf-8")
+    except ValueError:  # a number JSON cannot write: never a file that no reader opens
+        raise ValueError(
+            f"motion {motion.name!r}: a value is not a finite number and cannot be written as glTF"
+        ) from None
     text += b" " * (-len(text) % 4)
     data += b"\0" * (-len(data) % 4)
     length = 12 + 8 + len(text) + 8 + len(data)

@@ -82,6 +82,14 @@ class RigMappingError(ValueError):
         super().__init__(f"{reason} {hint}".strip())
         self.reason = reason
 
+    def for_file(self, role: str, path) -> str:
+        """The reason in a command-line user's words: which file (``role``: source, target, input,
+        character) does not map, the profiles a rig must follow, and how to list its joints."""
+        return (
+            f"{role} file {path}: {self.reason} Its joint names must follow one of the rig profiles "
+            f"{', '.join(PROFILES)}; `motionlab info {path} --joints` lists its joints."
+        )
+
 
 def strip_prefix(name: str) -> str:
     """Joint name without a namespace prefix: ``"mixamorig:LeftArm"`` → ``"LeftArm"``."""

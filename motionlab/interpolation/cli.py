@@ -36,7 +36,7 @@ import argparse
 from pathlib import Path
 
 from motionlab import cli_args
-from motionlab.cli_args import Stages
+from motionlab.cli_args import CLIError, Stages
 
 __all__ = ["register", "run_fill_gaps"]
 
@@ -44,7 +44,7 @@ __all__ = ["register", "run_fill_gaps"]
 def register(subparsers) -> None:
     with cli_args.command(subparsers, "fill-gaps", run_fill_gaps) as p:
         p.add_argument("input", help="BVH file with dropped frames")
-        cli_args.add_output(p, "where to write the filled BVH file")
+        cli_args.add_output(p, "where to write the filled motion: .bvh, or .glb for binary glTF 2.0")
         p.add_argument("--method", choices=("stride", "slerp", "hermite", "graph"), default="stride",
                        help="stride: the strides on both sides continued (default; slerp where the motion does not "
                        "repeat); slerp: SLERP; hermite: velocity-matched; graph: key-pose guided (needs --action)")  # fmt: skip
@@ -74,7 +74,6 @@ def register(subparsers) -> None:
 
 
 def _graph(actions: list[str], allow: list[str], src: Path, motion):
-    from motionlab.cli import CLIError
     from motionlab.core import bvh
     from motionlab.interpolation.action_graph import ActionGraph, GraphError
 
@@ -104,7 +103,6 @@ def _graph(actions: list[str], allow: list[str], src: Path, motion):
 def _takes(paths: list[str], src: Path, motion):
     """:class:`~.recorded.RecordedTakes` of the ``--takes`` files (none of them the input), each on
     the input ``motion``'s skeleton and frame rate."""
-    from motionlab.cli import CLIError
     from motionlab.core import bvh
     from motionlab.interpolation.recorded import RecordedTakes
 
@@ -141,7 +139,6 @@ def _takes(paths: list[str], src: Path, motion):
 
 def _check_rig(what: str, clip, src: Path, motion) -> None:
     """Refuse a clip (``what``: the option and file that named it) on another rig than the input."""
-    from motionlab.cli import CLIError
 
     if tuple(clip.skeleton.names) != tuple(motion.skeleton.names):
         sk, mine = clip.skeleton, motion.skeleton
@@ -153,7 +150,6 @@ def _check_rig(what: str, clip, src: Path, motion) -> None:
 
 def _check_rate(path: Path, take, src: Path, motion) -> None:
     """Refuse a ``--takes`` file at another frame rate than the input."""
-    from motionlab.cli import CLIError
 
     if abs(take.fps - motion.fps) > 1e-6 * motion.fps:
         raise CLIError(
@@ -174,7 +170,6 @@ def _times_gaps(path: str, src: Path, motion) -> list[tuple[int, int]]:
     input's Frame Time (times in another unit than seconds are refused, never filled)."""
     import numpy as np
 
-    from motionlab.cli import CLIError
     from motionlab.interpolation import gaps
 
     try:
@@ -204,17 +199,19 @@ def _times_gaps(path: str, src: Path, motion) -> list[tuple[int, int]]:
     return missing
 
 
-def _copy(src: Path, dst: Path, force: bool) -> None:
-    """Copy ``src`` to ``dst`` byte for byte, atomically."""
-    from motionlab.core import files
+def _copy(src: Path, dst: Path, motion, force: bool) -> None:
+    """Copy ``src`` to ``dst`` byte for byte, atomically (a ``.glb`` output: ``motion`` written as glTF)."""
+    from motionlab.core import files, motion_files
 
+    if dst.suffix.lower() != ".bvh":
+        motion_files.save(dst, motion, overwrite=force, unit=motion_files.file_unit(motion.skeleton), what="-o file")
+        return
     data = src.read_bytes()
     files.atomic_write(dst, lambda f: f.write(data), overwrite=force, binary=True, what="-o file")
 
 
 def _check_args(args: argparse.Namespace):
     """``(delta, src, dst)`` after checking the options and every output before any work."""
-    from motionlab.cli import CLIError
     from motionlab.cli_args import check_outputs
     from motionlab.core import files
     from motionlab.interpolation import detect
@@ -233,6 +230,7 @@ def _check_args(args: argparse.Namespace):
     src = files.check_input(args.input)
     inputs = [("input", src), ("--times", args.times)] + [("--takes", t) for t in args.takes]
     inputs += [("--action", a.split("=", 1)[1]) for a in args.action if "=" in a]
+    cli_args.motion_output("-o", args.output)
     (dst,) = check_outputs([("-o", args.output)], args.force, inputs=inputs)
     return delta, src, dst
 
@@ -248,8 +246,7 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
     CLIError carrying the message of a BVH file that cannot be read or of a value the fill
     refuses.
     """
-    from motionlab.cli import CLIError
-    from motionlab.core import bvh
+    from motionlab.core import bvh, motion_files
     from motionlab.interpolation import detect, gaps
 
     delta, src, dst = _check_args(args)
@@ -275,7 +272,7 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
     )
     if not missing:
         bar.close()
-        _copy(src, dst, args.force)
+        _copy(src, dst, motion, args.force)
         print(f"{nothing}; wrote an unchanged copy")
         if not args.quiet:
             print(f"wrote {dst} ({motion.num_frames} frames)")
@@ -287,7 +284,7 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
     except ValueError as e:
         raise CLIError(str(e)) from None
     bar.start("write")
-    bvh.save(dst, filled, overwrite=args.force)
+    motion_files.save(dst, filled, overwrite=args.force, unit=motion_files.file_unit(motion.skeleton))
     bar.close()
     if not report:
         print(f"{nothing}; wrote an unchanged copy")

@@ -22,8 +22,7 @@ import time
 from pathlib import Path
 
 from motionlab import cli_args
-from motionlab.cli import CLIError
-from motionlab.cli_args import check_outputs, non_negative_int, positive, positive_int
+from motionlab.cli_args import CLIError, check_outputs, non_negative_int, positive, positive_int
 
 __all__ = ["register", "DISTANCE_THRESHOLD"]
 
@@ -51,7 +50,9 @@ def register(subparsers) -> None:
                 help=f"largest frame distance of a transition, metres RMS (default {DISTANCE_THRESHOLD:g})",
             ),
         )
-        p.add_argument("--fps", type=positive, default=30.0, help="frame rate every clip is resampled to (default 30)")
+        p.add_argument(
+            "--fps", type=cli_args.frame_rate, default=30.0, help="frame rate every clip is resampled to (default 30)"
+        )
         p.add_argument(
             "--style-pairs",
             choices=("hub", "chain", "all"),
@@ -73,7 +74,7 @@ def register(subparsers) -> None:
             help='segments "behaviour:style:frames,...", e.g. "walk:angry:300,run:normal:200" '
             "(at most 100000 frames in all)",
         )
-        cli_args.add_output(p, "BVH file to write")
+        cli_args.add_output(p, "motion file to write: .bvh, or .glb for binary glTF 2.0")
         p.add_argument(
             "--blend", type=non_negative_int, default=8, help="transition blend length in frames (default 8)"
         )
@@ -94,6 +95,7 @@ def _load_graph(path: str):
 
 def _build_outputs(args: argparse.Namespace) -> tuple[Path, Path | None]:
     """The graph file and the report file, checked before any work."""
+    cli_args.check_replaceable("-o", args.output)
     out = Path(args.output)
     if out.is_dir():  # before '.mlgraph' is added: -o FOLDER must not write FOLDER.mlgraph beside it
         raise CLIError(f"-o {out} is a folder; expected a graph file name, such as {out / 'graph.mlgraph'}")
@@ -103,6 +105,8 @@ def _build_outputs(args: argparse.Namespace) -> tuple[Path, Path | None]:
         raise CLIError("--report needs a structured graph (leave out --standard, or leave out --report)")
     if not args.synthetic and not args.folder:
         raise CLIError("give a FOLDER of BVH clips or --synthetic")
+    if args.synthetic and args.folder:
+        raise CLIError(f"give a FOLDER of BVH clips or --synthetic, not both (FOLDER {args.folder} and --synthetic)")
     inputs = [("--name-map", args.name_map)]
     out, rep = check_outputs([("-o", out), ("--report", args.report)], args.force, inputs=inputs)
     return out, rep
@@ -124,10 +128,36 @@ def _load_clips(args: argparse.Namespace) -> list:
         motions = clips.synthetic_library(fps=args.fps)
         print(f"using {len(motions)} synthetic clips (no real data)")
         return motions
+    _check_folder_size(args.folder, args.fps)
     try:
         return clips.load_folder(args.folder, args.fps, name_map, progress=not args.quiet)
     except NamingError as e:
         raise CLIError(str(e)) from None
+
+
+def _header_seconds(path: Path) -> float:
+    """A BVH file's length in seconds from its ``Frames:`` and ``Frame Time:`` lines (0 when unreadable)."""
+    frames = None
+    try:
+        with open(path, encoding="utf-8", errors="replace") as f:
+            for line in f:
+                key, _, value = line.strip().partition(":")
+                if key == "Frames":
+                    frames = float(value)
+                elif key == "Frame Time" and frames is not None:
+                    return frames * float(value)
+    except (OSError, ValueError):
+        pass
+    return 0.0
+
+
+def _check_folder_size(folder: str, fps: float) -> None:
+    """Refuse, before loading, a folder whose clips at ``--fps`` would be more frames than
+    :func:`motionlab.cli_args.check_size` allows (read from the files' headers)."""
+    folder_path = Path(folder)
+    if folder_path.is_dir():
+        seconds = sum(_header_seconds(p) for p in folder_path.rglob("*.bvh"))
+        cli_args.check_size(f"--fps {fps:g} over the {seconds:.0f} s of clips in {folder}", seconds * fps, 22)
 
 
 def _build_graph(args: argparse.Namespace, motions: list):
@@ -183,7 +213,7 @@ def _build(args: argparse.Namespace) -> int:
     n_trans = sum(c.kind == "transition" for c in g.clips)
     pooled = f" ({len(motions) - n_trans} takes of {styles} styles, {n_trans} transition clips)" if styles else ""
     print(
-        f"built {g.info['kind']} graph from {len(motions)} clips{pooled} in {dt:.2f} s: {s['alive']} frames alive, "
+        f"built {g.info['kind']} graph from {len(motions)} clips{pooled} in {dt:.2f} s: {_alive_text(g)}, "
         f"{s['transitions']} transitions -> {out}"
     )
     if rep is not None:
@@ -195,15 +225,28 @@ def _build(args: argparse.Namespace) -> int:
     return 0
 
 
+def _alive_text(g) -> str:
+    """Alive frames, the recorded clips' apart from those of the clips the build made (interpolation)."""
+    import numpy as np
+
+    made = np.array([c.kind == "intermediate" for c in g.clips], dtype=bool)[g.clip_of(np.arange(g.num_frames))]
+    text = f"{int(g.alive[~made].sum())} of {int((~made).sum())} recorded frames alive"
+    if made.any():
+        clips = sum(c.kind == "intermediate" for c in g.clips)
+        text += f" (and {int(g.alive[made].sum())} frames of {clips} clips made between styles)"
+    return text
+
+
 def _search(args: argparse.Namespace) -> int:
     """synthesise a motion for a request from a graph
 
     Search a graph from graph-build for a path that meets a request of behaviour, style and frame count per segment,
-    and write the synthesised motion as BVH.
+    and write the synthesised motion as BVH or, when OUTPUT ends in .glb, binary glTF 2.0.
     """
-    from motionlab.core import bvh
+    from motionlab.core import motion_files
     from motionlab.motion_graphs import search, synthesis
 
+    cli_args.motion_output("-o", args.output)
     (out,) = check_outputs([("-o", args.output)], args.force, inputs=[("graph", args.graph)])
     try:
         segs = search.parse_request(args.request)
@@ -225,7 +268,7 @@ def _search(args: argparse.Namespace) -> int:
     except search.SearchError as e:
         raise CLIError(str(e)) from None
     motion = synthesis.synthesize(g, result.pieces, blend=args.blend)
-    bvh.save(out, motion, overwrite=args.force)
+    motion_files.save(out, motion, overwrite=args.force, unit=motion_files.file_unit(motion.skeleton))
     print(f"found a {result.num_frames}-frame path ({len(result.pieces)} pieces) in {dt * 1000:.1f} ms -> {out}")
     print(result.report())
     return 0

@@ -134,7 +134,7 @@ def save(path: str | os.PathLike, checkpoint: Checkpoint, overwrite: bool = True
     """
     path = Path(path)
     if path.exists() and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True (or --force) to replace it")
+        raise FileExistsError(files.exists_message("checkpoint", path))
     payload = {
         "format": FORMAT,
         "version": FORMAT_VERSION,

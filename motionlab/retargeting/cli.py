@@ -18,17 +18,19 @@ from pathlib import Path
 import numpy as np
 
 from motionlab import cli_args
-from motionlab.cli_args import check_outputs, non_negative, non_negative_int, positive, positive_int
+from motionlab.cli_args import (
+    CLIError,
+    check_outputs,
+    non_negative,
+    non_negative_int,
+    positive,
+    positive_int,
+    rig_error,
+)
 from motionlab.retargeting import cli_options
 from motionlab.retargeting.cli_options import ROOT_MODES
 
 __all__ = ["register"]
-
-
-def _error(msg: str):
-    from motionlab.cli import CLIError
-
-    return CLIError(msg)
 
 
 def _load_bvh(path: str, what: str):
@@ -44,7 +46,7 @@ def _check_result(args, result):
         print(f"{args.source}: {result.resampled}", file=sys.stderr)
     check = result.plausibility
     if not check.ok and not args.keep_implausible:
-        raise _error(
+        raise CLIError(
             f"{args.source} -> {args.target or 'scaled source'}: {check.describe()}; nothing written "
             "(--keep-implausible writes it anyway)"
         )
@@ -55,23 +57,23 @@ def _cmd_retarget(args) -> int:
     """retarget a BVH clip onto another character (latent iteration)
 
     Generate TARGET's version of SOURCE.bvh. The target character is defined by the rest skeleton of --target (its
-    motion is ignored) and/or --scale-* factors; the output is a BVH on the 22-joint canonical skeleton (BVH, or
-    glTF 2.0 when OUTPUT ends in .glb).
+    motion is ignored) and/or --scale-* factors; the output is the motion on the 22-joint canonical skeleton,
+    written as BVH (OUTPUT ending in .bvh) or binary glTF 2.0 (.glb).
     """
-    from motionlab.cli import rig_error
-    from motionlab.core import bvh, files, gltf, humanoid, rest_pose
+    from motionlab.core import files, humanoid, motion_files, rest_pose
     from motionlab.retargeting.pipeline import retarget
 
     cli_options.check_device(args.device)
     out = Path(args.output)
-    if out.suffix.lower() not in (".bvh", gltf.SUFFIX):
-        raise _error(f"output {out} must end in .bvh or {gltf.SUFFIX} (glTF 2.0)")
+    suffix = cli_args.motion_output("-o", args.output)
     npz = Path(args.npz) if args.npz else None
     if npz is not None and npz.suffix.lower() != ".npz":  # np.savez would silently add '.npz' to another name
-        raise _error(f"--npz {npz} must end in .npz")
+        raise CLIError(f"--npz {npz} must end in .npz")
     inputs = [("source", args.source), ("--target", args.target), ("--checkpoint", args.checkpoint)]
     check_outputs([("-o", out), ("--npz", npz)], args.force, inputs=inputs)  # before any work
     source = _load_bvh(args.source, "source")
+    if args.fps is not None:
+        cli_args.check_size(f"--fps {args.fps:g} over {source.duration:g} s", source.duration * args.fps + 1, 22)
     try:
         humanoid.find_mapping(source.skeleton)
     except humanoid.RigMappingError as e:
@@ -90,7 +92,7 @@ def _cmd_retarget(args) -> int:
     if any(v != 1.0 for v in scales.values()):
         target = humanoid.scale_bones(target, **scales)
     if not args.target and all(v == 1.0 for v in scales.values()):
-        raise _error("give --target TARGET.bvh and/or a --scale-* factor: otherwise the target is the source itself")
+        raise CLIError("give --target TARGET.bvh and/or a --scale-* factor: otherwise the target is the source itself")
     ckpt = None if args.method == "copy" else cli_options.load_checkpoint(args.checkpoint, args.device)
     result = retarget(
         source,
@@ -103,9 +105,8 @@ def _cmd_retarget(args) -> int:
         fps=args.fps,
     )
     check = _check_result(args, result)
-    binary = out.suffix.lower() == gltf.SUFFIX
-    data = (gltf.dumps if binary else bvh.dumps)(result.motion)  # any error shows before a file is written
-    outputs = [(out, lambda f: f.write(data), binary, "output")]
+    data = motion_files.encode(result.motion, suffix, motion_files.file_unit(base.skeleton))  # errors before writing
+    outputs = [(out, lambda f: f.write(data), True, "output")]
     if npz is not None:  # both files or neither
         arrays = dict(
             local_rot=result.motion.local_rot,
@@ -146,21 +147,21 @@ def _cmd_train(args) -> int:
     cli_options.check_device(args.device)
     (out,) = check_outputs([("-o", args.output)], args.force, inputs=[("clip", c) for c in args.clips])
     if not 0.0 <= args.pose_augment <= 0.5:  # also refuses nan; skeleton augmentation takes the other half
-        raise _error(f"--pose-augment must be between 0 and 0.5, got {args.pose_augment}")
+        raise CLIError(f"--pose-augment must be between 0 and 0.5, got {args.pose_augment}")
     if args.synthetic:
         if args.clips:
-            raise _error("give BVH clips or --synthetic N, not both")
+            raise CLIError("give BVH clips or --synthetic N, not both")
         from motionlab import synthetic
 
         motions = synthetic.dataset(args.synthetic, seed=args.seed)
     else:
         if not args.clips:
-            raise _error("give the BVH clips of ONE character to train on (or --synthetic N)")
+            raise CLIError("give the BVH clips of ONE character to train on (or --synthetic N)")
         motions = [_load_bvh(p, "training") for p in args.clips]
     try:
         data = training_set(motions, progress=not args.quiet)
     except ValueError as e:
-        raise _error(str(e)) from None
+        raise CLIError(str(e)) from None
     cfg = TrainConfig(
         steps=args.train_steps,
         batch_size=args.batch_size,
@@ -196,8 +197,22 @@ def _animations(args, folder: Path) -> list[str]:
         try:
             return shared_animations(folder, args.source, args.targets)
         except (FileNotFoundError, ValueError) as e:
-            raise _error(str(e)) from None
+            raise CLIError(str(e)) from None
     return list(DEFAULT_ANIMATIONS)
+
+
+def _check_characters_and_animations(args, folder: Path, animations: list[str]) -> None:
+    """Before any training: every character folder exists, and every animation has the source's clip and
+    at least one target's (a pair without its clips is skipped; an animation without any pair is refused)."""
+    for option, name in [("--source", args.source)] + [("--targets", t) for t in args.targets]:
+        if not (folder / name).is_dir():
+            have = sorted(p.name for p in folder.iterdir() if p.is_dir())
+            raise CLIError(f"{option} {name}: no folder {folder / name} (characters in {folder}: {', '.join(have)})")
+    for anim in animations:
+        if not (folder / args.source / f"{anim}.bvh").is_file():
+            raise CLIError(f"--animations {anim}: the source has no clip {folder / args.source / (anim + '.bvh')}")
+        if not any((folder / t / f"{anim}.bvh").is_file() for t in args.targets):
+            raise CLIError(f"--animations {anim}: none of the targets {', '.join(args.targets)} has {anim}.bvh")
 
 
 def _fold_checkpoint(args, folder: Path, fpath: Path, left_out: list[str]):
@@ -215,7 +230,7 @@ def _fold_checkpoint(args, folder: Path, fpath: Path, left_out: list[str]):
     try:
         clips = training_clips(folder, args.source, left_out)
     except FileNotFoundError as e:
-        raise _error(str(e)) from None
+        raise CLIError(str(e)) from None
     if not args.quiet:
         print(f"training on {len(clips)} clips of {args.source} (none of the {len(left_out)} evaluated) -> {fpath}")
     ckpt, _ = train(
@@ -256,13 +271,14 @@ def _cmd_evaluate(args) -> int:
     folder = Path(args.data) if args.data else mdata.data_root() / "mixamo"
     check_outputs([("--csv", args.csv)], args.force)  # refuse before hours of work, not after
     if not folder.is_dir():
-        raise _error(f"data folder {folder} not found")
+        raise CLIError(f"data folder {folder} not found")
     if args.folds < 1:
-        raise _error(f"--folds must be >= 1, got {args.folds}")
+        raise CLIError(f"--folds must be >= 1, got {args.folds}")
     path = Path(args.checkpoint) if args.checkpoint else Path(tempfile.gettempdir()) / f"motionlab_{args.source}.pt"
     animations = _animations(args, folder)
+    _check_characters_and_animations(args, folder, animations)
     if args.folds > len(animations):
-        raise _error(f"--folds {args.folds} is more than the {len(animations)} animations evaluated")
+        raise CLIError(f"--folds {args.folds} is more than the {len(animations)} animations evaluated")
     # leave animations out: fold k is evaluated by a network trained without the fold's animations
     folds = [animations[k :: args.folds] for k in range(args.folds)]
     fold_paths = [_fold_path(path, k, args.folds) for k in range(args.folds)]
@@ -314,7 +330,7 @@ def _add_retarget(subparsers) -> None:
         p.add_argument("--npz", help="also write arrays (local_rot, root_pos, positions, offsets) to this .npz")
         p.add_argument(
             "--method",
-            choices=("full", "network", "copy"),
+            choices=cli_options.METHODS,
             default="full",
             help="full = latent iteration (default); network = no iteration; copy = copy rotations",
         )
@@ -329,9 +345,15 @@ def _add_retarget(subparsers) -> None:
         )
         for name in ("legs", "arms", "spine", "neck"):
             p.add_argument(
-                f"--scale-{name}", type=positive, default=1.0, metavar="F", help=f"scale the target's {name} bones by F"
+                f"--scale-{name}",
+                type=cli_args.factor,
+                default=1.0,
+                metavar="F",
+                help=f"scale the target's {name} bones by F (0.1 to 10)",
             )
-        p.add_argument("--scale", type=positive, default=1.0, metavar="F", help="scale the whole target by F")
+        p.add_argument(
+            "--scale", type=cli_args.factor, default=1.0, metavar="F", help="scale the whole target by F (0.1 to 10)"
+        )
         p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
         cli_options.add_rest_from(p)
         cli_args.add_force(p, "overwrite existing output files")
@@ -351,7 +373,11 @@ def _add_train(subparsers) -> None:
             help="train on N built-in synthetic clips instead",
         )
         cli_args.add_output(p, "checkpoint file to write (.pt)")
-        p.add_argument("--train-steps", type=positive_int, default=1500, help="Adam steps (default 1500)")
+        cli_args.renamed(
+            p,
+            "--steps",
+            p.add_argument("--train-steps", type=positive_int, default=1500, help="Adam steps (default 1500)"),
+        )
         p.add_argument("--batch-size", type=positive_int, default=32, help="windows per Adam step")
         p.add_argument(
             "--pose-augment",
@@ -360,10 +386,14 @@ def _add_train(subparsers) -> None:
             metavar="F",
             help="fraction of each batch with joints turned at random (up to 0.3 rad; 0..0.5, default 0 = off)",
         )
-        p.add_argument("--train-lr", type=positive, default=2e-3, help="Adam learning rate of the training")
+        cli_args.renamed(
+            p,
+            "--lr",
+            p.add_argument("--train-lr", type=positive, default=2e-3, help="Adam learning rate of the training"),
+        )
         p.add_argument("--latent", type=positive_int, default=128, help="latent channels D per frame")
         p.add_argument("--hidden", type=positive_int, default=96, help="hidden channels")
-        p.add_argument("--seed", type=int, default=0, help="random seed")
+        p.add_argument("--seed", type=cli_args.seed, default=0, help="random seed")
         p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
         cli_args.add_force(p, "overwrite an existing checkpoint")
 
@@ -402,7 +432,7 @@ def _add_evaluate(subparsers) -> None:
             default=1500,
             help="Adam steps when the network is trained (default 1500)",
         )
-        p.add_argument("--seed", type=int, default=0, help="random seed")
+        p.add_argument("--seed", type=cli_args.seed, default=0, help="random seed")
         p.add_argument("--csv", help="write the per-clip records to this CSV")
         cli_args.add_force(p, "overwrite an existing --csv file")
         p.add_argument(

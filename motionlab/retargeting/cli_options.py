@@ -9,10 +9,12 @@ from __future__ import annotations
 
 import argparse
 
-from motionlab.cli_args import non_negative, non_negative_int, positive, renamed
+from motionlab.cli_args import CLIError, non_negative, non_negative_int, positive, renamed
 from motionlab.retargeting import terms
+from motionlab.retargeting.pipeline import METHODS, ROOT_MODES  # the choices come from the library
 
 __all__ = [
+    "METHODS",
     "ROOT_MODES",
     "check_device",
     "load_checkpoint",
@@ -21,15 +23,6 @@ __all__ = [
     "add_rest_from",
     "rest_from",
 ]
-
-ROOT_MODES = ("stride", "hips", "legs", "contacts")
-"""``pipeline.ROOT_MODES``, repeated so that ``--help`` does not import torch (a test keeps them equal)."""
-
-
-def _error(msg: str):
-    from motionlab.cli import CLIError
-
-    return CLIError(msg)
 
 
 def check_device(device: str | None) -> None:
@@ -46,23 +39,37 @@ def check_device(device: str | None) -> None:
     try:
         devices.pick(device)
     except ValueError as e:
-        raise _error(f"--device: {e}") from None
+        raise CLIError(f"--device: {e}") from None
 
 
 def load_checkpoint(path: str | None, device: str | None):
-    """The network of the checkpoint at ``path`` (the shipped one when ``path`` is None) on ``device``.
+    """The ``--checkpoint`` network (default: the shipped one) on ``device``.
 
     Raises
     ------
-    CLIError when the checkpoint cannot be loaded.
+    CLIError
+        the file is missing or not a checkpoint written by ``motionlab train``.
     """
+    import zipfile
+
     from motionlab import retargeting
+    from motionlab.core import files
 
     check_device(device)
+    if path:
+        try:
+            files.check_input(path, "--checkpoint")
+        except OSError as e:
+            raise CLIError(str(e)) from None
+        if not zipfile.is_zipfile(path):  # torch.save writes a zip archive; text or BVH is refused here
+            raise CLIError(
+                f"--checkpoint {path} is not a network checkpoint (a .pt file written by `motionlab train`, "
+                "which is a zip archive)"
+            )
     try:
         return retargeting.load(path, device) if path else retargeting.load_default(device)
     except retargeting.CheckpointError as e:
-        raise _error(str(e)) from None
+        raise CLIError(str(e)) from None
 
 
 def solver_config(args):
@@ -88,7 +95,7 @@ def solver_config(args):
         ("--exact-rounds", args.exact_rounds, 0 <= args.exact_rounds <= rounds, f"between 0 and {rounds}"),
     ):
         if not ok:  # also refuses nan
-            raise _error(f"{option} must be {expected}, got {value}")
+            raise CLIError(f"{option} must be {expected}, got {value}")
     return SolverConfig(
         max_steps=args.steps,
         lr=args.lr,
@@ -186,5 +193,5 @@ def rest_from(args):
         reference = bvh.load(files.check_input(args.rest_from, "--rest-from"))
         rest_pose.standing(humanoid.to_canonical(reference), f"--rest-from {args.rest_from}")
     except ValueError as e:  # also RigMappingError, RestPoseError, BVH errors
-        raise _error(f"--rest-from {args.rest_from}: {e}") from None
+        raise CLIError(f"--rest-from {args.rest_from}: {e}") from None
     return reference

@@ -42,6 +42,7 @@ Taught in ``notebooks/07_expanding_a_database.ipynb``.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import dataclasses
 import glob
@@ -49,7 +50,6 @@ import hashlib
 import io
 import json
 import os
-import tempfile
 import time
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
@@ -57,7 +57,7 @@ from pathlib import Path
 
 import numpy as np
 
-from motionlab.core import bvh, gltf, humanoid, metrics, rest_pose
+from motionlab.core import bvh, files, humanoid, metrics, motion_files, rest_pose
 from motionlab.core.skeleton import Skeleton
 from motionlab.core.threads import batch_threads, torch_threads
 from motionlab.retargeting import terms
@@ -149,6 +149,8 @@ class Character:
     origin : str                    the BVH path or ``preset:NAME``
     error : str                     why the character cannot be used ("" if it can)
     digest : str                    SHA-256 of the file's bytes, or of a preset's factors
+    unit : float                    metres per length unit of the file (:func:`motion_files.file_unit`):
+                                    a ``.glb`` output is written in metres from it
     """
 
     name: str
@@ -156,6 +158,7 @@ class Character:
     origin: str
     error: str = ""
     digest: str = ""
+    unit: float = motion_files.CM
 
 
 def _preset(spec: str) -> tuple[str, dict[str, float]]:
@@ -206,7 +209,7 @@ def characters(*specs: str, presets: Iterable[str] = (), rest_from=None) -> list
         try:
             rig = rest_pose.on_reference(bvh.load(p), rest_from, f"character file {p}")
             sk = rest_pose.standing_skeleton(rig, f"character file {p}")[0]
-            out.append(Character(name, sk, str(p), digest=digest))
+            out.append(Character(name, sk, str(p), digest=digest, unit=motion_files.file_unit(rig.skeleton)))
         except _ERRORS as err:
             out.append(Character(name, None, str(p), _why(err, "character", p), digest))
     for spec in presets:
@@ -256,9 +259,7 @@ def options_digest(
 def _why(err: Exception, role: str, path) -> str:
     """What went wrong with the ``role`` (character, source) file ``path``, in words a command-line user can act on."""
     if isinstance(err, humanoid.RigMappingError):  # its Python hint (profile=...) has no command-line form
-        from motionlab.cli import rig_error
-
-        return f"{type(err).__name__}: {rig_error(err, role, path)}"
+        return f"{type(err).__name__}: {err.for_file(role, path)}"
     return f"{type(err).__name__}: {err}"
 
 
@@ -338,41 +339,44 @@ def read_manifest(out: str | Path) -> list[dict]:
         return [{k: r.get(k, "") for k in cols} for r in reader]
 
 
-def _umask_mode() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return 0o666 & ~mask
-
-
-_MODE = _umask_mode()  # what open() would give a new file (mkstemp makes them private)
-
-
-def _write_atomic(path: Path, text: str) -> None:
+@contextlib.contextmanager
+def _folder_lock(out: Path):
+    """Hold an exclusive lock on the folder ``out`` (``flock`` on the folder itself, so no lock file
+    is left in it); where ``flock`` does not exist (Windows), no lock."""
     try:
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    except OSError as e:  # name the file the user knows, not the temporary one
-        raise type(e)(f"cannot write {path}: {(e.strerror or str(e)).lower()}") from None
+        import fcntl
+    except ImportError:
+        yield
+        return
+    fd = os.open(out, os.O_RDONLY)
     try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as f:
-            f.write(text)
-            f.flush()
-            os.fsync(f.fileno())
-        os.chmod(tmp, _MODE)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # closing releases the lock
 
 
-def _write_manifest(out: Path, rows: list[dict]) -> None:
-    buf = io.StringIO()
-    cols = columns()
-    w = csv.DictWriter(buf, fieldnames=cols, lineterminator="\n")
-    w.writeheader()
-    for r in sorted(rows, key=lambda r: (r["character"], r["clip"])):
-        w.writerow({k: r.get(k, "") for k in cols})
-    _write_atomic(out / MANIFEST, buf.getvalue())
+def _write_manifest(out: Path, rows: list[dict], outputs: Sequence[tuple[Path, bytes]] = ()) -> None:
+    """Write ``rows`` as the manifest, merged by ``(character, clip)`` with the rows on disk for
+    pairs not among ``rows`` (another run's, written meanwhile), under a lock on the folder: two runs
+    into one folder keep both runs' rows. A kept row is checked again when a run reuses it.
+    ``outputs`` (path, bytes) are written with it as one (:func:`motionlab.core.files.atomic_write_all`),
+    renamed after the manifest: a kill in between leaves rows without files, which a rerun redoes."""
+    mine = {(r["character"], r["clip"]): r for r in rows}
+    with _folder_lock(out):
+        merged = dict(mine)
+        for r in read_manifest(out):
+            merged.setdefault((r["character"], r["clip"]), r)
+        buf = io.StringIO()
+        cols = columns()
+        w = csv.DictWriter(buf, fieldnames=cols, lineterminator="\n")
+        w.writeheader()
+        for key in sorted(merged):
+            w.writerow({k: merged[key].get(k, "") for k in cols})
+        text = buf.getvalue()
+        writes = [(out / MANIFEST, lambda f: f.write(text), False, "manifest")]
+        writes += [(file, lambda f, data=data: f.write(data), True, "output") for file, data in outputs]
+        files.atomic_write_all(writes, overwrite=True)
 
 
 def _fmt(v: float) -> str:
@@ -526,8 +530,10 @@ def _error_row(clip: str, character: str, source: str, origin: str, message: str
 
 
 def _clean_temporaries(folder: Path) -> None:
-    """Remove what a killed run left: our own ``.<name>.*.tmp`` files, nothing else."""
+    """Remove what a killed run left: the temporary files of writers that no longer run
+    (:func:`motionlab.core.files.remove_stale_in`), and ``.<name>.*.tmp`` files of older releases."""
     if folder.is_dir():
+        files.remove_stale_in(folder)
         for t in folder.glob(".*.tmp"):
             t.unlink(missing_ok=True)
 
@@ -693,33 +699,21 @@ def _expand(
 
 
 def _write_batch(solved, sources_by_clip, chars, limits, suffix, options, fps, out, rows, result) -> list[dict]:
-    """Rows first (manifest), then the files: a kill between the two leaves rows without files,
-    which a rerun redoes."""
+    """Rows first (manifest), then the files, in one :func:`_write_manifest`: a kill between the two
+    leaves rows without files, which a rerun redoes."""
     new, staged = [], []
-    try:
-        for pr in solved:
-            src = sources_by_clip[pr.clip]
-            motion = at_rate(pr.result, fps or src.fps, src.fps).motion
-            row = _row(pr, src, chars[pr.character], limits, suffix, motion, options)
-            result.implausible += not pr.result.plausibility.ok
-            file = out / row["output"]
-            file.parent.mkdir(parents=True, exist_ok=True)
-            fd, tmp = tempfile.mkstemp(dir=file.parent, prefix=f".{file.name}.", suffix=".tmp")
-            data = gltf.dumps(motion) if suffix == gltf.SUFFIX else bvh.dumps(motion).encode("utf-8")
-            with os.fdopen(fd, "wb") as f:
-                f.write(data)
-            os.chmod(tmp, _MODE)
-            staged.append((tmp, file))
-            new.append(row)
-            rows[(pr.character, pr.clip)] = row
-            result.source_frames += pr.result.motion.num_frames
-        _write_manifest(out, list(rows.values()))
-        for tmp, file in staged:
-            os.replace(tmp, file)
-    finally:
-        for tmp, _ in staged:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
+    for pr in solved:
+        src = sources_by_clip[pr.clip]
+        motion = at_rate(pr.result, fps or src.fps, src.fps).motion
+        row = _row(pr, src, chars[pr.character], limits, suffix, motion, options)
+        result.implausible += not pr.result.plausibility.ok
+        file = out / row["output"]
+        file.parent.mkdir(parents=True, exist_ok=True)
+        staged.append((file, motion_files.encode(motion, suffix, chars[pr.character].unit)))
+        new.append(row)
+        rows[(pr.character, pr.clip)] = row
+        result.source_frames += pr.result.motion.num_frames
+    _write_manifest(out, list(rows.values()), staged)
     return new
 
 

@@ -13,7 +13,7 @@ import argparse
 import sys
 
 from motionlab import cli_args
-from motionlab.cli_args import check_output_folder, non_negative, non_negative_int, positive, positive_int
+from motionlab.cli_args import CLIError, check_output_folder, non_negative, non_negative_int, positive, positive_int
 from motionlab.retargeting import cli_options
 from motionlab.retargeting.cli_options import ROOT_MODES
 
@@ -27,7 +27,6 @@ def _cmd_expand(args) -> int:
     with --format glb) with OUT/manifest.csv (one row per output). Rerunning the same command redoes only what is
     missing. Exit status 1 when some pair failed (see the manifest's error column).
     """
-    from motionlab.cli import CLIError
     from motionlab.retargeting import expand as ex
 
     cli_options.check_device(args.device)
@@ -127,7 +126,11 @@ def register(subparsers) -> None:
         p.add_argument("--address", help="Ray cluster address (default: $RAY_ADDRESS, else a local Ray instance)")
         p.add_argument("--workers", type=positive_int, default=2, help="Ray actors (default 2)")
         p.add_argument(
-            "--threads", type=non_negative_int, default=0, help="torch threads (default: 1 on the CPU, see expand())"
+            "--threads",
+            type=non_negative_int,
+            default=0,
+            help="torch threads during the job (default 0: 1 on the CPU, which keeps a long job fast when the "
+            "machine turns busy; torch's own count on a GPU)",
         )
         p.add_argument(
             "--max-penetration", type=non_negative, default=1.0, metavar="CM", help="flag above this (default 1 cm)"

@@ -17,15 +17,14 @@ import time
 from pathlib import Path
 
 from motionlab import cli_args
-from motionlab.cli_args import check_outputs, non_negative_int, positive, positive_int
+from motionlab.cli_args import CLIError, check_outputs, non_negative_int, positive, positive_int, rig_error
 
 __all__ = ["register"]
 
 
-def _error(message: str):
-    from motionlab.cli import CLIError
-
-    return CLIError(message)
+MAX_SIZE = 4096
+"""Largest picture side in pixels: what an off-screen OpenGL framebuffer gives everywhere
+(larger ones abort the renderer instead of failing)."""
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -33,8 +32,8 @@ def _size(text: str) -> tuple[int, int]:
         width, height = (int(v) for v in text.lower().split("x"))
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT in pixels (e.g. 640x480), got {text!r}") from None
-    if width < 16 or height < 16:
-        raise argparse.ArgumentTypeError(f"the window must be at least 16x16 pixels, got {text!r}")
+    if not (16 <= width <= MAX_SIZE and 16 <= height <= MAX_SIZE):
+        raise argparse.ArgumentTypeError(f"expected 16 to {MAX_SIZE} pixels a side, got {text!r}")
     return width, height
 
 
@@ -88,28 +87,26 @@ def _cmd_view(args) -> int:
     source = files.check_input(args.file, "BVH")
     out = Path(args.output) if args.output else None
     if out is None and not backend.has_display():  # never write into the current folder unasked
-        raise _error(f"no display found to open a window for {source}; write a movie instead with -o {source.stem}.mp4")
+        raise CLIError(
+            f"no display found to open a window for {source}; write a movie instead with -o {source.stem}.mp4"
+        )
     if out is not None:
         if out.suffix.lower() not in MOVIE_SUFFIXES:
-            raise _error(f"-o must end in .mp4 or .gif, got {str(out)!r}")
-        check_outputs([("-o", out)], args.force, inputs=[("input", source)])
+            raise CLIError(f"-o must end in .mp4 or .gif, got {str(out)!r}")
+        check_outputs([("-o", args.output)], args.force, inputs=[("input", source)])
     try:
         motion = bvh.load(source, scale=args.unit_scale)
     except bvh.BVHError as e:
-        raise _error(str(e)) from None
+        raise CLIError(str(e)) from None
     if args.canonical:
         from motionlab.core import humanoid
 
         try:
             motion = humanoid.to_canonical(motion)
         except humanoid.RigMappingError as e:
-            from motionlab.cli import rig_error
-
             raise rig_error(e, "input", source) from None
     if args.start or args.stop is not None:
-        motion = motion[args.start : args.stop]
-        if motion.num_frames == 0:
-            raise _error(f"no frames between --start {args.start} and --stop {args.stop}")
+        motion = _frames(motion, args.start, args.stop, source)
     trails = tuple(t for t, on in (("root", not args.no_trail), ("feet", args.feet_trails)) if on)
     options = dict(camera=args.camera, window_size=args.size, trails=trails, contacts=not args.no_contacts)
     if out is None:
@@ -119,7 +116,7 @@ def _cmd_view(args) -> int:
     try:
         backend.import_pyvista()
     except backend.RenderingUnavailable as e:
-        raise _error(str(e)) from None
+        raise CLIError(str(e)) from None
     start = time.perf_counter()
     kwargs = {"stride": args.stride} if args.stride else {}
     save_movie(motion, out, overwrite=args.force, off_screen=True, anti_aliasing=args.smooth, **kwargs, **options)
@@ -131,6 +128,16 @@ def _cmd_view(args) -> int:
             f"({motion.num_frames} frames at {motion.fps:g} fps; rendered in {seconds:.1f} s)"
         )
     return 0
+
+
+def _frames(motion, start: int, stop: int | None, source: Path):
+    """Frames ``start`` up to ``stop`` (``None``: the end) of ``motion``, or a CLIError naming the options."""
+    if start >= motion.num_frames:
+        raise CLIError(f"--start {start} is past the last frame of {source} ({motion.num_frames} frames: 0 to "
+                     f"{motion.num_frames - 1})")  # fmt: skip
+    if stop is not None and stop <= start:
+        raise CLIError(f"--stop {stop} must be after --start {start}")
+    return motion[start:stop]
 
 
 def _movie_length(out: Path, motion, stride: int | None) -> tuple[int, float]:
@@ -172,7 +179,9 @@ def register(subparsers) -> None:
             ),
         )
         p.add_argument("--start", type=non_negative_int, default=0, help="first frame")
-        p.add_argument("--stop", type=int, default=None, help="frame to stop before (default: the end)")
+        p.add_argument(
+            "--stop", type=positive_int, default=None, help="frame to stop before, 1 or more (default: the end)"
+        )
         p.add_argument(
             "--stride", type=positive_int, default=None, help="movie: keep every N-th frame (GIF default: ~15 fps)"
         )

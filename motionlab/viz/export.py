@@ -46,7 +46,9 @@ def _target(path, suffixes: Sequence[str], overwrite: bool) -> Path:
     if path.suffix.lower() not in suffixes:
         raise ValueError(f"expected a file name ending in {' or '.join(suffixes)}, got {str(path)!r}")
     if path.exists() and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True (or --force) to replace it")
+        from motionlab.core import files
+
+        raise FileExistsError(files.exists_message("output", path))
     if not path.parent.exists():
         raise FileNotFoundError(f"folder {path.parent} does not exist (writing {path.name})")
     return path
@@ -96,14 +98,11 @@ def to_png(image: np.ndarray) -> bytes:
 
 
 def _write_atomically(path: Path, write) -> None:
-    """Call ``write(tmp_path)`` then move the finished file into place (no half-written files)."""
-    tmp = path.with_name(f".{path.stem}.partial{path.suffix}")
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
+    """Call ``write(tmp_path)`` then move the finished file into place (no half-written files):
+    :func:`motionlab.core.files.atomic_write_file` (``path`` was checked by :func:`_target`)."""
+    from motionlab.core import files
+
+    files.atomic_write_file(path, write, overwrite=True, what=path.suffix.lstrip(".").upper() or "output")
 
 
 def save_gif(

@@ -2,7 +2,9 @@
 
 Whatever the arguments, ``motionlab`` ends with exit status 0 or 2 and no traceback; a command
 that refuses (2) leaves every file as it was, and no command replaces a file without ``--force``
-or leaves a temporary file behind. The long-running work (training, solving, building, rendering)
+or leaves a temporary file behind. Output names are drawn with every suffix, as a folder's name
+(``new_dir/``), and as a named pipe or a symbolic link, which are never replaced, ``--force`` or
+not; numbers are drawn huge and tiny (``1e300``, ``1e-300``) for every numeric option. The long-running work (training, solving, building, rendering)
 is replaced by a stand-in that stops the command where its work would begin, so a valid argument
 list costs milliseconds and the check "nothing written before the work starts" holds too.
 """
@@ -55,14 +57,18 @@ COMMANDS = PARSER._subparsers._group_actions[0].choices
 NAMES = ["in.bvh", "dir", "notes.txt", "old.bvh", "g.mlgraph", "missing.bvh", "nowhere/x.bvh", "", ".",
          "walk:normal:30", "walk:normal:10,run:normal:10", "walk:normal:10,,run:normal:10"]  # fmt: skip
 OUTPUTS = ["out.bvh", "out.mlgraph", "r.json", "out.gif", "out.mp4", "out.npz", "out.pt", "new_dir", "old.bvh",
-           "in.bvh", "dir", "nowhere/x.bvh"]  # fmt: skip
-NUMBERS = ["0", "-1", "-5", "0.5", "nan", "inf", "-inf", "1e9", "abc", "2.5"]
+           "in.bvh", "dir", "nowhere/x.bvh",
+           # every suffix a user may try, a folder's name, and names that are no plain file (made by _sandbox)
+           "out.glb", "out.gltf", "out.fbx", "out.txt", "out.csv", "out", "new_dir/", "dir/", "pipe.bvh", "link.bvh"]  # fmt: skip
+NUMBERS = ["0", "-1", "-5", "0.5", "nan", "inf", "-inf", "1e9", "abc", "2.5",
+           "1e300", "-1e300", "1e6", "1e-9", "1e-300", "100000x100000", "4294967296"]  # huge and tiny  # fmt: skip
 RANDOM = st.one_of(
     st.sampled_from(NAMES),
     st.sampled_from(NUMBERS),
     st.integers(-10, 10**6).map(str),
     st.text("abcxyz019:,._=-", max_size=12),  # no "/": a path never leaves the sandbox
 )
+FLOAT_TYPES = ("float", "positive", "non_negative", "in_range", "frame_rate", "factor")
 GOOD_INTS = st.sampled_from(["1", "2", "3", "10"])
 GOOD_FLOATS = st.sampled_from(["0.5", "1", "0.03", "30", "1.2"])
 
@@ -74,9 +80,9 @@ def _values(action: argparse.Action):
         good = st.sampled_from(list(action.choices))
     elif action.dest in ("output", "out", "report", "csv", "npz"):
         good = st.sampled_from(OUTPUTS)
-    elif getattr(action.type, "__name__", "") in ("int", "positive_int", "non_negative_int"):
+    elif getattr(action.type, "__name__", "") in ("int", "positive_int", "non_negative_int", "seed"):
         good = GOOD_INTS
-    elif getattr(action.type, "__name__", "") in ("float", "positive", "non_negative"):
+    elif getattr(action.type, "__name__", "") in FLOAT_TYPES:
         good = GOOD_FLOATS
     else:
         good = st.sampled_from(NAMES)
@@ -92,13 +98,21 @@ def _sandbox(folder: Path, text: str, graph: bytes) -> None:
     (folder / "dir" / "walk_normal.bvh").write_text(text)
     (folder / "notes.txt").write_text("not a motion\n")
     (folder / "old.bvh").write_text("a file that must survive\n")
+    os.mkfifo(folder / "pipe.bvh")  # a special file: never replaced, --force or not
+    (folder / "link.bvh").symlink_to("old.bvh")  # a link: never replaced, nor what it points to
+
+
+def _state(p: Path) -> str:
+    """What ``p`` is and holds: a link's target, a named pipe, a folder, or a file's hash."""
+    if p.is_symlink():
+        return f"link to {os.readlink(p)}"
+    if p.is_fifo():
+        return "named pipe"
+    return hashlib.sha1(p.read_bytes()).hexdigest() if p.is_file() else "folder"
 
 
 def _snapshot(folder: Path) -> dict[str, str]:
-    return {
-        str(p.relative_to(folder)): hashlib.sha1(p.read_bytes()).hexdigest() if p.is_file() else "folder"
-        for p in sorted(folder.rglob("*"))
-    }
+    return {str(p.relative_to(folder)): _state(p) for p in sorted(folder.rglob("*"))}
 
 
 def _resolve(dotted: str):
@@ -181,6 +195,9 @@ def _check(argv, inputs, code, err, before, after) -> None:
         assert after == before, (argv, err)
     if "--force" not in argv:
         assert all(after.get(k) == v for k, v in before.items()), argv  # nothing replaced
+    assert [after.get(k) for k in ("pipe.bvh", "link.bvh")] == [before[k] for k in ("pipe.bvh", "link.bvh")], argv
+    if "old.bvh" not in argv:  # nothing written through the link either
+        assert after.get("old.bvh") == before["old.bvh"], argv
     changed = [k for k in inputs if k in before and after.get(k) != before[k]]
     assert not changed, (argv, changed)  # a file the command reads is never written, --force or not
     assert not [k for k in after if k.endswith((".tmp", ".motionlab-tmp"))], argv
@@ -223,3 +240,43 @@ def test_every_command_ends_cleanly_on_random_arguments(command, graph_parts, mo
     for inputs, options in EXAMPLES.get(command, []):
         run = example(case=([command, *inputs, *options], inputs))(run)
     run()
+
+
+WRITERS = {  # commands that write a motion, with arguments that make them write one quickly
+    "convert": ["convert", "in.bvh"],
+    "synth": ["synth", "walk", "--seconds", "0.2"],
+    "fill-gaps": ["fill-gaps", "in.bvh"],
+    "graph-search": ["graph-search", "g.mlgraph", "--request", "walk:normal:10"],
+    "retarget": ["retarget", "in.bvh", "--scale-legs", "1.2", "--method", "copy", "--keep-implausible"],
+}
+MAGIC = {".bvh": b"HIERARCHY", ".glb": b"glTF"}
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(
+    command=st.sampled_from(sorted(WRITERS)),
+    output=st.sampled_from(OUTPUTS),
+    force=st.booleans(),
+)
+def test_every_motion_writer_writes_what_its_output_name_says(graph_parts, capsys, command, output, force):
+    """For real (no stand-ins): exit 0 writes the format the name's suffix says; else exit 2 and
+    nothing changed. A named pipe or a link is never replaced."""
+    clip = bvh.dumps(synthetic.generate("walk", humanoid.canonical_skeleton(), num_frames=12, fps=30, seed=0))
+    here = os.getcwd()
+    argv = [*WRITERS[command], "-o", output, "-q"] + (["--force"] if force else [])
+    with tempfile.TemporaryDirectory() as name:
+        folder = Path(name)
+        _sandbox(folder, clip, graph_parts[0])
+        before = _snapshot(folder)
+        os.chdir(folder)
+        try:
+            code = cli.main(argv)
+        except SystemExit as e:
+            code = e.code
+        finally:
+            os.chdir(here)
+        after = _snapshot(folder)
+        _check(argv, WRITERS[command][1:2], code, capsys.readouterr().err, before, after)
+        if code == 0:
+            magic = MAGIC.get(Path(output).suffix.lower(), b"(refused: no writer for this suffix)")
+            assert (folder / output).read_bytes().startswith(magic), argv

@@ -48,8 +48,8 @@ VOCABULARY = {
     "--output": ("output", "text", "the file or folder the command writes"),
     "--force": ("force", "flag", "replace existing outputs"),
     "--quiet": ("quiet", "flag", "no progress bars or status lines"),
-    "--fps": ("fps", "positive", "frame rate, frames per second"),
-    "--seed": ("seed", "int", "random seed"),
+    "--fps": ("fps", "frame_rate", "frame rate, frames per second"),
+    "--seed": ("seed", "seed", "random seed"),
     "--device": ("device", "text", "torch device"),
     "--checkpoint": ("checkpoint", "text", "the retargeting network's checkpoint file"),
     "--canonical": ("canonical", "flag", "reduce the rig to the canonical 22 joints"),
@@ -62,7 +62,7 @@ VOCABULARY = {
     "--stop-loss": ("stop_loss", "non_negative", "the latent iteration stops when L_iter drops below it"),
     "--distance-threshold": ("threshold", "positive", "largest frame distance of a motion-graph transition"),
     "--delta": ("delta", "text", "Δ, the dropped-frame factor of fill-gaps"),
-    "--scale": ("scale", "positive", "scale the whole target character (retarget)"),
+    "--scale": ("scale", "factor", "scale the whole target character (retarget)"),
     "--unit-scale": ("unit_scale", "positive", "BVH units to metres (view)"),
     "--steps": ("steps", "non_negative_int", "step limit of the latent iteration"),
     "--lr": ("lr", "positive", "Adam step of the latent iteration"),
@@ -91,6 +91,8 @@ RENAMED = {  # (command, old spelling) -> new spelling
     ("view", "--out"): "--output",
     ("demo", "--out"): "--output",
     ("demo", "--characters"): "--num-characters",
+    ("train", "--steps"): "--train-steps",  # one idea, two names: train's Adam steps
+    ("train", "--lr"): "--train-lr",
 }
 
 

@@ -114,3 +114,39 @@ def test_atomic_write_all_writes_every_file_or_none(tmp_path):
         overwrite=True,
     )
     assert old.read_text() == "new a" and (tmp_path / "b.npz").read_bytes() == b"b"
+
+
+def test_nothing_changes_the_process_umask(tmp_path):
+    """Importing the package and writing a file never set the umask (it is shared by every thread)."""
+    code = (
+        "import os\n"
+        "def refuse(*args):\n"
+        "    raise AssertionError('the umask was changed')\n"
+        "os.umask = refuse\n"
+        "import motionlab.retargeting.expand, motionlab.viz.export\n"
+        "from motionlab.core import files\n"
+        f"files.atomic_write({str(tmp_path / 'x.txt')!r}, lambda f: f.write('x'))\n"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert (tmp_path / "x.txt").stat().st_mode & 0o777 == 0o666 & ~_current_umask()
+
+
+def _current_umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def test_a_writer_that_needs_a_name_gets_one_with_the_suffix(tmp_path):
+    seen = []
+
+    def fill(tmp):
+        seen.append(tmp)
+        tmp.write_bytes(b"GIF89a")
+
+    path = files.atomic_write_file(tmp_path / "movie.gif", fill)
+    assert path.read_bytes() == b"GIF89a" and seen[0].suffix == ".gif" and seen[0].parent == tmp_path
+    assert [p.name for p in tmp_path.iterdir()] == ["movie.gif"]
+    with pytest.raises(FileExistsError, match="add --force"):
+        files.atomic_write_file(tmp_path / "movie.gif", fill)

@@ -3,6 +3,7 @@ composition in ``tests/gltf_reader.py``) and must put the joints where motionlab
 
 from __future__ import annotations
 
+import functools
 import json
 import shutil
 import struct
@@ -116,7 +117,7 @@ def test_refusing_writes_nothing(walk, tmp_path):
     assert list(tmp_path.iterdir()) == []
     path = gltf.save(tmp_path / "walk.glb", walk)
     before = path.read_bytes()
-    with pytest.raises(FileExistsError, match="exists; pass --force"):
+    with pytest.raises(FileExistsError, match="exists; add --force"):
         gltf.save(path, walk[:10])
     assert path.read_bytes() == before and [p.name for p in tmp_path.iterdir()] == ["walk.glb"]
     gltf.save(path, walk[:10], overwrite=True)
@@ -174,11 +175,25 @@ def test_threejs_puts_the_joints_where_fk_does(walk, tmp_path, source):
     assert err <= 1e-4 * motion.skeleton.height(), f"three.js joints {err:.3g} m from FK"
 
 
+@functools.cache
+def _blender_has_numpy() -> bool:
+    """Whether the Python inside Blender imports numpy (Debian's ``blender`` without ``python3-numpy`` does not)."""
+    run = subprocess.run(
+        ["blender", "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr", "import numpy"],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    return run.returncode == 0
+
+
 @pytest.mark.parametrize("source", ["synthetic", "bandai_namco"])
 def test_blender_imports_the_joints_where_fk_does(walk, tmp_path, source):
     """Blender's own glTF importer (skipped where Blender is not installed; Z-up inside Blender)."""
     if shutil.which("blender") is None:
         pytest.skip("needs Blender on PATH (Debian: apt-get install blender python3-numpy)")
+    if not _blender_has_numpy():
+        pytest.skip(
+            "Blender's Python has no numpy, which its glTF importer needs (Debian: apt-get install python3-numpy)"
+        )
     motion = walk if source == "synthetic" else bvh.load(sorted(require_data("bandai_namco").rglob("*.bvh"))[0])
     path = gltf.save(tmp_path / "clip.glb", motion)
     frames = sorted({0, motion.num_frames // 2, motion.num_frames - 1})
@@ -195,3 +210,17 @@ def test_blender_imports_the_joints_where_fk_does(walk, tmp_path, source):
     order = [motion.skeleton.names.index(n) for n in result["names"]]
     err = np.abs(got - motion.global_positions()[frames][:, order]).max()
     assert err <= 1e-4 * motion.skeleton.height(), f"Blender {result['blender']}: joints {err:.3g} m from FK"
+
+
+@pytest.mark.parametrize(("status", "has"), [(0, True), (1, False)])
+def test_blender_without_numpy_is_told_apart(tmp_path, monkeypatch, status, has):
+    """The Blender test skips, with the reason, where Blender's Python cannot import numpy."""
+    fake = tmp_path / "blender"
+    fake.write_text(f"#!/bin/sh\nexit {status}\n")
+    fake.chmod(0o755)
+    monkeypatch.setenv("PATH", f"{tmp_path}:/usr/bin:/bin")
+    _blender_has_numpy.cache_clear()
+    try:
+        assert _blender_has_numpy() is has
+    finally:
+        _blender_has_numpy.cache_clear()

@@ -190,12 +190,38 @@ def test_ray_backend_without_ray_says_how_to_install(monkeypatch, library, tmp_p
 
 
 @pytest.mark.slow
+def _start_ray(workers: int) -> None:
+    """``ray.init``, tried twice: Ray waits a fixed 30 s for its node to start (``ray/_private/node.py``,
+    not configurable), which a loaded 2-core machine exceeds ("The current node timed out during
+    startup"). Twice timed out: the test is skipped with that reason, as the machine, not motionlab, failed."""
+    import ray
+
+    for _ in range(2):
+        try:
+            ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False)
+            return
+        except Exception as e:  # Ray raises a bare Exception for it
+            ray.shutdown()
+            if "timed out during startup" not in str(e):
+                raise
+    pytest.skip("Ray's node did not start within Ray's fixed 30 s, twice: the machine is too loaded to start Ray")
+
+
 def test_ray_backend_equals_local(ckpt, library, tmp_path):
     if importlib.util.find_spec("ray") is None:
         pytest.skip('Ray is not installed: pip install "motionlab[cluster]" (CI installs it)')
+    import ray
+
     targets = _targets(library)
     local = ex.expand([str(library / "clips")], targets, tmp_path / "local", ckpt, FAST)
-    remote = ex.expand([str(library / "clips")], targets, tmp_path / "ray", ckpt, FAST, backend="ray", workers=2)
+    started = not ray.is_initialized()
+    if started:
+        _start_ray(workers=2)
+    try:
+        remote = ex.expand([str(library / "clips")], targets, tmp_path / "ray", ckpt, FAST, backend="ray", workers=2)
+    finally:
+        if started:
+            ray.shutdown()
     assert remote.done == local.done == 9
     assert _bvh_files(tmp_path / "ray") == _bvh_files(tmp_path / "local")
     for f in _bvh_files(tmp_path / "local"):

@@ -45,7 +45,7 @@ def test_retarget_writes_glb_with_the_npz_motion(source, tmp_path, capsys):
 
 def test_retarget_refuses_other_suffixes_before_work(source, tmp_path, capsys):
     code, _, err = _run(capsys, "retarget", source, "--scale-legs", "1.3", "-o", tmp_path / "x.fbx", "--method", "copy")
-    assert code == 2 and "must end in .bvh or .glb" in err
+    assert code == 2 and "choose a name ending in .bvh or .glb" in err
     assert list(tmp_path.iterdir()) == []
 
 
