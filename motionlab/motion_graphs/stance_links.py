@@ -140,15 +140,27 @@ def leads(graph: MotionGraph) -> tuple[np.ndarray, np.ndarray]:
     transition of the style enters a start); a link from another pool may enter a lead-in and
     step forward into the alive frames, or leave from a lead-out after stepping out of them."""
     n = graph.num_frames
-    lead_in, lead_out = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
-    for c in graph.clips:
-        a = graph.alive[c.start : c.stop]
-        if c.kind != "basic" or not a.any() or a.all():
-            continue
-        first, last = int(np.argmax(a)), c.num_frames - 1 - int(np.argmax(a[::-1]))
-        lead_in[c.start : c.start + first] = True
-        lead_out[c.start + last + 1 : c.stop] = True
-    return lead_in, lead_out
+    basic = [c for c in graph.clips if c.kind == "basic" and c.num_frames > 0]
+    start = np.array([c.start for c in basic], dtype=np.int64)
+    stop = np.array([c.stop for c in basic], dtype=np.int64)
+    alive_at = np.flatnonzero(graph.alive)
+    if alive_at.size == 0 or not basic:
+        return np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+    k0 = np.searchsorted(alive_at, start)  # first alive frame at or after each clip's start
+    k1 = np.searchsorted(alive_at, stop) - 1  # last alive frame before each clip's stop
+    some = k1 >= k0
+    first = np.where(some, alive_at[np.minimum(k0, alive_at.size - 1)], start)
+    last = np.where(some, alive_at[np.maximum(k1, 0)], stop - 1)
+    partial = some & ((k1 - k0 + 1) < (stop - start))
+    return _ranges(n, start[partial], first[partial]), _ranges(n, last[partial] + 1, stop[partial])
+
+
+def _ranges(n: int, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """(n,) bool, True on every ``lo[k] <= f < hi[k]`` (ranges that do not overlap)."""
+    mark = np.zeros(n + 1, dtype=np.int64)
+    np.add.at(mark, lo, 1)
+    np.add.at(mark, hi, -1)
+    return np.cumsum(mark[:n]) > 0
 
 
 def _direction(graph: MotionGraph, lead: tuple, src: np.ndarray, dst: np.ndarray, cost: np.ndarray):

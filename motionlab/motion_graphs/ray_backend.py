@@ -1,0 +1,90 @@
+"""The Ray backend of the structured build: the comparisons inside each style as Ray tasks.
+
+Ray (https://docs.ray.io) is an optional extra: ``pip install "motionlab[cluster]"``.
+``build_structured(..., backend="ray")`` (``motionlab graph-build --backend ray``) sends each
+style's frames to one Ray task, which computes its takes' point clouds and the transition
+candidates of every take with itself and with its neighbouring takes
+(:func:`.structured.pool_pair_candidates`, the function the local backend calls). The calling
+process keeps everything else (ports, pruning, links, the structure table) and reads the
+answers in style order, so the graph equals the local build's, edge for edge.
+
+Where Ray runs: ``address`` (or the ``RAY_ADDRESS`` environment variable) names an existing
+cluster; without one, a local Ray instance with ``workers`` CPUs is started and shut down
+afterwards.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Sequence
+from contextlib import contextmanager
+
+import numpy as np
+
+__all__ = ["INSTALL_HINT", "session", "pool_candidates"]
+
+INSTALL_HINT = 'graph-build --backend ray needs Ray: pip install "motionlab[cluster]" (or pip install ray)'
+
+
+def _ray():
+    try:
+        import ray
+    except ImportError:
+        raise ImportError(INSTALL_HINT) from None
+    return ray
+
+
+@contextmanager
+def session(address: str | None = None, workers: int = 2):
+    """Ray, initialised for the ``with`` block: the cluster at ``address`` (or ``RAY_ADDRESS``),
+    else a local instance with ``workers`` CPUs, shut down at the end (a Ray already initialised
+    by the caller is used as it is and left running).
+
+    Raises ``ImportError`` saying how to install Ray, ``ValueError`` for ``workers < 1``."""
+    ray = _ray()
+    if workers < 1:
+        raise ValueError(f"workers must be >= 1, got {workers}")
+    address = address or os.environ.get("RAY_ADDRESS") or None
+    started = not ray.is_initialized()
+    if started:
+        kw = dict(address=address) if address else dict(num_cpus=workers)
+        ray.init(**kw, include_dashboard=False, log_to_driver=False)
+    try:
+        yield ray
+    finally:
+        if started:
+            ray.shutdown()
+
+
+def _pool_task(skeleton, rot, root, fps, lengths, pairs, threshold, window, min_loop):
+    """One style's candidates from its frames (takes side by side, ``lengths`` frames each)."""
+    from motionlab.core.motion import Motion
+    from motionlab.motion_graphs import distance, structured
+
+    bounds = np.cumsum([0, *lengths])
+    motions = [Motion(skeleton, rot[a:b], root[a:b], fps, None, "") for a, b in zip(bounds[:-1], bounds[1:])]
+    feats = [distance.cloud_features(p, window) for p in structured.positions(motions)]
+    return structured.pool_pair_candidates(feats, pairs, threshold, window, min_loop)
+
+
+def pool_candidates(graph, pools: Sequence[tuple], ring_pairs: Callable, opt) -> Callable:
+    """Submit one Ray task per style and return ``run(key, takes, pairs)``, which waits for that
+    style's answer (:func:`.structured.pool_pair_candidates`).
+
+    ``pools``: ``(key, graph clip indices of its takes)`` in build order; ``ring_pairs(n,
+    neighbours)``: the take pairs of a style of ``n`` takes; ``opt``: the build's options
+    (``threshold``, ``window``, ``min_loop``, ``neighbours``). Needs :func:`session` active."""
+    ray = _ray()
+    task = ray.remote(num_cpus=1)(_pool_task)
+    skeleton = ray.put(graph.skeleton)
+    refs = {}
+    for key, ks in pools:
+        st, sp = graph.clips[ks[0]].start, graph.clips[ks[-1]].stop
+        lengths = [graph.clips[c].num_frames for c in ks]
+        refs[key] = task.remote(skeleton, graph.local_rot[st:sp], graph.root_pos[st:sp], graph.fps, lengths,
+                                ring_pairs(len(ks), opt.neighbours), opt.threshold, opt.window, opt.min_loop)  # fmt: skip
+
+    def run(key, ks, pairs):
+        return ray.get(refs.pop(key))
+
+    return run
