@@ -64,8 +64,14 @@ __all__ = [
     "rms",
     "threshold_from",
     "DEFAULT_WINDOW",
+    "DEFAULT_THRESHOLD",
     "GRID",
 ]
+
+DEFAULT_THRESHOLD = 0.04
+"""The default transition threshold, metres RMS between aligned point clouds (pass it through
+:func:`threshold_from`): ``graph-build``'s ``--distance-threshold`` and library callers use it.
+The rule that chose it and its check on held-out takes: ``docs/results_motion_graphs.md``."""
 
 DEFAULT_WINDOW = 5
 """Frames per point cloud (centred on the frame): 5 frames ≈ 0.17 s at 30 fps."""
