@@ -16,12 +16,16 @@ afterwards.
 from __future__ import annotations
 
 import os
+import time
 from collections.abc import Callable, Sequence
 from contextlib import contextmanager
 
 import numpy as np
 
-__all__ = ["INSTALL_HINT", "session", "pool_candidates"]
+__all__ = ["INSTALL_HINT", "START_TIMEOUT_S", "session", "pool_candidates"]
+
+START_TIMEOUT_S = 600.0
+"""How long :func:`session` keeps trying to start a local Ray instance, seconds."""
 
 INSTALL_HINT = 'graph-build --backend ray needs Ray: pip install "motionlab[cluster]" (or pip install ray)'
 
@@ -48,12 +52,26 @@ def session(address: str | None = None, workers: int = 2):
     started = not ray.is_initialized()
     if started:
         kw = dict(address=address) if address else dict(num_cpus=workers)
-        ray.init(**kw, include_dashboard=False, log_to_driver=False)
+        _start(ray, dict(kw, include_dashboard=False, log_to_driver=False), START_TIMEOUT_S)
     try:
         yield ray
     finally:
         if started:
             ray.shutdown()
+
+
+def _start(ray, kwargs: dict, timeout: float) -> None:
+    """``ray.init(**kwargs)``, tried again while a local node misses Ray's own 30-second start
+    window (a busy machine) until ``timeout`` seconds have passed."""
+    deadline = time.monotonic() + timeout
+    while True:
+        try:
+            ray.init(**kwargs)
+            return
+        except Exception as e:  # Ray raises a bare Exception when its node starts too slowly
+            ray.shutdown()
+            if "timed out during startup" not in str(e) or time.monotonic() > deadline:
+                raise
 
 
 def _pool_task(skeleton, rot, root, fps, lengths, pairs, threshold, window, min_loop):

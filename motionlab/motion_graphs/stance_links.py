@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable, Mapping, Sequence
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -229,6 +230,7 @@ def link_pools(
     pool_start: Callable[[Key], int],
     threshold: float,
     window: int = _distance.DEFAULT_WINDOW,
+    workers: int = 1,
 ) -> tuple[list[dict], tuple[np.ndarray, np.ndarray, np.ndarray], int]:
     """Kovar transitions between the ports of pool pairs (see the module docstring).
 
@@ -240,6 +242,7 @@ def link_pools(
     pool_start : key → global index of the pool's first frame (routes count from it)
     threshold : largest frame distance, m² (the graph's transition threshold)
     window : frames per point cloud
+    workers : threads comparing pool pairs at once (the answer does not depend on it)
 
     Returns
     -------
@@ -249,12 +252,19 @@ def link_pools(
     """
     links, parts, comparisons = [], [], 0
     lead = leads(graph)
-    for a, b, fwd, bwd in pairs:
+    pairs = [p for p in pairs if port_feats[p[0]][0] is not None and port_feats[p[1]][0] is not None]
+
+    def compare(pair):
+        return _distance.candidates(port_feats[pair[0]][0], port_feats[pair[1]][0], threshold, window)
+
+    if workers > 1:
+        with ThreadPoolExecutor(workers) as pool:
+            found = list(pool.map(compare, pairs))
+    else:
+        found = [compare(p) for p in pairs]
+    for (a, b, fwd, bwd), (i, j, cost) in zip(pairs, found):
         (fa, ga), (fb, gb) = port_feats[a], port_feats[b]
-        if fa is None or fb is None:
-            continue
         comparisons += len(fa) * len(fb)
-        i, j, cost = _distance.candidates(fa, fb, threshold, window)
         for ok, (x, y, sx, sy) in ((fwd, (ga[i], gb[j], a, b)), (bwd, (gb[j], ga[i], b, a))):
             if not ok:
                 continue

@@ -61,6 +61,7 @@ import functools
 import itertools
 import time
 from collections.abc import Mapping, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass
 
@@ -176,6 +177,7 @@ class _Options:
     neighbours: int
     rep_cycles: int
     progress: bool
+    workers: int = 1
 
 
 @dataclass
@@ -331,20 +333,21 @@ class _Compare:
         self.cache: dict[int, _distance.CloudFeatures] = {}
         self.comparisons = 0
 
-    def _motion(self, c: int) -> Motion:
+    def motion(self, c: int) -> Motion:
+        """Clip ``c`` of the graph as a Motion on the graph's skeleton (views of its arrays)."""
         g, info = self.graph, self.graph.clips[c]
         st, sp = info.start, info.stop
         return Motion(g.skeleton, g.local_rot[st:sp], g.root_pos[st:sp], g.fps, None, info.name)
 
     def feats(self, c: int) -> _distance.CloudFeatures:
         if c not in self.cache:
-            self.cache[c] = _distance.cloud_features(self._motion(c).global_positions(), self.window)
+            self.cache[c] = _distance.cloud_features(self.motion(c).global_positions(), self.window)
         return self.cache[c]
 
     def load(self, ks: Sequence[int]) -> None:
         """Cache the features of clips ``ks`` (one style's takes) from one FK pass (:func:`positions`)."""
         todo = [c for c in ks if c not in self.cache]
-        for c, pos in zip(todo, positions([self._motion(c) for c in todo])):
+        for c, pos in zip(todo, positions([self.motion(c) for c in todo])):
             self.cache[c] = _distance.cloud_features(pos, self.window)
 
     def __call__(self, x: int, y: int | None, rows=None, cols=None, thr=None, min_gap=0):
@@ -370,14 +373,40 @@ def pool_pair_candidates(feats: Sequence[_distance.CloudFeatures], pairs: Sequen
     return out
 
 
-def _local_candidates(cmp: _Compare, opt: _Options):
-    """The local backend: ``run(key, takes, pairs)`` computes :func:`pool_pair_candidates` here."""
+class _LocalPools:
+    """The local backend: ``run(key, takes, pairs)`` gives :func:`pool_pair_candidates` of one
+    style. With ``workers > 1`` threads compute the next styles ahead (at most ``workers`` at
+    once, so memory holds only their point clouds); answers are taken in build order."""
 
-    def run(key, ks, pairs):
-        cmp.load(ks)
-        return pool_pair_candidates([cmp.feats(c) for c in ks], pairs, opt.threshold, opt.window, opt.min_loop)
+    def __init__(self, cmp: _Compare, opt: _Options, pools: list, workers: int):
+        self.cmp, self.opt, self.todo, self.pending = cmp, opt, list(pools), {}
+        self.workers = workers
+        self.pool = ThreadPoolExecutor(workers) if workers > 1 else None
 
-    return run
+    def _task(self, ks: list[int]):
+        motions = [self.cmp.motion(c) for c in ks]
+        feats = [_distance.cloud_features(p, self.opt.window) for p in positions(motions)]
+        pairs = _ring_pairs(len(ks), self.opt.neighbours)
+        return feats, pool_pair_candidates(feats, pairs, self.opt.threshold, self.opt.window, self.opt.min_loop)
+
+    def _submit(self) -> None:
+        while self.todo and len(self.pending) < self.workers:
+            key, ks = self.todo.pop(0)
+            self.pending[key] = self.pool.submit(self._task, ks)
+
+    def __call__(self, key, ks, pairs):
+        if self.pool is None:
+            feats, out = self._task(ks)
+        else:
+            self._submit()
+            feats, out = self.pending.pop(key).result()
+            self._submit()
+        self.cmp.cache.update(zip(ks, feats))
+        return out
+
+    def close(self) -> None:
+        if self.pool is not None:
+            self.pool.shutdown(cancel_futures=True)
 
 
 def _link_takes(graph: MotionGraph, cmp: _Compare, arr: _Arranged, cuts: _Cuts, opt: _Options, notes: _Notes,
@@ -385,15 +414,15 @@ def _link_takes(graph: MotionGraph, cmp: _Compare, arr: _Arranged, cuts: _Cuts, 
     """Stage 3: within each style, every take with itself, its neighbouring takes and (port to
     port) every other take; then the style keeps its largest strongly connected part.
 
-    ``pool_candidates(key, takes, pairs)``: the candidates of one style (default: computed here,
-    :func:`_local_candidates`). Returns the ports of every pool
+    ``pool_candidates(key, takes, pairs)``: the candidates of one style (:class:`_LocalPools`
+    or :func:`.ray_backend.pool_candidates`). Returns the ports of every pool
     (:func:`.stance_links.port_features`, after pruning)."""
     clips = graph.clips
     ports: dict = {}
     port_masks = {
         c: (s.ports if s is not None else np.zeros(clips[c].num_frames, dtype=bool)) for c, s in cuts.seg.items()
     }
-    run = pool_candidates or _local_candidates(cmp, opt)
+    run = pool_candidates
     for key, ks in _progress(sorted(arr.pools.items()), "takes", enabled=opt.progress):
         with clock("distances"):
             ring = _ring_pairs(len(ks), opt.neighbours)
@@ -657,7 +686,7 @@ def _link_stances(graph: MotionGraph, arr: _Arranged, table: dict, ports: dict, 
     kinds = {(b, s): cell["kind"] for b, cells in table["behaviours"].items() for s, cell in cells.items()}
     pairs = _stance_links.pool_pairs(list(arr.pools), recorded, kinds)
     links, (src, dst, cost), n_cmp = _stance_links.link_pools(graph, pairs, ports, pool_start, opt.threshold,
-                                                              opt.window)  # fmt: skip
+                                                              opt.window, opt.workers)  # fmt: skip
     graph.add_edges(src, dst, cost, "transition")
     table["links"].extend(links)
     return n_cmp
@@ -681,7 +710,7 @@ def build_structured(
     progress: bool = False,
     backend: str = "local",
     ray_address: str | None = None,
-    workers: int = 2,
+    workers: int = 1,
 ) -> MotionGraph:
     """Build the structured motion graph (see the module docstring).
 
@@ -704,9 +733,10 @@ def build_structured(
     neighbours : each take is compared with itself and the next ``neighbours`` takes of its style
     rep_cycles : whole cycles of each representative take that the interpolation space blends
     progress : show a tqdm bar per stage
-    backend : ``"local"`` (this process) or ``"ray"``: the comparisons inside each style run as Ray
-        tasks (:mod:`.ray_backend`; same edges); ``ray_address`` names a running cluster (default:
-        ``RAY_ADDRESS``, else a local instance with ``workers`` CPUs)
+    backend : ``"local"`` (this process, ``workers`` threads) or ``"ray"``: the comparisons inside
+        each style run as Ray tasks (:mod:`.ray_backend`); ``ray_address`` names a running cluster
+        (default: ``RAY_ADDRESS``, else a local instance with ``workers`` CPUs). The graph does
+        not depend on the backend or the workers
 
     Returns
     -------
@@ -729,6 +759,7 @@ def build_structured(
                    max(1, int(round(fps / 5)) if dwell is None else int(dwell)), neighbours, rep_cycles, progress)  # fmt: skip
     if backend not in BACKENDS:
         raise ValueError(f"backend must be one of {BACKENDS}, got {backend!r}")
+    opt.workers = max(1, int(workers))
     graph = _build(_arrange(motions, labels), opt, synthetic, backend, ray_address, workers)
     graph.info.update(input_clips=len(motions), build_seconds=time.perf_counter() - t0)
     return graph
@@ -745,7 +776,7 @@ def _build(arr: _Arranged, opt: _Options, synthetic, backend: str, ray_address, 
     arr.motions = []  # the graph holds the frames now
     cmp = _Compare(graph, opt.threshold, opt.window)
     pool_start = functools.partial(_pool_start, graph, arr)
-    with _timer(seconds, "takes_seconds"), _backend(backend, graph, arr, opt, ray_address, workers) as remote:
+    with _timer(seconds, "takes_seconds"), _backend(backend, cmp, arr, opt, ray_address, workers) as remote:
         ports = _link_takes(graph, cmp, arr, cuts, opt, notes, clock, remote)
     table = _structure_table(graph, arr, cuts, opt)
     on_route = np.zeros(graph.num_frames, dtype=bool)
@@ -762,16 +793,20 @@ def _build(arr: _Arranged, opt: _Options, synthetic, backend: str, ray_address, 
 
 
 @contextmanager
-def _backend(backend: str, graph: MotionGraph, arr: _Arranged, opt: _Options, address: str | None, workers: int):
-    """``None`` for the local backend; for ``"ray"`` the :func:`.ray_backend.pool_candidates`
+def _backend(backend: str, cmp: _Compare, arr: _Arranged, opt: _Options, address: str | None, workers: int):
+    """The candidates of every style: :class:`_LocalPools` with ``workers`` threads, or for ``"ray"`` the :func:`.ray_backend.pool_candidates`
     of every style, submitted at once (Ray is started here and shut down after, unless running)."""
     if backend == "local":
-        yield None
+        local = _LocalPools(cmp, opt, sorted(arr.pools.items()), workers)
+        try:
+            yield local
+        finally:
+            local.close()
         return
     from motionlab.motion_graphs import ray_backend
 
     with ray_backend.session(address, workers):
-        yield ray_backend.pool_candidates(graph, sorted(arr.pools.items()), _ring_pairs, opt)
+        yield ray_backend.pool_candidates(cmp.graph, sorted(arr.pools.items()), _ring_pairs, opt)
 
 
 def _info(opt: _Options, comparisons: int, n_input: int, seconds: dict, n_extra: int, notes: _Notes) -> dict:
