@@ -87,7 +87,8 @@ def _pool_task(skeleton, rot, root, fps, lengths, pairs, threshold, window, min_
 
 def pool_candidates(graph, pools: Sequence[tuple], ring_pairs: Callable, opt) -> Callable:
     """Submit one Ray task per style and return ``run(key, takes, pairs)``, which waits for that
-    style's answer (:func:`.structured.pool_pair_candidates`).
+    style's answer (:func:`.structured.pool_pair_candidates`) and returns it with ``None`` (the
+    caller computes the port rows).
 
     ``pools``: ``(key, graph clip indices of its takes)`` in build order; ``ring_pairs(n,
     neighbours)``: the take pairs of a style of ``n`` takes; ``opt``: the build's options
@@ -103,6 +104,6 @@ def pool_candidates(graph, pools: Sequence[tuple], ring_pairs: Callable, opt) ->
                                 ring_pairs(len(ks), opt.neighbours), opt.threshold, opt.window, opt.min_loop)  # fmt: skip
 
     def run(key, ks, pairs):
-        return ray.get(refs.pop(key))
+        return ray.get(refs.pop(key)), None
 
     return run

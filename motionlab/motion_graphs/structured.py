@@ -375,19 +375,21 @@ def pool_pair_candidates(feats: Sequence[_distance.CloudFeatures], pairs: Sequen
 
 class _LocalPools:
     """The local backend: ``run(key, takes, pairs)`` gives :func:`pool_pair_candidates` of one
-    style. With ``workers > 1`` threads compute the next styles ahead (at most ``workers`` at
-    once, so memory holds only their point clouds); answers are taken in build order."""
+    style and its takes' port rows (:class:`_PortRows`). With ``workers > 1`` threads compute the
+    next styles ahead (at most ``workers`` at once); answers are taken in build order. Only port
+    rows outlive a task, so memory holds at most ``workers`` styles' point clouds."""
 
-    def __init__(self, cmp: _Compare, opt: _Options, pools: list, workers: int):
+    def __init__(self, cmp: _Compare, opt: _Options, pools: list, workers: int, port_masks: dict):
         self.cmp, self.opt, self.todo, self.pending = cmp, opt, list(pools), {}
-        self.workers = workers
+        self.workers, self.port_masks = workers, port_masks
         self.pool = ThreadPoolExecutor(workers) if workers > 1 else None
 
     def _task(self, ks: list[int]):
         motions = [self.cmp.motion(c) for c in ks]
         feats = [_distance.cloud_features(p, self.opt.window) for p in positions(motions)]
         pairs = _ring_pairs(len(ks), self.opt.neighbours)
-        return feats, pool_pair_candidates(feats, pairs, self.opt.threshold, self.opt.window, self.opt.min_loop)
+        found = pool_pair_candidates(feats, pairs, self.opt.threshold, self.opt.window, self.opt.min_loop)
+        return found, {c: _PortRows(f, self.port_masks[c]) for c, f in zip(ks, feats)}
 
     def _submit(self) -> None:
         while self.todo and len(self.pending) < self.workers:
@@ -396,12 +398,10 @@ class _LocalPools:
 
     def __call__(self, key, ks, pairs):
         if self.pool is None:
-            feats, out = self._task(ks)
-        else:
-            self._submit()
-            feats, out = self.pending.pop(key).result()
-            self._submit()
-        self.cmp.cache.update(zip(ks, feats))
+            return self._task(ks)
+        self._submit()
+        out = self.pending.pop(key).result()
+        self._submit()
         return out
 
     def close(self) -> None:
@@ -409,39 +409,36 @@ class _LocalPools:
             self.pool.shutdown(cancel_futures=True)
 
 
-def _link_takes(graph: MotionGraph, cmp: _Compare, arr: _Arranged, cuts: _Cuts, opt: _Options, notes: _Notes,
-                clock: _report.StageClock, pool_candidates=None):  # fmt: skip
+def _link_takes(graph: MotionGraph, cmp: _Compare, arr: _Arranged, port_masks: dict, opt: _Options, notes: _Notes,
+                clock: _report.StageClock, pool_candidates):  # fmt: skip
     """Stage 3: within each style, every take with itself, its neighbouring takes and (port to
     port) every other take; then the style keeps its largest strongly connected part.
 
-    ``pool_candidates(key, takes, pairs)``: the candidates of one style (:class:`_LocalPools`
-    or :func:`.ray_backend.pool_candidates`). Returns the ports of every pool
+    ``port_masks``: clip index → (frames,) bool ports of each take; ``pool_candidates(key,
+    takes, pairs)``: the candidates of one style and its port rows or ``None``
+    (:class:`_LocalPools` or :func:`.ray_backend.pool_candidates`). Returns the ports of every pool
     (:func:`.stance_links.port_features`, after pruning)."""
-    clips = graph.clips
     ports: dict = {}
-    port_masks = {
-        c: (s.ports if s is not None else np.zeros(clips[c].num_frames, dtype=bool)) for c, s in cuts.seg.items()
-    }
-    run = pool_candidates
     for key, ks in _progress(sorted(arr.pools.items()), "takes", enabled=opt.progress):
         with clock("distances"):
             ring = _ring_pairs(len(ks), opt.neighbours)
-            found = _pool_edges(graph, ks, ring, run(key, ks, ring), cmp)
-            cmp.load(ks)
+            found, port_rows = pool_candidates(key, ks, ring)
+            edges = _pool_edges(graph, ks, ring, found, cmp)
+            if port_rows is None:  # the remote backend sent candidates only
+                cmp.load(ks)
+                port_rows = {c: _PortRows(cmp.feats(c), port_masks[c]) for c in ks}
+                for c in ks:
+                    cmp.cache.pop(c, None)
             # takes connect stance to stance: every take's ports with every other take's
-            port_rows = {c: _PortRows(cmp.feats(c), port_masks[c]) for c in ks}
-            found["transition"].append(
+            edges["transition"].append(
                 _stance_links.link_within(graph, _stance_links.port_features(graph, ks, port_masks, port_rows.get),
                                           opt.threshold, opt.min_loop, opt.window)
             )  # fmt: skip
-            for kind, parts in found.items():
+            for kind, parts in edges.items():
                 if parts:
                     graph.add_edges(*(np.concatenate(p) for p in zip(*parts)), kind)
         with clock("pruning"):
             _prune_pool(graph, cmp, ks, opt, notes)
-        for c in ks:
-            if c != cuts.rep[key]:
-                cmp.cache.pop(c, None)
         ports[key] = _stance_links.port_features(graph, ks, port_masks, port_rows.get)
     with clock("pruning"):
         graph.drop_dead_edges()
@@ -760,12 +757,12 @@ def build_structured(
     if backend not in BACKENDS:
         raise ValueError(f"backend must be one of {BACKENDS}, got {backend!r}")
     opt.workers = max(1, int(workers))
-    graph = _build(_arrange(motions, labels), opt, synthetic, backend, ray_address, workers)
+    graph = _build(_arrange(motions, labels), opt, synthetic, backend, ray_address)
     graph.info.update(input_clips=len(motions), build_seconds=time.perf_counter() - t0)
     return graph
 
 
-def _build(arr: _Arranged, opt: _Options, synthetic, backend: str, ray_address, workers: int) -> MotionGraph:
+def _build(arr: _Arranged, opt: _Options, synthetic, backend: str, ray_address) -> MotionGraph:
     """The stages of :func:`build_structured` on the arranged clips, each timed (``info["stages"]``)."""
     notes, seconds, clock = _Notes(), {}, _report.StageClock()
     with _timer(seconds, "cycles_seconds"), clock("cycles"):
@@ -776,8 +773,11 @@ def _build(arr: _Arranged, opt: _Options, synthetic, backend: str, ray_address, 
     arr.motions = []  # the graph holds the frames now
     cmp = _Compare(graph, opt.threshold, opt.window)
     pool_start = functools.partial(_pool_start, graph, arr)
-    with _timer(seconds, "takes_seconds"), _backend(backend, cmp, arr, opt, ray_address, workers) as remote:
-        ports = _link_takes(graph, cmp, arr, cuts, opt, notes, clock, remote)
+    port_masks = {
+        c: s.ports if s is not None else np.zeros(graph.clips[c].num_frames, bool) for c, s in cuts.seg.items()
+    }
+    with _timer(seconds, "takes_seconds"), _backend(backend, cmp, arr, opt, ray_address, port_masks) as run:
+        ports = _link_takes(graph, cmp, arr, port_masks, opt, notes, clock, run)
     table = _structure_table(graph, arr, cuts, opt)
     on_route = np.zeros(graph.num_frames, dtype=bool)
     with _timer(seconds, "links_seconds"), clock("links"):
@@ -793,11 +793,12 @@ def _build(arr: _Arranged, opt: _Options, synthetic, backend: str, ray_address, 
 
 
 @contextmanager
-def _backend(backend: str, cmp: _Compare, arr: _Arranged, opt: _Options, address: str | None, workers: int):
-    """The candidates of every style: :class:`_LocalPools` with ``workers`` threads, or for ``"ray"`` the :func:`.ray_backend.pool_candidates`
-    of every style, submitted at once (Ray is started here and shut down after, unless running)."""
+def _backend(backend: str, cmp: _Compare, arr: _Arranged, opt: _Options, address: str | None, port_masks: dict):
+    """The candidates of every style: :class:`_LocalPools` (``opt.workers`` threads), or for
+    ``"ray"`` :func:`.ray_backend.pool_candidates`, every style submitted at once (Ray is started
+    here and shut down after, unless running)."""
     if backend == "local":
-        local = _LocalPools(cmp, opt, sorted(arr.pools.items()), workers)
+        local = _LocalPools(cmp, opt, sorted(arr.pools.items()), opt.workers, port_masks)
         try:
             yield local
         finally:
@@ -805,7 +806,7 @@ def _backend(backend: str, cmp: _Compare, arr: _Arranged, opt: _Options, address
         return
     from motionlab.motion_graphs import ray_backend
 
-    with ray_backend.session(address, workers):
+    with ray_backend.session(address, opt.workers):
         yield ray_backend.pool_candidates(cmp.graph, sorted(arr.pools.items()), _ring_pairs, opt)
 
 
