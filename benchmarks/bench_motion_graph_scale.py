@@ -83,7 +83,7 @@ def session(frames: int, behaviours: str = "walk"):
 
 
 def _gb(kib: int) -> float:
-    return kib / 1024**2  # ru_maxrss is in KiB on Linux
+    return kib * 1024 / 1e9  # ru_maxrss is in KiB on Linux; GB = 10^9 bytes, as the stage table
 
 
 def build_case(kind: str, frames: int, out: Path, workers: int) -> dict:
@@ -103,7 +103,7 @@ def build_case(kind: str, frames: int, out: Path, workers: int) -> dict:
         rep = report.build_report(g)
         summary = g.summary()
     with clock("save"):
-        io.save(out, g, overwrite=True)
+        io.save(out, g, overwrite=True, summary=summary)
     return dict(
         kind=kind, frames=g.num_frames, takes=len(motions), threshold_m=rms, workers=workers, build_s=build_s,
         cpu_s=(c1.ru_utime + c1.ru_stime) - (c0.ru_utime + c0.ru_stime), transitions=summary["transitions"],

@@ -4,7 +4,8 @@ The file is an *uncompressed* NumPy ``.npz`` archive (no pickle: it loads with
 ``allow_pickle=False``): arrays ``local_rot`` (float64, as the graph holds them), ``root_pos``,
 ``alive``, ``src``, ``dst``, ``cost``, ``kind``, ``offsets``, ``parents`` and ``meta``, the
 UTF-8 bytes of a JSON object — format version, fps, joint names, clips, structure table, build
-info and the graph's :meth:`~.graph.MotionGraph.summary`. Because the members are stored, not
+info and the graph's :meth:`~.graph.MotionGraph.summary` — and the routes of the structure
+table's links as arrays ``route_*`` (read back as :class:`Routes`). Because the members are stored, not
 compressed, :func:`load` *maps* the arrays (``numpy.memmap``, copy-on-write) instead of reading
 them: opening a graph reads only its JSON, and a search reads only the pages it touches.
 
@@ -20,6 +21,7 @@ import os
 import struct
 import zipfile
 import zlib
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +30,7 @@ from motionlab.core import files
 from motionlab.core.skeleton import Skeleton
 from motionlab.motion_graphs.graph import ClipInfo, GraphError, MotionGraph
 
-__all__ = ["save", "load", "writer", "read_meta", "FORMAT", "READABLE"]
+__all__ = ["save", "load", "writer", "read_meta", "Routes", "FORMAT", "READABLE"]
 
 FORMAT = "motionlab-graph-3"
 """Version 3: uncompressed members, mapped on load; ``meta`` is UTF-8 bytes and holds the summary."""
@@ -44,13 +46,82 @@ _DTYPES = {"local_rot": np.float64, "root_pos": np.float64, "alive": np.bool_, "
 def _jsonable(x):
     if isinstance(x, dict):
         return {str(k): _jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
+    if isinstance(x, (list, tuple, Routes)):
         return [_jsonable(v) for v in x]
     if isinstance(x, np.generic):
         return x.item()
     if isinstance(x, np.ndarray):
         return x.tolist()
     return x
+
+
+_ROUTE_KEYS = {"exit", "enter", "pieces", "frames", "cost"}
+ROUTE_ARRAYS = ("route_exit", "route_enter", "route_frames", "route_cost", "route_piece_start", "route_pieces")
+
+
+class Routes(Sequence):
+    """The routes of one structure-table link, read from the file's route arrays on access.
+
+    Behaves as the list of route dicts the build made (``exit``, ``enter``, ``frames``, ``cost``,
+    ``pieces``: a list of ``[clip, first, last]``), so a search reads only the links it uses."""
+
+    def __init__(self, arrays: dict, first: int, count: int):
+        self.a, self.first, self.count = arrays, int(first), int(count)
+
+    def __len__(self) -> int:
+        return self.count
+
+    def __getitem__(self, k):
+        if isinstance(k, slice):
+            return [self[i] for i in range(*k.indices(self.count))]
+        if not -self.count <= k < self.count:
+            raise IndexError(k)
+        r, a = self.first + (k % self.count), self.a
+        p0, p1 = int(a["route_piece_start"][r]), int(a["route_piece_start"][r + 1])
+        return {
+            "exit": int(a["route_exit"][r]),
+            "enter": int(a["route_enter"][r]),
+            "pieces": a["route_pieces"][p0:p1].tolist(),
+            "frames": int(a["route_frames"][r]),
+            "cost": float(a["route_cost"][r]),
+        }
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, Sequence) and len(other) == self.count and list(self) == list(other)
+
+    def __repr__(self) -> str:
+        return f"Routes({self.count} routes)"
+
+
+def _pack_routes(table: dict) -> tuple[dict, dict]:
+    """The table with each link's routes replaced by ``{"first", "count"}`` into the route arrays,
+    and those arrays (links whose routes hold other keys keep them in the JSON)."""
+    cols = {k: [] for k in ("exit", "enter", "frames", "cost")}
+    pieces, starts, links = [], [0], []
+    for link in table.get("links", []):
+        routes = list(link.get("routes", []))
+        if not all(isinstance(r, dict) and set(r) == _ROUTE_KEYS for r in routes):
+            links.append(link)
+            continue
+        links.append({**link, "routes": {"first": len(starts) - 1, "count": len(routes)}})
+        for r in routes:
+            for k in cols:
+                cols[k].append(r[k])
+            pieces.extend(r["pieces"])
+            starts.append(len(pieces))
+    arrays = {f"route_{k}": np.asarray(v, dtype=np.float64 if k == "cost" else np.int64) for k, v in cols.items()}
+    arrays["route_piece_start"] = np.asarray(starts, dtype=np.int64)
+    arrays["route_pieces"] = np.asarray(pieces, dtype=np.int64).reshape(-1, 3)
+    return {**table, "links": links}, arrays
+
+
+def _unpack_routes(table: dict, arrays: dict) -> dict:
+    """The table as the build made it, with :class:`Routes` reading the route arrays."""
+    for link in table.get("links", []):
+        r = link.get("routes")
+        if isinstance(r, dict) and set(r) == {"first", "count"}:
+            link["routes"] = Routes(arrays, r["first"], r["count"])
+    return table
 
 
 def writer(graph: MotionGraph, summary: dict | None = None):
@@ -65,10 +136,10 @@ def writer(graph: MotionGraph, summary: dict | None = None):
         "names": list(sk.names),
         "end_sites": {str(k): v.tolist() for k, v in sk.end_sites.items()},
         "clips": [c.to_dict() for c in graph.clips],
-        "table": graph.table,
         "info": graph.info,
         "summary": graph.summary() if summary is None else summary,
     }
+    meta["table"], route_arrays = _pack_routes(graph.table)
 
     def write(fh) -> None:
         np.savez(
@@ -83,20 +154,22 @@ def writer(graph: MotionGraph, summary: dict | None = None):
             kind=np.asarray(graph.kind, dtype=np.int8),
             offsets=sk.offsets,
             parents=sk.parents,
+            **route_arrays,
         )
 
     return write
 
 
-def save(path: str | os.PathLike, graph: MotionGraph, overwrite: bool = False) -> Path:
+def save(path: str | os.PathLike, graph: MotionGraph, overwrite: bool = False, summary: dict | None = None) -> Path:
     """Write ``graph`` to ``path`` (``.mlgraph`` added if there is no suffix), atomically.
 
+    ``summary``: ``graph.summary()`` when the caller has it (computed here otherwise).
     Raises ``FileExistsError`` when the file exists and ``overwrite`` is False.
     """
     path = Path(path)
     if path.suffix == "":
         path = path.with_suffix(".mlgraph")
-    return files.atomic_write(path, writer(graph), overwrite=overwrite, binary=True, what="motion graph")
+    return files.atomic_write(path, writer(graph, summary), overwrite=overwrite, binary=True, what="motion graph")
 
 
 def _member_offset(fh, info: zipfile.ZipInfo) -> int:
@@ -186,13 +259,14 @@ def _arrays(path: Path) -> tuple[dict, dict]:
         missing = [k for k in ARRAYS if k not in names]
         if missing:
             raise GraphError(f"{path} is not a complete motion graph file (missing {missing})")
-        stored = all(names[k].compress_type == zipfile.ZIP_STORED for k in ARRAYS)
+        keys = ARRAYS + tuple(k for k in ROUTE_ARRAYS if k in names)
+        stored = all(names[k].compress_type == zipfile.ZIP_STORED for k in keys)
         if meta["format"] == FORMAT and stored:
             size = path.stat().st_size
             with open(path, "rb") as fh:
-                return meta, {k: _mapped(path, fh, names[k], size) for k in ARRAYS}
+                return meta, {k: _mapped(path, fh, names[k], size) for k in keys}
         arrays = {}
-        for k in ARRAYS:
+        for k in keys:
             with z.open(names[k]) as f:
                 arrays[k] = np.lib.format.read_array(f, allow_pickle=False)
         return meta, arrays
@@ -225,7 +299,7 @@ def load(path: str | os.PathLike) -> MotionGraph:
             arrays["local_rot"] = rot / np.linalg.norm(rot, axis=-1, keepdims=True)
         a = {k: arrays[k] if arrays[k].dtype == t else arrays[k].astype(t) for k, t in _DTYPES.items()}
         return MotionGraph(sk, float(meta["fps"]), [ClipInfo(**c) for c in meta["clips"]], a["local_rot"],
-                           a["root_pos"], a["alive"], a["src"], a["dst"], a["cost"], a["kind"], meta["table"],
-                           meta["info"])  # fmt: skip
+                           a["root_pos"], a["alive"], a["src"], a["dst"], a["cost"], a["kind"],
+                           _unpack_routes(meta["table"], arrays), meta["info"])  # fmt: skip
     except (KeyError, TypeError, ValueError) as e:
         raise GraphError(f"{path}: damaged motion graph metadata ({type(e).__name__}: {e})") from None
