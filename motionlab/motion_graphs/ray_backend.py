@@ -4,7 +4,8 @@ Ray (https://docs.ray.io) is an optional extra: ``pip install "motionlab[cluster
 ``build_structured(..., backend="ray")`` (``motionlab graph-build --backend ray``) sends each
 style's frames to one Ray task, which computes its takes' point clouds and the transition
 candidates of every take with itself and with its neighbouring takes
-(:func:`.structured.pool_pair_candidates`, the function the local backend calls). The calling
+(:func:`.structured.style_task`, which calls :func:`.structured.pool_pair_candidates` as the
+local backend does). The calling
 process keeps everything else (ports, pruning, links, the structure table) and reads the
 answers in style order, so the graph equals the local build's, edge for edge.
 
@@ -19,8 +20,6 @@ import os
 import time
 from collections.abc import Callable, Sequence
 from contextlib import contextmanager
-
-import numpy as np
 
 __all__ = ["INSTALL_HINT", "START_TIMEOUT_S", "session", "pool_candidates"]
 
@@ -74,27 +73,18 @@ def _start(ray, kwargs: dict, timeout: float) -> None:
                 raise
 
 
-def _pool_task(skeleton, rot, root, fps, lengths, pairs, threshold, window, min_loop):
-    """One style's candidates from its frames (takes side by side, ``lengths`` frames each)."""
-    from motionlab.core.motion import Motion
-    from motionlab.motion_graphs import distance, structured
-
-    bounds = np.cumsum([0, *lengths])
-    motions = [Motion(skeleton, rot[a:b], root[a:b], fps, None, "") for a, b in zip(bounds[:-1], bounds[1:])]
-    feats = [distance.cloud_features(p, window) for p in structured.positions(motions)]
-    return structured.pool_pair_candidates(feats, pairs, threshold, window, min_loop)
-
-
-def pool_candidates(graph, pools: Sequence[tuple], ring_pairs: Callable, opt) -> Callable:
+def pool_candidates(graph, pools: Sequence[tuple], ring_pairs: Callable, opt, task: Callable) -> Callable:
     """Submit one Ray task per style and return ``run(key, takes, pairs)``, which waits for that
     style's answer (:func:`.structured.pool_pair_candidates`) and returns it with ``None`` (the
     caller computes the port rows).
 
     ``pools``: ``(key, graph clip indices of its takes)`` in build order; ``ring_pairs(n,
     neighbours)``: the take pairs of a style of ``n`` takes; ``opt``: the build's options
-    (``threshold``, ``window``, ``min_loop``, ``neighbours``). Needs :func:`session` active."""
+    (``threshold``, ``window``, ``min_loop``, ``neighbours``); ``task(skeleton, rot, root, fps,
+    lengths, pairs, threshold, window, min_loop)``: one style's candidates from its frames (a
+    module-level function, :func:`.structured.style_task`). Needs :func:`session` active."""
     ray = _ray()
-    task = ray.remote(num_cpus=1)(_pool_task)
+    task = ray.remote(num_cpus=1)(task)
     skeleton = ray.put(graph.skeleton)
     refs = {}
     for key, ks in pools:

@@ -86,6 +86,7 @@ __all__ = [
     "structure_rows",
     "positions",
     "pool_pair_candidates",
+    "style_task",
     "STYLE_PAIRS",
     "BACKENDS",
 ]
@@ -371,6 +372,15 @@ def pool_pair_candidates(feats: Sequence[_distance.CloudFeatures], pairs: Sequen
     out = [_distance.candidates(f, None, threshold, window, min_loop) for f in feats]
     out += [_distance.candidates(feats[x], feats[y], threshold, window) for x, y in pairs]
     return out
+
+
+def style_task(skeleton, rot, root, fps: float, lengths, pairs, threshold: float, window: int, min_loop: int):
+    """One style's :func:`pool_pair_candidates` from its frames alone (``rot`` (N, J, 4), ``root``
+    (N, 3): the takes side by side, ``lengths`` frames each), for the Ray backend's tasks."""
+    bounds = np.cumsum([0, *lengths])
+    motions = [Motion(skeleton, rot[a:b], root[a:b], fps, None, "") for a, b in zip(bounds[:-1], bounds[1:])]
+    feats = [_distance.cloud_features(p, window) for p in positions(motions)]
+    return pool_pair_candidates(feats, pairs, threshold, window, min_loop)
 
 
 class _LocalPools:
@@ -807,7 +817,7 @@ def _backend(backend: str, cmp: _Compare, arr: _Arranged, opt: _Options, address
     from motionlab.motion_graphs import ray_backend
 
     with ray_backend.session(address, opt.workers):
-        yield ray_backend.pool_candidates(cmp.graph, sorted(arr.pools.items()), _ring_pairs, opt)
+        yield ray_backend.pool_candidates(cmp.graph, sorted(arr.pools.items()), _ring_pairs, opt, style_task)
 
 
 def _info(opt: _Options, comparisons: int, n_input: int, seconds: dict, n_extra: int, notes: _Notes) -> dict:
