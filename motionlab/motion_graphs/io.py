@@ -67,24 +67,27 @@ class Routes(Sequence):
 
     def __init__(self, arrays: dict, first: int, count: int):
         self.a, self.first, self.count = arrays, int(first), int(count)
+        self._items: list[dict] | None = None
 
     def __len__(self) -> int:
         return self.count
 
+    def _all(self) -> list[dict]:
+        """Every route of the link, made from the arrays at the first access (then kept)."""
+        if self._items is None:
+            a, s, e = self.a, self.first, self.first + self.count
+            starts = np.asarray(a["route_piece_start"][s : e + 1])
+            pieces = np.asarray(a["route_pieces"][starts[0] : starts[-1]]).tolist()
+            rel = (starts - starts[0]).tolist()
+            cols = [np.asarray(a[f"route_{k}"][s:e]).tolist() for k in ("exit", "enter", "frames", "cost")]
+            self._items = [
+                {"exit": x, "enter": y, "pieces": pieces[rel[k] : rel[k + 1]], "frames": f, "cost": c}
+                for k, (x, y, f, c) in enumerate(zip(*cols))
+            ]
+        return self._items
+
     def __getitem__(self, k):
-        if isinstance(k, slice):
-            return [self[i] for i in range(*k.indices(self.count))]
-        if not -self.count <= k < self.count:
-            raise IndexError(k)
-        r, a = self.first + (k % self.count), self.a
-        p0, p1 = int(a["route_piece_start"][r]), int(a["route_piece_start"][r + 1])
-        return {
-            "exit": int(a["route_exit"][r]),
-            "enter": int(a["route_enter"][r]),
-            "pieces": a["route_pieces"][p0:p1].tolist(),
-            "frames": int(a["route_frames"][r]),
-            "cost": float(a["route_cost"][r]),
-        }
+        return self._all()[k]
 
     def __eq__(self, other) -> bool:
         return isinstance(other, Sequence) and len(other) == self.count and list(self) == list(other)
