@@ -71,7 +71,12 @@ def register(subparsers) -> None:
             help="where the comparisons inside each style run: this process, or Ray tasks (RAY_ADDRESS or a local "
             "Ray instance; same graph)",
         )
-        p.add_argument("--workers", type=positive_int, default=2, help="CPUs of a local Ray instance (default 2)")
+        p.add_argument(
+            "--workers",
+            type=positive_int,
+            default=2,
+            help="threads of the local build, or CPUs of a local Ray instance",
+        )
         p.add_argument(
             "--verbose", action="store_true", help="print the seconds and peak memory of every stage of the build"
         )
