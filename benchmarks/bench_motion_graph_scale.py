@@ -117,8 +117,9 @@ def measure(cmd: list[str]) -> dict:
     t0 = time.perf_counter()
     p = subprocess.run(cmd, capture_output=True, text=True)
     wall = time.perf_counter() - t0
-    peak = _gb(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)
-    return dict(rc=p.returncode, wall_s=wall, peak_gb=peak, out=p.stdout[-2000:], err=p.stderr[-2000:])
+    use = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return dict(rc=p.returncode, wall_s=wall, cpu_s=use.ru_utime + use.ru_stime, peak_gb=_gb(use.ru_maxrss),
+                out=p.stdout[-2000:], err=p.stderr[-2000:])  # fmt: skip
 
 
 def _measured(cmd: list[str]) -> dict:
@@ -177,10 +178,10 @@ def run_case(case: str, workers: int) -> int:
         print(f"largest strongly connected component per behaviour (goal >= {GOAL_SCC:g}%):")
         for b, v in sorted(r["behaviours"].items()):
             print(f"  {b}: {v:.1f}% {'met' if v >= GOAL_SCC else 'NOT met'}")
-        print("command | wall s (start-up included) | peak GB | result")
+        print("command | wall s (start-up included) | CPU s | peak GB | result")
         for name, m in commands(graph, kind, Path(d)):
             first = (m["out"].strip().splitlines() or m["err"].strip().splitlines() or [""])[0][:70]
-            print(f"{name} | {m['wall_s']:.2f} | {m['peak_gb']:.2f} | rc {m['rc']} {first}")
+            print(f"{name} | {m['wall_s']:.2f} | {m['cpu_s']:.2f} | {m['peak_gb']:.2f} | rc {m['rc']} {first}")
         print(f"load average after {os.getloadavg()[0]:.1f}")
     return 0
 
