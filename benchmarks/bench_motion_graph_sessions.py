@@ -26,6 +26,9 @@ the request's frame counts, the median search time over :data:`REPEATS` runs of 
 of each behaviour's style pairs, and the build's seconds and peak memory (a fresh process)::
 
     MOTIONLAB_DATA=/path/to/shared/data python benchmarks/bench_motion_graph_sessions.py --session
+
+**Behaviours left out** (``--leave-out``): the same rule run on two behaviours' pick half, the
+chosen threshold checked on the third behaviour's takes (:func:`leave_out`).
 """
 
 from __future__ import annotations
@@ -38,7 +41,7 @@ import time
 import numpy as np
 
 from motionlab import data
-from motionlab.motion_graphs import cli, clips, distance, report, search, segments, structured
+from motionlab.motion_graphs import clips, distance, report, search, segments, structured
 
 GRID = (0.015, 0.02, 0.025, 0.03, 0.04, 0.05)
 """Thresholds tried, metres RMS."""
@@ -221,7 +224,9 @@ def session(folder) -> int:
         print("no threshold of the grid meets the goals on the pick half")
         return 1
     print(f"chosen threshold (smallest meeting the goals on the pick half): {chosen} m")
-    print(f"graph-build's default threshold (motion_graphs.cli.DISTANCE_THRESHOLD): {cli.DISTANCE_THRESHOLD} m")
+    print(
+        f"the library's and graph-build's default threshold (distance.DEFAULT_THRESHOLD): {distance.DEFAULT_THRESHOLD} m"
+    )
     for name, ms in (("check", check), ("all", motions)):
         t0 = time.perf_counter()
         g = structured.build_structured(ms, distance.threshold_from(chosen))
@@ -253,18 +258,61 @@ def session(folder) -> int:
     return 0
 
 
+GOAL_HELD_OUT = 95.0
+"""Share of a left-out behaviour's frames its largest component must hold (issue 43's goal)."""
+
+
+def leave_out(folder) -> int:
+    """The threshold rule checked on behaviours it never saw: for each behaviour, the rule (the
+    smallest threshold of the grid for which every behaviour of the pick half holds >= 90% of its
+    frames in its largest component and joins every ordered style pair) is run on the pick half
+    of the *other* behaviours only; the left-out behaviour's takes (all of them) are then built
+    at the chosen threshold and must keep >= 95% of their frames in the largest component, with
+    every style pair joined."""
+    motions = clips.load_folder(folder)
+    behaviours = sorted({m.name.split("_")[0] for m in motions})
+    print(f"session {folder}: behaviours {behaviours}; goal for the left-out behaviour >= {GOAL_HELD_OUT}%")
+    ok = True
+    for held in behaviours:
+        pick = [m for m in motions if m.name.split("_")[0] != held and take_number(m.name) % 2 == 1]
+        chosen = None
+        for rms in GRID:
+            rep = report.build_report(structured.build_structured(pick, distance.threshold_from(rms)))
+            beh = rep["behaviours"]
+            if all(v["percent"] >= GOAL_BEHAVIOUR and v["reachable_pairs"] == v["style_pairs"] for v in beh.values()):
+                chosen = rms
+                break
+        if chosen is None:
+            print(f"  {held} left out: no threshold of the grid meets the goals on the others")
+            ok = False
+            continue
+        mine = [m for m in motions if m.name.split("_")[0] == held]
+        v = report.build_report(structured.build_structured(mine, distance.threshold_from(chosen)))["behaviours"][held]
+        met = v["percent"] >= GOAL_HELD_OUT and v["reachable_pairs"] == v["style_pairs"]
+        ok &= met
+        print(
+            f"  {held} left out: chosen on {', '.join(b for b in behaviours if b != held)} (pick half): {chosen} m; "
+            f"{held} (all {len(mine)} takes) at {chosen} m: {v['percent']:.1f}% in its largest component, "
+            f"{v['reachable_pairs']}/{v['style_pairs']} style pairs: {'met' if met else 'NOT met'}"
+        )
+    return 0 if ok else 1
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--behaviour", default="walk")
     ap.add_argument("--session", action="store_true", help="every behaviour of the session at once")
     ap.add_argument("--build-only", type=float, help="only time one build of all takes at this threshold (m)")
+    ap.add_argument("--leave-out", action="store_true", help="the threshold rule checked on each behaviour left out")
     ap.add_argument("--folder", help="session folder (default MOTIONLAB_DATA/bandai_namco/sessions)")
     args = ap.parse_args(argv)
-    if args.session or args.build_only:
+    if args.session or args.build_only or args.leave_out:
         folder = args.folder or data.data_root() / "bandai_namco" / "sessions"
         if not (data.data_root() / "bandai_namco" / "sessions").is_dir() and not args.folder:
             print(f"needs {folder}: {data.HOW_TO}")
             return 1
+        if args.leave_out:
+            return leave_out(folder)
         return build_only(folder, args.build_only) if args.build_only else session(folder)
     folder = data.data_root() / "bandai_namco" / "sessions" / args.behaviour
     if not folder.is_dir():

@@ -3,6 +3,7 @@
 ::
 
     motionlab graph-build FOLDER -o walk.mlgraph [--report walk.json] [--distance-threshold 0.04] [--force]
+                          [--backend ray] [--verbose]
     motionlab graph-search walk.mlgraph --request "walk:angry:300,run:normal:200" -o out.bvh
     motionlab graph-info walk.mlgraph
 
@@ -23,13 +24,13 @@ from pathlib import Path
 
 from motionlab import cli_args
 from motionlab.cli_args import CLIError, check_outputs, non_negative_int, positive, positive_int
+from motionlab.motion_graphs.distance import DEFAULT_THRESHOLD
 
 __all__ = ["register", "DISTANCE_THRESHOLD"]
 
-DISTANCE_THRESHOLD = 0.04
-"""Default ``--distance-threshold`` of ``graph-build``, metres RMS between aligned point clouds
-(:func:`~motionlab.motion_graphs.distance.threshold_from`). The rule that chose it and its check
-on held-out takes: ``docs/results_motion_graphs.md``."""
+DISTANCE_THRESHOLD = DEFAULT_THRESHOLD
+"""Default ``--distance-threshold`` of ``graph-build``: the library's
+:data:`~motionlab.motion_graphs.distance.DEFAULT_THRESHOLD` (metres RMS)."""
 
 
 def register(subparsers) -> None:
@@ -64,6 +65,22 @@ def register(subparsers) -> None:
         )
         p.add_argument("--name-map", help="JSON file {clip stem: 'behaviour_style[_take]'} for names that do not parse")
         p.add_argument("--report", help="also write the build report as JSON to this file")
+        p.add_argument(
+            "--backend",
+            choices=("local", "ray"),
+            default="local",
+            help="where the comparisons inside each style run: this process, or Ray tasks (RAY_ADDRESS or a local "
+            "Ray instance; same graph)",
+        )
+        p.add_argument(
+            "--workers",
+            type=positive_int,
+            default=2,
+            help="threads of the local build, or CPUs of a local Ray instance",
+        )
+        p.add_argument(
+            "--verbose", action="store_true", help="print the seconds and peak memory of every stage of the build"
+        )
         cli_args.add_force(p, "overwrite the output files")
 
     with cli_args.command(subparsers, "graph-search", _search) as p:
@@ -180,8 +197,12 @@ def _build_graph(args: argparse.Namespace, motions: list):
             synthetic=[args.synthetic] * len(motions),
             neighbours=args.neighbours,
             progress=not args.quiet,
+            backend=args.backend,
+            workers=args.workers,
         )
     except graph.GraphError as e:
+        raise CLIError(str(e)) from None
+    except ImportError as e:  # --backend ray without Ray: the message says how to install it
         raise CLIError(str(e)) from None
 
 
@@ -196,19 +217,26 @@ def _build(args: argparse.Namespace) -> int:
     from motionlab.motion_graphs import io, report
 
     out, report_path = _build_outputs(args)
-    motions = _load_clips(args)
+    if args.standard and args.backend != "local":
+        raise CLIError("--backend ray builds structured graphs only (leave out --standard)")
+    clock = report.StageClock()
+    with clock("load"):
+        motions = _load_clips(args)
     t0 = time.perf_counter()
     g = _build_graph(args, motions)
     dt = time.perf_counter() - t0
+    clock.extend(g.info.get("stages", []))
     g.info["input_clips"] = len(motions)
-    rep = report.build_report(g) if g.table.get("behaviours") else None
-    outputs = [(out, io.writer(g), True, "graph (-o)")]
+    with clock("report"):
+        rep = report.build_report(g) if g.table.get("behaviours") else None
+        s = g.summary()
+    outputs = [(out, io.writer(g, s), True, "graph (-o)")]
     if report_path is not None:
         if rep is None:
             raise CLIError("--report needs a structured graph, and these clips gave none; leave out --report")
         outputs.append((report_path, lambda f: f.write(report.to_json(rep)), False, "report (--report)"))
-    files.atomic_write_all(outputs, overwrite=args.force)  # both files or neither
-    s = g.summary()
+    with clock("save"):
+        files.atomic_write_all(outputs, overwrite=args.force)  # both files or neither
     styles = sum(len(v) for v in g.table.get("behaviours", {}).values())
     n_trans = sum(c.kind == "transition" for c in g.clips)
     pooled = f" ({len(motions) - n_trans} takes of {styles} styles, {n_trans} transition clips)" if styles else ""
@@ -222,6 +250,8 @@ def _build(args: argparse.Namespace) -> int:
             print(f"report -> {report_path}")
     else:
         print(f"largest strongly connected component: {s['largest_scc']} frames")
+    if args.verbose:
+        print(report.format_stages(clock.rows))
     return 0
 
 
@@ -279,9 +309,13 @@ def _info(args: argparse.Namespace) -> int:
 
     Print the structure table (behaviours, styles, frames) and the counts of a .mlgraph file.
     """
-    from motionlab.motion_graphs import plots
+    from motionlab.motion_graphs import graph, io, plots
 
     g = _load_graph(args.graph)
     print(plots.structure_table_text(g))
-    print(json.dumps(g.summary(), indent=1))
+    try:
+        summary = io.read_meta(args.graph).get("summary") or g.summary()  # version 2 files hold none
+    except graph.GraphError as e:
+        raise CLIError(str(e)) from None
+    print(json.dumps(summary, indent=1))
     return 0

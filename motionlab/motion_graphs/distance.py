@@ -58,12 +58,20 @@ __all__ = [
     "distance_blocks",
     "local_minima",
     "candidates",
+    "block_cells",
+    "BLOCK_CELLS",
     "alignment",
     "rms",
     "threshold_from",
     "DEFAULT_WINDOW",
+    "DEFAULT_THRESHOLD",
     "GRID",
 ]
+
+DEFAULT_THRESHOLD = 0.04
+"""The default transition threshold, metres RMS between aligned point clouds (pass it through
+:func:`threshold_from`): ``graph-build``'s ``--distance-threshold`` and library callers use it.
+The rule that chose it and its check on held-out takes: ``docs/results_motion_graphs.md``."""
 
 DEFAULT_WINDOW = 5
 """Frames per point cloud (centred on the frame): 5 frames ≈ 0.17 s at 30 fps."""
@@ -74,7 +82,11 @@ GRID = 2.0**-18
 _JOINT_WEIGHT_LEVELS = 16  # joint weights are rounded to multiples of 1/16 of the largest
 _EXACT_LIMIT = 2.0**52  # sums of whole grid units below this are exact in float64
 
-_BLOCK_ELEMENTS = 4_000_000  # cells of D computed at once (≈ 32 MB in float64, plus temporaries)
+BLOCK_CELLS = 1 << 20
+"""Most cells of ``D`` computed at once (:func:`block_cells` takes fewer when memory is short)."""
+
+_BYTES_PER_CELL = 56  # float64 block, [a | b] (two cells), Y and two temporaries
+_MEMORY_SHARE = 16  # a block takes at most this fraction of the memory available
 
 
 @dataclass
@@ -201,6 +213,20 @@ def _one_blas_thread():
     return ctl.limit(limits=1, user_api="blas") if ctl is not None else contextlib.nullcontext()
 
 
+def block_cells(available: int | None = None) -> int:
+    """Cells of ``D`` per block: :data:`BLOCK_CELLS`, or fewer so that a block and its
+    temporaries take at most 1/16 of ``available`` bytes (default: the memory the system reports
+    available), and never fewer than 65,536. The candidates do not depend on it."""
+    if available is None:
+        try:
+            import psutil
+
+            available = int(psutil.virtual_memory().available)
+        except (ImportError, OSError):  # pragma: no cover - psutil is a dependency
+            available = BLOCK_CELLS * _BYTES_PER_CELL * _MEMORY_SHARE
+    return int(min(BLOCK_CELLS, max(1 << 16, available // (_MEMORY_SHARE * _BYTES_PER_CELL))))
+
+
 def _block(fa: CloudFeatures, fb: CloudFeatures, rows: slice, right: np.ndarray, yb: np.ndarray) -> np.ndarray:
     units = fa.unit_weights
     left = fa.centred[rows] * np.concatenate([units, units])  # (r, 2n); exact: see the module docstring
@@ -209,7 +235,16 @@ def _block(fa: CloudFeatures, fb: CloudFeatures, rows: slice, right: np.ndarray,
         ab = left @ right  # (r, 2 Tb): [a | b] times the weights' total, exact in any summation order
         cross_y = (fa.height[rows] * units) @ yb
     a, b = ab[:, :tb], ab[:, tb:]
-    d = fa.self_term[rows, None] + fb.self_term[None, :] - (2.0 * cross_y + 2.0 * np.sqrt(a * a + b * b)) / units.sum()
+    # S_A + S_B - (2 Y + 2 sqrt(a² + b²)) / Σw, in place (the same operations in the same order)
+    root = np.multiply(a, a)
+    root += np.multiply(b, b, out=b)
+    np.sqrt(root, out=root)
+    root *= 2.0
+    cross_y *= 2.0
+    cross_y += root
+    cross_y /= units.sum()
+    d = np.add(fa.self_term[rows, None], fb.self_term[None, :], out=root)
+    d -= cross_y
     return np.maximum(d, 0.0, out=d)
 
 
@@ -234,12 +269,12 @@ def distance_blocks(
     """Yield ``(first_row, D[rows])`` blocks of the distance matrix, in row order.
 
     ``a``, ``b``: positions (T, J, 3) or :class:`CloudFeatures`. Each block has at most
-    ``block_rows`` rows (default: about 4 million cells per block).
+    ``block_rows`` rows (default: :func:`block_cells` cells per block).
     """
     fa, fb = _as_features(a, window), _as_features(b, window)
     _check_pair(fa, fb)
     right, yb = _right(fb)
-    rows = block_rows or max(1, _BLOCK_ELEMENTS // max(len(fb), 1))
+    rows = block_rows or max(1, block_cells() // max(len(fb), 1))
     for r0 in range(0, len(fa), rows):
         yield r0, _block(fa, fb, slice(r0, min(r0 + rows, len(fa))), right, yb)
 
@@ -301,6 +336,34 @@ def local_minima(block: np.ndarray, above: np.ndarray | None = None, below: np.n
     return mask
 
 
+def _minima_under(d: np.ndarray, first: int, count: int, threshold: float) -> tuple[np.ndarray, np.ndarray]:
+    """Rows ``first … first + count - 1`` of the rows ``d`` of ``D``: the cells below ``threshold``
+    that are no larger than any of their 8 neighbours (as :func:`local_minima`; the rows of ``d``
+    around them are the neighbours, cells beyond ``d``'s edges count as ``inf``). Only the cells
+    below the threshold are tested, so the work follows the candidates kept.
+
+    Returns the cells' row (from ``first``) and column indices, in row-major order."""
+    core = d[first : first + count]
+    if not np.isfinite(threshold) or np.count_nonzero(core < threshold) * 4 > core.size:
+        above = d[first - 1] if first > 0 else None
+        below = d[first + count] if first + count < d.shape[0] else None
+        return np.nonzero(local_minima(core, above, below) & (core < threshold))
+    ii, jj = np.nonzero(core < threshold)
+    value = core[ii, jj]
+    rows, cols = d.shape
+    keep = np.ones(ii.size, dtype=bool)
+    for di in (-1, 0, 1):
+        r = ii + first + di
+        r_ok = (r >= 0) & (r < rows)
+        for dj in (-1, 0, 1):
+            if di == 0 and dj == 0:
+                continue
+            c = jj + dj
+            ok = r_ok & (c >= 0) & (c < cols)
+            keep &= ~ok | (value <= d[np.where(ok, r, 0), np.where(ok, c, 0)])
+    return ii[keep], jj[keep]
+
+
 def candidates(
     a,
     b=None,
@@ -337,18 +400,15 @@ def candidates(
         empty = np.zeros(0, dtype=np.int64)
         return empty, empty, np.zeros(0)
     right, yb = _right(sub_b)
-    n_rows = block_rows or max(1, _BLOCK_ELEMENTS // max(len(sub_b), 1))
+    n_rows = block_rows or max(1, block_cells() // max(len(sub_b), 1))
     out_i, out_j, out_c = [], [], []
     T = len(sub_a)
     for start in range(0, T, n_rows):
         stop = min(start + n_rows, T)
         lo, hi = max(start - 1, 0), min(stop + 1, T)  # one extra row each side for the 3x3 test
         d = _block(sub_a, sub_b, slice(lo, hi), right, yb)
+        ii, jj = _minima_under(d, start - lo, stop - start, threshold)
         core = d[start - lo : start - lo + (stop - start)]
-        above = d[0] if start > 0 else None
-        below = d[-1] if stop < T else None
-        mask = local_minima(core, above, below) & (core < threshold)
-        ii, jj = np.nonzero(mask)
         gi, gj = ii + start + r0_, jj + c0_
         if same and min_gap > 0:
             keep = np.abs(gi - gj) >= min_gap

@@ -1,9 +1,15 @@
 """Saving and loading motion graphs: one ``.mlgraph`` file, NumPy arrays plus JSON.
 
-The file is a NumPy ``.npz`` archive (no pickle: it loads with ``allow_pickle=False``):
-arrays ``local_rot``, ``root_pos``, ``alive``, ``src``, ``dst``, ``cost``, ``kind``,
-``offsets``, ``parents`` and one string array ``meta`` holding JSON — format version, fps,
-joint names, clips, structure table and build info.
+The file is an *uncompressed* NumPy ``.npz`` archive (no pickle: it loads with
+``allow_pickle=False``): arrays ``local_rot`` (float64, as the graph holds them), ``root_pos``,
+``alive``, ``src``, ``dst``, ``cost``, ``kind``, ``offsets``, ``parents`` and ``meta``, the
+UTF-8 bytes of a JSON object — format version, fps, joint names, clips, structure table, build
+info and the graph's :meth:`~.graph.MotionGraph.summary` — and the routes of the structure
+table's links as arrays ``route_*`` (read back as :class:`Routes`). Because the members are stored, not
+compressed, :func:`load` *maps* the arrays (``numpy.memmap``, copy-on-write) instead of reading
+them: opening a graph reads only its JSON, and a search reads only the pages it touches.
+
+Files of the previous version (``motionlab-graph-2``, compressed) are still read, whole.
 
 Taught in ``notebooks/05_motion_graphs.ipynb``.
 """
@@ -12,8 +18,10 @@ from __future__ import annotations
 
 import json
 import os
+import struct
 import zipfile
 import zlib
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -22,16 +30,23 @@ from motionlab.core import files
 from motionlab.core.skeleton import Skeleton
 from motionlab.motion_graphs.graph import ClipInfo, GraphError, MotionGraph
 
-__all__ = ["save", "load", "writer", "FORMAT"]
+__all__ = ["save", "load", "writer", "read_meta", "Routes", "FORMAT", "READABLE"]
 
-FORMAT = "motionlab-graph-2"
-"""Version 2: style cells hold pooled takes (version 1 held one clip per style)."""
+FORMAT = "motionlab-graph-3"
+"""Version 3: uncompressed members, mapped on load; ``meta`` is UTF-8 bytes and holds the summary."""
+
+READABLE = ("motionlab-graph-2", FORMAT)
+"""Versions :func:`load` reads (2: compressed, read whole; 1 held one clip per style: rebuild)."""
+
+ARRAYS = ("local_rot", "root_pos", "alive", "src", "dst", "cost", "kind", "offsets", "parents")
+_DTYPES = {"local_rot": np.float64, "root_pos": np.float64, "alive": np.bool_, "src": np.int64,
+           "dst": np.int64, "cost": np.float64, "kind": np.int8}  # fmt: skip
 
 
 def _jsonable(x):
     if isinstance(x, dict):
         return {str(k): _jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
+    if isinstance(x, (list, tuple, Routes)):
         return [_jsonable(v) for v in x]
     if isinstance(x, np.generic):
         return x.item()
@@ -40,9 +55,83 @@ def _jsonable(x):
     return x
 
 
-def writer(graph: MotionGraph):
+_ROUTE_KEYS = {"exit", "enter", "pieces", "frames", "cost"}
+ROUTE_ARRAYS = ("route_exit", "route_enter", "route_frames", "route_cost", "route_piece_start", "route_pieces")
+
+
+class Routes(Sequence):
+    """The routes of one structure-table link, read from the file's route arrays on access.
+
+    Behaves as the list of route dicts the build made (``exit``, ``enter``, ``frames``, ``cost``,
+    ``pieces``: a list of ``[clip, first, last]``), so a search reads only the links it uses."""
+
+    def __init__(self, arrays: dict, first: int, count: int):
+        self.a, self.first, self.count = arrays, int(first), int(count)
+        self._items: list[dict] | None = None
+
+    def __len__(self) -> int:
+        return self.count
+
+    def _all(self) -> list[dict]:
+        """Every route of the link, made from the arrays at the first access (then kept)."""
+        if self._items is None:
+            a, s, e = self.a, self.first, self.first + self.count
+            starts = np.asarray(a["route_piece_start"][s : e + 1])
+            pieces = np.asarray(a["route_pieces"][starts[0] : starts[-1]]).tolist()
+            rel = (starts - starts[0]).tolist()
+            cols = [np.asarray(a[f"route_{k}"][s:e]).tolist() for k in ("exit", "enter", "frames", "cost")]
+            self._items = [
+                {"exit": x, "enter": y, "pieces": pieces[rel[k] : rel[k + 1]], "frames": f, "cost": c}
+                for k, (x, y, f, c) in enumerate(zip(*cols))
+            ]
+        return self._items
+
+    def __getitem__(self, k):
+        return self._all()[k]
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, Sequence) and len(other) == self.count and list(self) == list(other)
+
+    def __repr__(self) -> str:
+        return f"Routes({self.count} routes)"
+
+
+def _pack_routes(table: dict) -> tuple[dict, dict]:
+    """The table with each link's routes replaced by ``{"first", "count"}`` into the route arrays,
+    and those arrays (links whose routes hold other keys keep them in the JSON)."""
+    cols = {k: [] for k in ("exit", "enter", "frames", "cost")}
+    pieces, starts, links = [], [0], []
+    for link in table.get("links", []):
+        routes = list(link.get("routes", []))
+        if not all(isinstance(r, dict) and set(r) == _ROUTE_KEYS for r in routes):
+            links.append(link)
+            continue
+        links.append({**link, "routes": {"first": len(starts) - 1, "count": len(routes)}})
+        for r in routes:
+            for k in cols:
+                cols[k].append(r[k])
+            pieces.extend(r["pieces"])
+            starts.append(len(pieces))
+    arrays = {f"route_{k}": np.asarray(v, dtype=np.float64 if k == "cost" else np.int64) for k, v in cols.items()}
+    arrays["route_piece_start"] = np.asarray(starts, dtype=np.int64)
+    arrays["route_pieces"] = np.asarray(pieces, dtype=np.int64).reshape(-1, 3)
+    return {**table, "links": links}, arrays
+
+
+def _unpack_routes(table: dict, arrays: dict) -> dict:
+    """The table as the build made it, with :class:`Routes` reading the route arrays."""
+    for link in table.get("links", []):
+        r = link.get("routes")
+        if isinstance(r, dict) and set(r) == {"first", "count"}:
+            link["routes"] = Routes(arrays, r["first"], r["count"])
+    return table
+
+
+def writer(graph: MotionGraph, summary: dict | None = None):
     """``write(fh)``: writes ``graph`` in the ``.mlgraph`` format to a binary file ``fh`` (for
-    :func:`motionlab.core.files.atomic_write_all`, which writes several files as one)."""
+    :func:`motionlab.core.files.atomic_write_all`, which writes several files as one).
+
+    ``summary``: ``graph.summary()`` when the caller has it (computed here otherwise)."""
     sk = graph.skeleton
     meta = {
         "format": FORMAT,
@@ -50,45 +139,85 @@ def writer(graph: MotionGraph):
         "names": list(sk.names),
         "end_sites": {str(k): v.tolist() for k, v in sk.end_sites.items()},
         "clips": [c.to_dict() for c in graph.clips],
-        "table": graph.table,
         "info": graph.info,
+        "summary": graph.summary() if summary is None else summary,
     }
+    meta["table"], route_arrays = _pack_routes(graph.table)
 
     def write(fh) -> None:
-        np.savez_compressed(
+        np.savez(
             fh,
-            meta=np.array(json.dumps(_jsonable(meta))),
-            local_rot=graph.local_rot.astype(np.float32),
-            root_pos=graph.root_pos,
-            alive=graph.alive,
-            src=graph.src,
-            dst=graph.dst,
-            cost=graph.cost,
-            kind=graph.kind,
+            meta=np.frombuffer(json.dumps(_jsonable(meta)).encode("utf-8"), dtype=np.uint8),
+            local_rot=np.asarray(graph.local_rot, dtype=np.float64),
+            root_pos=np.asarray(graph.root_pos, dtype=np.float64),
+            alive=np.asarray(graph.alive, dtype=bool),
+            src=np.asarray(graph.src, dtype=np.int64),
+            dst=np.asarray(graph.dst, dtype=np.int64),
+            cost=np.asarray(graph.cost, dtype=np.float64),
+            kind=np.asarray(graph.kind, dtype=np.int8),
             offsets=sk.offsets,
             parents=sk.parents,
+            **route_arrays,
         )
 
     return write
 
 
-def save(path: str | os.PathLike, graph: MotionGraph, overwrite: bool = False) -> Path:
+def save(path: str | os.PathLike, graph: MotionGraph, overwrite: bool = False, summary: dict | None = None) -> Path:
     """Write ``graph`` to ``path`` (``.mlgraph`` added if there is no suffix), atomically.
 
+    ``summary``: ``graph.summary()`` when the caller has it (computed here otherwise).
     Raises ``FileExistsError`` when the file exists and ``overwrite`` is False.
     """
     path = Path(path)
     if path.suffix == "":
         path = path.with_suffix(".mlgraph")
-    return files.atomic_write(path, writer(graph), overwrite=overwrite, binary=True, what="motion graph")
+    return files.atomic_write(path, writer(graph, summary), overwrite=overwrite, binary=True, what="motion graph")
 
 
-def load(path: str | os.PathLike) -> MotionGraph:
-    """Read a graph written by :func:`save`.
+def _member_offset(fh, info: zipfile.ZipInfo) -> int:
+    """Byte offset in the file of a stored zip member's data (after its local header)."""
+    fh.seek(info.header_offset)
+    head = fh.read(30)
+    if len(head) < 30 or head[:4] != b"PK\x03\x04":
+        raise ValueError("bad local header")
+    name_len, extra_len = struct.unpack("<HH", head[26:30])
+    return info.header_offset + 30 + name_len + extra_len
 
-    Raises :class:`GraphError` naming the file for anything else: a file that is not a zip
-    archive, a truncated or damaged one, or an archive without the graph's entries.
-    """
+
+def _mapped(path: Path, fh, info: zipfile.ZipInfo, size: int) -> np.ndarray:
+    """A stored ``.npy`` member as a copy-on-write memory map (its header read, its data not)."""
+    fh.seek(_member_offset(fh, info))
+    version = np.lib.format.read_magic(fh)
+    if version == (1, 0):
+        shape, fortran, dtype = np.lib.format.read_array_header_1_0(fh)
+    elif version == (2, 0):
+        shape, fortran, dtype = np.lib.format.read_array_header_2_0(fh)
+    else:
+        raise ValueError(f"npy version {version}")
+    if dtype.hasobject:
+        raise ValueError("object array")
+    offset = fh.tell()
+    nbytes = int(np.prod(shape, dtype=np.int64)) * dtype.itemsize
+    if offset + nbytes > size:
+        raise EOFError("member runs past the end of the file")
+    if nbytes == 0:
+        return np.zeros(shape, dtype=dtype)
+    return np.memmap(path, dtype=dtype, mode="c", offset=offset, shape=shape, order="F" if fortran else "C")
+
+
+def _read_meta(z: zipfile.ZipFile) -> dict:
+    with z.open("meta.npy") as f:
+        m = np.lib.format.read_array(f, allow_pickle=False)
+    meta = json.loads(m.tobytes().decode("utf-8") if m.dtype == np.uint8 else str(m))
+    if not isinstance(meta, dict) or meta.get("format") not in READABLE:
+        found = meta.get("format") if isinstance(meta, dict) else None
+        hint = "; rebuild it with motionlab graph-build" if str(found).startswith("motionlab-graph-") else ""
+        raise GraphError(f"unknown format {found!r}, expected {FORMAT!r}{hint}")
+    return meta
+
+
+def _open(path) -> Path:
     path = Path(path)
     if path.is_dir():
         raise GraphError(f"{path} is a folder, not a motion graph file (.mlgraph)")
@@ -101,46 +230,79 @@ def load(path: str | os.PathLike) -> MotionGraph:
             f"{path} is not a motion graph file: expected the zip archive that graph-build writes "
             f"(it starts with PK), found {magic!r}"
         )
+    return path
+
+
+def _damaged(path: Path, e: Exception) -> GraphError:
+    return GraphError(f"{path} is truncated or damaged and cannot be read as a motion graph ({type(e).__name__})")
+
+
+def read_meta(path: str | os.PathLike) -> dict:
+    """The JSON part of a graph file (format, fps, clips, table, info and, from version 3 on,
+    ``summary``) without touching its arrays. Raises as :func:`load`."""
+    path = _open(path)
     try:
-        with np.load(path, allow_pickle=False) as z:
-            arrays = {k: z[k] for k in z.files}
-        meta = json.loads(str(arrays["meta"]))
-    except KeyError:
-        raise GraphError(f"{path} is not a motion graph file (no 'meta' entry)") from None
+        with zipfile.ZipFile(path) as z:
+            if "meta.npy" not in z.namelist():
+                raise GraphError(f"{path} is not a motion graph file (no 'meta' entry)")
+            return _read_meta(z)
+    except GraphError as e:
+        raise GraphError(str(e) if str(path) in str(e) else f"{path}: {e}") from None
     except (ValueError, OSError, EOFError, zipfile.BadZipFile, zlib.error) as e:
-        raise GraphError(
-            f"{path} is truncated or damaged and cannot be read as a motion graph ({type(e).__name__})"
-        ) from None
-    if not isinstance(meta, dict) or meta.get("format") != FORMAT:
-        found = meta.get("format") if isinstance(meta, dict) else None
-        hint = "; rebuild it with motionlab graph-build" if str(found).startswith("motionlab-graph-") else ""
-        raise GraphError(f"{path}: unknown format {found!r}, expected {FORMAT!r}{hint}")
-    need = ("local_rot", "root_pos", "alive", "src", "dst", "cost", "kind", "offsets", "parents")
-    missing = [k for k in need if k not in arrays]
-    if missing:
-        raise GraphError(f"{path} is not a complete motion graph file (missing {missing})")
+        raise _damaged(path, e) from None
+
+
+def _arrays(path: Path) -> tuple[dict, dict]:
+    """Meta and arrays of a graph file: mapped for version 3, read whole for version 2."""
+    with zipfile.ZipFile(path) as z:
+        names = {n[: -len(".npy")]: z.getinfo(n) for n in z.namelist() if n.endswith(".npy")}
+        if "meta" not in names:
+            raise GraphError(f"{path} is not a motion graph file (no 'meta' entry)")
+        meta = _read_meta(z)
+        missing = [k for k in ARRAYS if k not in names]
+        if missing:
+            raise GraphError(f"{path} is not a complete motion graph file (missing {missing})")
+        keys = ARRAYS + tuple(k for k in ROUTE_ARRAYS if k in names)
+        stored = all(names[k].compress_type == zipfile.ZIP_STORED for k in keys)
+        if meta["format"] == FORMAT and stored:
+            size = path.stat().st_size
+            with open(path, "rb") as fh:
+                return meta, {k: _mapped(path, fh, names[k], size) for k in keys}
+        arrays = {}
+        for k in keys:
+            with z.open(names[k]) as f:
+                arrays[k] = np.lib.format.read_array(f, allow_pickle=False)
+        return meta, arrays
+
+
+def load(path: str | os.PathLike) -> MotionGraph:
+    """Read a graph written by :func:`save`; its arrays are memory-mapped (module docstring).
+
+    Raises :class:`GraphError` naming the file for anything else: a file that is not a zip
+    archive, a truncated or damaged one, an archive without the graph's entries, or a format
+    version it cannot read (``motionlab-graph-1``: rebuild it). ``FileNotFoundError`` when there
+    is no file.
+    """
+    path = _open(path)
+    try:
+        meta, arrays = _arrays(path)
+    except GraphError as e:
+        raise GraphError(str(e) if str(path) in str(e) else f"{path}: {e}") from None
+    except (ValueError, OSError, EOFError, zipfile.BadZipFile, zlib.error) as e:
+        raise _damaged(path, e) from None
     try:
         sk = Skeleton(
             tuple(meta["names"]),
-            arrays["parents"],
-            arrays["offsets"],
+            np.array(arrays["parents"]),
+            np.array(arrays["offsets"]),
             {int(k): np.array(v) for k, v in meta["end_sites"].items()},
         )
-        rot = arrays["local_rot"].astype(np.float64)
-        rot /= np.linalg.norm(rot, axis=-1, keepdims=True)
-        return MotionGraph(
-            sk,
-            float(meta["fps"]),
-            [ClipInfo(**c) for c in meta["clips"]],
-            rot,
-            arrays["root_pos"],
-            arrays["alive"].astype(bool),
-            arrays["src"].astype(np.int64),
-            arrays["dst"].astype(np.int64),
-            arrays["cost"].astype(np.float64),
-            arrays["kind"].astype(np.int8),
-            meta["table"],
-            meta["info"],
-        )
+        if meta["format"] != FORMAT:  # version 2 kept rotations as float32: back to unit float64
+            rot = arrays["local_rot"].astype(np.float64)
+            arrays["local_rot"] = rot / np.linalg.norm(rot, axis=-1, keepdims=True)
+        a = {k: arrays[k] if arrays[k].dtype == t else arrays[k].astype(t) for k, t in _DTYPES.items()}
+        return MotionGraph(sk, float(meta["fps"]), [ClipInfo(**c) for c in meta["clips"]], a["local_rot"],
+                           a["root_pos"], a["alive"], a["src"], a["dst"], a["cost"], a["kind"],
+                           _unpack_routes(meta["table"], arrays), meta["info"])  # fmt: skip
     except (KeyError, TypeError, ValueError) as e:
         raise GraphError(f"{path}: damaged motion graph metadata ({type(e).__name__}: {e})") from None

@@ -23,6 +23,10 @@ from __future__ import annotations
 
 import json
 import os
+import resource
+import sys
+import time
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -30,7 +34,7 @@ import numpy as np
 from motionlab.core import files
 from motionlab.motion_graphs.graph import MotionGraph
 
-__all__ = ["build_report", "format_report", "to_json", "write_report", "COLUMNS"]
+__all__ = ["build_report", "format_report", "to_json", "write_report", "COLUMNS", "StageClock", "format_stages"]
 
 COLUMNS = ("behaviour", "style", "takes", "frames", "cycles", "transitions", "in largest", "pruned")
 
@@ -211,3 +215,57 @@ def write_report(path: str | os.PathLike, report: dict, overwrite: bool = False)
     naming the path.
     """
     return files.atomic_write(path, lambda f: f.write(to_json(report)), overwrite=overwrite, what="report")
+
+
+def _peak_mb() -> float:
+    """Peak resident memory of this process so far, MB (``ru_maxrss``: KiB on Linux, bytes on macOS)."""
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return peak / 1e6 if sys.platform == "darwin" else peak * 1024 / 1e6
+
+
+def _rss_mb() -> float:
+    """Resident memory of this process now, MB (0 where ``/proc`` is missing)."""
+    try:
+        with open("/proc/self/statm") as fh:
+            return int(fh.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 1e6
+    except (OSError, ValueError, IndexError):  # pragma: no cover - not Linux
+        return 0.0
+
+
+class StageClock:
+    """Seconds and memory of named stages of a long job (a graph build, a command).
+
+    ``with clock("distances"): ...`` times one stage; a stage entered again adds its seconds.
+    :attr:`rows` lists the stages in the order first entered, each a dict with ``stage``,
+    ``seconds``, ``peak_mb`` (the process's peak resident memory when the stage last ended: a
+    stage that raised the peak shows it first) and ``rss_mb`` (resident memory then), MB.
+    """
+
+    def __init__(self):
+        self.rows: list[dict] = []
+
+    @contextmanager
+    def __call__(self, stage: str):
+        t = time.perf_counter()
+        try:
+            yield
+        finally:
+            row = next((r for r in self.rows if r["stage"] == stage), None)
+            if row is None:
+                row = {"stage": stage, "seconds": 0.0}
+                self.rows.append(row)
+            row["seconds"] += time.perf_counter() - t
+            row["peak_mb"], row["rss_mb"] = round(_peak_mb(), 1), round(_rss_mb(), 1)
+
+    def extend(self, rows: list[dict]) -> None:
+        """Append stages measured elsewhere (e.g. a build's ``info["stages"]``)."""
+        self.rows.extend(dict(r) for r in rows)
+
+
+def format_stages(rows: list[dict]) -> str:
+    """Stage rows (:class:`StageClock`) as a table: seconds, peak so far and resident memory, GB."""
+    lines = [f"{'stage':<22} {'seconds':>8} {'peak GB':>8} {'RSS GB':>7}"]
+    for r in rows:
+        lines.append(f"{r['stage']:<22} {r['seconds']:8.2f} {r['peak_mb'] / 1e3:8.2f} {r['rss_mb'] / 1e3:7.2f}")
+    lines.append(f"{'total':<22} {sum(r['seconds'] for r in rows):8.2f} {max(r['peak_mb'] for r in rows) / 1e3:8.2f}")
+    return "\n".join(lines)

@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable, Mapping, Sequence
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -140,15 +141,27 @@ def leads(graph: MotionGraph) -> tuple[np.ndarray, np.ndarray]:
     transition of the style enters a start); a link from another pool may enter a lead-in and
     step forward into the alive frames, or leave from a lead-out after stepping out of them."""
     n = graph.num_frames
-    lead_in, lead_out = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
-    for c in graph.clips:
-        a = graph.alive[c.start : c.stop]
-        if c.kind != "basic" or not a.any() or a.all():
-            continue
-        first, last = int(np.argmax(a)), c.num_frames - 1 - int(np.argmax(a[::-1]))
-        lead_in[c.start : c.start + first] = True
-        lead_out[c.start + last + 1 : c.stop] = True
-    return lead_in, lead_out
+    basic = [c for c in graph.clips if c.kind == "basic" and c.num_frames > 0]
+    start = np.array([c.start for c in basic], dtype=np.int64)
+    stop = np.array([c.stop for c in basic], dtype=np.int64)
+    alive_at = np.flatnonzero(graph.alive)
+    if alive_at.size == 0 or not basic:
+        return np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+    k0 = np.searchsorted(alive_at, start)  # first alive frame at or after each clip's start
+    k1 = np.searchsorted(alive_at, stop) - 1  # last alive frame before each clip's stop
+    some = k1 >= k0
+    first = np.where(some, alive_at[np.minimum(k0, alive_at.size - 1)], start)
+    last = np.where(some, alive_at[np.maximum(k1, 0)], stop - 1)
+    partial = some & ((k1 - k0 + 1) < (stop - start))
+    return _ranges(n, start[partial], first[partial]), _ranges(n, last[partial] + 1, stop[partial])
+
+
+def _ranges(n: int, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """(n,) bool, True on every ``lo[k] <= f < hi[k]`` (ranges that do not overlap)."""
+    mark = np.zeros(n + 1, dtype=np.int64)
+    np.add.at(mark, lo, 1)
+    np.add.at(mark, hi, -1)
+    return np.cumsum(mark[:n]) > 0
 
 
 def _direction(graph: MotionGraph, lead: tuple, src: np.ndarray, dst: np.ndarray, cost: np.ndarray):
@@ -217,6 +230,7 @@ def link_pools(
     pool_start: Callable[[Key], int],
     threshold: float,
     window: int = _distance.DEFAULT_WINDOW,
+    workers: int = 1,
 ) -> tuple[list[dict], tuple[np.ndarray, np.ndarray, np.ndarray], int]:
     """Kovar transitions between the ports of pool pairs (see the module docstring).
 
@@ -228,6 +242,7 @@ def link_pools(
     pool_start : key → global index of the pool's first frame (routes count from it)
     threshold : largest frame distance, m² (the graph's transition threshold)
     window : frames per point cloud
+    workers : threads comparing pool pairs at once (the answer does not depend on it)
 
     Returns
     -------
@@ -237,12 +252,19 @@ def link_pools(
     """
     links, parts, comparisons = [], [], 0
     lead = leads(graph)
-    for a, b, fwd, bwd in pairs:
+    pairs = [p for p in pairs if port_feats[p[0]][0] is not None and port_feats[p[1]][0] is not None]
+
+    def compare(pair):
+        return _distance.candidates(port_feats[pair[0]][0], port_feats[pair[1]][0], threshold, window)
+
+    if workers > 1:
+        with ThreadPoolExecutor(workers) as pool:
+            found = list(pool.map(compare, pairs))
+    else:
+        found = [compare(p) for p in pairs]
+    for (a, b, fwd, bwd), (i, j, cost) in zip(pairs, found):
         (fa, ga), (fb, gb) = port_feats[a], port_feats[b]
-        if fa is None or fb is None:
-            continue
         comparisons += len(fa) * len(fb)
-        i, j, cost = _distance.candidates(fa, fb, threshold, window)
         for ok, (x, y, sx, sy) in ((fwd, (ga[i], gb[j], a, b)), (bwd, (gb[j], ga[i], b, a))):
             if not ok:
                 continue

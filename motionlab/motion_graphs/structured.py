@@ -64,15 +64,18 @@ import functools
 import itertools
 import time
 from collections.abc import Mapping, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
 
+from motionlab.core import fk as _fk
 from motionlab.core.motion import Motion
 from motionlab.motion_graphs import cycles as _cycles
 from motionlab.motion_graphs import distance as _distance
 from motionlab.motion_graphs import registration as _registration
+from motionlab.motion_graphs import report as _report
 from motionlab.motion_graphs import segments as _segments
 from motionlab.motion_graphs import stance_links as _stance_links
 from motionlab.motion_graphs.graph import EDGE_KINDS, ClipInfo, GraphError, MotionGraph, check_motions, pair_edges
@@ -80,9 +83,21 @@ from motionlab.motion_graphs.naming import ClipLabel, label_name, parse_name
 
 Key = tuple[str, str]
 
-__all__ = ["build_structured", "build_wcmg", "structure_rows", "STYLE_PAIRS"]
+__all__ = [
+    "build_structured",
+    "build_wcmg",
+    "structure_rows",
+    "positions",
+    "pool_pair_candidates",
+    "style_task",
+    "STYLE_PAIRS",
+    "BACKENDS",
+]
 
 STYLE_PAIRS = ("hub", "chain", "all", "none")
+
+BACKENDS = ("local", "ray")
+"""Where the comparisons inside each style run (:func:`build_structured`'s ``backend``)."""
 
 NEIGHBOURS = 3
 """Takes of one style each compared with the next 3 takes (cyclically, in take order)."""
@@ -167,6 +182,7 @@ class _Options:
     rep_cycles: int
     progress: bool
     prune: bool = True
+    workers: int = 1
 
 
 @dataclass
@@ -231,10 +247,9 @@ def _cut_takes(arr: _Arranged, notes: _Notes, progress: bool) -> _Cuts:
     """Stage 1: cycles and segments of every take, and the representative take of every style."""
     cyc, seg, cuts = {}, {}, {}
     for _key, ks in _progress(sorted(arr.pools.items()), "cycles", enabled=progress):
-        for c in ks:
+        for c, pos in zip(ks, positions([arr.motions[c] for c in ks])):
             try:
-                cyc[c] = _cycles.segment_cycles(arr.motions[c])
-                seg[c] = _segments.segment_take(arr.motions[c])
+                cyc[c], seg[c] = _cut_one(arr.motions[c], pos)
             except ValueError:
                 cyc[c] = seg[c] = None
             # a gait is cut into whole cycles, a standing action into segments between stances
@@ -246,6 +261,33 @@ def _cut_takes(arr: _Arranged, notes: _Notes, progress: bool) -> _Cuts:
         if cuts[rep[key]] is None or cuts[rep[key]].count == 0:
             notes.add("no whole cycle", f"{arr.motions[rep[key]].name}: the whole take represents its style")
     return _Cuts(cyc, seg, cuts, rep, [m.num_frames for m in arr.motions])
+
+
+def positions(motions: Sequence[Motion]) -> list[np.ndarray]:
+    """World joint positions (T, J, 3) of each clip, by one forward-kinematics pass over all of
+    them when they share a joint hierarchy (FK works frame by frame, so every value equals the
+    clip's own :meth:`Motion.global_positions`); each clip keeps its own bone offsets."""
+    if not motions:
+        return []
+    parents = motions[0].skeleton.parents
+    if any(not np.array_equal(m.skeleton.parents, parents) for m in motions):
+        return [m.global_positions() for m in motions]
+    rot = np.concatenate([m.local_rot for m in motions])
+    trans = np.concatenate([m.translations() for m in motions])
+    pos = _fk.fk(rot, trans, parents)[1]
+    return np.split(pos, np.cumsum([m.num_frames for m in motions])[:-1])
+
+
+def _cut_one(motion: Motion, pos: np.ndarray):
+    """:func:`.cycles.segment_cycles` and :func:`.segments.segment_take` of one take from its
+    world positions ``pos``. Raises ``ValueError`` as they do (a joint missing)."""
+    names = list(motion.skeleton.names)
+    missing = [f for f in _cycles.FOOT_JOINTS if f not in names]
+    if missing:
+        raise ValueError(f"clip {motion.name!r} has no joint {missing[0]!r}")
+    idx = tuple(names.index(f) for f in _cycles.FOOT_JOINTS)
+    cyc = _cycles.cycles_from_ankles(pos[:, list(idx)], motion.fps)
+    return cyc, _segments.segments_from_positions(pos, idx, motion.fps, _segments.leg_length(motion.skeleton))
 
 
 def _interpolation_spaces(arr: _Arranged, cuts: _Cuts, opt: _Options) -> tuple[list[Motion], list[ClipInfo], list]:
@@ -296,13 +338,22 @@ class _Compare:
         self.cache: dict[int, _distance.CloudFeatures] = {}
         self.comparisons = 0
 
+    def motion(self, c: int) -> Motion:
+        """Clip ``c`` of the graph as a Motion on the graph's skeleton (views of its arrays)."""
+        g, info = self.graph, self.graph.clips[c]
+        st, sp = info.start, info.stop
+        return Motion(g.skeleton, g.local_rot[st:sp], g.root_pos[st:sp], g.fps, None, info.name)
+
     def feats(self, c: int) -> _distance.CloudFeatures:
         if c not in self.cache:
-            g, info = self.graph, self.graph.clips[c]
-            st, sp = info.start, info.stop
-            m = Motion(g.skeleton, g.local_rot[st:sp], g.root_pos[st:sp], g.fps, None, info.name)
-            self.cache[c] = _distance.cloud_features(m.global_positions(), self.window)
+            self.cache[c] = _distance.cloud_features(self.motion(c).global_positions(), self.window)
         return self.cache[c]
+
+    def load(self, ks: Sequence[int]) -> None:
+        """Cache the features of clips ``ks`` (one style's takes) from one FK pass (:func:`positions`)."""
+        todo = [c for c in ks if c not in self.cache]
+        for c, pos in zip(todo, positions([self.motion(c) for c in todo])):
+            self.cache[c] = _distance.cloud_features(pos, self.window)
 
     def __call__(self, x: int, y: int | None, rows=None, cols=None, thr=None, min_gap=0):
         """Candidates ``(i, j, cost)`` of clip ``x`` (``rows``) against clip ``y`` (``cols``; ``None``:
@@ -315,43 +366,127 @@ class _Compare:
         return _distance.candidates(fa, fb, thr, self.window, min_gap, r, cl)
 
 
-def _link_takes(graph: MotionGraph, cmp: _Compare, arr: _Arranged, cuts: _Cuts, opt: _Options, notes: _Notes):
+def pool_pair_candidates(feats: Sequence[_distance.CloudFeatures], pairs: Sequence[tuple[int, int]], threshold: float,
+                         window: int, min_loop: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:  # fmt: skip
+    """Transition candidates inside one style: every take with itself (``min_loop`` frames apart
+    at least), then each pair ``(x, y)`` of ``pairs`` (indices into ``feats``).
+
+    Returns ``(i, j, cost)`` take-local arrays (:func:`.distance.candidates`): one per take, then
+    one per pair. A pure function of its arguments, so the local and the Ray backends share it."""
+    out = [_distance.candidates(f, None, threshold, window, min_loop) for f in feats]
+    out += [_distance.candidates(feats[x], feats[y], threshold, window) for x, y in pairs]
+    return out
+
+
+def style_task(skeleton, rot, root, fps: float, lengths, pairs, threshold: float, window: int, min_loop: int):
+    """One style's :func:`pool_pair_candidates` from its frames alone (``rot`` (N, J, 4), ``root``
+    (N, 3): the takes side by side, ``lengths`` frames each), for the Ray backend's tasks."""
+    bounds = np.cumsum([0, *lengths])
+    motions = [Motion(skeleton, rot[a:b], root[a:b], fps, None, "") for a, b in zip(bounds[:-1], bounds[1:])]
+    feats = [_distance.cloud_features(p, window) for p in positions(motions)]
+    return pool_pair_candidates(feats, pairs, threshold, window, min_loop)
+
+
+class _LocalPools:
+    """The local backend: ``run(key, takes, pairs)`` gives :func:`pool_pair_candidates` of one
+    style and its takes' port rows (:class:`_PortRows`). With ``workers > 1`` threads compute the
+    next styles ahead (at most ``workers`` at once); answers are taken in build order. Only port
+    rows outlive a task, so memory holds at most ``workers`` styles' point clouds."""
+
+    def __init__(self, cmp: _Compare, opt: _Options, pools: list, workers: int, port_masks: dict):
+        self.cmp, self.opt, self.todo, self.pending = cmp, opt, list(pools), {}
+        self.workers, self.port_masks = workers, port_masks
+        self.pool = ThreadPoolExecutor(workers) if workers > 1 else None
+
+    def _task(self, ks: list[int]):
+        motions = [self.cmp.motion(c) for c in ks]
+        feats = [_distance.cloud_features(p, self.opt.window) for p in positions(motions)]
+        pairs = _ring_pairs(len(ks), self.opt.neighbours)
+        found = pool_pair_candidates(feats, pairs, self.opt.threshold, self.opt.window, self.opt.min_loop)
+        return found, {c: _PortRows(f, self.port_masks[c]) for c, f in zip(ks, feats)}
+
+    def _submit(self) -> None:
+        while self.todo and len(self.pending) < self.workers:
+            key, ks = self.todo.pop(0)
+            self.pending[key] = self.pool.submit(self._task, ks)
+
+    def __call__(self, key, ks, pairs):
+        if self.pool is None:
+            return self._task(ks)
+        self._submit()
+        out = self.pending.pop(key).result()
+        self._submit()
+        return out
+
+    def close(self) -> None:
+        if self.pool is not None:
+            self.pool.shutdown(cancel_futures=True)
+
+
+def _link_takes(graph: MotionGraph, cmp: _Compare, arr: _Arranged, port_masks: dict, opt: _Options, notes: _Notes,
+                clock: _report.StageClock, pool_candidates):  # fmt: skip
     """Stage 3: within each style, every take with itself, its neighbouring takes and (port to
     port) every other take; then the style keeps its largest strongly connected part.
 
-    Returns the ports of every pool (:func:`.stance_links.port_features`, after pruning)."""
-    clips = graph.clips
+    ``port_masks``: clip index → (frames,) bool ports of each take; ``pool_candidates(key,
+    takes, pairs)``: the candidates of one style and its port rows or ``None``
+    (:class:`_LocalPools` or :func:`.ray_backend.pool_candidates`). Returns the ports of every pool
+    (:func:`.stance_links.port_features`, after pruning)."""
     ports: dict = {}
-    port_masks = {
-        c: (s.ports if s is not None else np.zeros(clips[c].num_frames, dtype=bool)) for c, s in cuts.seg.items()
-    }
     for key, ks in _progress(sorted(arr.pools.items()), "takes", enabled=opt.progress):
-        found = {"loop": [], "transition": []}  # (src, dst, cost) global, added at once
-        for c in ks:
-            i, j, cost = cmp(c, None, min_gap=opt.min_loop)
-            ok = j + 1 < clips[c].num_frames
-            found["loop"].append((clips[c].start + i[ok], clips[c].start + j[ok] + 1, cost[ok]))
-        for x, y in _ring_pairs(len(ks), opt.neighbours):
-            a, z = ks[x], ks[y]
-            i, j, cost = cmp(a, z)
-            src, dst, which = pair_edges(i, j, clips[a].start, clips[z].start, clips[z].num_frames,
-                                         clips[a].num_frames, False)  # fmt: skip
-            found["transition"].append((src, dst, cost[which]))
-        # takes connect stance to stance: every take's ports with every other take's
-        port = _stance_links.port_features(graph, ks, port_masks, cmp.feats)
-        cmp.comparisons += 0 if port[0] is None else len(port[1]) ** 2
-        found["transition"].append(_stance_links.link_within(graph, port, opt.threshold, opt.min_loop, opt.window))
-        for kind, parts in found.items():
-            if parts:
-                graph.add_edges(*(np.concatenate(p) for p in zip(*parts)), kind)
-        for c in ks:
-            if c != cuts.rep[key]:
-                cmp.cache.pop(c, None)
+        with clock("distances"):
+            ring = _ring_pairs(len(ks), opt.neighbours)
+            found, port_rows = pool_candidates(key, ks, ring)
+            edges = _pool_edges(graph, ks, ring, found, cmp)
+            if port_rows is None:  # the remote backend sent candidates only
+                cmp.load(ks)
+                port_rows = {c: _PortRows(cmp.feats(c), port_masks[c]) for c in ks}
+                for c in ks:
+                    cmp.cache.pop(c, None)
+            # takes connect stance to stance: every take's ports with every other take's
+            port = _stance_links.port_features(graph, ks, port_masks, port_rows.get)
+            cmp.comparisons += 0 if port[0] is None else len(port[1]) ** 2
+            edges["transition"].append(_stance_links.link_within(graph, port, opt.threshold, opt.min_loop, opt.window))
+            for kind, parts in edges.items():
+                if parts:
+                    graph.add_edges(*(np.concatenate(p) for p in zip(*parts)), kind)
         if opt.prune:
-            _prune_pool(graph, cmp, ks, opt, notes)
-        ports[key] = _stance_links.port_features(graph, ks, port_masks, cmp.feats)
-    graph.drop_dead_edges()
+            with clock("pruning"):
+                _prune_pool(graph, cmp, ks, opt, notes)
+        ports[key] = _stance_links.port_features(graph, ks, port_masks, port_rows.get)
+    with clock("pruning"):
+        graph.drop_dead_edges()
     return ports
+
+
+def _pool_edges(graph: MotionGraph, ks: list[int], ring: list, found: list, cmp: _Compare) -> dict:
+    """Loop and transition edges (global) of one style from :func:`pool_pair_candidates`'s
+    answer ``found``; counts the cells compared in ``cmp.comparisons``."""
+    clips = graph.clips
+    out = {"loop": [], "transition": []}  # (src, dst, cost) global, added at once
+    for c, (i, j, cost) in zip(ks, found):
+        ok = j + 1 < clips[c].num_frames
+        out["loop"].append((clips[c].start + i[ok], clips[c].start + j[ok] + 1, cost[ok]))
+        cmp.comparisons += clips[c].num_frames ** 2
+    for (x, y), (i, j, cost) in zip(ring, found[len(ks) :]):
+        a, z = ks[x], ks[y]
+        src, dst, which = pair_edges(i, j, clips[a].start, clips[z].start, clips[z].num_frames,
+                                     clips[a].num_frames, False)  # fmt: skip
+        out["transition"].append((src, dst, cost[which]))
+        cmp.comparisons += clips[a].num_frames * clips[z].num_frames
+    return out
+
+
+class _PortRows:
+    """The features of a take's port frames only, indexed by the take's frame numbers (the rows
+    :func:`.stance_links.port_features` reads), so a pool's full features need not be kept."""
+
+    def __init__(self, feats: _distance.CloudFeatures, ports: np.ndarray):
+        self.rows = feats[np.flatnonzero(ports)]
+        self.where = np.cumsum(ports) - 1
+
+    def __getitem__(self, frames) -> _distance.CloudFeatures:
+        return self.rows[self.where[frames]]
 
 
 def _prune_pool(graph: MotionGraph, cmp: _Compare, ks: list[int], opt: _Options, notes: _Notes) -> None:
@@ -562,7 +697,7 @@ def _link_stances(graph: MotionGraph, arr: _Arranged, table: dict, ports: dict, 
     kinds = {(b, s): cell["kind"] for b, cells in table["behaviours"].items() for s, cell in cells.items()}
     pairs = _stance_links.pool_pairs(list(arr.pools), recorded, kinds)
     links, (src, dst, cost), n_cmp = _stance_links.link_pools(graph, pairs, ports, pool_start, opt.threshold,
-                                                              opt.window)  # fmt: skip
+                                                              opt.window, opt.workers)  # fmt: skip
     graph.add_edges(src, dst, cost, "transition")
     table["links"].extend(links)
     return n_cmp
@@ -585,6 +720,9 @@ def build_structured(
     rep_cycles: int = REP_CYCLES,
     progress: bool = False,
     prune: bool = True,
+    backend: str = "local",
+    ray_address: str | None = None,
+    workers: int = 1,
 ) -> MotionGraph:
     """Build the structured motion graph (see the module docstring).
 
@@ -607,15 +745,21 @@ def build_structured(
     neighbours : each take is compared with itself and the next ``neighbours`` takes of its style
     rep_cycles : whole cycles of each representative take that the interpolation space blends
     progress : show a tqdm bar per stage; prune : ``False`` skips every pruning step (for paper B's ablation)
+    backend : ``"local"`` (this process, ``workers`` threads) or ``"ray"``: the comparisons inside
+        each style run as Ray tasks (:mod:`.ray_backend`); ``ray_address`` names a running cluster
+        (default: ``RAY_ADDRESS``, else a local instance with ``workers`` CPUs). The graph does
+        not depend on the backend or the workers
 
     Returns
     -------
     MotionGraph with ``table`` (structure table and links) and ``info`` (timings, counts,
-    ``conditions``); clips stored style by style, each style's takes side by side.
+    ``conditions``, ``stages``: seconds and memory per stage, :class:`.report.StageClock`);
+    clips stored style by style, each style's takes side by side.
 
     Raises
     ------
-    GraphError when the clips do not share one skeleton and fps, or ``labels`` does not match them.
+    GraphError when the clips do not share one skeleton and fps, or ``labels`` does not match them;
+    ValueError for an unknown ``backend``; ImportError for ``"ray"`` without Ray installed.
     """
     t0 = time.perf_counter()
     _, fps = check_motions(motions)
@@ -626,28 +770,60 @@ def build_structured(
                    tuple(weights), style_pairs, reference_style, force,
                    max(1, int(round(fps / 5)) if dwell is None else int(dwell)), neighbours, rep_cycles, progress,
                    prune)  # fmt: skip
-    notes, seconds, arr = _Notes(), {}, _arrange(motions, labels)
-    with _timer(seconds, "cycles_seconds"):
-        cuts = _cut_takes(arr, notes, progress)
-    with _timer(seconds, "registration_seconds"):
+    if backend not in BACKENDS:
+        raise ValueError(f"backend must be one of {BACKENDS}, got {backend!r}")
+    opt.workers = max(1, int(workers))
+    graph = _build(_arrange(motions, labels), opt, synthetic, backend, ray_address)
+    graph.info.update(input_clips=len(motions), build_seconds=time.perf_counter() - t0)
+    return graph
+
+
+def _build(arr: _Arranged, opt: _Options, synthetic, backend: str, ray_address) -> MotionGraph:
+    """The stages of :func:`build_structured` on the arranged clips, each timed (``info["stages"]``)."""
+    notes, seconds, clock = _Notes(), {}, _report.StageClock()
+    with _timer(seconds, "cycles_seconds"), clock("cycles"):
+        cuts = _cut_takes(arr, notes, opt.progress)
+    with _timer(seconds, "registration_seconds"), clock("interpolation spaces"):
         extra, extra_infos, spaces = _interpolation_spaces(arr, cuts, opt)
     graph = MotionGraph.from_motions(arr.motions + extra, _clip_infos(arr, synthetic) + extra_infos)
     arr.motions = []  # the graph holds the frames now
-    cmp = _Compare(graph, opt.threshold, window)
+    cmp = _Compare(graph, opt.threshold, opt.window)
     pool_start = functools.partial(_pool_start, graph, arr)
-    with _timer(seconds, "takes_seconds"):
-        ports = _link_takes(graph, cmp, arr, cuts, opt, notes)
+    port_masks = {
+        c: s.ports if s is not None else np.zeros(graph.clips[c].num_frames, bool) for c, s in cuts.seg.items()
+    }
+    with _timer(seconds, "takes_seconds"), _backend(backend, cmp, arr, opt, ray_address, port_masks) as run:
+        ports = _link_takes(graph, cmp, arr, port_masks, opt, notes, clock, run)
     table = _structure_table(graph, arr, cuts, opt)
     on_route = np.zeros(graph.num_frames, dtype=bool)
-    with _timer(seconds, "links_seconds"):
+    with _timer(seconds, "links_seconds"), clock("links"):
         _link_styles(graph, cmp, spaces, cuts, pool_start, opt, notes, table, on_route)
         _link_transition_clips(graph, cmp, arr, pool_start, opt, notes, table, on_route)
-    with _timer(seconds, "stance_seconds"):
+    with _timer(seconds, "stance_seconds"), clock("links"):
         cmp.comparisons += _link_stances(graph, arr, table, ports, pool_start, opt)
-    _finish(graph, table, on_route if opt.prune else None)
-    graph.info = _info(opt, cmp.comparisons, len(motions), seconds, len(extra), notes)
-    graph.info["build_seconds"] = time.perf_counter() - t0
+    with clock("pruning"):
+        _finish(graph, table, on_route if opt.prune else None)
+    graph.info = _info(opt, cmp.comparisons, 0, seconds, len(extra), notes)
+    graph.info.update(stages=clock.rows, backend=backend)
     return graph
+
+
+@contextmanager
+def _backend(backend: str, cmp: _Compare, arr: _Arranged, opt: _Options, address: str | None, port_masks: dict):
+    """The candidates of every style: :class:`_LocalPools` (``opt.workers`` threads), or for
+    ``"ray"`` :func:`.ray_backend.pool_candidates`, every style submitted at once (Ray is started
+    here and shut down after, unless running)."""
+    if backend == "local":
+        local = _LocalPools(cmp, opt, sorted(arr.pools.items()), opt.workers, port_masks)
+        try:
+            yield local
+        finally:
+            local.close()
+        return
+    from motionlab.motion_graphs import ray_backend
+
+    with ray_backend.session(address, opt.workers):
+        yield ray_backend.pool_candidates(cmp.graph, sorted(arr.pools.items()), _ring_pairs, opt, style_task)
 
 
 def _info(opt: _Options, comparisons: int, n_input: int, seconds: dict, n_extra: int, notes: _Notes) -> dict:

@@ -145,7 +145,7 @@ def test_old_format_is_named(sgraph, tmp_path):
     path = io.save(tmp_path / "g", sgraph)
     with np.load(path) as z:
         arrays = {k: z[k] for k in z.files}
-    meta = json.loads(str(arrays["meta"]))
+    meta = json.loads(arrays["meta"].tobytes().decode("utf-8"))
     meta["format"] = "motionlab-graph-1"
     arrays["meta"] = np.array(json.dumps(meta))
     old = tmp_path / "old.mlgraph"
