@@ -23,15 +23,25 @@ _PARTS = (
     "motionlab.viz.cli",
 )
 
+_HEAVY = ("motionlab.retargeting.cli",)
+"""Parts whose import loads torch (seconds): looked in last when a single command is wanted."""
 
-def build_parser() -> argparse.ArgumentParser:
+
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The ``motionlab`` parser with every part's sub-commands; with ``command``, the parts are
+    imported (light ones first) only until one registers it, so a command of one part does not pay
+    for another part's imports (torch, for the retargeting commands); an unknown ``command``
+    imports them all."""
     parser = argparse.ArgumentParser(
         prog="motionlab",
         description="Skeletal character animation: BVH tools, retargeting by latent iteration, "
         "motion graphs, key-pose in-betweening and 3D playback.",
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for name in _PARTS:
+    parts = _PARTS if command is None else sorted(_PARTS, key=lambda name: name in _HEAVY)
+    for name in parts:
+        if command is not None and command in sub.choices:
+            break
         try:
             module = importlib.import_module(name)
         except ModuleNotFoundError as e:
@@ -39,9 +49,11 @@ def build_parser() -> argparse.ArgumentParser:
                 continue  # that part has no commands (yet)
             raise
         module.register(sub)
-    for command in sub.choices.values():  # every option's default in its --help
-        raw = issubclass(command.formatter_class, argparse.RawDescriptionHelpFormatter)
-        command.formatter_class = RawDescriptionHelpFormatter if raw else HelpFormatter
+    if command is not None and command not in sub.choices:
+        return build_parser()  # an unknown command: the full parser, in its order, says which exist
+    for each in sub.choices.values():  # every option's default in its --help
+        raw = issubclass(each.formatter_class, argparse.RawDescriptionHelpFormatter)
+        each.formatter_class = RawDescriptionHelpFormatter if raw else HelpFormatter
     return parser
 
 
@@ -54,7 +66,9 @@ def _os_message(e: OSError) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    command = argv[0] if argv and not argv[0].startswith("-") else None
+    parser = build_parser(command)
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
         parser.print_help()

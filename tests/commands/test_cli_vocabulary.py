@@ -74,9 +74,15 @@ VOCABULARY = {
     "--exact-rounds": ("exact_rounds", "non_negative_int", "exact Gauss-Newton rounds of the latent start"),
     "--train-steps": ("train_steps", "positive_int", "Adam steps of training"),
     "--method": ("method", "text", "the command's algorithm"),
+    "--backend": ("backend", "text", "where the parallel work runs: this process or Ray (expand, graph-build)"),
+    "--workers": ("workers", "positive_int", "how many parallel workers (Ray actors or CPUs, threads locally)"),
 }
 PER_COMMAND_CHOICES = {"--method"}
-SAME_CHOICES = {"--root": ("stride", "hips", "legs", "contacts"), "--gap-root": ("stride", "hermite", "linear")}
+SAME_CHOICES = {
+    "--root": ("stride", "hips", "legs", "contacts"),
+    "--gap-root": ("stride", "hermite", "linear"),
+    "--backend": ("local", "ray"),
+}
 SYNTHETIC = {"train": "non_negative_int", "graph-build": "flag"}  # both: built-in synthetic clips instead of files
 
 RENAMED = {  # (command, old spelling) -> new spelling
