@@ -4,8 +4,8 @@ Aj's Jumping retargeted onto the ``long_arms`` preset (arms x 1.35) with the shi
 notebook 07 does, with and without the floor term: the deepest joint of the output, the
 plausibility check, the returned iterate's losses and the planted-foot slide::
 
-    MOTIONLAB_DATA=/path/to/data python experiments/retargeting/floor_term.py [--steps 20 100]
-    MOTIONLAB_DATA=/path/to/data python experiments/retargeting/floor_term.py --character Mousey_m --steps 100
+    MOTIONLAB_DATA=/path/to/data python -m experiments.retargeting.floor_term [--steps 20 100]
+    MOTIONLAB_DATA=/path/to/data python -m experiments.retargeting.floor_term --character Mousey_m --steps 100
 
 ``--character`` is an ``expand`` preset or a Mixamo character of the course data (its rig from
 its Running clip); ``--clip`` one of Aj's clips.
@@ -42,14 +42,14 @@ def run(source, target, ckpt, steps: int) -> dict:
     }
 
 
-def main() -> None:
+def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument(
         "--steps", type=int, nargs="+", default=[20, 100], help="solver step limits (notebook 07: 20 quick, 100)"
     )
     parser.add_argument("--character", default="long_arms", help="preset or Mixamo character (default long_arms)")
     parser.add_argument("--clip", default="Jumping", help="Aj's clip (default Jumping)")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     root = data.data_root() / "mixamo"
     source = bvh.load(root / "Aj" / f"{args.clip}.bvh")
     if args.character in expand.PRESETS:

@@ -36,8 +36,8 @@ still on B's legs (:func:`contact_stride`; the leg chain when the clip has no st
 ``root_mode="hips"`` scales all three axes by the hip height and ``"legs"`` by thigh + shin
 (:func:`humanoid.leg_length`, the plain baseline of the data notes). The default is the rule
 closest to Mixamo's own root paths; how it was chosen and how it holds with each character left
-out is on the results page, docs/results_retargeting.md (``benchmarks/bench_root.py``,
-``benchmarks/bench_root_loco.py``). All three methods (copy-rotation, network without
+out is on the results page, docs/results_retargeting.md (``experiments/retargeting/root_rules.py``,
+``experiments/retargeting/root_rules_loco.py``). All three methods (copy-rotation, network without
 iteration, full method) use the same root trajectory, so the comparison is on poses.
 
 Taught in ``notebooks/03_latent_iteration.ipynb``.

@@ -226,7 +226,7 @@ def step_grid(size: float) -> float:
     in the last bits of the gradients (another CPU's kernels add in another order) are rounded
     away instead of growing step by step, so the iterates, and the step at which the stopping rule
     stops, are the same on every CPU (``docs/reproducibility.md``,
-    ``benchmarks/bench_reproducibility.py``).
+    ``experiments/retargeting/reproducibility.py``).
     """
     return 2.0 ** math.floor(math.log2(size) - 12)
 

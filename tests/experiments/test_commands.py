@@ -1,16 +1,26 @@
-"""Every study of experiments/interpolation runs as a module and answers --help (no data needed)."""
+"""Every study of experiments/ runs as a module and answers --help (no data needed)."""
 
 import importlib
+from pathlib import Path
 
 import pytest
 
-STUDIES = ["bench_gap_rigs", "bench_inbetween", "check_gaps", "check_tracking_pose", "compare_counts", "compare_feet",
-           "compare_stride_root", "gap_cases", "reproduce_keypose_paper"]  # fmt: skip
+EXPERIMENTS = Path(__file__).resolve().parents[2] / "experiments"
+STUDIES = sorted(
+    f"{path.parent.name}.{path.stem}"
+    for path in EXPERIMENTS.glob("*/*.py")
+    if "\ndef main(" in path.read_text(encoding="utf-8")
+)
+"""Every module of experiments/<system>/ that has a ``main``: the command-line studies."""
+
+
+def test_every_system_has_its_studies_here():
+    assert {name.split(".")[0] for name in STUDIES} == {"interpolation", "motion_graphs", "retargeting"}
 
 
 @pytest.mark.parametrize("name", STUDIES)
 def test_the_study_answers_help(name, capsys):
-    module = importlib.import_module(f"experiments.interpolation.{name}")
+    module = importlib.import_module(f"experiments.{name}")
     with pytest.raises(SystemExit) as stop:
         module.main(["--help"])
     assert stop.value.code == 0

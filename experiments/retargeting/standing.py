@@ -1,6 +1,6 @@
 """Standing pose of every Bandai Namco dataset-2 take, and the run hip heights across rigs.
 
-    MOTIONLAB_DATA=/path/to/data python benchmarks/bench_standing.py
+    MOTIONLAB_DATA=/path/to/data python -m experiments.retargeting.standing
 
 Part 1 runs only the retargeting's preparation of each take (reduction to the 22 canonical joints
 and the canonical standing pose, :func:`motionlab.core.preprocess.prepare` with ``stand=True``)
@@ -100,10 +100,10 @@ def run_heights(root) -> None:
         )
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--old", action="store_true", help="also the take's own most upright frame (no rig profile)")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     if not data.has_data():
         raise SystemExit("needs MOTIONLAB_DATA")
     root = data.data_root()

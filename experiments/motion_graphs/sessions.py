@@ -13,7 +13,7 @@ then checked, untouched, on the check half and on all takes.
 
 Run::
 
-    MOTIONLAB_DATA=/path/to/shared/data python benchmarks/bench_motion_graph_sessions.py [--behaviour walk]
+    MOTIONLAB_DATA=/path/to/shared/data python -m experiments.motion_graphs.sessions [--behaviour walk]
 
 **Whole session** (``--session``): every behaviour folder under ``sessions/`` at once (gaits and
 standing actions, :mod:`motionlab.motion_graphs.segments`). It prints, per take kind, the
@@ -25,7 +25,7 @@ and it is then checked on the check half and on all takes. For all takes it prin
 the request's frame counts, the median search time over :data:`REPEATS` runs of the request and
 of each behaviour's style pairs, and the build's seconds and peak memory (a fresh process)::
 
-    MOTIONLAB_DATA=/path/to/shared/data python benchmarks/bench_motion_graph_sessions.py --session
+    MOTIONLAB_DATA=/path/to/shared/data python -m experiments.motion_graphs.sessions --session
 
 **Behaviours left out** (``--leave-out``): the same rule run on two behaviours' pick half, the
 chosen threshold checked on the third behaviour's takes (:func:`leave_out`).
@@ -34,6 +34,7 @@ chosen threshold checked on the third behaviour's takes (:func:`leave_out`).
 from __future__ import annotations
 
 import argparse
+import os
 import re
 import sys
 import time
@@ -254,7 +255,19 @@ def session(folder) -> int:
         f"search median over {REPEATS} runs: request {ms_req:.1f} ms; style pairs (each style to the next, "
         f"{len(pair_times)} requests) median {np.median(pair_times):.1f} ms, worst {max(pair_times):.1f} ms"
     )
-    subprocess.run([sys.executable, __file__, "--build-only", str(chosen), "--folder", str(folder)], check=True)
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "experiments.motion_graphs.sessions",
+            "--build-only",
+            str(chosen),
+            "--folder",
+            str(folder),
+        ],
+        check=True,
+        cwd=os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
+    )
     return 0
 
 

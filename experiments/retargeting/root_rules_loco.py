@@ -1,7 +1,7 @@
 """Which root rule holds on a character never seen? Whole-motion leave-one-character-out check.
 
-    python benchmarks/bench_root_loco.py                     # $MOTIONLAB_DATA/mixamo, Aj -> 6 targets
-    python benchmarks/bench_root_loco.py --checkpoint /tmp/motionlab_Aj.pt --animations Running Jumping
+    python -m experiments.retargeting.root_rules_loco                     # $MOTIONLAB_DATA/mixamo, Aj -> 6 targets
+    python -m experiments.retargeting.root_rules_loco --checkpoint /tmp/motionlab_Aj.pt --animations Running Jumping
 
 A root rule scales A's root trajectory by B/A of one skeleton measure on the ground plane and
 one up (:mod:`motionlab.retargeting.pipeline`); it sees the two skeletons only. For every rule
@@ -146,7 +146,7 @@ def main(argv=None) -> int:
     try:
         folder = Path(args.folder) if args.folder else data.data_root() / "mixamo"
     except data.DataNotFound as e:
-        sys.exit(f"bench_root_loco: {e}")
+        sys.exit(f"root_rules_loco: {e}")
     path = Path(args.checkpoint or Path(tempfile.gettempdir()) / f"motionlab_{args.source}.pt")
     if not path.is_file():
         sys.exit(f"no checkpoint {path}: run `motionlab evaluate` first (it trains {args.source}'s network there)")

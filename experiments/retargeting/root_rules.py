@@ -1,7 +1,7 @@
 """Which leg measure should scale the root trajectory? Measured against Mixamo's own retargets.
 
-    python benchmarks/bench_root.py                          # $MOTIONLAB_DATA/mixamo, Aj -> 6 targets
-    python benchmarks/bench_root.py path/to/folder --source Aj --targets BigVegas Kaya
+    python -m experiments.retargeting.root_rules                          # $MOTIONLAB_DATA/mixamo, Aj -> 6 targets
+    python -m experiments.retargeting.root_rules path/to/folder --source Aj --targets BigVegas Kaya
 
 The paper leaves B's root motion open. All three retargeting methods share it, and on the
 shared Mixamo data it carries most of the error, so the choice is measured here, with no
@@ -52,7 +52,7 @@ def main(argv=None) -> int:
     try:
         folder = Path(args.folder) if args.folder else data.data_root() / "mixamo"
     except data.DataNotFound as e:
-        sys.exit(f"bench_root: {e}")
+        sys.exit(f"root_rules: {e}")
     if not (folder / args.source).is_dir():
         sys.exit(f"no folder {folder / args.source}: set MOTIONLAB_DATA to the shared data (see README) or pass FOLDER")
 

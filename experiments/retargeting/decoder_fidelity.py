@@ -1,7 +1,7 @@
 """Why does the network alone not reconstruct Aj's held-back clips to 2 cm (issue 30)? Measured.
 
-    MOTIONLAB_DATA=/path/to/shared/data python benchmarks/bench_decoder_fidelity.py
-    python benchmarks/bench_decoder_fidelity.py --checkpoint /tmp/motionlab_Aj.pt --half-steps 1500
+    MOTIONLAB_DATA=/path/to/shared/data python -m experiments.retargeting.decoder_fidelity
+    python -m experiments.retargeting.decoder_fidelity --checkpoint /tmp/motionlab_Aj.pt --half-steps 1500
 
 "Reconstruction by the network alone" is encoder -> decoder -> FK on Aj's own skeleton
 (``benchmarks/bench_retarget.py``), mean joint error in cm, root-relative. Printed, on Aj's 10
@@ -120,7 +120,7 @@ def main(argv=None) -> int:
     try:
         root = data.data_root() / "mixamo"
     except data.DataNotFound as e:
-        sys.exit(f"bench_decoder_fidelity: {e}")
+        sys.exit(f"decoder_fidelity: {e}")
     path = Path(args.checkpoint or Path(tempfile.gettempdir()) / "motionlab_Aj.pt")
     if not path.is_file():
         sys.exit(f"no checkpoint {path}: run `motionlab evaluate` first (it trains Aj's network there)")

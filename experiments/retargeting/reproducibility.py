@@ -7,8 +7,8 @@ second test pass). For each pair it prints the Adam steps and stop of both runs 
 relative difference of their loss histories, with the step grid of ``solver.step_grid`` and
 without it (spacing 2⁻⁶⁰ of a step: no rounding in practice).
 
-    MOTIONLAB_DATA=/path/to/shared/data python benchmarks/bench_reproducibility.py
-    python benchmarks/bench_reproducibility.py            # synthetic clips only
+    MOTIONLAB_DATA=/path/to/shared/data python -m experiments.retargeting.reproducibility
+    python -m experiments.retargeting.reproducibility            # synthetic clips only
 
 The pairs: Aj's clips of the ``retarget_gt`` set onto other Mixamo characters when the course
 data is there (:data:`CHOSEN_ON`, looked at while the grids were chosen, and :data:`HELD_OUT`,
@@ -17,6 +17,7 @@ run only afterwards), and synthetic clips onto synthetic characters always.
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 import subprocess
@@ -80,12 +81,14 @@ def _run_pairs(grid_off: bool) -> list[dict]:
 
 def _child(env_extra: dict, grid_off: bool) -> list[dict]:
     env = dict(os.environ, **env_extra)
-    code = f"import json, sys; sys.path.insert(0, {os.path.dirname(__file__)!r}); import bench_reproducibility as b; print(json.dumps(b._run_pairs({grid_off})))"
+    repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    code = f"import json, sys; sys.path.insert(0, {repo!r}); from experiments.retargeting import reproducibility as b; print(json.dumps(b._run_pairs({grid_off})))"
     done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
-def main() -> int:
+def main(argv=None) -> int:
+    argparse.ArgumentParser(description=__doc__.split("\n\n")[0]).parse_args(argv)
     print("back end A: this machine's; back end B:", ", ".join(f"{k}={v}" for k, v in OTHER_BACK_END.items()))
     print("* held out: run only after the grids were chosen")
     print(f"{'pair':44s} {'grid':>5s} {'steps A':>10s} {'steps B':>10s} {'max rel. loss difference':>25s}")
