@@ -73,6 +73,14 @@ def _whole(text: str) -> int:
         raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
 
 
+def _checked(text: str, parse, accepted, expected: str):
+    """``parse(text)`` when ``accepted`` by the rule, else argparse's error ``expected EXPECTED, got 'TEXT'``."""
+    value = parse(text)
+    if not accepted(value):
+        raise argparse.ArgumentTypeError(f"expected {expected}, got {text!r}")
+    return value
+
+
 def positive(text: str) -> float:
     """argparse type: a finite number > 0 (``0``, ``-1.7``, ``nan`` refused).
 
@@ -80,10 +88,7 @@ def positive(text: str) -> float:
     ------
     argparse.ArgumentTypeError for anything but a finite number > 0.
     """
-    value = _number(text)
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"expected a positive number, got {text!r}")
-    return value
+    return _checked(text, _number, lambda v: math.isfinite(v) and v > 0, "a positive number")
 
 
 def non_negative(text: str) -> float:
@@ -93,10 +98,7 @@ def non_negative(text: str) -> float:
     ------
     argparse.ArgumentTypeError for anything but a finite number >= 0.
     """
-    value = _number(text)
-    if not (math.isfinite(value) and value >= 0):
-        raise argparse.ArgumentTypeError(f"expected 0 or a positive number, got {text!r}")
-    return value
+    return _checked(text, _number, lambda v: math.isfinite(v) and v >= 0, "0 or a positive number")
 
 
 def positive_int(text: str) -> int:
@@ -106,10 +108,7 @@ def positive_int(text: str) -> int:
     ------
     argparse.ArgumentTypeError for anything but a whole number >= 1.
     """
-    value = _whole(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a whole number of 1 or more, got {text!r}")
-    return value
+    return _checked(text, _whole, lambda v: v >= 1, "a whole number of 1 or more")
 
 
 def non_negative_int(text: str) -> int:
@@ -119,20 +118,16 @@ def non_negative_int(text: str) -> int:
     ------
     argparse.ArgumentTypeError for anything but a whole number >= 0.
     """
-    value = _whole(text)
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"expected a whole number of 0 or more, got {text!r}")
-    return value
+    return _checked(text, _whole, lambda v: v >= 0, "a whole number of 0 or more")
 
 
 def in_range(low: float, high: float, what: str = "a number", name: str = "in_range"):
     """argparse type named ``name``: a finite number from ``low`` to ``high`` (the message states the range)."""
 
     def check(text: str) -> float:
-        value = _number(text)
-        if not (math.isfinite(value) and low <= value <= high):
-            raise argparse.ArgumentTypeError(f"expected {what} from {low:g} to {high:g}, got {text!r}")
-        return value
+        return _checked(
+            text, _number, lambda v: math.isfinite(v) and low <= v <= high, f"{what} from {low:g} to {high:g}"
+        )
 
     check.__name__ = name
     return check
@@ -161,10 +156,7 @@ def seed(text: str) -> int:
     ------
     argparse.ArgumentTypeError for anything else.
     """
-    value = _whole(text)
-    if not 0 <= value <= SEED_MAX:
-        raise argparse.ArgumentTypeError(f"expected a whole number from 0 to {SEED_MAX}, got {text!r}")
-    return value
+    return _checked(text, _whole, lambda v: 0 <= v <= SEED_MAX, f"a whole number from 0 to {SEED_MAX}")
 
 
 MAX_OUTPUT_GB = 2.0

@@ -66,6 +66,15 @@ def has_data(*parts: str) -> bool:
     return root is not None and root.joinpath(*parts).exists()
 
 
+def _folder(subdir: str) -> Path:
+    """The folder ``MOTIONLAB_DATA/subdir``; :class:`DataNotFound` when it does not exist."""
+    root = data_root()
+    base = root / subdir
+    if not base.is_dir():
+        raise DataNotFound(f"{base} does not exist in {ENV_VAR}={root}")
+    return base
+
+
 def list_clips(subdir: str = "", pattern: str = "*.bvh") -> list[Path]:
     """All BVH files under ``MOTIONLAB_DATA/subdir`` (recursively), sorted.
 
@@ -73,11 +82,7 @@ def list_clips(subdir: str = "", pattern: str = "*.bvh") -> list[Path]:
     ------
     DataNotFound when the folder does not exist under ``MOTIONLAB_DATA``.
     """
-    root = data_root()
-    base = root / subdir
-    if not base.is_dir():
-        raise DataNotFound(f"{base} does not exist in {ENV_VAR}={root}")
-    return sorted(base.rglob(pattern))
+    return sorted(_folder(subdir).rglob(pattern))
 
 
 def list_characters(subdir: str = "mixamo") -> dict[str, list[str]]:
@@ -87,10 +92,7 @@ def list_characters(subdir: str = "mixamo") -> dict[str, list[str]]:
     ------
     DataNotFound when the folder does not exist under ``MOTIONLAB_DATA``.
     """
-    root = data_root()
-    base = root / subdir
-    if not base.is_dir():
-        raise DataNotFound(f"{base} does not exist in {ENV_VAR}={root}")
+    base = _folder(subdir)
     out = {}
     for d in sorted(p for p in base.iterdir() if p.is_dir()):
         clips = sorted(f.stem for f in d.glob("*.bvh"))

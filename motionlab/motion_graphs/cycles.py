@@ -150,6 +150,19 @@ def segment_cycles(
     return cycles_from_ankles(motion.global_positions()[:, idx], motion.fps, height, speed, min_frames)
 
 
+def as_ankles(ankles) -> np.ndarray:
+    """``ankles`` as a float64 array of shape (T, 2, 3): left then right ankle, world positions.
+
+    Raises
+    ------
+    ValueError when ``ankles`` is not (T, 2, 3).
+    """
+    ankles = np.asarray(ankles, dtype=np.float64)
+    if ankles.ndim != 3 or ankles.shape[1:] != (2, 3):
+        raise ValueError(f"expected ankle positions of shape (T, 2, 3), got {ankles.shape}")
+    return ankles
+
+
 def cycles_from_ankles(ankles, fps: float, height: float = 0.06, speed: float = 0.6, min_frames: int = 3) -> Cycles:
     """Whole gait cycles from ankle positions.
 
@@ -167,9 +180,7 @@ def cycles_from_ankles(ankles, fps: float, height: float = 0.06, speed: float = 
     ------
     ValueError when ``ankles`` is not (T, 2, 3).
     """
-    ankles = np.asarray(ankles, dtype=np.float64)
-    if ankles.ndim != 3 or ankles.shape[1:] != (2, 3):
-        raise ValueError(f"expected ankle positions of shape (T, 2, 3), got {ankles.shape}")
+    ankles = as_ankles(ankles)
     c = contacts(ankles, fps, (0, 1), height, speed)
     left, right = strikes(c[:, 0], min_frames), strikes(c[:, 1], min_frames)
     if left.size >= 2:

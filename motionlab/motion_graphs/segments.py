@@ -148,10 +148,7 @@ def planted(ankles, fps: float, leg: float) -> np.ndarray:
     ------
     ValueError when ``ankles`` is not (T, 2, 3).
     """
-    ankles = np.asarray(ankles, dtype=np.float64)
-    if ankles.ndim != 3 or ankles.shape[1:] != (2, 3):
-        raise ValueError(f"expected ankle positions of shape (T, 2, 3), got {ankles.shape}")
-    return _cycles.contacts(ankles, fps, (0, 1), CONTACT_HEIGHT * leg, CONTACT_SPEED * leg)
+    return _cycles.contacts(_cycles.as_ankles(ankles), fps, (0, 1), CONTACT_HEIGHT * leg, CONTACT_SPEED * leg)
 
 
 def _runs(mask: np.ndarray, min_frames: int) -> np.ndarray:

@@ -354,12 +354,7 @@ def _add_retarget(subparsers) -> None:
         p.add_argument(
             "--scale", type=cli_args.factor, default=1.0, metavar="F", help="scale the whole target by F (0.1 to 10)"
         )
-        p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
-        cli_options.add_rest_from(p)
-        cli_args.add_force(p, "overwrite existing output files")
-        cli_args.add_rate_and_plausibility_args(p)
-        cli_args.add_quiet(p)
-        cli_options.add_solver_args(p)
+        cli_options.add_run_options(p, "overwrite existing output files")
 
 
 def _add_train(subparsers) -> None:
@@ -394,7 +389,7 @@ def _add_train(subparsers) -> None:
         p.add_argument("--latent", type=positive_int, default=128, help="latent channels D per frame")
         p.add_argument("--hidden", type=positive_int, default=96, help="hidden channels")
         p.add_argument("--seed", type=cli_args.seed, default=0, help="random seed")
-        p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
+        cli_options.add_device(p)
         cli_args.add_force(p, "overwrite an existing checkpoint")
 
 
@@ -444,6 +439,6 @@ def _add_evaluate(subparsers) -> None:
             default="stride",
             help="root trajectory of every row but the plain baseline (default stride, as in `motionlab retarget`)",
         )
-        p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
+        cli_options.add_device(p)
         cli_args.add_quiet(p)
         cli_options.add_solver_args(p)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 
+from motionlab import cli_args
 from motionlab.cli_args import CLIError, non_negative, non_negative_int, positive, renamed
 from motionlab.retargeting import terms
 from motionlab.retargeting.pipeline import METHODS, ROOT_MODES  # the choices come from the library
@@ -22,6 +23,8 @@ __all__ = [
     "add_solver_args",
     "add_rest_from",
     "rest_from",
+    "add_device",
+    "add_run_options",
 ]
 
 
@@ -167,6 +170,23 @@ def add_solver_args(p: argparse.ArgumentParser) -> None:
         metavar="K",
         help="of the projection's 8 Gauss-Newton rounds, how many last ones are not smoothed over time (default 4)",
     )
+
+
+def add_device(p: argparse.ArgumentParser) -> None:
+    """``--device``: the torch device of a command that runs the network."""
+    p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
+
+
+def add_run_options(p: argparse.ArgumentParser, force_help: str) -> None:
+    """The options that end a command retargeting clips (``retarget``, ``expand``): ``--device``,
+    ``--rest-from``, ``--force`` (``force_help``), the frame-rate and plausibility options, ``-q``
+    and the latent iteration's."""
+    add_device(p)
+    add_rest_from(p)
+    cli_args.add_force(p, force_help)
+    cli_args.add_rate_and_plausibility_args(p)
+    cli_args.add_quiet(p)
+    add_solver_args(p)
 
 
 def add_rest_from(p: argparse.ArgumentParser) -> None:

@@ -142,9 +142,4 @@ def register(subparsers) -> None:
             help="flag skating when the planted feet slide faster than the contact speed limit and this times the "
             "source's own planted feet (scaled by the root ratio; default 2)",
         )
-        p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
-        cli_options.add_rest_from(p)
-        cli_args.add_force(p, "redo every pair and replace existing outputs")
-        cli_args.add_rate_and_plausibility_args(p)
-        cli_args.add_quiet(p)
-        cli_options.add_solver_args(p)
+        cli_options.add_run_options(p, "redo every pair and replace existing outputs")

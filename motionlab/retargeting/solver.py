@@ -524,15 +524,8 @@ def solve(
         inputs of the wrong shape, contact labels without the root path or frame rate, a
         non-positive frame rate, or a weight for a term that is not registered.
     """
-    cfg = config or SolverConfig()
-    x = _in_model_type(model, x)
-    _check_inputs(x, source, offsets, root_height, cfg)
-    contact = _contact_inputs(x, root_height, cfg, root_xz, yaw, planted, fps)
-    extra = _extra_inputs(x, inputs, cfg)
-    with threads.torch_threads(threads.threads_for(x.shape[0] * x.shape[1])):
-        return _iterate(model, x, source, offsets, root_height, cfg, [x.shape[0]], callback, progress, contact, extra)[
-            0
-        ]
+    problem = (model, x, source, offsets, root_height, config)
+    return _solve(problem, True, callback, progress, root_xz, yaw, planted, fps, inputs)[0]
 
 
 def solve_many(
@@ -562,13 +555,22 @@ def solve_many(
     sequence). Returns one :class:`SolverResult` per sequence, arrays with a leading axis of 1;
     ``seconds`` is the wall time of the whole batch.
     """
+    problem = (model, x, source, offsets, root_height, config)
+    return _solve(problem, False, None, progress, root_xz, yaw, planted, fps, inputs)
+
+
+def _solve(problem, joint: bool, callback, progress, root_xz, yaw, planted, fps, inputs) -> list[SolverResult]:
+    """:func:`solve` (``joint``: the N sequences are one problem) or :func:`solve_many` (N problems)
+    of ``problem = (model, x, source, offsets, root_height, config)``; one result per problem."""
+    model, x, source, offsets, root_height, config = problem
     cfg = config or SolverConfig()
     x = _in_model_type(model, x)
     _check_inputs(x, source, offsets, root_height, cfg)
     contact = _contact_inputs(x, root_height, cfg, root_xz, yaw, planted, fps)
     extra = _extra_inputs(x, inputs, cfg)
+    sizes = [x.shape[0]] if joint else [1] * x.shape[0]
     with threads.torch_threads(threads.threads_for(x.shape[0] * x.shape[1])):
-        return _iterate(model, x, source, offsets, root_height, cfg, [1] * x.shape[0], None, progress, contact, extra)
+        return _iterate(model, x, source, offsets, root_height, cfg, sizes, callback, progress, contact, extra)
 
 
 @contextmanager

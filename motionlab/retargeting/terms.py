@@ -151,9 +151,7 @@ def unregister(name: str) -> Term:
     ------
     KeyError naming the registered terms if there is none called ``name``.
     """
-    if name not in _REGISTRY:
-        raise KeyError(f"no loss term {name!r}; registered: {list(_REGISTRY)}")
-    return _REGISTRY.pop(name)
+    return _REGISTRY.pop(get(name).name)
 
 
 def registered() -> tuple[Term, ...]:
