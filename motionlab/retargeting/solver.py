@@ -96,6 +96,8 @@ __all__ = [
 _LAMBDAS = {"angle": "lambda_angle", "foot": "lambda_foot", "contact": "lambda_contact"}
 """The terms whose weights are also :class:`SolverConfig` fields (the paper's two and L_contact)."""
 
+PROJECT_DAMPING = 1e-3
+
 INITS = ("auto", "project", "encoder")
 """How the iteration starts: least-squares projection onto A's rotations, or ``F_enc(X_A)``;
 ``auto`` projects when θ is the rotations and starts from the encoder otherwise."""
@@ -126,6 +128,8 @@ class SolverConfig:
     project_iters : int    Gauss–Newton rounds of the projection
     smooth_projection : bool  smooth each Gauss–Newton step over time with G_σ (below), so the
                            start latent is as smooth in time as the encoder's
+    project_damping : float   relative damping of the Gauss–Newton rounds (:func:`project_latent`,
+                           :data:`PROJECT_DAMPING`)
     project_exact : int    of the ``project_iters`` rounds, how many last ones are not smoothed
                            (they remove what the smoothed rounds leave of A's fastest details;
                            ``motionlab evaluate --exact-rounds K`` compares values)
@@ -150,6 +154,7 @@ class SolverConfig:
     smooth_sigma: float = 3.0
     smooth_projection: bool = True
     project_exact: int = 4
+    project_damping: float = PROJECT_DAMPING
     weights: dict = field(default_factory=dict)
 
     def weight(self, name: str) -> float:
@@ -175,6 +180,8 @@ class SolverConfig:
             raise ValueError(
                 f"project_exact must be between 0 and project_iters ({self.project_iters}), got {self.project_exact}"
             )
+        if not self.project_damping > 0:
+            raise ValueError(f"project_damping must be positive, got {self.project_damping}")
         if not self.lambda_contact >= 0:
             raise ValueError(f"lambda_contact must be >= 0, got {self.lambda_contact}")
         if self.theta not in ("rotations", "directions"):
@@ -311,7 +318,7 @@ def project_latent(
     target_rot: torch.Tensor,
     offsets: torch.Tensor,
     iters: int = 4,
-    damping: float = 1e-3,
+    damping: float | None = None,
     smooth=None,
     exact_rounds: int = 0,
 ) -> torch.Tensor:
@@ -333,7 +340,7 @@ def project_latent(
     target_rot : Tensor (N, T, 22, 4)  rotations to reproduce (root in the heading frame)
     offsets : Tensor (22, 3) or (N, 22, 3)   B's bone offsets, metres
     iters : int                        Gauss–Newton rounds
-    damping : float                    relative damping μ
+    damping : float or None            relative damping (``μ`` above); None: :data:`PROJECT_DAMPING`
     smooth : callable or None          applied to each round's step (N, T, D), e.g. the Gaussian
         filter over time of :func:`solve`: exact per-frame steps make a latent that jumps from
         frame to frame (q_Δ reacts to it), so that later Adam steps add jitter (measured: mean
@@ -354,6 +361,7 @@ def project_latent(
         target = target_rot.reshape(N * T, NUM_JOINTS, 4)
         flat = phi.reshape(N * T, D)
 
+        damping = PROJECT_DAMPING if damping is None else damping
         eye = torch.eye(4 * NUM_JOINTS, dtype=phi.dtype, device=phi.device)
         for k in range(iters):
             out, jac = model.rotation_jacobian(flat, emb_frames)
@@ -650,6 +658,7 @@ def _start(p: _Problem, x: torch.Tensor):
                         p.src[i : i + 1],
                         offsets[i] if p.per_row_offsets else offsets,
                         cfg.project_iters,
+                        cfg.project_damping,
                         smooth=steps_filter,
                         exact_rounds=cfg.project_exact,
                     )
