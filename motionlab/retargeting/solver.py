@@ -96,7 +96,11 @@ __all__ = [
 _LAMBDAS = {"angle": "lambda_angle", "foot": "lambda_foot", "contact": "lambda_contact"}
 """The terms whose weights are also :class:`SolverConfig` fields (the paper's two and L_contact)."""
 
-PROJECT_DAMPING = 1e-3
+PROJECT_DAMPING = 1e-6
+"""Relative damping ``d`` of the Gauss–Newton start (:func:`project_latent`, ``μ = d × mean diag
+JJᵀ``): the smallest of 1e-3, 1e-4, … whose damped normal equations keep half of float64's digits
+(condition number ≤ 1/√ε ≈ 6.7e7) on every frame of the Mixamo and Bandai Namco clips it was
+chosen on (``benchmarks/bench_gn_damping.py``, ``docs/rigs.md``)."""
 
 INITS = ("auto", "project", "encoder")
 """How the iteration starts: least-squares projection onto A's rotations, or ``F_enc(X_A)``;
