@@ -89,7 +89,9 @@ def main() -> None:
                   f"{m['angle_max']:>8.3f} {m['angle_p99']:>8.4f}")  # fmt: skip
     print(f"\nrule: the smallest damping with cond <= 1/sqrt(eps) = {HALF_DIGITS:.3g} on every frame")
     for label, fams in (("chosen on", args.choose), ("checked on", [f for f in clips if f not in args.choose])):
-        ok = [d for d in args.damping if all(m["cond_max"] <= HALF_DIGITS for f, dd, m in rows if dd == d and f in fams)]
+        ok = [
+            d for d in args.damping if all(m["cond_max"] <= HALF_DIGITS for f, dd, m in rows if dd == d and f in fams)
+        ]
         print(f"{label:<11} {','.join(fams):<28} smallest damping within the bound: {min(ok) if ok else 'none':}")
     print(f"{time.perf_counter() - start:.0f} s")
 
