@@ -12,8 +12,8 @@ B's leg length), foot skating (cm/s, B and A) and the output frame rate
 With ``--methods``: the planted-foot slide of each pair under the three methods (copy rotations,
 the network alone, the full latent iteration), beside the source's own; ``--source-fps`` resamples
 every source clip first; ``--gn-damping`` runs the study of ``docs/rigs.md`` with the Gauss–Newton
-start's relative damping (:func:`motionlab.retargeting.solver.project_latent`, 1e-3 in the solver)
-set to another value. With ``--flags``: held-out clips (every dataset-2 walk-turn take, a Xia
+start's relative damping (:func:`motionlab.retargeting.solver.project_latent`,
+:data:`motionlab.retargeting.solver.PROJECT_DAMPING` by default) set to another value. With ``--flags``: held-out clips (every dataset-2 walk-turn take, a Xia
 walk and a CMU walk not in the matrix) retargeted by the full method onto three Mixamo characters, with
 ``expand``'s skating flag before this change (foot joints below 5 cm, against twice the source's
 own, scaled) and now (planted-foot slide on the source's stance frames,
@@ -29,20 +29,21 @@ from motionlab import data, retargeting
 from motionlab.core import bvh, humanoid, metrics, preprocess
 from motionlab.retargeting import rig_matrix
 from motionlab.retargeting.pipeline import retarget
+from motionlab.retargeting.solver import SolverConfig
 
 METHODS = ("copy", "network", "full")
 
 
-def method_slides(clips, checkpoint, pairs=None) -> None:
+def method_slides(clips, checkpoint, pairs=None, config: SolverConfig | None = None) -> None:
     """Print B's planted-foot slide (cm/s, on A's contact frames, at the network's rate: the skating
     flag's measure, :attr:`motionlab.retargeting.plausibility.Plausibility.slide`) per pair and
-    method, and A's own."""
+    method, and A's own; ``config`` the full method's solver settings."""
     print(f"{'source':<10} {'target':<10} " + " ".join(f"{m:>8}" for m in METHODS) + f" {'(source)':>9} flagged")
     for a in clips:
         for b in clips:
             if a == b or (pairs is not None and (a, b) not in pairs):
                 continue
-            checks = [retarget(clips[a], clips[b], checkpoint, method=m).plausibility for m in METHODS]
+            checks = [retarget(clips[a], clips[b], checkpoint, m, config).plausibility for m in METHODS]
             flagged = ",".join(m for m, c in zip(METHODS, checks) if c.skating) or "-"
             print(
                 f"{a:<10} {b:<10} "
@@ -89,11 +90,6 @@ def main() -> None:
     ap.add_argument("--flags", action="store_true", help="old and new skating flag on held-out clips instead")
     ap.add_argument("--gn-damping", type=float, help="with --methods: the Gauss-Newton start's relative damping")
     args = ap.parse_args()
-    if args.gn_damping is not None:  # a study: the solver's projection with another damping
-        from motionlab.retargeting import solver
-
-        project = solver.project_latent
-        solver.project_latent = lambda *a, **k: project(*a, **{**k, "damping": args.gn_damping})
     if args.flags:
         start = time.perf_counter()
         skating_flags(data.data_root(), retargeting.load_default())
@@ -106,7 +102,8 @@ def main() -> None:
     if args.methods:
         if args.source_fps:
             clips = {name: clip.resample(args.source_fps) for name, clip in clips.items()}
-        method_slides(clips, retargeting.load_default(), pairs)
+        config = SolverConfig() if args.gn_damping is None else SolverConfig(project_damping=args.gn_damping)
+        method_slides(clips, retargeting.load_default(), pairs, config)
         print(f"{time.perf_counter() - start:.0f} s")
         return
     rows = rig_matrix.pair_matrix(clips, retargeting.load_default(), pairs=pairs)
