@@ -50,9 +50,18 @@ def check_pair(ckpt, source, src: pipeline.PreparedSource, gt_rig) -> tuple:
     return truth, out.plausibility, deepest
 
 
-def leg_share(skeleton) -> float:
-    """Thigh + shin over the standing hip height: how much of the hip height bends with the knee."""
-    return humanoid.leg_length(skeleton) / pipeline.hip_height(skeleton)
+def rest_angles(skeleton) -> tuple[float, float]:
+    """The standing rest pose's knee bend (angle between thigh and shin) and the foot's pitch
+    (ankle → toe below the horizontal), degrees, mean of both legs."""
+    rest, j = skeleton.rest_positions(), humanoid.JOINTS.index
+    knee, pitch = [], []
+    for side in ("Left", "Right"):
+        thigh = rest[j(side + "Leg")] - rest[j(side + "UpLeg")]
+        shin = rest[j(side + "Foot")] - rest[j(side + "Leg")]
+        foot = rest[j(side + "ToeBase")] - rest[j(side + "Foot")]
+        knee.append(np.arccos(np.clip(thigh @ shin / np.linalg.norm(thigh) / np.linalg.norm(shin), -1, 1)))
+        pitch.append(np.arcsin(np.clip(-foot[1] / np.linalg.norm(foot), -1, 1)))
+    return float(np.degrees(np.mean(knee))), float(np.degrees(np.mean(pitch)))
 
 
 def _share(checks: list) -> str:
@@ -79,13 +88,14 @@ def main() -> None:
         for target in args.targets:
             rig = bvh.load(folder / target / f"{anim}.bvh")
             results[target, anim] = check_pair(ckpt, source, src, rig)
-            shares[target] = leg_share(preprocess.prepare(rig, ckpt.fps, stand=True).skeleton)
-        shares[evaluate.DEFAULT_SOURCE] = leg_share(src.motion.skeleton)
+            shares[target] = rest_angles(preprocess.prepare(rig, ckpt.fps, stand=True).skeleton)
+        shares[evaluate.DEFAULT_SOURCE] = rest_angles(src.motion.skeleton)
     print(f"network: {args.checkpoint or 'shipped default'}")
-    print(f"{'character':<14} {'ground truth fails':<34} {'motionlab fails':<34} leg / standing hip height")
+    print(f"{'character':<14} {'ground truth fails':<34} {'motionlab fails':<34} rest knee bend, foot pitch (deg)")
     for target in args.targets + ["all"]:
         pairs = [v for (t, _), v in results.items() if target in ("all", t)]
-        share = f"{shares[target]:.3f}" if target in shares else f"(source {shares[evaluate.DEFAULT_SOURCE]:.3f})"
+        knee, pitch = shares.get(target, shares[evaluate.DEFAULT_SOURCE])
+        share = f"{knee:5.1f} {pitch:5.1f}" + ("" if target in shares else f" ({evaluate.DEFAULT_SOURCE}'s)")
         print(f"{target:<14} {_share([p[0] for p in pairs]):<34} {_share([p[1] for p in pairs]):<34} {share}")
     print("\nfailing pairs: ground truth | motionlab (lowest joint / leg, source's, motionlab's deepest; hips; foot)")
     for (target, anim), (truth, ours, deepest) in results.items():
