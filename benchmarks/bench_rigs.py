@@ -17,7 +17,7 @@ start's relative damping (:func:`motionlab.retargeting.solver.project_latent`,
 walk and a CMU walk not in the matrix) retargeted by the full method onto three Mixamo characters, with
 ``expand``'s skating flag before this change (foot joints below 5 cm, against twice the source's
 own, scaled) and now (planted-foot slide on the source's stance frames,
-:attr:`motionlab.retargeting.plausibility.Plausibility.skating`).
+:attr:`motionlab.retargeting.plausibility.Plausibility.skating`), and copying rotations' slide.
 """
 
 from __future__ import annotations
@@ -62,7 +62,7 @@ def skating_flags(root, checkpoint, skate_ratio: float = 2.0) -> None:
     """Print, per held-out clip and Mixamo character, the old and the new skating measure and flag."""
     feet = [humanoid.JOINTS.index(f) for f in humanoid.FEET]
     print(f"{'source':<42} {'target':<9} {'old cm/s':>8} {'limit':>6} {'flag':>5} {'slide cm/s':>10} "
-          f"{'limit':>6} {'(source)':>8} {'flag':>5}")  # fmt: skip
+          f"{'limit':>6} {'(source)':>8} {'flag':>5} {'copy cm/s':>9}")  # fmt: skip
     for pattern in HELD_OUT:
         for path in sorted(root.glob(pattern))[:2]:
             source = bvh.load(path)
@@ -71,6 +71,7 @@ def skating_flags(root, checkpoint, skate_ratio: float = 2.0) -> None:
             for name in CHARACTERS:
                 target = root / "mixamo" / name / "Running.bvh"
                 res = retarget(source, bvh.load(target), checkpoint)
+                copy = retarget(source, bvh.load(target), checkpoint, "copy").plausibility.slide
                 check = res.plausibility
                 old = 100 * metrics.foot_skating(res.positions, feet, res.motion.fps)
                 old_limit = skate_ratio * old_src * res.root_scale[0]
@@ -78,7 +79,7 @@ def skating_flags(root, checkpoint, skate_ratio: float = 2.0) -> None:
                 new_flag = check.skating and check.slide > skate_ratio * check.source_slide * res.root_scale[0]
                 print(f"{path.stem:<42} {name:<9} {old:>8.1f} {old_limit:>6.1f} {str(old > old_limit):>5} "
                       f"{cm * check.slide:>10.1f} {cm * check.slide_limit:>6.1f} {cm * check.source_slide * res.root_scale[0]:>8.1f} "
-                      f"{str(new_flag):>5}")  # fmt: skip
+                      f"{str(new_flag):>5} {cm * copy:>9.1f}")  # fmt: skip
 
 
 def main() -> None:
