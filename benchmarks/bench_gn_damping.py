@@ -1,6 +1,7 @@
 """How the Gauss–Newton start's relative damping is chosen: condition numbers and residual angles.
 
     MOTIONLAB_DATA=/path/to/data python benchmarks/bench_gn_damping.py [--seconds 3] [--damping 1e-3 1e-5 ...]
+    MOTIONLAB_DATA=/path/to/data python benchmarks/bench_gn_damping.py --evaluate CHECKPOINT --damping 1e-3 1e-6
 
 For each rig family's clip (:data:`motionlab.retargeting.rig_matrix.FAMILY_CLIPS`, plus the
 synthetic walk) projected onto another family's rig by
@@ -14,6 +15,9 @@ The rule (``docs/rigs.md``): the smallest ``d`` on the grid whose normal equatio
 half of float64's digits on every frame of the choosing families (``cond ≤ 1 / √ε``: the
 Cholesky solve's relative error, about ``cond · ε``, stays below ``√ε``), chosen on the
 ``--choose`` families and checked on the others.
+
+With ``--evaluate CHECKPOINT`` (Table 1's network, ``motionlab evaluate``'s): Table 1's copy
+and full rows (:func:`motionlab.retargeting.evaluate.evaluate`) with each damping, one line each.
 """
 
 from __future__ import annotations
@@ -26,7 +30,7 @@ import torch
 
 from motionlab import data, retargeting
 from motionlab.core import humanoid
-from motionlab.retargeting import pipeline, rig_matrix, solver
+from motionlab.retargeting import checkpoint, evaluate, pipeline, rig_matrix, solver
 
 TARGET_OF = {"mixamo": "bandai", "bandai": "mixamo", "cmu": "mixamo", "xia": "mixamo", "synthetic": "mixamo"}
 """The rig each family's clip is projected onto (another family's)."""
@@ -66,13 +70,35 @@ def measure(ckpt, source, target, damping: float, cfg: solver.SolverConfig) -> d
     }
 
 
+def table1(path: str, dampings) -> None:
+    """Table 1's "copy rotations, our root" and "full method" rows with each damping."""
+    ckpt = checkpoint.load(path)
+    rows = tuple(r for r in evaluate.ROWS if r[0] in ("copy rotations, our root", "full method"))
+    keys = ("mse_h2", "pose_mse_h2", "skate", "slide")
+    print(f"{'damping':>8} {'row':<26} " + " ".join(f"{k:>12}" for k in keys))
+    for d in dampings:
+        ev = evaluate.evaluate(
+            data.data_root() / "mixamo", ckpt, rows=rows, solver=solver.SolverConfig(project_damping=d), progress=False
+        )
+        summary = ev.summary()
+        for row in (r[0] for r in rows):
+            print(f"{d:>8.0e} {row:<26} " + " ".join(f"{summary[row][k]:>12.3e}" for k in keys))
+    truth = summary["ground truth"]
+    print(f"{'':>8} {'ground truth':<26} {'-':>12} {'-':>12} {truth['skate']:>12.3e} {truth['slide']:>12.3e}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=3.0, help="seconds of each family's clip (default 3)")
     ap.add_argument("--damping", type=float, nargs="+", default=list(GRID), help="relative dampings to measure")
     ap.add_argument("--choose", nargs="+", default=["mixamo", "bandai"], help="families the rule is chosen on")
+    ap.add_argument("--evaluate", metavar="CHECKPOINT", help="Table 1's copy and full rows with each damping instead")
     args = ap.parse_args()
     start = time.perf_counter()
+    if args.evaluate:
+        table1(args.evaluate, args.damping)
+        print(f"{time.perf_counter() - start:.0f} s")
+        return
     ckpt = retargeting.load_default()
     clips = rig_matrix.family_clips(data.data_root() if data.has_data() else None, args.seconds)
     cfg = solver.SolverConfig()
