@@ -167,3 +167,17 @@ def test_projected_start_reaches_a_cmu_skeleton_source_on_every_frame():
     dot = (rot * src.theta).sum(-1).abs().clamp(max=1.0)
     degrees = np.degrees(2 * torch.arccos(dot).numpy())
     assert degrees.max() < 0.1, f"the start is {degrees.max():.2f} deg from A's rotations somewhere"
+
+
+def test_a_float32_network_projects_every_family():
+    """float32 keeps a damping its Cholesky factorisation survives (1e-6 fails on every family)."""
+    from motionlab import data, retargeting
+    from motionlab.retargeting import pipeline, rig_matrix
+    from tests.conftest import require_data
+
+    require_data("xia")
+    require_data("mixamo")
+    ckpt = retargeting.load_default("cpu", dtype="float32")
+    clips = rig_matrix.family_clips(data.data_root(), seconds=1.5)
+    result = pipeline.retarget(clips["xia"], clips["mixamo"], ckpt, "full", SolverConfig(max_steps=2))
+    assert result.history["angle"][0] < 1e-2
