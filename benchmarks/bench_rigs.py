@@ -12,12 +12,12 @@ B's leg length), foot skating (cm/s, B and A) and the output frame rate
 With ``--methods``: the planted-foot slide of each pair under the three methods (copy rotations,
 the network alone, the full latent iteration), beside the source's own; ``--source-fps`` resamples
 every source clip first; ``--gn-damping`` runs the study of ``docs/rigs.md`` with the Gauss–Newton
-start's relative damping (:func:`motionlab.retargeting.solver.project_latent`, 1e-3 in the solver)
-set to another value. With ``--flags``: held-out clips (every dataset-2 walk-turn take, a Xia
+start's relative damping (:func:`motionlab.retargeting.solver.project_latent`,
+:data:`motionlab.retargeting.solver.PROJECT_DAMPING` by default) set to another value. With ``--flags``: held-out clips (every dataset-2 walk-turn take, a Xia
 walk and a CMU walk not in the matrix) retargeted by the full method onto three Mixamo characters, with
 ``expand``'s skating flag before this change (foot joints below 5 cm, against twice the source's
 own, scaled) and now (planted-foot slide on the source's stance frames,
-:attr:`motionlab.retargeting.plausibility.Plausibility.skating`).
+:attr:`motionlab.retargeting.plausibility.Plausibility.skating`), and copying rotations' slide.
 """
 
 from __future__ import annotations
@@ -29,20 +29,21 @@ from motionlab import data, retargeting
 from motionlab.core import bvh, humanoid, metrics, preprocess
 from motionlab.retargeting import rig_matrix
 from motionlab.retargeting.pipeline import retarget
+from motionlab.retargeting.solver import SolverConfig
 
 METHODS = ("copy", "network", "full")
 
 
-def method_slides(clips, checkpoint, pairs=None) -> None:
+def method_slides(clips, checkpoint, pairs=None, config: SolverConfig | None = None) -> None:
     """Print B's planted-foot slide (cm/s, on A's contact frames, at the network's rate: the skating
     flag's measure, :attr:`motionlab.retargeting.plausibility.Plausibility.slide`) per pair and
-    method, and A's own."""
+    method, and A's own; ``config`` the full method's solver settings."""
     print(f"{'source':<10} {'target':<10} " + " ".join(f"{m:>8}" for m in METHODS) + f" {'(source)':>9} flagged")
     for a in clips:
         for b in clips:
             if a == b or (pairs is not None and (a, b) not in pairs):
                 continue
-            checks = [retarget(clips[a], clips[b], checkpoint, method=m).plausibility for m in METHODS]
+            checks = [retarget(clips[a], clips[b], checkpoint, m, config).plausibility for m in METHODS]
             flagged = ",".join(m for m, c in zip(METHODS, checks) if c.skating) or "-"
             print(
                 f"{a:<10} {b:<10} "
@@ -61,7 +62,7 @@ def skating_flags(root, checkpoint, skate_ratio: float = 2.0) -> None:
     """Print, per held-out clip and Mixamo character, the old and the new skating measure and flag."""
     feet = [humanoid.JOINTS.index(f) for f in humanoid.FEET]
     print(f"{'source':<42} {'target':<9} {'old cm/s':>8} {'limit':>6} {'flag':>5} {'slide cm/s':>10} "
-          f"{'limit':>6} {'(source)':>8} {'flag':>5}")  # fmt: skip
+          f"{'limit':>6} {'(source)':>8} {'flag':>5} {'copy cm/s':>9}")  # fmt: skip
     for pattern in HELD_OUT:
         for path in sorted(root.glob(pattern))[:2]:
             source = bvh.load(path)
@@ -70,6 +71,7 @@ def skating_flags(root, checkpoint, skate_ratio: float = 2.0) -> None:
             for name in CHARACTERS:
                 target = root / "mixamo" / name / "Running.bvh"
                 res = retarget(source, bvh.load(target), checkpoint)
+                copy = retarget(source, bvh.load(target), checkpoint, "copy").plausibility.slide
                 check = res.plausibility
                 old = 100 * metrics.foot_skating(res.positions, feet, res.motion.fps)
                 old_limit = skate_ratio * old_src * res.root_scale[0]
@@ -77,7 +79,7 @@ def skating_flags(root, checkpoint, skate_ratio: float = 2.0) -> None:
                 new_flag = check.skating and check.slide > skate_ratio * check.source_slide * res.root_scale[0]
                 print(f"{path.stem:<42} {name:<9} {old:>8.1f} {old_limit:>6.1f} {str(old > old_limit):>5} "
                       f"{cm * check.slide:>10.1f} {cm * check.slide_limit:>6.1f} {cm * check.source_slide * res.root_scale[0]:>8.1f} "
-                      f"{str(new_flag):>5}")  # fmt: skip
+                      f"{str(new_flag):>5} {cm * copy:>9.1f}")  # fmt: skip
 
 
 def main() -> None:
@@ -89,11 +91,6 @@ def main() -> None:
     ap.add_argument("--flags", action="store_true", help="old and new skating flag on held-out clips instead")
     ap.add_argument("--gn-damping", type=float, help="with --methods: the Gauss-Newton start's relative damping")
     args = ap.parse_args()
-    if args.gn_damping is not None:  # a study: the solver's projection with another damping
-        from motionlab.retargeting import solver
-
-        project = solver.project_latent
-        solver.project_latent = lambda *a, **k: project(*a, **{**k, "damping": args.gn_damping})
     if args.flags:
         start = time.perf_counter()
         skating_flags(data.data_root(), retargeting.load_default())
@@ -106,7 +103,8 @@ def main() -> None:
     if args.methods:
         if args.source_fps:
             clips = {name: clip.resample(args.source_fps) for name, clip in clips.items()}
-        method_slides(clips, retargeting.load_default(), pairs)
+        config = SolverConfig() if args.gn_damping is None else SolverConfig(project_damping=args.gn_damping)
+        method_slides(clips, retargeting.load_default(), pairs, config)
         print(f"{time.perf_counter() - start:.0f} s")
         return
     rows = rig_matrix.pair_matrix(clips, retargeting.load_default(), pairs=pairs)

@@ -96,6 +96,13 @@ __all__ = [
 _LAMBDAS = {"angle": "lambda_angle", "foot": "lambda_foot", "contact": "lambda_contact"}
 """The terms whose weights are also :class:`SolverConfig` fields (the paper's two and L_contact)."""
 
+PROJECT_DAMPING = {torch.float64: 1e-6, torch.float32: 1e-3}
+"""Relative damping ``d`` of the Gauss–Newton start (:func:`project_latent`, ``μ = d × mean diag
+JJᵀ``) per float type of the network. float64: the smallest of 1e-3, 1e-4, … whose damped normal
+equations keep half of float64's digits (condition number ≤ 1/√ε ≈ 6.7e7) on every frame of the
+Mixamo and Bandai Namco clips it was chosen on (``benchmarks/bench_gn_damping.py``,
+``docs/rigs.md``). float32 keeps the earlier 1e-3: at 1e-6 its Cholesky factorisation fails."""
+
 INITS = ("auto", "project", "encoder")
 """How the iteration starts: least-squares projection onto A's rotations, or ``F_enc(X_A)``;
 ``auto`` projects when θ is the rotations and starts from the encoder otherwise."""
@@ -126,6 +133,9 @@ class SolverConfig:
     project_iters : int    Gauss–Newton rounds of the projection
     smooth_projection : bool  smooth each Gauss–Newton step over time with G_σ (below), so the
                            start latent is as smooth in time as the encoder's
+    project_damping : float or None   relative damping of the Gauss–Newton rounds
+                           (:func:`project_latent`); None: :data:`PROJECT_DAMPING` for the
+                           network's float type
     project_exact : int    of the ``project_iters`` rounds, how many last ones are not smoothed
                            (they remove what the smoothed rounds leave of A's fastest details;
                            ``motionlab evaluate --exact-rounds K`` compares values)
@@ -150,6 +160,7 @@ class SolverConfig:
     smooth_sigma: float = 3.0
     smooth_projection: bool = True
     project_exact: int = 4
+    project_damping: float | None = None
     weights: dict = field(default_factory=dict)
 
     def weight(self, name: str) -> float:
@@ -175,6 +186,8 @@ class SolverConfig:
             raise ValueError(
                 f"project_exact must be between 0 and project_iters ({self.project_iters}), got {self.project_exact}"
             )
+        if self.project_damping is not None and not self.project_damping > 0:
+            raise ValueError(f"project_damping must be positive, got {self.project_damping}")
         if not self.lambda_contact >= 0:
             raise ValueError(f"lambda_contact must be >= 0, got {self.lambda_contact}")
         if self.theta not in ("rotations", "directions"):
@@ -311,7 +324,7 @@ def project_latent(
     target_rot: torch.Tensor,
     offsets: torch.Tensor,
     iters: int = 4,
-    damping: float = 1e-3,
+    damping: float | None = None,
     smooth=None,
     exact_rounds: int = 0,
 ) -> torch.Tensor:
@@ -333,7 +346,8 @@ def project_latent(
     target_rot : Tensor (N, T, 22, 4)  rotations to reproduce (root in the heading frame)
     offsets : Tensor (22, 3) or (N, 22, 3)   B's bone offsets, metres
     iters : int                        Gauss–Newton rounds
-    damping : float                    relative damping μ
+    damping : float or None            relative damping (``μ`` above); None: :data:`PROJECT_DAMPING`
+                                       for ``phi``'s float type (1e-3 for another)
     smooth : callable or None          applied to each round's step (N, T, D), e.g. the Gaussian
         filter over time of :func:`solve`: exact per-frame steps make a latent that jumps from
         frame to frame (q_Δ reacts to it), so that later Adam steps add jitter (measured: mean
@@ -354,6 +368,7 @@ def project_latent(
         target = target_rot.reshape(N * T, NUM_JOINTS, 4)
         flat = phi.reshape(N * T, D)
 
+        damping = PROJECT_DAMPING.get(phi.dtype, 1e-3) if damping is None else damping
         eye = torch.eye(4 * NUM_JOINTS, dtype=phi.dtype, device=phi.device)
         for k in range(iters):
             out, jac = model.rotation_jacobian(flat, emb_frames)
@@ -652,6 +667,7 @@ def _start(p: _Problem, x: torch.Tensor):
                         p.src[i : i + 1],
                         offsets[i] if p.per_row_offsets else offsets,
                         cfg.project_iters,
+                        cfg.project_damping,
                         smooth=steps_filter,
                         exact_rounds=cfg.project_exact,
                     )
