@@ -607,6 +607,12 @@ def fill(
     Raises ``ValueError`` for an unknown ``method``, ``root`` or ``feet``, a ``"graph"`` fill
     without a graph or with one on another skeleton, or a motion with every frame missing.
 
+    Every rule moves the body by the joint that carries it, the reference joint of the known
+    frames (:func:`~.alignment.reference_joint`): on a rig whose joint 0 the recording holds still
+    while a joint below it moves (Bandai Namco's ``joint_Root`` and hips), the joints above the
+    reference joint keep the recorded values between each gap's ends
+    (:func:`~.alignment.carry_by_reference`), never a path of their own.
+
     Parameters
     ----------
     motion : Motion with NaN rows where frames are missing (see :func:`insert_missing`)
@@ -635,11 +641,6 @@ def fill(
         body by what the legs cannot reach; ``"lift"`` lifts the body only
         (:func:`lift_above_floor`).
 
-    Every rule moves the body by the joint that carries it, the reference joint of the known
-    frames (:func:`~.alignment.reference_joint`): on a rig whose joint 0 the recording holds still
-    while a joint below it moves (Bandai Namco's ``joint_Root`` and hips), the joints above the
-    reference joint keep the recorded values between each gap's ends
-    (:func:`~.alignment.carry_by_reference`), never a path of their own.
     """
     _check_fill(motion, method, graph, root, feet)
     out = motion.copy()

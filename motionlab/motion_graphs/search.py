@@ -840,9 +840,11 @@ def search(graph: MotionGraph, request, progress: bool = False, cost=default_cos
 
     Raises
     ------
-    SearchError naming a missing behaviour or style, or two behaviours with no transition clip.
-    ValueError (:class:`RequestTooLong`) for a request of more than :data:`MAX_FRAMES` frames,
-    or when ``cost`` does not return one finite price >= 0 per edge.
+    SearchError
+        naming a missing behaviour or style, or two behaviours with no transition clip.
+    ValueError
+        (:class:`RequestTooLong`) for a request of more than :data:`MAX_FRAMES` frames, or when
+        ``cost`` does not return one finite price >= 0 per edge.
     """
     segs = _segments(request)  # a bad request is refused before the graph is read
     return Planner(graph, cost).search(segs, progress)
@@ -884,8 +886,10 @@ def search_standard(graph: MotionGraph, request, start_clip: int | None = None, 
 
     Raises
     ------
-    SearchError when no clip carries a segment's label or no path leads to it.
-    ValueError for a bad request (see :func:`parse_request`) or a bad ``cost``.
+    SearchError
+        when no clip carries a segment's label or no path leads to it.
+    ValueError
+        for a bad request (see :func:`parse_request`) or a bad ``cost``.
     """
     segs = _segments(request)
     g = graph.segment_graph()

@@ -64,7 +64,7 @@ from motionlab.retargeting import terms
 from motionlab.retargeting.batching import Pair, PairResult, batch_frames, plan_batches, quality, solve_pairs
 from motionlab.retargeting.checkpoint import Checkpoint
 from motionlab.retargeting.pipeline import at_rate, prepare_source
-from motionlab.retargeting.solver import SolverConfig
+from motionlab.retargeting.solver import PROJECT_DAMPING, SolverConfig
 
 __all__ = [
     "PRESETS",
@@ -249,6 +249,8 @@ def options_digest(
     h.update(np.asarray(checkpoint.stats.std, dtype=np.float64).tobytes())
     settings = {"solver": dataclasses.asdict(solver), "root": root_mode, "fps": fps, "ckpt_fps": checkpoint.fps}
     settings["terms"] = [[t.name, solver.weight(t.name)] for t in terms.registered()]  # what L_iter sums
+    dtype = next(checkpoint.model.parameters()).dtype
+    settings["damping"] = solver.project_damping or PROJECT_DAMPING.get(dtype, 1e-3)  # the one project_latent uses
     h.update(json.dumps(settings, sort_keys=True, default=str).encode())
     if rest_from is not None:
         h.update(np.asarray(rest_from.skeleton.offsets, dtype=np.float64).tobytes())

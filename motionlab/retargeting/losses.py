@@ -68,6 +68,7 @@ __all__ = [
     "floor_loss",
     "LAMBDA_CONTACT",
     "LAMBDA_FLOOR",
+    "FLOOR_DEFAULT",
 ]
 
 LAMBDA_RECON = 0.5
@@ -80,9 +81,14 @@ LAMBDA_CONTACT = 0.5
 """Weight of the contact term (our addition), the same number as λ_foot; the term is a speed
 (m/s), so a planted foot sliding at 2 cm/s costs as much as a foot 2 cm below the ground."""
 LAMBDA_FLOOR = LAMBDA_FOOT * 18 / 4
-"""Weight of the floor term (our addition): λ_foot × 18 / 4. L_foot is a mean over the 4 foot
-joints, L_floor over the other 18, so a joint under the floor costs what a foot under the ground
-costs in the paper's L_foot."""
+"""The floor term's weight when it is switched on (our addition; ``--floor-weight 2.25``):
+λ_foot × 18 / 4. L_foot is a mean over the 4 foot joints, L_floor over the other 18, so a joint
+under the floor costs what a foot under the ground costs in the paper's L_foot. The registered
+term's default weight is 0 (:data:`FLOOR_DEFAULT`)."""
+FLOOR_DEFAULT = 0.0
+"""The floor term's default weight: off. On the paper's Table 1 protocol it raises the full
+method's pose error above copying rotations (docs/results_retargeting.md, "L_floor"), so it is
+an opt-in (:data:`LAMBDA_FLOOR`)."""
 FOOT_JOINTS: tuple[int, ...] = tuple(humanoid.JOINTS.index(n) for n in humanoid.FEET)
 """Indices of LeftFoot, RightFoot, LeftToeBase, RightToeBase in the canonical skeleton."""
 

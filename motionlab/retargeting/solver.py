@@ -7,7 +7,8 @@ angles and keeps its feet above the ground (eq. 15)::
     L_iter = Σ_k w_k · L_k = λ_angle · L_angle(A, B') + λ_foot · L_foot(B')
              [+ λ_contact · L_contact(B')] + λ_floor · L_floor(B') [+ any registered term]
 
-with λ_angle = 0.3, λ_foot = 0.5 (paper), λ_contact = 0.5 and λ_floor = 2.25 (ours), until
+with λ_angle = 0.3, λ_foot = 0.5 (paper), λ_contact = 0.5 and λ_floor = 0 (ours; 2.25 when
+switched on, :data:`losses.LAMBDA_FLOOR`), until
 ``L_iter`` drops below ``threshold``, stops improving (``patience`` steps without a relative
 gain of ``min_delta``), or ``max_steps`` is reached. :func:`solve` treats all sequences of a
 batch (e.g. several clips of equal length) as one problem: their losses are averaged, so one

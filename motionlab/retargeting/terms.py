@@ -32,13 +32,14 @@ name          value                                                             
 ``angle``     L_angle (eq. 16): A's joint angles vs B's (:func:`losses.angle_loss`)    —       0.3
 ``foot``      L_foot (eq. 17): the feet below the ground (:func:`losses.foot_loss`)     m       0.5
 ``contact``   L_contact (motionlab): speed of A's planted feet on B                    m/s     0.5
-``floor``     L_floor (motionlab): the other 18 joints below the floor, beyond the     m       2.25
+``floor``     L_floor (motionlab): the other 18 joints below the floor, beyond the     m       0 (off)
               source's own depth scaled to B (:func:`losses.floor_loss`)
 ============  =======================================================================  ======  ======
 
-L_floor's weight is λ_foot × 18 / 4: L_foot is a mean over the 4 foot joints, L_floor over the
-other 18, so a joint under the floor costs exactly what a foot under the ground costs in the
-paper's L_foot (the feet stay L_foot's alone). Where no joint goes under its allowed depth L_floor and its gradient are exactly 0, so
+L_floor is off by default (:data:`losses.FLOOR_DEFAULT`); switched on, its weight is
+λ_foot × 18 / 4 = 2.25 (:data:`losses.LAMBDA_FLOOR`, ``--floor-weight 2.25``): L_foot is a mean over
+the 4 foot joints, L_floor over the other 18, so a joint under the floor costs exactly what a foot
+under the ground costs in the paper's L_foot (the feet stay L_foot's alone). Where no joint goes under its allowed depth L_floor and its gradient are exactly 0, so
 the iteration's numbers are those without it.
 """
 
@@ -207,7 +208,7 @@ register(
 register(
     Term(
         "floor",
-        losses.LAMBDA_FLOOR,
+        losses.FLOOR_DEFAULT,
         _floor,
         "m",
         (),

@@ -7,6 +7,7 @@ import pytest
 import torch
 
 from motionlab.core import humanoid
+from motionlab.retargeting import terms
 from motionlab.retargeting.model import Decoded
 from motionlab.retargeting.solver import SolverConfig, iteration_loss, solve
 
@@ -29,7 +30,7 @@ def test_solver_lowers_the_loss_and_keeps_weights(tiny_checkpoint, data):
     assert res.steps == 30 and res.stop_reason == "max_steps"
     assert len(h["loss"]) == len(h["angle"]) == len(h["foot"]) == 31
     assert h["loss"][-1] < h["loss"][0]
-    floor = 2.25 * np.array(h["floor"])  # L_floor (motionlab): the tiny network puts joints under the floor
+    floor = terms.get("floor").weight * np.array(h["floor"])  # L_floor (motionlab; off by default)
     np.testing.assert_allclose(h["loss"], 0.3 * np.array(h["angle"]) + 0.5 * np.array(h["foot"]) + floor, rtol=1e-5)
     for k, v in model.state_dict().items():
         assert torch.equal(v, before[k]), f"weight {k} changed"

@@ -109,7 +109,8 @@ def test_the_built_in_terms_keep_the_papers_weights():
     assert [t.name for t in terms.registered()][:4] == ["angle", "foot", "contact", "floor"]
     assert terms.get("angle").weight == losses.LAMBDA_ANGLE == SolverConfig().weight("angle") == 0.3
     assert terms.get("foot").weight == losses.LAMBDA_FOOT == 0.5
-    assert terms.get("floor").weight == losses.LAMBDA_FOOT * 18 / 4
+    assert terms.get("floor").weight == losses.FLOOR_DEFAULT == 0.0  # motionlab's addition: opt-in
+    assert losses.LAMBDA_FLOOR == losses.LAMBDA_FOOT * 18 / 4  # its weight when switched on
 
 
 # ----------------------------------------------------------------------------- L_floor
@@ -130,7 +131,8 @@ def test_floor_loss_is_a_hinge_on_the_joints_other_than_the_feet():
 
 def test_floor_changes_nothing_where_no_joint_goes_under(ckpt, clip):
     """Zero loss and zero gradient there: bit-identical results with and without the term."""
-    with_floor = retargeting.retarget(clip, _target(clip), ckpt, "full", SolverConfig(max_steps=12))
+    on = SolverConfig(max_steps=12, weights={"floor": losses.LAMBDA_FLOOR})
+    with_floor = retargeting.retarget(clip, _target(clip), ckpt, "full", on)
     assert max(with_floor.history["floor"]) == 0.0
     floor = terms.unregister("floor")
     try:
