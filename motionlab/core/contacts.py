@@ -40,8 +40,8 @@ Defaults, chosen on motionlab's synthetic clips, whose contacts are known becaus
 plants the feet by IK (:func:`motionlab.synthetic.generate` with ``return_contacts=True``), never
 on the evaluation clips: a 3 %·h height tolerance and an 8 %·h/s speed limit (≈ 0.11 m/s for a
 1.42 m performer; slower limits miss real, slightly jittery plants, faster ones add heel-off
-frames). Over walk, run, jump and squat × 3 seeds their precision is 0.98 and recall 0.99
-(``tests/retargeting/test_contacts.py`` checks ≥ 0.95 for both).
+frames); ``tests/retargeting/test_contacts.py`` checks precision and recall ≥ 0.95 on walk, run,
+jump and squat.
 
 Taught in ``notebooks/03_latent_iteration.ipynb``; :mod:`motionlab.retargeting.contacts` re-exports it.
 """

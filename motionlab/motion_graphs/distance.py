@@ -207,8 +207,8 @@ def _blas_controller():
 
 
 def _one_blas_thread():
-    """Run BLAS single-threaded: these products are a few hundred columns wide, and a second
-    BLAS thread competing for a 2-core machine made the whole build 3-4x slower (measured)."""
+    """Run BLAS single-threaded: these products are a few hundred columns wide, too small for a
+    second BLAS thread to pay for itself beside the build's own threads."""
     ctl = _blas_controller()
     return ctl.limit(limits=1, user_api="blas") if ctl is not None else contextlib.nullcontext()
 

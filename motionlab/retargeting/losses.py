@@ -19,14 +19,11 @@ in :mod:`motionlab.retargeting.terms`; the λ constants here are theirs.
 local rotation as a unit quaternion (the root's in the heading frame), compared up to sign:
 ``‖θ(A) − θ(B')‖ = min(‖q_A − q_B'‖, ‖q_A + q_B'‖) = 2 sin(α/4)``, where α is the angle of the
 rotation that takes one to the other: about α/2 for small differences (not α, and not exactly
-a half-angle either; 0.0175 ≈ 2°). We tried the other natural choice first — the unit direction of every bone
-in the root-centred heading frame, computed from positions (:func:`direction_loss`) — and
-measured why it is worse: real rigs have *different rest poses* (a bone of B points elsewhere
+a half-angle either; 0.0175 ≈ 2°). The other natural choice — the unit direction of every bone
+in the root-centred heading frame, computed from positions (:func:`direction_loss`) — meets a
+difference between real rigs: they have *different rest poses* (a bone of B points elsewhere
 than A's in the T-pose), so matching A's bone directions bends B away from what its animators
-(and Mixamo's retargeter) do, which is to keep the local rotations. On the shared Mixamo data,
-copying the rotations already leaves a direction loss of 0.12–0.16; for Aj → BigVegas
-"Running" the direction-driven iteration ended with a root-centred pose error (MSE/h²) of
-8.5e-4, the rotation-driven one with 1.7e-4, copy-rotation 1.3e-4. With joint angles,
+(and Mixamo's retargeter) do, which is to keep the local rotations. With joint angles,
 copy-rotation has zero angle loss, and the foot term decides how far the pose moves from it.
 ``SolverConfig(theta="directions")`` keeps the other choice available.
 

@@ -17,8 +17,7 @@ Design choices the paper leaves open (documented here, shown in notebook 02):
   (``replicate`` padding, no down-sampling), so it runs on a clip of any length and the latent
   solver can optimise a whole clip at once, with no window seams.
 * ``D = 128`` by default, more than the 88 numbers of 22 quaternions: F_qlinear can then reach
-  any pose, which the latent iteration needs to match A's joint angles closely (with D = 48 the
-  iteration stalled 3–10× further from the real clips on the Mixamo data).
+  any pose, which the latent iteration needs to match A's joint angles closely.
 * F_qlinear and F_Δ act on each frame independently (linear layers), F_skel is a small MLP
   on the 21 bone offsets (metres, root excluded). F_Δ's last layer starts at zero weights with
   bias ``(1, 0, 0, 0)``, so an untrained correction is the identity rotation.

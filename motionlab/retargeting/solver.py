@@ -351,9 +351,8 @@ def project_latent(
                                        for ``phi``'s float type (1e-3 for another)
     smooth : callable or None          applied to each round's step (N, T, D), e.g. the Gaussian
         filter over time of :func:`solve`: exact per-frame steps make a latent that jumps from
-        frame to frame (q_Δ reacts to it), so that later Adam steps add jitter (measured: mean
-        acceleration 0.41 vs 0.28 cm/frame² on the Mixamo data); smoothed steps converge more
-        slowly on the fastest details but keep the latent as smooth as the encoder's
+        frame to frame (q_Δ reacts to it), so that later Adam steps add jitter; smoothed steps
+        converge more slowly on the fastest details but keep the latent as smooth as the encoder's
     exact_rounds : int                 the last ``exact_rounds`` rounds are not smoothed, so the
         start still reaches the target's fastest details
 
