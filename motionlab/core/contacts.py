@@ -5,7 +5,7 @@ height is less than its *contact height* plus a height tolerance and its speed i
 speed limit. Every part of the package uses it, each with thresholds it states:
 
 * retargeting (the source's planted feet for the contact term, the plausibility tests and the
-  skating flag, ``bench_rigs --methods``) and :func:`motionlab.core.metrics.planted_slide`'s
+  skating flag, ``python -m experiments.retargeting.rigs --methods``) and :func:`motionlab.core.metrics.planted_slide`'s
   labels: :func:`detect_contacts` / :func:`of_motion`, thresholds from the rig (below);
 * :func:`motionlab.core.metrics.foot_contacts`: contact height 0, thresholds given in the
   position unit;

@@ -28,7 +28,7 @@ planted frames skips the foot test.
 
 Beside the tests, a **skating** flag (:attr:`Plausibility.skating`, ``expand``'s ``skating``):
 the planted-foot slide, the mean horizontal speed of B's foot joints on the frames where A's are
-planted (:func:`motionlab.core.metrics.planted_slide`, as ``bench_rigs --methods`` prints it), is
+planted (:func:`motionlab.core.metrics.planted_slide`, as ``python -m experiments.retargeting.rigs --methods`` prints it), is
 more than :data:`SLIDE_TOL` × B's 22-joint height per second, the speed under which the contact
 detector (:mod:`motionlab.core.contacts`) counts a foot as planted: B's feet then move, on
 average, faster than any foot the detector would call planted on B. A low swinging foot does not

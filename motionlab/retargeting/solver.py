@@ -101,7 +101,7 @@ PROJECT_DAMPING = {torch.float64: 1e-6, torch.float32: 1e-3}
 """Relative damping ``d`` of the Gauss–Newton start (:func:`project_latent`, ``μ = d × mean diag
 JJᵀ``) per float type of the network. float64: the smallest of 1e-3, 1e-4, … whose damped normal
 equations keep half of float64's digits (condition number ≤ 1/√ε ≈ 6.7e7) on every frame of the
-Mixamo and Bandai Namco clips it was chosen on (``benchmarks/bench_gn_damping.py``,
+Mixamo and Bandai Namco clips it was chosen on (``experiments/retargeting/gn_damping.py``,
 ``docs/rigs.md``). float32 keeps the earlier 1e-3: at 1e-6 its Cholesky factorisation fails."""
 
 INITS = ("auto", "project", "encoder")

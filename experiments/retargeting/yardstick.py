@@ -1,6 +1,6 @@
 """The yardstick: Table 1's 60 pairs, Mixamo's own clips and motionlab's, under one plausibility check.
 
-    MOTIONLAB_DATA=/path/to/data python benchmarks/bench_plausibility.py [--checkpoint PATH]
+    MOTIONLAB_DATA=/path/to/data python -m experiments.retargeting.yardstick [--checkpoint PATH]
 
 For each of Table 1's 10 animations (:data:`motionlab.retargeting.evaluate.DEFAULT_ANIMATIONS`)
 and 6 target characters (:data:`~motionlab.retargeting.evaluate.DEFAULT_TARGETS`), checks with
@@ -85,7 +85,7 @@ def _share(checks: list) -> str:
     return f"{len(failed):>3}/{len(checks):<3} ({named})"
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--checkpoint", help="network (default: the shipped one)")
     ap.add_argument("--targets", nargs="+", default=list(evaluate.DEFAULT_TARGETS))
@@ -95,7 +95,7 @@ def main() -> None:
         action="store_true",
         help="a study: motionlab's targets with thighs and shins straight at rest",
     )
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     start = time.perf_counter()
     ckpt = ckpt_io.load(args.checkpoint) if args.checkpoint else retargeting.load_default()
     folder = data.data_root() / "mixamo"

@@ -1,16 +1,16 @@
 """Every ordered pair of rig families, retargeted both ways, passes the plausibility check.
 
-One shared clip per family (:data:`motionlab.retargeting.rig_matrix.FAMILY_CLIPS`, first 2 s):
+One shared clip per family (:data:`experiments.retargeting.rig_matrix.FAMILY_CLIPS`, first 2 s):
 Mixamo, Bandai Namco, CMU and Xia from MOTIONLAB_DATA (skipped with the how-to without it)
-and motionlab's synthetic character (always). ``benchmarks/bench_rigs.py`` prints the numbers.
+and motionlab's synthetic character (always). ``experiments/retargeting/rigs.py`` prints the numbers.
 """
 
 from __future__ import annotations
 
 import pytest
 
+from experiments.retargeting import rig_matrix
 from motionlab import data, retargeting
-from motionlab.retargeting import rig_matrix
 from motionlab.retargeting.solver import SolverConfig
 from tests.conftest import require_data
 

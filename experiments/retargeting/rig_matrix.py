@@ -4,7 +4,7 @@ The families are those of the shared data (``$MOTIONLAB_DATA/README.md``) and mo
 synthetic character; :data:`FAMILY_CLIPS` names the one clip of each. :func:`pair_matrix`
 retargets every clip onto every other family's rig (the rig of that family's clip) and returns
 the plausibility measures (:mod:`motionlab.retargeting.plausibility`) and skating per pair.
-``benchmarks/bench_rigs.py`` prints the table; ``tests/retargeting/test_rig_matrix.py`` requires
+``experiments/retargeting/rigs.py`` prints the table; ``tests/experiments/test_rig_matrix.py`` requires
 every pair to be plausible.
 """
 

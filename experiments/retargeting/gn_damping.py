@@ -1,9 +1,9 @@
 """How the Gauss–Newton start's relative damping is chosen: condition numbers and residual angles.
 
-    MOTIONLAB_DATA=/path/to/data python benchmarks/bench_gn_damping.py [--seconds 3] [--damping 1e-3 1e-5 ...]
-    MOTIONLAB_DATA=/path/to/data python benchmarks/bench_gn_damping.py --evaluate CHECKPOINT --damping 1e-3 1e-6
+    MOTIONLAB_DATA=/path/to/data python -m experiments.retargeting.gn_damping [--seconds 3] [--damping 1e-3 1e-5 ...]
+    MOTIONLAB_DATA=/path/to/data python -m experiments.retargeting.gn_damping --evaluate CHECKPOINT --damping 1e-3 1e-6
 
-For each rig family's clip (:data:`motionlab.retargeting.rig_matrix.FAMILY_CLIPS`, plus the
+For each rig family's clip (:data:`experiments.retargeting.rig_matrix.FAMILY_CLIPS`, plus the
 synthetic walk) projected onto another family's rig by
 :func:`motionlab.retargeting.solver.project_latent` with each relative damping ``d`` (the
 solver's rounds and smoothing), prints, over the clip's frames at the returned start: the
@@ -28,9 +28,10 @@ import time
 import numpy as np
 import torch
 
+from experiments.retargeting import rig_matrix
 from motionlab import data, retargeting
 from motionlab.core import humanoid
-from motionlab.retargeting import checkpoint, evaluate, pipeline, rig_matrix, solver
+from motionlab.retargeting import checkpoint, evaluate, pipeline, solver
 
 TARGET_OF = {"mixamo": "bandai", "bandai": "mixamo", "cmu": "mixamo", "xia": "mixamo", "synthetic": "mixamo"}
 """The rig each family's clip is projected onto (another family's)."""
@@ -87,13 +88,13 @@ def table1(path: str, dampings) -> None:
     print(f"{'':>8} {'ground truth':<26} {'-':>12} {'-':>12} {truth['skate']:>12.3e} {truth['slide']:>12.3e}")
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=3.0, help="seconds of each family's clip (default 3)")
     ap.add_argument("--damping", type=float, nargs="+", default=list(GRID), help="relative dampings to measure")
     ap.add_argument("--choose", nargs="+", default=["mixamo", "bandai"], help="families the rule is chosen on")
     ap.add_argument("--evaluate", metavar="CHECKPOINT", help="Table 1's copy and full rows with each damping instead")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     start = time.perf_counter()
     if args.evaluate:
         table1(args.evaluate, args.damping)

@@ -1,14 +1,14 @@
 """Every ordered pair of rig families retargeted, with the plausibility measures of each output.
 
-    MOTIONLAB_DATA=/path/to/data python benchmarks/bench_rigs.py [--seconds 3] [--pair bandai mixamo]
-    MOTIONLAB_DATA=/path/to/data python benchmarks/bench_rigs.py --methods [--source-fps 60] [--pair xia cmu]
-    MOTIONLAB_DATA=/path/to/data python benchmarks/bench_rigs.py --flags
-    MOTIONLAB_DATA=/path/to/data python benchmarks/bench_rigs.py --methods --gn-damping 1e-5
+    MOTIONLAB_DATA=/path/to/data python -m experiments.retargeting.rigs [--seconds 3] [--pair bandai mixamo]
+    MOTIONLAB_DATA=/path/to/data python -m experiments.retargeting.rigs --methods [--source-fps 60] [--pair xia cmu]
+    MOTIONLAB_DATA=/path/to/data python -m experiments.retargeting.rigs --flags
+    MOTIONLAB_DATA=/path/to/data python -m experiments.retargeting.rigs --methods --gn-damping 1e-5
 
 Prints, per (source, target) pair: the hip height ratio (B's median hip height over B's standing
 hip height, and the same for A on A), the median foot height in A's contact frames (cm and /
 B's leg length), foot skating (cm/s, B and A) and the output frame rate
-(:mod:`motionlab.retargeting.rig_matrix`). Without MOTIONLAB_DATA only the synthetic character runs.
+(:mod:`experiments.retargeting.rig_matrix`). Without MOTIONLAB_DATA only the synthetic character runs.
 With ``--methods``: the planted-foot slide of each pair under the three methods (copy rotations,
 the network alone, the full latent iteration), beside the source's own; ``--source-fps`` resamples
 every source clip first; ``--gn-damping`` runs the study of ``docs/rigs.md`` with the Gauss–Newton
@@ -25,9 +25,9 @@ from __future__ import annotations
 import argparse
 import time
 
+from experiments.retargeting import rig_matrix
 from motionlab import data, retargeting
 from motionlab.core import bvh, humanoid, metrics, preprocess
-from motionlab.retargeting import rig_matrix
 from motionlab.retargeting.pipeline import retarget
 from motionlab.retargeting.solver import SolverConfig
 
@@ -82,7 +82,7 @@ def skating_flags(root, checkpoint, skate_ratio: float = 2.0) -> None:
                       f"{str(new_flag):>5} {cm * copy:>9.1f}")  # fmt: skip
 
 
-def main() -> None:
+def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seconds", type=float, default=3.0, help="seconds of each family's clip (default 3)")
     ap.add_argument("--pair", nargs=2, action="append", metavar=("SOURCE", "TARGET"), help="only these pairs")
@@ -90,7 +90,7 @@ def main() -> None:
     ap.add_argument("--source-fps", type=float, help="with --methods: resample every source clip to this rate")
     ap.add_argument("--flags", action="store_true", help="old and new skating flag on held-out clips instead")
     ap.add_argument("--gn-damping", type=float, help="with --methods: the Gauss-Newton start's relative damping")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     if args.flags:
         start = time.perf_counter()
         skating_flags(data.data_root(), retargeting.load_default())
