@@ -444,9 +444,8 @@ def _floor_guard(motion: Motion, a: int, b: int, drop: np.ndarray) -> np.ndarray
     The root joint is left out (:func:`.footing.lowest_joints`).
 
     The limit is per frame, so where it acts the path follows the fill's own height (which the
-    recorded pose put on the floor) instead of the smooth curve: a floor contact outranks C1 there.
-    A smooth alternative — lifting each piece by a C1 bump that vanishes at its anchors — had to
-    lift whole pieces by up to 14 cm to cover millimetres of contact next to an anchor.
+    recorded pose put on the floor) instead of the smooth curve: a floor contact outranks C1 there
+    (a C1 bump that vanishes at the anchors would lift a whole piece to cover contact next to one).
     """
     low = lowest_joints(motion, a, b)
     return np.maximum(drop, np.minimum(0.0, min(low[0], low[-1]) - low[1:-1]))

@@ -1,8 +1,7 @@
 """Does a clip show what its label says? Root height, speed and foot contacts, not the file name.
 
-An action node is only as good as its clip. Mixamo's ``Running.bvh`` for Aj is a dive roll (the
-hips drop to 9% of their standing height) and ``Idle.bvh`` a crouched idle (58%); named by file,
-they would teach run → walk → stand → squat wrongly. :func:`measure` reads three things off the motion
+An action node is only as good as its clip. Mixamo's ``Running.bvh`` for Aj is a dive roll and
+``Idle.bvh`` a crouched idle; named by file, they would teach run → walk → stand → squat wrongly. :func:`measure` reads three things off the motion
 (22-joint canonical skeleton, :func:`motionlab.core.humanoid.to_canonical`):
 
 * **hip height**: the hips' height above the clip's floor (its lowest foot or toe) over their

@@ -17,9 +17,8 @@ rotations alone when only proportions change; the latent iteration then adapts t
 ``augment=False`` gives the paper's plain setting.
 
 **Mirrored clips (our addition, on by default).** :func:`training_set` also adds every clip
-mirrored left↔right (:func:`mirrored`): twice the poses from the same recording. On Aj's 10
-held-back clips it lowers the reconstruction error from 3.57 to 3.28 cm
-(``benchmarks/bench_retarget.py`` prints the figure for the current settings).
+mirrored left↔right (:func:`mirrored`): twice the poses from the same recording
+(``benchmarks/bench_retarget.py`` prints its effect on held-back clips).
 
 Taught in ``notebooks/02_training_autoencoder.ipynb``.
 """
