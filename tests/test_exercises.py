@@ -602,6 +602,7 @@ def _walk_error(walk, every, curve="linear", degrees=True, per_joint=False):
     return np.degrees(e) if degrees else e
 
 
+@pytest.mark.slow  # a spacing sweep over a whole walk: over 10 s
 def test_walk_spacing_experiment(walk_120):
     q = exercises.walk_spacing
     answer = K06.my_walk_spacing(walk_120)

@@ -207,6 +207,7 @@ def _start_ray(workers: int) -> None:
     pytest.skip("Ray's node did not start within Ray's fixed 30 s, twice: the machine is too loaded to start Ray")
 
 
+@pytest.mark.slow  # starts a local Ray instance: over 10 s
 def test_ray_backend_equals_local(ckpt, library, tmp_path):
     if importlib.util.find_spec("ray") is None:
         pytest.skip('Ray is not installed: pip install "motionlab[cluster]" (CI installs it)')
