@@ -66,6 +66,7 @@ __all__ = [
     "LAMBDA_CONTACT",
     "LAMBDA_FLOOR",
     "FLOOR_DEFAULT",
+    "frame_mean",
 ]
 
 LAMBDA_RECON = 0.5
@@ -93,6 +94,19 @@ FOOT_JOINTS: tuple[int, ...] = tuple(humanoid.JOINTS.index(n) for n in humanoid.
 _OTHER_JOINTS: tuple[int, ...] = tuple(j for j in range(len(humanoid.JOINTS)) if j not in FOOT_JOINTS)
 
 
+def frame_mean(values: torch.Tensor, frames: torch.Tensor | None = None) -> torch.Tensor:
+    """Mean of ``values`` (..., T, ...) over every entry of the frames that count.
+
+    ``frames`` (..., T) of bool marks the real frames of a padded sequence (its shape is a prefix
+    of ``values``'); None: every frame counts (the plain mean). Padded frames add nothing to the
+    value or its gradient.
+    """
+    if frames is None:
+        return values.mean()
+    w = frames.to(values.dtype).reshape(frames.shape + (1,) * (values.ndim - frames.ndim))
+    return (values * w).sum() / (w.sum() * (values.numel() // frames.numel())).clamp_min(1.0)
+
+
 def _same_shape(a: torch.Tensor, b: torch.Tensor, what: str) -> None:
     if a.shape != b.shape or a.shape[-1] != 3:
         raise ValueError(
@@ -118,13 +132,16 @@ def bone_directions(positions: torch.Tensor) -> torch.Tensor:
     return fk_torch.bone_directions(positions, humanoid.PARENTS)
 
 
-def angle_loss(source_rot: torch.Tensor, generated_rot: torch.Tensor) -> torch.Tensor:
+def angle_loss(
+    source_rot: torch.Tensor, generated_rot: torch.Tensor, frames: torch.Tensor | None = None
+) -> torch.Tensor:
     """L_angle with θ = joint rotations (eq. 16): mean over frames and joints of ``min(‖q_A − q_B'‖, ‖q_A + q_B'‖)``.
 
     For unit quaternions that distance is ``2 sin(α/4)`` with α the angle between the two
     rotations (so ≈ α/2 for small α, in radians).
 
-    Both inputs are local rotations (..., T, 22, 4) (unit quaternions; the root's in the heading frame).
+    Both inputs are local rotations (..., T, 22, 4) (unit quaternions; the root's in the heading
+    frame); ``frames`` (..., T) of bool, optional: the frames that count (:func:`frame_mean`).
 
     Raises
     ------
@@ -135,7 +152,7 @@ def angle_loss(source_rot: torch.Tensor, generated_rot: torch.Tensor) -> torch.T
             f"angle_loss: expected two (..., T, J, 4) rotation tensors of equal shape, got {tuple(source_rot.shape)} and {tuple(generated_rot.shape)}"
         )
     diff = torch.minimum(_length(source_rot - generated_rot), _length(source_rot + generated_rot))
-    return diff.mean()
+    return frame_mean(diff, frames)
 
 
 def _length(v: torch.Tensor) -> torch.Tensor:
@@ -143,17 +160,20 @@ def _length(v: torch.Tensor) -> torch.Tensor:
     return torch.sqrt((v * v).sum(-1) + 1e-12)
 
 
-def direction_loss(source_positions: torch.Tensor, generated_positions: torch.Tensor) -> torch.Tensor:
+def direction_loss(
+    source_positions: torch.Tensor, generated_positions: torch.Tensor, frames: torch.Tensor | None = None
+) -> torch.Tensor:
     """L_angle with θ = unit bone directions: mean over frames and the 22 joints of ‖θ(A) − θ(B')‖₂.
 
     Both inputs are root-centred heading-frame positions (..., T, 22, 3); their bone lengths may
     differ (that is the point).
     """
     _same_shape(source_positions, generated_positions, "angle_loss")
-    return (bone_directions(source_positions) - bone_directions(generated_positions)).norm(dim=-1).mean()
+    diff = (bone_directions(source_positions) - bone_directions(generated_positions)).norm(dim=-1)
+    return frame_mean(diff, frames)
 
 
-def foot_loss(world_y: torch.Tensor) -> torch.Tensor:
+def foot_loss(world_y: torch.Tensor, frames: torch.Tensor | None = None) -> torch.Tensor:
     """L_foot (eq. 17): mean of ``|min(y, 0)|`` over frames and the four foot joints.
 
     Parameters
@@ -169,7 +189,7 @@ def foot_loss(world_y: torch.Tensor) -> torch.Tensor:
         world_y = world_y[..., list(FOOT_JOINTS)]
     elif world_y.shape[-1] != len(FOOT_JOINTS):
         raise ValueError(f"expected heights (..., T, 22) or (..., T, 4), got {tuple(world_y.shape)}")
-    return torch.relu(-world_y).mean()
+    return frame_mean(torch.relu(-world_y), frames)
 
 
 def rotation_loss(local_rot: torch.Tensor, target_rot: torch.Tensor) -> torch.Tensor:
@@ -226,7 +246,9 @@ def feet_in_world(positions: torch.Tensor, root_pos: torch.Tensor, yaw: torch.Te
     return torch.stack([c * x + s * z, y, -s * x + c * z], dim=-1) + root_pos[..., None, :]
 
 
-def floor_loss(heights: torch.Tensor, allowed: torch.Tensor | None = None) -> torch.Tensor:
+def floor_loss(
+    heights: torch.Tensor, allowed: torch.Tensor | None = None, frames: torch.Tensor | None = None
+) -> torch.Tensor:
     """L_floor: mean over frames and the 18 joints other than the feet of ``max(allowed − y, 0)``, metres.
 
     The four foot joints are L_foot's (:func:`foot_loss`); this term sees every other joint.
@@ -236,6 +258,7 @@ def floor_loss(heights: torch.Tensor, allowed: torch.Tensor | None = None) -> to
     heights : Tensor (..., T, 22)    every joint's height above the floor, metres
     allowed : Tensor (..., T, 22) or None   the lowest height each joint may reach (<= 0: the
         source's own depth there, scaled); None: 0, the floor itself
+    frames : Tensor (..., T) of bool, optional   the frames that count (:func:`frame_mean`)
 
     Exactly 0, with a zero gradient, where every joint is above its allowed height.
 
@@ -250,4 +273,4 @@ def floor_loss(heights: torch.Tensor, allowed: torch.Tensor | None = None) -> to
             f"floor_loss: expected allowed {tuple(heights.shape)} like heights, got {tuple(allowed.shape)}"
         )
     depth = -heights if allowed is None else allowed - heights
-    return torch.relu(depth[..., list(_OTHER_JOINTS)]).mean()
+    return frame_mean(torch.relu(depth[..., list(_OTHER_JOINTS)]), frames)

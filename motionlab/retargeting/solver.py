@@ -66,7 +66,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
@@ -246,16 +246,25 @@ def step_grid(size: float) -> float:
 
 
 def _smoother(sigma: float, channels: int, dtype, device):
-    """``δ ↦ G_σ * δ`` along time for latents (N, T, D); the identity when ``sigma == 0``."""
+    """``(δ, index) ↦ G_σ * δ`` along time for latents (N, T, D); the identity when ``sigma == 0``.
+
+    ``index`` (N, T) of int, optional: frame ``t`` of row ``n`` reads ``δ[n, index[n, t]]`` first;
+    with ``index = min(t, length − 1)`` a row padded beyond its length is filtered exactly as the
+    row alone (both ends replicate the end frame).
+    """
+
+    def gather(d: torch.Tensor, index: torch.Tensor | None = None) -> torch.Tensor:
+        return d if index is None else d.gather(1, index[..., None].expand(-1, -1, d.shape[-1]))
+
     if sigma <= 0:
-        return lambda d: d
+        return gather
     radius = max(int(round(3 * sigma)), 1)
     t = torch.arange(-radius, radius + 1, dtype=dtype, device=device)
     kernel = torch.exp(-0.5 * (t / sigma) ** 2)
     kernel = (kernel / kernel.sum()).expand(channels, 1, -1).contiguous()
 
-    def apply(d: torch.Tensor) -> torch.Tensor:
-        padded = torch.nn.functional.pad(d.transpose(1, 2), (radius, radius), mode="replicate")
+    def apply(d: torch.Tensor, index: torch.Tensor | None = None) -> torch.Tensor:
+        padded = torch.nn.functional.pad(gather(d, index).transpose(1, 2), (radius, radius), mode="replicate")
         return torch.nn.functional.conv1d(padded, kernel, groups=channels).transpose(1, 2)
 
     return apply
@@ -264,6 +273,7 @@ def _smoother(sigma: float, channels: int, dtype, device):
 def smoother(sigma: float, channels: int, dtype=torch.float64, device="cpu") -> Callable[[torch.Tensor], torch.Tensor]:
     """The filter ``δ ↦ G_σ * δ`` along time that :func:`solve` applies to latent updates (N, T, D).
 
+    Called as ``f(δ)``, or ``f(δ, index)`` for rows padded beyond their length (:func:`_smoother`).
     ``sigma`` in frames (``SolverConfig.smooth_sigma``; 0: the identity), ``channels`` = D. The
     same filter smooths the Gauss–Newton steps of :func:`project_latent` (its ``smooth`` argument).
     """
@@ -328,6 +338,7 @@ def project_latent(
     damping: float | None = None,
     smooth=None,
     exact_rounds: int = 0,
+    index: torch.Tensor | None = None,
 ) -> torch.Tensor:
     """The latent whose decoded rotations ``q ⊗ q_Δ`` match ``target_rot``: Gauss–Newton per frame.
 
@@ -355,6 +366,11 @@ def project_latent(
         converge more slowly on the fastest details but keep the latent as smooth as the encoder's
     exact_rounds : int                 the last ``exact_rounds`` rounds are not smoothed, so the
         start still reaches the target's fastest details
+    index : Tensor (N, T) of int, optional   for rows padded beyond their length: the frame each
+        frame stands for (``min(t, length − 1)``), as in :func:`smoother`
+
+    Each row is solved as if alone: a row stops (keeps its latent) once all its residuals are
+    below 1e-5 (≈ 0.001°), and the frames are computed in chunks of :data:`PROJECT_FRAMES`.
 
     Returns
     -------
@@ -364,27 +380,46 @@ def project_latent(
     with torch.no_grad():
         emb = model.skeleton_embedding(offsets)
         emb = emb.expand(N, -1) if emb.shape[0] == 1 else emb
-        emb_frames = emb[:, None, :].expand(N, T, emb.shape[-1]).reshape(N * T, -1)
-        target = target_rot.reshape(N * T, NUM_JOINTS, 4)
-        flat = phi.reshape(N * T, D)
-
         damping = PROJECT_DAMPING.get(phi.dtype, 1e-3) if damping is None else damping
-        eye = torch.eye(4 * NUM_JOINTS, dtype=phi.dtype, device=phi.device)
+        out = phi.clone()
+        alive = torch.arange(N, device=phi.device)
         for k in range(iters):
-            out, jac = model.rotation_jacobian(flat, emb_frames)
-            goal = torch.where((out * target).sum(-1, keepdim=True) < 0, -target, target)
-            resid = (goal - out).reshape(N * T, -1, 1)
-            if float(resid.abs().max()) < 1e-5:  # already there (≈ 0.001°)
+            step, done = _gauss_newton_step(model, out[alive], target_rot[alive], emb[alive], damping)
+            alive, step = alive[~done], step[~done]  # a row whose residuals are all tiny is finished
+            if len(alive) == 0:
                 break
-            # (JᵀJ + μI)⁻¹ Jᵀ r = Jᵀ (J Jᵀ + μI)⁻¹ r: an 88 × 88 system per frame instead of D × D
-            jjt = jac @ jac.transpose(1, 2)
-            mu = damping * jjt.diagonal(dim1=1, dim2=2).mean(-1).clamp_min(1e-12)
-            chol = torch.linalg.cholesky(jjt + mu[:, None, None] * eye)  # symmetric positive definite
-            step = (jac.transpose(1, 2) @ torch.cholesky_solve(resid, chol))[..., 0]
             if smooth is not None and k < iters - exact_rounds:
-                step = smooth(step.reshape(N, T, D)).reshape(N * T, D)
-            flat = flat + step
-    return flat.reshape(N, T, D)
+                step = smooth(step, None if index is None else index[alive])
+            out[alive] += step
+    return out
+
+
+PROJECT_FRAMES = 2048
+"""Frames per chunk of :func:`project_latent`'s Jacobians: a frame's (88 × D) Jacobian, its
+88 × 88 normal matrix and their factor take about 0.3 MB in float64 (D = 128), so a chunk takes
+about 1.2 GB; per-frame results do not depend on the chunk."""
+
+
+def _gauss_newton_step(model, phi, target_rot, emb, damping) -> tuple[torch.Tensor, torch.Tensor]:
+    """One damped Gauss–Newton step (N, T, D) of :func:`project_latent` for each row, unsmoothed,
+    and which rows (N,) have every residual below 1e-5 already."""
+    N, T, D = phi.shape
+    flat, target = phi.reshape(N * T, D), target_rot.reshape(N * T, NUM_JOINTS, 4)
+    emb_frames = emb[:, None, :].expand(N, T, emb.shape[-1]).reshape(N * T, -1)
+    eye = torch.eye(4 * NUM_JOINTS, dtype=phi.dtype, device=phi.device)
+    step, worst = torch.empty_like(flat), torch.empty(N * T, dtype=phi.dtype, device=phi.device)
+    for c in range(0, N * T, PROJECT_FRAMES):
+        part = slice(c, c + PROJECT_FRAMES)
+        out, jac = model.rotation_jacobian(flat[part], emb_frames[part])
+        goal = torch.where((out * target[part]).sum(-1, keepdim=True) < 0, -target[part], target[part])
+        resid = (goal - out).reshape(out.shape[0], -1, 1)
+        worst[part] = resid.abs().amax(dim=(1, 2))
+        # (JᵀJ + μI)⁻¹ Jᵀ r = Jᵀ (J Jᵀ + μI)⁻¹ r: an 88 × 88 system per frame instead of D × D
+        jjt = jac @ jac.transpose(1, 2)
+        mu = damping * jjt.diagonal(dim1=1, dim2=2).mean(-1).clamp_min(1e-12)
+        chol = torch.linalg.cholesky(jjt + mu[:, None, None] * eye)  # symmetric positive definite
+        step[part] = (jac.transpose(1, 2) @ torch.cholesky_solve(resid, chol))[..., 0]
+    return step.reshape(N, T, D), worst.reshape(N, T).amax(1) < 1e-5
 
 
 def sequence_terms(
@@ -397,18 +432,23 @@ def sequence_terms(
     planted: torch.Tensor | None = None,
     fps: torch.Tensor | None = None,
     extra: dict | None = None,
+    frames: torch.Tensor | None = None,
 ) -> tuple[torch.Tensor, dict[str, torch.Tensor]]:
     """``(L_iter (N,), {term name: value (N,)})``: every sequence on its own, every registered term.
 
     Each registered term (:mod:`.terms`) is mapped over the batch axis with ``torch.func.vmap``,
     so entry ``i`` is what sequence ``i`` gives alone. Inputs as :func:`iteration_loss`, (N, T, ...);
     with ``root_world`` (N, T, 3), ``yaw`` (N, T), ``planted`` (N, T, 4) and ``fps`` (N,) the
-    contact term is evaluated (otherwise it is 0); ``extra`` holds other terms' inputs (N, T, ...).
+    contact term is evaluated (otherwise it is 0); ``extra`` holds other terms' inputs (N, T, ...);
+    ``frames`` (N, T) of bool, optional: each sequence's real frames (:attr:`TermInputs.frames`).
     """
     cfg = config or SolverConfig()
     given = {"root_world": root_world, "yaw": yaw, "planted": planted}
     rows = {k: v for k, v in given.items() if v is not None and planted is not None}
     rate = {"fps": fps} if planted is not None else {}
+
+    if frames is not None:
+        rows["frames"] = frames
 
     def one(src, out, height, row, rate, more):
         decoded = Decoded(*(t[None] for t in out))
@@ -556,6 +596,7 @@ def solve_many(
     planted: torch.Tensor | None = None,
     fps: float | torch.Tensor | None = None,
     inputs: dict | None = None,
+    lengths: Sequence[int] | None = None,
 ) -> list[SolverResult]:
     """Solve N independent problems (one per sequence) in one batched latent iteration.
 
@@ -563,18 +604,27 @@ def solve_many(
     its own stopping rule and its own best iterate, so result ``i`` is what :func:`solve` gives for
     sequence ``i`` alone (up to float rounding: batched matrix products may round differently).
     A sequence that has stopped leaves the batch, so later steps only compute the others.
-    Typical use: the windows of several clips and characters of equal length
-    (:mod:`motionlab.retargeting.expand`).
+    Typical use: many (clip, character) pairs (:mod:`motionlab.retargeting.expand`).
 
     Parameters are those of :func:`solve` (``offsets`` usually (N, 22, 3): one skeleton per
-    sequence). Returns one :class:`SolverResult` per sequence, arrays with a leading axis of 1;
+    sequence), and ``lengths`` (N,), optional: sequence ``i`` is its first ``lengths[i]`` frames,
+    the rest of its row padding (any values). Padded frames count in no term
+    (:attr:`terms.TermInputs.frames`) and the smoothing filter treats a row's last real frame as
+    its end, so a padded sequence gives the result it gives alone, cut to its length. Returns one
+    :class:`SolverResult` per sequence, arrays with a leading axis of 1 and ``lengths[i]`` frames;
     ``seconds`` is the wall time of the whole batch.
+
+    Raises
+    ------
+    ValueError
+        as :func:`solve`; lengths outside 1..T; padding while a registered term does not honour
+        padded frames (:func:`terms.unpadded`).
     """
     problem = (model, x, source, offsets, root_height, config)
-    return _solve(problem, False, None, progress, root_xz, yaw, planted, fps, inputs)
+    return _solve(problem, False, None, progress, root_xz, yaw, planted, fps, inputs, lengths)
 
 
-def _solve(problem, joint: bool, callback, progress, root_xz, yaw, planted, fps, inputs) -> list[SolverResult]:
+def _solve(problem, joint, callback, progress, root_xz, yaw, planted, fps, inputs, lengths=None) -> list[SolverResult]:
     """:func:`solve` (``joint``: the N sequences are one problem) or :func:`solve_many` (N problems)
     of ``problem = (model, x, source, offsets, root_height, config)``; one result per problem."""
     model, x, source, offsets, root_height, config = problem
@@ -584,8 +634,27 @@ def _solve(problem, joint: bool, callback, progress, root_xz, yaw, planted, fps,
     contact = _contact_inputs(x, root_height, cfg, root_xz, yaw, planted, fps)
     extra = _extra_inputs(x, inputs, cfg)
     sizes = [x.shape[0]] if joint else [1] * x.shape[0]
+    frames = _padding(x, lengths)
     with threads.torch_threads(threads.threads_for(x.shape[0] * x.shape[1])):
-        return _iterate(model, x, source, offsets, root_height, cfg, sizes, callback, progress, contact, extra)
+        problem = _problem(model, x, source, offsets, root_height, cfg, sizes, contact, extra, frames)
+        return _iterate(problem, callback, progress)
+
+
+def _padding(x: torch.Tensor, lengths) -> np.ndarray | None:
+    """Each row's length (N,) when some row is padded, else None; checked."""
+    if lengths is None:
+        return None
+    n = np.asarray(lengths, dtype=np.int64).reshape(-1)
+    N, T = x.shape[:2]
+    if n.shape != (N,) or n.min(initial=1) < 1 or n.max(initial=1) > T:
+        raise ValueError(f"lengths must be {N} numbers between 1 and {T} frames, got {list(lengths)}")
+    if (n == T).all():
+        return None
+    if terms.unpadded():
+        raise ValueError(
+            f"sequences of other lengths cannot share a batch: terms {list(terms.unpadded())} do not honour padded frames (Term.padded)"
+        )
+    return n
 
 
 @contextmanager
@@ -610,10 +679,13 @@ class _Problem:
 
     ``bounds`` (groups + 1,): row ranges of the groups; ``group_of_row`` (N,): each row's group;
     ``contact``: ``(root_world, yaw, planted, fps)`` of :func:`_contact_inputs`, or None;
-    ``extra``: other terms' inputs (N, T, ...) by name.
+    ``extra``: other terms' inputs (N, T, ...) by name; ``lengths`` (N,) each row's real frames,
+    ``frames`` (N, T) the same as a mask and ``index`` (N, T) ``min(t, length − 1)`` when rows
+    are padded, else None.
     """
 
     model: RetargetNet
+    x: torch.Tensor
     src: torch.Tensor
     offsets: torch.Tensor
     root_height: torch.Tensor
@@ -623,13 +695,23 @@ class _Problem:
     group_of_row: torch.Tensor
     cfg: SolverConfig
     extra: dict = field(default_factory=dict)
+    lengths: np.ndarray | None = None
+    frames: torch.Tensor | None = None
+    index: torch.Tensor | None = None
 
     @property
     def per_row_offsets(self) -> bool:
         return self.offsets.ndim == 3
 
+    def rows(self, rows: torch.Tensor | None) -> dict:
+        """The per-row inputs of the terms (:func:`sequence_terms`) for ``rows`` (None: all)."""
+        pick = (lambda t: t) if rows is None else (lambda t: t[rows])
+        given = dict(zip(("root_world", "yaw", "planted", "fps"), map(pick, self.contact))) if self.contact else {}
+        frames = None if self.frames is None else pick(self.frames)
+        return dict(given, extra={k: pick(v) for k, v in self.extra.items()}, frames=frames)
 
-def _problem(model, x, source, offsets, root_height, cfg, sizes, contact, extra) -> tuple[_Problem, torch.Tensor]:
+
+def _problem(model, x, source, offsets, root_height, cfg, sizes, contact, extra, lengths=None) -> _Problem:
     """Move every input onto the network's device (``x`` and ``source`` in ``x``'s float type)."""
     device = next(model.parameters()).device
     x, src = x.to(device), source.to(device=device, dtype=x.dtype)
@@ -640,16 +722,26 @@ def _problem(model, x, source, offsets, root_height, cfg, sizes, contact, extra)
         contact = tuple(t.to(device) for t in contact)
     bounds = np.cumsum([0] + list(sizes))
     extra = {k: v.to(device=device, dtype=x.dtype) for k, v in (extra or {}).items()}
-    return _Problem(model, src, offsets, root_height, contact, list(sizes), bounds, group_of_row, cfg, extra), x
+    p = _Problem(model, x, src, offsets, root_height, contact, list(sizes), bounds, group_of_row, cfg, extra, lengths)
+    if lengths is not None:
+        t = torch.arange(x.shape[1], device=device)
+        last = torch.as_tensor(lengths, device=device)[:, None] - 1
+        p.frames, p.index = t[None] <= last, torch.minimum(t[None], last)
+    return p
 
 
-def _start(p: _Problem, x: torch.Tensor):
+def _start(p: _Problem):
     """φ₀ (N, T, D) (the encoder's, then the Gauss–Newton start where ``cfg`` asks for it), the
-    skeleton embedding and the temporal smoother of the steps; one row at a time, so that a row's
-    numbers do not depend on the batch."""
-    model, cfg, offsets = p.model, p.cfg, p.offsets
+    skeleton embedding and the temporal smoother of the steps. The encoder runs one row at a time
+    on the row's real frames, so that a row's numbers do not depend on the batch; padded frames
+    repeat the last real one."""
+    model, cfg, offsets, x = p.model, p.cfg, p.offsets, p.x
+    lengths = [x.shape[1]] * x.shape[0] if p.lengths is None else p.lengths
     with torch.no_grad():
-        phi0 = torch.cat([model.encode(x[i : i + 1]) for i in range(x.shape[0])])
+        phi0 = [model.encode(x[i : i + 1, :n]) for i, n in enumerate(lengths)]
+        phi0 = torch.cat(
+            [torch.nn.functional.pad(f, (0, 0, 0, x.shape[1] - f.shape[1]), mode="replicate") for f in phi0]
+        )
         embedding = (
             model.skeleton_embedding(offsets)
             if offsets.ndim == 2
@@ -658,46 +750,47 @@ def _start(p: _Problem, x: torch.Tensor):
     smooth = _smoother(cfg.smooth_sigma, phi0.shape[-1], x.dtype, x.device)
     if cfg.init == "project" or (cfg.init == "auto" and cfg.theta == "rotations"):
         steps_filter = smooth if cfg.smooth_projection else None
-        with torch.no_grad():
-            phi0 = torch.cat(
-                [
-                    project_latent(
-                        model,
-                        phi0[i : i + 1],
-                        p.src[i : i + 1],
-                        offsets[i] if p.per_row_offsets else offsets,
-                        cfg.project_iters,
-                        cfg.project_damping,
-                        smooth=steps_filter,
-                        exact_rounds=cfg.project_exact,
-                    )
-                    for i in range(x.shape[0])
-                ]
-            )
+        phi0 = project_latent(
+            model, phi0, p.src, offsets, cfg.project_iters, cfg.project_damping, smooth=steps_filter,
+            exact_rounds=cfg.project_exact, index=p.index,
+        )  # fmt: skip
     return phi0, embedding, smooth
+
+
+_BETAS, _EPS = (0.9, 0.999), 1e-8
+"""Adam's defaults (Kingma and Ba 2015), as ``torch.optim.Adam`` has them."""
 
 
 @dataclass
 class _Steps:
-    """Each group's latent offset δ (its rows of φ = φ₀ + smooth(δ)), step grid, and the Adam over them."""
+    """The latent offset δ (N, T, D) (φ = φ₀ + smooth(δ)) and Adam's state over it, written out
+    so that every row has its own step size, grid and step count (a group's rows share them)."""
 
-    deltas: list
-    grids: list
-    opt: torch.optim.Adam
+    delta: torch.Tensor
+    lr: np.ndarray
+    grid: torch.Tensor
+    m: torch.Tensor
+    v: torch.Tensor
+    count: np.ndarray
 
 
-def _steps(phi0: torch.Tensor, bounds: np.ndarray, lr: float) -> _Steps:
-    """Per group: Adam's step size ``lr · std(φ₀)``, its grid (:func:`step_grid`); φ₀ put on the grid in place."""
-    deltas, param_groups, grids = [], [], []
+def _steps(phi0: torch.Tensor, p: _Problem) -> _Steps:
+    """Per group: Adam's step size ``lr · std(φ₀)`` (real frames), its grid (:func:`step_grid`);
+    φ₀ put on the grid in place."""
+    N, bounds = phi0.shape[0], p.bounds
+    lr, grid = np.empty(N), np.empty(N)
     for g in range(len(bounds) - 1):
         part = phi0[bounds[g] : bounds[g + 1]]
-        scale = max(float(part.std()) if part.numel() > 1 else 1.0, 1e-6)
+        real = part if p.frames is None else part[p.frames[bounds[g] : bounds[g + 1]]]
+        scale = max(float(real.std()) if real.numel() > 1 else 1.0, 1e-6)
         with torch.no_grad():  # the start on the grid too (see step_grid)
             part.copy_(torch.round(part / step_grid(scale)) * step_grid(scale))
-        deltas.append(torch.zeros_like(part, requires_grad=True))
-        param_groups.append({"params": [deltas[-1]], "lr": lr * scale})
-        grids.append(step_grid(param_groups[-1]["lr"]))
-    return _Steps(deltas, grids, torch.optim.Adam(param_groups))
+        lr[bounds[g] : bounds[g + 1]] = p.cfg.lr * scale
+        grid[bounds[g] : bounds[g + 1]] = step_grid(p.cfg.lr * scale)
+    like = dict(dtype=phi0.dtype, device=phi0.device)
+    grid = torch.as_tensor(grid, **like)[:, None, None]
+    zeros = torch.zeros_like(phi0)
+    return _Steps(zeros.clone().requires_grad_(True), lr, grid, zeros.clone(), zeros, np.zeros(N, dtype=np.int64))
 
 
 def _losses(p: _Problem, phi0, embedding, smooth, steps: _Steps, active: list):
@@ -706,21 +799,13 @@ def _losses(p: _Problem, phi0, embedding, smooth, steps: _Steps, active: list):
     groups, bounds, device, dtype = len(p.sizes), p.bounds, phi0.device, phi0.dtype
     everyone = len(active) == groups
     rows = None if everyone else torch.cat([torch.arange(bounds[g], bounds[g + 1], device=device) for g in active])
-    delta = steps.deltas[0] if groups == 1 else torch.cat([steps.deltas[g] for g in active])
-    phi = (phi0 if everyone else phi0[rows]) + smooth(delta)
-    if p.per_row_offsets and not everyone:
-        out = p.model.decode(phi, p.offsets[rows], embedding[rows])
-    else:
-        out = p.model.decode(phi, p.offsets, embedding)
-    s, h = (p.src, p.root_height) if everyone else (p.src[rows], p.root_height[rows])
-    extra = {}
-    if p.contact is not None:
-        extra = dict(
-            zip(("root_world", "yaw", "planted", "fps"), p.contact if everyone else [c[rows] for c in p.contact])
-        )
-    more = p.extra if everyone else {k: v[rows] for k, v in p.extra.items()}
-    loss, by_term = sequence_terms(s, out, h, p.cfg, **extra, extra=more)  # (rows,): each sequence on its own
-    owner = p.group_of_row if everyone else p.group_of_row[rows]
+    pick = (lambda t: t) if everyone else (lambda t: None if t is None else t[rows])
+    phi = pick(phi0) + smooth(pick(steps.delta), pick(p.index))
+    offsets = p.offsets[rows] if p.per_row_offsets and not everyone else p.offsets
+    out = p.model.decode(phi, offsets, pick(embedding) if p.per_row_offsets else embedding)
+    given = p.rows(rows)
+    loss, by_term = sequence_terms(pick(p.src), out, pick(p.root_height), p.cfg, **given)  # (rows,): each alone
+    owner = pick(p.group_of_row)
     which = owner if everyone else torch.searchsorted(torch.as_tensor(active, device=device), owner)
     count = torch.zeros(len(active), dtype=dtype, device=device).index_add_(0, which, torch.ones_like(loss))
     parts = [
@@ -768,7 +853,7 @@ class _Track:
     def record(self, p: _Problem, active: list, values: list, out, phi, callback) -> list[int]:
         """Log one evaluation of the active groups, keep their best iterates; the indices into
         ``active`` of the groups that stop here."""
-        cfg, stopped, row = p.cfg, [], 0
+        cfg, stopped, row, better = p.cfg, [], 0, []
         for k, g in enumerate(active):
             value, n = values[k][0], p.sizes[g]
             for key, v in zip(self.keys, values[k]):
@@ -777,33 +862,43 @@ class _Track:
                 callback(self.steps[g], dict(zip(self.keys, values[k])))
             if value < self.best_value[g]:  # Adam can overshoot: keep the best iterate seen, not the last
                 self.best_value[g], self.best_step[g] = value, self.steps[g]
-                b0, b1 = p.bounds[g], p.bounds[g + 1]
-                self.best_rot[b0:b1] = out.local_rot[row : row + n].detach()
-                self.best_pos[b0:b1] = out.positions[row : row + n].detach()
-                self.best_phi[b0:b1] = phi[row : row + n].detach()
+                better.append((row, p.bounds[g], n))
             if value < self.best[g] * (1.0 - cfg.min_delta):
                 self.best[g], self.since_best[g] = value, 0
             else:
                 self.since_best[g] += 1
+            row += n
             if value < cfg.threshold:
                 self.reasons[g] = "threshold"
             elif cfg.patience and self.since_best[g] >= cfg.patience:
                 self.reasons[g] = "plateau"
             elif self.steps[g] < cfg.max_steps:
-                row += n
                 continue
             stopped.append(k)
-            row += n
+        self._keep(better, out, phi)
         return stopped
 
-    def results(self, bounds: np.ndarray, seconds: float) -> list[SolverResult]:
+    def _keep(self, better: list, out, phi) -> None:
+        """Copy the improved groups' rows ``(row in out, row in the batch, rows)`` into the best iterate."""
+        if not better:
+            return
+        src = np.concatenate([np.arange(r, r + n) for r, _, n in better])
+        dst = torch.as_tensor(np.concatenate([np.arange(b, b + n) for _, b, n in better]), device=phi.device)
+        src = torch.as_tensor(src, device=phi.device)
+        self.best_rot[dst] = out.local_rot.detach()[src]
+        self.best_pos[dst] = out.positions.detach()[src]
+        self.best_phi[dst] = phi.detach()[src]
+
+    def results(self, p: _Problem, seconds: float) -> list[SolverResult]:
         rot = self.best_rot.cpu().numpy().astype(np.float64)
         pos = self.best_pos.cpu().numpy().astype(np.float64)
+        bounds, T = p.bounds, rot.shape[1]
+        ends = [T] * len(p.sizes) if p.lengths is None else [int(n) for n in p.lengths]
         return [
             SolverResult(
-                local_rot=rot[bounds[g] : bounds[g + 1]],
-                positions=pos[bounds[g] : bounds[g + 1]],
-                phi=self.best_phi[bounds[g] : bounds[g + 1]],
+                local_rot=rot[bounds[g] : bounds[g + 1], : ends[g]],
+                positions=pos[bounds[g] : bounds[g + 1], : ends[g]],
+                phi=self.best_phi[bounds[g] : bounds[g + 1], : ends[g]],
                 best_step=self.best_step[g],
                 history=self.histories[g],
                 stop_reason=self.reasons[g],
@@ -814,45 +909,53 @@ class _Track:
         ]
 
 
-def _adam_step(steps: _Steps, group_loss: torch.Tensor, active: list, stopped: list) -> list:
-    """One Adam update of the groups still running, their δ put back on the grid; the groups left."""
+def _adam_step(p: _Problem, steps: _Steps, group_loss: torch.Tensor, active: list, stopped: list) -> list:
+    """One Adam update (``torch.optim.Adam``'s arithmetic) of the groups still running, their δ put
+    back on the grid; the groups left. A stopped group keeps its latent."""
     keep = torch.ones(len(active), dtype=group_loss.dtype, device=group_loss.device)
     keep[stopped] = 0.0
-    steps.opt.zero_grad(set_to_none=True)
+    steps.delta.grad = None
     (group_loss * keep).sum().backward()
-    for k in stopped:
-        steps.deltas[active[k]].grad = None  # Adam skips it: a stopped problem keeps its latent
-    steps.opt.step()
     active = [g for k, g in enumerate(active) if k not in stopped]
-    with torch.no_grad():  # on the grid: the same iterates on every CPU (see step_grid)
-        for g in active:
-            steps.deltas[g].copy_(torch.round(steps.deltas[g] / steps.grids[g]) * steps.grids[g])
+    rows = np.concatenate([np.arange(p.bounds[g], p.bounds[g + 1]) for g in active])
+    steps.count[rows] += 1
+    like = dict(dtype=steps.m.dtype, device=steps.m.device)
+    (b1, b2), t = _BETAS, steps.count[rows]
+    step_size = torch.as_tensor([lr / (1 - b1 ** float(c)) for lr, c in zip(steps.lr[rows], t)], **like)
+    root2 = torch.as_tensor([(1 - b2 ** float(c)) ** 0.5 for c in t], **like)  # Python floats, as Adam's
+    step_size, root2 = step_size[:, None, None], root2[:, None, None]
+    index = torch.as_tensor(rows, device=steps.m.device)
+    with torch.no_grad():
+        g = steps.delta.grad[index]
+        m = steps.m[index].lerp_(g, 1 - b1)
+        v = steps.v[index].mul_(b2).addcmul_(g, g, value=1 - b2)
+        d = steps.delta[index] + (-step_size * m) / (v.sqrt() / root2).add_(_EPS)
+        grid = steps.grid[index]
+        steps.m[index], steps.v[index] = m, v
+        steps.delta[index] = torch.round(d / grid) * grid  # on the grid: the same iterates on every CPU
     return active
 
 
-def _iterate(
-    model, x, source, offsets, root_height, cfg, sizes, callback, progress, contact=None, extra=None
-) -> list[SolverResult]:
-    """The latent iteration for consecutive groups of sequences (``sizes`` rows each), each group
-    an independent problem: group loss = mean of its sequences' losses, own step size and stop.
-    ``contact``: ``(root_world, yaw, planted)`` of :func:`_contact_inputs`, or None."""
-    p, x = _problem(model, x, source, offsets, root_height, cfg, sizes, contact, extra)
+def _iterate(p: _Problem, callback, progress) -> list[SolverResult]:
+    """The latent iteration for consecutive groups of sequences (``p.sizes`` rows each), each group
+    an independent problem: group loss = mean of its sequences' losses, own step size and stop."""
+    cfg, model = p.cfg, p.model
     start = time.perf_counter()
     with _frozen(model):
-        phi0, embedding, smooth = _start(p, x)
-        steps = _steps(phi0, p.bounds, cfg.lr)
-        track = _Track.new(phi0, len(sizes))
-        active = list(range(len(sizes)))
+        phi0, embedding, smooth = _start(p)
+        steps = _steps(phi0, p)
+        track = _Track.new(phi0, len(p.sizes))
+        active = list(range(len(p.sizes)))
         bar = tqdm(total=cfg.max_steps, desc="latent iteration", disable=not progress, leave=False)
         while active:
             out, phi, group_loss, values = _losses(p, phi0, embedding, smooth, steps, active)
             stopped = track.record(p, active, values, out, phi, callback)
             if len(stopped) == len(active):
                 break
-            active = _adam_step(steps, group_loss, active, stopped)
+            active = _adam_step(p, steps, group_loss, active, stopped)
             for g in active:
                 track.steps[g] += 1
             bar.update(1)
             bar.set_postfix(loss=f"{np.mean([v[0] for v in values]):.4g}")  # values: already on the host
         bar.close()
-    return track.results(p.bounds, time.perf_counter() - start)
+    return track.results(p, time.perf_counter() - start)

@@ -24,6 +24,11 @@ Adding a term is one function and one :func:`register` call (``tests/retargeting
 does it from outside the package). Per-sequence data a term needs beyond the built-in inputs
 travel in ``TermInputs.extra`` (``solve(..., inputs={"name": tensor (N, T, ...)})``).
 
+Sequences of different lengths share a batch by padding (``solve_many(..., lengths=)``, which is
+how ``expand`` fills a GPU): each term then sees ``TermInputs.frames``, the real frames, and must
+average over those alone (:func:`losses.frame_mean`). A term declares that it does with
+``padded=True``; while a registered term does not, batches keep to one length (:func:`unpadded`).
+
 The built-in terms, in order:
 
 ============  =======================================================================  ======  ======
@@ -58,6 +63,7 @@ __all__ = [
     "unregister",
     "registered",
     "get",
+    "unpadded",
     "PAPER_TERMS",
 ]
 
@@ -81,6 +87,11 @@ class TermInputs:
     fps : Tensor () or None        frame rate
     extra : dict of Tensor         per-sequence inputs of other terms, e.g. ``"floor"`` (1, T, 22):
                                    the lowest height each joint of B may reach, metres (<= 0)
+    frames : Tensor (1, T) of bool or None   the sequence's real frames when it was padded to a
+                                   batch's length (:func:`motionlab.retargeting.solver.solve_many`
+                                   with ``lengths``); None: every frame is real. A term that honours
+                                   it (:attr:`Term.padded`) averages over these frames alone
+                                   (:func:`losses.frame_mean`)
     """
 
     source: Any
@@ -91,6 +102,7 @@ class TermInputs:
     planted: Any = None
     fps: Any = None
     extra: dict = field(default_factory=dict)
+    frames: Any = None
 
     def has(self, name: str) -> bool:
         """Whether input ``name`` (a field or a key of ``extra``) is given."""
@@ -111,6 +123,9 @@ class Term:
     unit : str           unit of the value ("" for none), for reports
     needs : tuple of str inputs the term cannot be evaluated without (fields or ``extra`` keys)
     description : str    one line for ``--help`` and the docs
+    padded : bool        the function honours :attr:`TermInputs.frames` (padded frames change
+                         neither its value nor its gradient), so sequences of other lengths can
+                         share a batch; a term without it keeps batches to one length
     """
 
     name: str
@@ -119,6 +134,7 @@ class Term:
     unit: str = ""
     needs: tuple[str, ...] = ()
     description: str = ""
+    padded: bool = False
 
     def __post_init__(self) -> None:
         if not self.name.isidentifier() or self.name == "loss":
@@ -172,29 +188,37 @@ def get(name: str) -> Term:
     return _REGISTRY[name]
 
 
+def unpadded() -> tuple[str, ...]:
+    """Names of the registered terms that do not honour padded frames (:attr:`Term.padded` False)."""
+    return tuple(t.name for t in _REGISTRY.values() if not t.padded)
+
+
 # ---------------------------------------------------------------------------- built-in terms
 def _angle(decoded, inputs: TermInputs):
     if inputs.theta == "rotations":
-        return losses.angle_loss(inputs.source, decoded.local_rot)
-    return losses.direction_loss(inputs.source, decoded.positions)
+        return losses.angle_loss(inputs.source, decoded.local_rot, inputs.frames)
+    return losses.direction_loss(inputs.source, decoded.positions, inputs.frames)
 
 
 def _foot(decoded, inputs: TermInputs):
-    return losses.foot_loss(decoded.positions[..., 1] + inputs.root_height[..., None])
+    return losses.foot_loss(decoded.positions[..., 1] + inputs.root_height[..., None], inputs.frames)
 
 
 def _contact(decoded, inputs: TermInputs):
     feet = losses.feet_in_world(decoded.positions, inputs.root_world, inputs.yaw)
-    return losses.contact_loss(feet, inputs.planted, inputs.fps)
+    planted = inputs.planted if inputs.frames is None else inputs.planted & inputs.frames[..., None]
+    return losses.contact_loss(feet, planted, inputs.fps)
 
 
 def _floor(decoded, inputs: TermInputs):
     heights = decoded.positions[..., 1] + inputs.root_height[..., None]
-    return losses.floor_loss(heights, inputs.extra.get("floor"))
+    return losses.floor_loss(heights, inputs.extra.get("floor"), inputs.frames)
 
 
-register(Term("angle", losses.LAMBDA_ANGLE, _angle, "", (), "L_angle: the source's joint angles kept (paper, eq. 16)"))
-register(Term("foot", losses.LAMBDA_FOOT, _foot, "m", (), "L_foot: feet above the ground (paper, eq. 17)"))
+register(
+    Term("angle", losses.LAMBDA_ANGLE, _angle, "", (), "L_angle: the source's joint angles kept (paper, eq. 16)", True)
+)
+register(Term("foot", losses.LAMBDA_FOOT, _foot, "m", (), "L_foot: feet above the ground (paper, eq. 17)", True))
 register(
     Term(
         "contact",
@@ -203,6 +227,7 @@ register(
         "m/s",
         ("root_world", "yaw", "planted", "fps"),
         "L_contact: the source's planted feet stay still (motionlab's addition)",
+        True,
     )
 )
 register(
@@ -213,5 +238,6 @@ register(
         "m",
         (),
         "L_floor: every joint at or above the floor, or no deeper than the source's own (motionlab's addition)",
+        True,
     )
 )

@@ -77,6 +77,64 @@ def test_solve_many_is_solve_per_sequence(ckpt):
         assert one.steps == many[i].steps and one.stop_reason == many[i].stop_reason
 
 
+def test_sequences_of_other_lengths_padded_into_one_batch_are_solved_as_alone(ckpt):
+    """Padding (lengths=) changes no sequence: every term averages over its real frames, the
+    smoothing filter ends a row at its last real frame, the encoder sees the real frames only."""
+    from motionlab.retargeting.pipeline import prepare_pair, prepare_source
+
+    clips = [synthetic.dataset(1, seed=s, num_frames=n)[0] for s, n in ((3, 30), (4, 44), (5, 37))]
+    chars = synthetic.character_set(3, seed=0)
+    jobs = [prepare_pair(prepare_source(c, ckpt), k) for c, k in zip(clips, chars)]
+    T = max(j.source.x.shape[1] for j in jobs)
+
+    def padded(t):  # garbage after each row's end: it must not matter
+        return (
+            torch.cat([t, torch.full((1, T - t.shape[1]) + t.shape[2:], 7.0, dtype=t.dtype)], 1)
+            if t.shape[1] < T
+            else t
+        )
+
+    args = [torch.cat([padded(getattr(j.source, k)) for j in jobs]) for k in ("x", "theta")]
+    heights = torch.cat([padded(j.root_height) for j in jobs])
+    contact = dict(
+        root_xz=torch.cat([padded(j.root_xz) for j in jobs]),
+        yaw=torch.cat([padded(j.source.yaw) for j in jobs]),
+        planted=torch.cat([padded(j.source.planted.double()).bool() for j in jobs]),
+        fps=torch.tensor([60.0] * 3, dtype=torch.float64),
+        inputs={"floor": torch.cat([padded(j.floor) for j in jobs])},
+    )
+    cfg = SolverConfig(max_steps=15)
+    lengths = [j.source.x.shape[1] for j in jobs]
+    many = solve_many(
+        ckpt.model, *args, torch.stack([j.offsets for j in jobs]), heights, cfg, **contact, lengths=lengths
+    )
+    for j, m, n in zip(jobs, many, lengths):
+        alone = solve_many(
+            ckpt.model, j.source.x, j.source.theta, j.offsets[None], j.root_height, cfg, root_xz=j.root_xz,
+            yaw=j.source.yaw, planted=j.source.planted, fps=60.0, inputs={"floor": j.floor},
+        )[0]  # fmt: skip
+        assert m.local_rot.shape == alone.local_rot.shape == (1, n, 22, 4)
+        assert m.steps == alone.steps and m.stop_reason == alone.stop_reason and m.best_step == alone.best_step
+        np.testing.assert_allclose(m.positions, alone.positions, atol=1e-9)
+        for key, values in alone.history.items():
+            np.testing.assert_allclose(m.history[key], values, rtol=1e-9, atol=1e-12)
+
+
+def test_padding_is_refused_while_a_term_ignores_padded_frames(ckpt):
+    from motionlab.retargeting import terms
+
+    term = terms.register(terms.Term("plain_mean", 1.0, lambda d, i: d.positions[..., 1].mean()))
+    try:
+        x = torch.zeros(2, 10, 70, dtype=torch.float64)
+        th = torch.tensor([1.0, 0, 0, 0], dtype=torch.float64).expand(2, 10, 22, 4)
+        with pytest.raises(ValueError, match="plain_mean"):
+            solve_many(ckpt.model, x, th, torch.zeros(2, 22, 3), torch.ones(2, 10), lengths=[10, 6])
+        with pytest.raises(ValueError, match="lengths must be 2 numbers between 1 and 10"):
+            solve_many(ckpt.model, x, th, torch.zeros(2, 22, 3), torch.ones(2, 10), lengths=[11, 6])
+    finally:
+        terms.unregister(term.name)
+
+
 @pytest.mark.slow
 def test_outputs_equal_single_pair_path(ckpt, library, tmp_path):
     targets = _targets(library)
