@@ -9,10 +9,14 @@ the other sequences of the batch, so each output is bit-for-bit the single-pair 
 checks it).
 
 **What can share a batch.** The network's latent is per frame and a clip is solved as one
-sequence (no windows, no seams, as in the single-pair path), so the sequences of one batch must
-have the same number of frames. :func:`plan_batches` therefore groups pairs by length (one clip
-onto all characters always qualifies; clips of equal length join them) and cuts each group so
-that a batch holds at most ``max_frames`` frames, chosen from memory by :func:`batch_frames`.
+sequence (no windows, no seams, as in the single-pair path). By default (the CPU)
+:func:`plan_batches` groups pairs by length (one clip onto all characters always qualifies;
+clips of equal length join them) and cuts each group so that a batch holds at most
+``max_frames`` frames, chosen from memory by :func:`batch_frames`. With ``pad=True`` (``expand``
+on a GPU, where a step costs about the same for ten sequences as for a thousand) pairs of any
+length share a batch, longest first, each padded to the batch's longest
+(:func:`motionlab.retargeting.solver.solve_many` with ``lengths``: a padded sequence's result is
+the one it gets alone, a test checks it).
 
 Taught in ``notebooks/07_expanding_a_database.ipynb``.
 """
@@ -28,11 +32,30 @@ import torch
 from motionlab.core import humanoid, metrics
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
+from motionlab.retargeting import terms
 from motionlab.retargeting.checkpoint import Checkpoint
-from motionlab.retargeting.pipeline import PreparedSource, RetargetResult, finish, prepare_pair, prepare_source
-from motionlab.retargeting.solver import SolverConfig, solve_many
+from motionlab.retargeting.pipeline import (
+    PreparedPair,
+    PreparedSource,
+    RetargetResult,
+    finish,
+    prepare_pair,
+    prepare_source,
+)
+from motionlab.retargeting.solver import SolverConfig, SolverResult, solve_many
 
-__all__ = ["BYTES_PER_FRAME", "Pair", "PairResult", "batch_frames", "plan_batches", "solve_pairs", "quality"]
+__all__ = [
+    "BYTES_PER_FRAME",
+    "Pair",
+    "PairResult",
+    "batch_frames",
+    "plan_batches",
+    "prepare_jobs",
+    "solve_jobs",
+    "finish_job",
+    "solve_pairs",
+    "quality",
+]
 
 BYTES_PER_FRAME = 32_000
 """Memory one sequence frame takes in a latent-iteration step (forward + backward + Adam state,
@@ -52,7 +75,8 @@ class Pair:
     source : Motion            the clip as loaded (any mappable rig)
     target : Skeleton          the character's rest skeleton (any mappable rig or canonical)
     frames : int               frames after resampling to the checkpoint's rate
-    prepared : PreparedSource or None   the source side, when already computed in this process
+    prepared : PreparedSource or None   the source side, when already computed
+    job : PreparedPair or None the pair prepared for the network, when already computed
     """
 
     clip: str
@@ -61,6 +85,7 @@ class Pair:
     target: Skeleton
     frames: int
     prepared: PreparedSource | None = None
+    job: PreparedPair | None = None
 
 
 @dataclass
@@ -106,10 +131,12 @@ def batch_frames(device: str | torch.device = "cpu", fraction: float = 0.25, cap
     return int(max(1, min(cap, fraction * free // BYTES_PER_FRAME)))
 
 
-def plan_batches(pairs: Sequence[Pair], max_frames: int) -> list[list[Pair]]:
-    """Group pairs of equal length into batches of at most ``max_frames`` frames (at least one pair).
+def plan_batches(pairs: Sequence[Pair], max_frames: int, pad: bool = False) -> list[list[Pair]]:
+    """Cut pairs into batches of at most ``max_frames`` frames (at least one pair); deterministic.
 
-    Longest clips first, pairs kept in their given order within a length; deterministic.
+    ``pad=False``: pairs of equal length only, longest clips first, pairs kept in their given order
+    within a length. ``pad=True``: pairs of any length, longest first (ties in their given order);
+    a batch's frames are its pairs × its longest pair's frames (the padded size).
 
     Raises
     ------
@@ -117,6 +144,13 @@ def plan_batches(pairs: Sequence[Pair], max_frames: int) -> list[list[Pair]]:
     """
     if max_frames < 1:
         raise ValueError(f"max_frames must be >= 1, got {max_frames}")
+    if pad:
+        batches: list[list[Pair]] = []
+        for p in sorted(pairs, key=lambda p: -p.frames):
+            if not batches or (len(batches[-1]) + 1) * batches[-1][0].frames > max_frames:
+                batches.append([])
+            batches[-1].append(p)
+        return batches
     by_length: dict[int, list[Pair]] = {}
     for p in pairs:
         by_length.setdefault(p.frames, []).append(p)
@@ -140,58 +174,87 @@ def quality(result: RetargetResult) -> dict[str, float]:
     }
 
 
+def prepare_jobs(
+    checkpoint: Checkpoint, pairs: Sequence[Pair], solver: SolverConfig | None = None, root_mode: str = "stride"
+) -> list[PreparedPair]:
+    """Each pair's :class:`~motionlab.retargeting.pipeline.PreparedPair` (its ``job`` when given);
+    a source shared by several pairs is prepared once.
+
+    Raises ``ValueError`` when a pair's prepared length differs from its planned ``frames``.
+    """
+    prepared: dict[int, PreparedSource] = {}
+    jobs = []
+    for p in pairs:
+        if p.job is None:
+            key = id(p.source)
+            if key not in prepared:
+                prepared[key] = p.prepared or prepare_source(p.source, checkpoint, "full", solver)
+        job = p.job or prepare_pair(prepared[id(p.source)], p.target, root_mode)
+        if job.source.motion.num_frames != p.frames:
+            raise ValueError(f"pair {p.clip!r}: {job.source.motion.num_frames} frames, planned {p.frames}")
+        jobs.append(job)
+    return jobs
+
+
+def _stacked(tensors: list[torch.Tensor], frames: int) -> torch.Tensor:
+    """(1, T_i, ...) tensors as one (N, frames, ...) tensor, each padded by repeating its last frame."""
+    return torch.cat([torch.cat([t, t[:, -1:].expand((1, frames - t.shape[1]) + t.shape[2:])], 1) for t in tensors])
+
+
+def solve_jobs(
+    checkpoint: Checkpoint, jobs: Sequence[PreparedPair], solver: SolverConfig | None = None
+) -> list[SolverResult]:
+    """The latent iteration of every job in one batch (:func:`~motionlab.retargeting.solver.solve_many`);
+    jobs of other lengths are padded to the longest (``lengths``).
+
+    Raises ``ValueError`` when the lengths differ and a registered term does not honour padded
+    frames (:func:`motionlab.retargeting.terms.unpadded`).
+    """
+    lengths = [j.source.x.shape[1] for j in jobs]
+    if len(set(lengths)) > 1 and terms.unpadded():
+        raise ValueError(
+            f"a batch needs pairs of one length, got lengths {sorted(set(lengths))} (terms {list(terms.unpadded())} do not honour padding)"
+        )
+    T = max(lengths)
+    x = _stacked([j.source.x for j in jobs], T)
+    return solve_many(
+        checkpoint.model,
+        x,
+        _stacked([j.source.theta for j in jobs], T),
+        torch.stack([j.offsets for j in jobs]),
+        _stacked([j.root_height for j in jobs], T),
+        solver or SolverConfig(),
+        root_xz=_stacked([j.root_xz for j in jobs], T),
+        yaw=_stacked([j.source.yaw for j in jobs], T),
+        planted=_stacked([j.source.planted for j in jobs], T),
+        fps=torch.tensor([j.source.motion.fps for j in jobs], dtype=x.dtype, device=x.device),
+        inputs={"floor": _stacked([j.floor for j in jobs], T)},
+        lengths=lengths,
+    )
+
+
+def finish_job(pair: Pair, job: PreparedPair, res: SolverResult, batch_size: int, seconds: float) -> PairResult:
+    """The pair's :class:`PairResult`: B's Motion and its checks (:func:`~motionlab.retargeting.pipeline.finish`)."""
+    r = finish(job, res.local_rot[0], "full", res.history, res.stop_reason, res.steps, res.seconds, res.best_step)
+    return PairResult(pair.clip, pair.character, r, batch_size, seconds)
+
+
 def solve_pairs(
     checkpoint: Checkpoint,
     pairs: Sequence[Pair],
     solver: SolverConfig | None = None,
     root_mode: str = "stride",
 ) -> list[PairResult]:
-    """Retarget every pair with one batched latent iteration (all pairs must have equal ``frames``).
+    """Retarget every pair with one batched latent iteration: :func:`prepare_jobs`,
+    :func:`solve_jobs`, :func:`finish_job`.
 
     Steps per pair are those of :func:`~motionlab.retargeting.pipeline.retarget` with
-    ``method="full"``; the solve is :func:`~motionlab.retargeting.solver.solve_many`.
-    Raises ``ValueError`` when the pairs differ in length.
+    ``method="full"``. Raises ``ValueError`` as :func:`prepare_jobs` and :func:`solve_jobs`.
     """
     if not pairs:
         return []
-    lengths = {p.frames for p in pairs}
-    if len(lengths) != 1:
-        raise ValueError(f"a batch needs pairs of one length, got lengths {sorted(lengths)}")
-    solver = solver or SolverConfig()
-    prepared: dict[int, PreparedSource] = {}
-    jobs = []
-    for p in pairs:
-        key = id(p.source)
-        if key not in prepared:
-            prepared[key] = p.prepared or prepare_source(p.source, checkpoint, "full", solver)
-        jobs.append(prepare_pair(prepared[key], p.target, root_mode))
-    if jobs[0].source.motion.num_frames != pairs[0].frames:
-        raise ValueError(
-            f"pair {pairs[0].clip!r}: {jobs[0].source.motion.num_frames} frames, planned {pairs[0].frames}"
-        )
     start = time.perf_counter()
-    x = torch.cat([j.source.x for j in jobs])
-    theta = torch.cat([j.source.theta for j in jobs])
-    offsets = torch.stack([j.offsets for j in jobs])
-    height = torch.cat([j.root_height for j in jobs])
-    solved = solve_many(
-        checkpoint.model,
-        x,
-        theta,
-        offsets,
-        height,
-        solver,
-        root_xz=torch.cat([j.root_xz for j in jobs]),
-        yaw=torch.cat([j.source.yaw for j in jobs]),
-        planted=torch.cat([j.source.planted for j in jobs]),
-        fps=torch.tensor([j.source.motion.fps for j in jobs], dtype=x.dtype, device=x.device),
-        inputs={"floor": torch.cat([j.floor for j in jobs])},
-    )
-    out = []
-    for p, job, res in zip(pairs, jobs, solved):
-        r = finish(job, res.local_rot[0], "full", res.history, res.stop_reason, res.steps, res.seconds, res.best_step)
-        out.append(PairResult(p.clip, p.character, r, len(pairs), 0.0))
+    jobs = prepare_jobs(checkpoint, pairs, solver, root_mode)
+    solved = solve_jobs(checkpoint, jobs, solver)
     share = (time.perf_counter() - start) / len(pairs)
-    for o in out:
-        o.seconds = share
-    return out
+    return [finish_job(p, j, r, len(pairs), share) for p, j, r in zip(pairs, jobs, solved)]

@@ -60,10 +60,18 @@ import numpy as np
 from motionlab.core import bvh, files, humanoid, metrics, motion_files, rest_pose
 from motionlab.core.skeleton import Skeleton
 from motionlab.core.threads import batch_threads, torch_threads
-from motionlab.retargeting import terms
-from motionlab.retargeting.batching import Pair, PairResult, batch_frames, plan_batches, quality, solve_pairs
+from motionlab.retargeting import host, terms
+from motionlab.retargeting.batching import (
+    Pair,
+    PairResult,
+    batch_frames,
+    finish_job,
+    plan_batches,
+    quality,
+    solve_jobs,
+)
 from motionlab.retargeting.checkpoint import Checkpoint
-from motionlab.retargeting.pipeline import at_rate, prepare_source
+from motionlab.retargeting.pipeline import at_rate, prepare_pair, prepare_source
 from motionlab.retargeting.solver import PROJECT_DAMPING, SolverConfig
 
 __all__ = [
@@ -404,9 +412,11 @@ class ExpandResult:
                             ``character changed``, ``options changed``, ``file missing``)
     resampled : list of str   one line per source whose frame rate changed on the way
     implausible : int       outputs of this run that failed a plausibility test
-    timings : dict          wall time, seconds: ``load`` (plan, read and prepare the sources),
-                            ``solve`` (the batches: pairs prepared, the latent iteration, outputs
-                            finished and checked), ``write`` (files and manifest)
+    timings : dict          wall time, seconds: ``load`` (plan, read and prepare the sources and
+                            pairs), ``solve`` (the latent iteration of the batches, and the outputs
+                            finished, checked and encoded where no host workers do it),
+                            ``finish`` (waiting for the host workers' outputs, with workers),
+                            ``write`` (files and manifest)
     """
 
     out: Path
@@ -560,6 +570,8 @@ def expand(
     output_format: str = "bvh",
     fps: float | None = None,
     rest_from=None,
+    host_workers: int | None = None,
+    pad: bool | None = None,
 ) -> ExpandResult:
     """Retarget every source clip onto every character; see the module docstring.
 
@@ -586,6 +598,11 @@ def expand(
         checkpoint's rate
     rest_from : a Motion whose standing pose serves every source on its rig
         (:func:`rest_pose.on_reference`, ``--rest-from``; pass the same to :func:`characters`)
+    host_workers : processes that read and prepare the clips and finish and encode the outputs
+        while the network solves (:mod:`motionlab.retargeting.host`); default
+        :func:`host.default_workers`: none on the CPU, every core but one on a GPU
+    pad : let pairs of other lengths share a batch (:func:`batching.plan_batches`); default: on a
+        GPU, when every registered term honours padding (:func:`terms.unpadded`)
 
     Returns
     -------
@@ -603,6 +620,7 @@ def expand(
         return _expand(
             sources, targets, out, checkpoint, solver, root_mode, force, max_frames, backend, address, workers,
             max_penetration_cm, skate_ratio, progress, on_batch, "." + output_format, fps, rest_from,
+            host_workers, pad,
         )  # fmt: skip
 
 
@@ -642,7 +660,7 @@ def _plan(clips, targets, out, known, force, suffix, options, result, rows):
 
 def _expand(
     sources, targets, out, checkpoint, solver, root_mode, force, max_frames, backend, address, workers,
-    max_penetration_cm, skate_ratio, progress, on_batch, suffix, fps, rest_from=None,
+    max_penetration_cm, skate_ratio, progress, on_batch, suffix, fps, rest_from=None, host_workers=None, pad=None,
 ) -> ExpandResult:  # fmt: skip
     start = time.perf_counter()
     out = Path(out)
@@ -661,88 +679,158 @@ def _expand(
     rows: dict[tuple[str, str], dict] = {}
     options = options_digest(checkpoint, solver, root_mode, fps, rest_from)
     todo = _plan(clips, targets, out, known, force, suffix, options, result, rows)
-    pairs, sources_by_clip = _load_pairs(todo, checkpoint, solver, rows, result, suffix, rest_from)
-    result.timings["load"] = time.perf_counter() - start
-    for src in sources_by_clip.values():
-        rates = (src.fps, checkpoint.fps, fps or src.fps)
-        if max(rates) - min(rates) > 1e-4 * max(rates):
-            result.resampled.append(
-                f"{src.path}: resampled: source {rates[0]:g} fps -> network {rates[1]:g} fps -> output {rates[2]:g} fps"
-            )
-    _write_manifest(out, list(rows.values()))
-    chars = {c.name: c for c in targets}
-    limits = (max_penetration_cm, skate_ratio)
-    batches = plan_batches(pairs, max_frames or batch_frames(checkpoint.device))
-    if backend == "ray":
-        from motionlab.retargeting.cluster import solve_batches_ray
+    gpu = checkpoint.device.type != "cpu"
+    workers_here = host.default_workers(checkpoint.device) if host_workers is None else host_workers
+    with host.pool(checkpoint, workers_here if todo else 0) as pool:
+        pairs, sources_by_clip = _load_pairs(todo, checkpoint, solver, rows, result, suffix, rest_from, root_mode, pool)
+        result.timings["load"] = time.perf_counter() - start
+        for src in sources_by_clip.values():
+            rates = (src.fps, checkpoint.fps, fps or src.fps)
+            if max(rates) - min(rates) > 1e-4 * max(rates):
+                result.resampled.append(
+                    f"{src.path}: resampled: source {rates[0]:g} fps -> network {rates[1]:g} fps -> output {rates[2]:g} fps"
+                )
+        _write_manifest(out, list(rows.values()))
+        context = (
+            sources_by_clip,
+            {c.name: c for c in targets},
+            (max_penetration_cm, skate_ratio),
+            suffix,
+            options,
+            fps,
+        )
+        padding = (gpu and not terms.unpadded()) if pad is None else pad
+        batches = plan_batches(pairs, max_frames or batch_frames(checkpoint.device), pad=padding)
+        if backend == "ray":
+            from motionlab.retargeting.cluster import solve_batches_ray
 
-        stream = solve_batches_ray(checkpoint, batches, solver, root_mode, address=address, workers=workers)
-    else:
-        stream = (solve_pairs(checkpoint, b, solver, root_mode) for b in batches)
-    from tqdm.auto import tqdm
-
-    bar = tqdm(total=len(batches), desc="expand", unit="batch", disable=not progress)
-    clock = time.perf_counter()
-    for index, solved in enumerate(stream):
-        result.timings["solve"] += time.perf_counter() - clock
-        clock = time.perf_counter()
-        new = _write_batch(solved, sources_by_clip, chars, limits, suffix, options, fps, out, rows, result)
-        result.timings["write"] += time.perf_counter() - clock
-        result.done += len(new)
-        result.batches += 1
-        bar.update(1)
-        if on_batch is not None:
-            on_batch(index, new)
-        clock = time.perf_counter()
-    bar.close()
+            stream = solve_batches_ray(checkpoint, batches, solver, root_mode, address=address, workers=workers)
+            outputs = ([_output(pr, *context) for pr in solved] for solved in stream)
+        else:
+            outputs = _local_outputs(batches, checkpoint, solver, pool, context, result.timings)
+        _write_all(outputs, len(batches), out, rows, result, progress, on_batch)
+    result.timings["solve"] -= result.timings.get("finish", 0.0)  # waited for the workers, not the solve
     result.rows = sorted(rows.values(), key=lambda r: (r["character"], r["clip"]))
     result.seconds = time.perf_counter() - start
     return result
 
 
-def _write_batch(solved, sources_by_clip, chars, limits, suffix, options, fps, out, rows, result) -> list[dict]:
-    """Rows first (manifest), then the files, in one :func:`_write_manifest`: a kill between the two
-    leaves rows without files, which a rerun redoes."""
-    new, staged = [], []
-    for pr in solved:
-        src = sources_by_clip[pr.clip]
-        motion = at_rate(pr.result, fps or src.fps, src.fps).motion
-        row = _row(pr, src, chars[pr.character], limits, suffix, motion, options)
-        result.implausible += not pr.result.plausibility.ok
-        file = out / row["output"]
-        file.parent.mkdir(parents=True, exist_ok=True)
-        staged.append((file, motion_files.encode(motion, suffix, chars[pr.character].unit)))
-        new.append(row)
-        rows[(pr.character, pr.clip)] = row
-        result.source_frames += pr.result.motion.num_frames
-    _write_manifest(out, list(rows.values()), staged)
-    return new
+def _write_all(outputs, count: int, out: Path, rows: dict, result: ExpandResult, progress: bool, on_batch) -> None:
+    """Write each batch's outputs (rows, then files) as they come; time the waits as ``solve``."""
+    from tqdm.auto import tqdm
+
+    bar = tqdm(total=count, desc="expand", unit="batch", disable=not progress)
+    clock = time.perf_counter()
+    for index, batch in enumerate(outputs):
+        result.timings["solve"] += time.perf_counter() - clock
+        clock = time.perf_counter()
+        for row, _, _, ok, frames in batch:
+            rows[(row["character"], row["clip"])] = row
+            result.implausible += not ok
+            result.source_frames += frames
+        staged = [(out / file, data) for _, file, data, _, _ in batch]
+        for file, _ in staged:
+            file.parent.mkdir(parents=True, exist_ok=True)
+        _write_manifest(out, list(rows.values()), staged)
+        result.timings["write"] += time.perf_counter() - clock
+        result.done += len(batch)
+        result.batches += 1
+        bar.update(1)
+        if on_batch is not None:
+            on_batch(index, [b[0] for b in batch])
+        clock = time.perf_counter()
+    bar.close()
 
 
-def _load_pairs(todo, checkpoint, solver, rows, result, suffix, rest_from=None):
-    """Read each source once; a clip or character that fails becomes ``error`` rows."""
+def _local_outputs(batches, checkpoint, solver, pool, context, timings):
+    """Each batch's outputs (:func:`_output`), in order. With a pool, a batch is finished and encoded
+    there while the next one is solved; ``timings["finish"]`` is the time spent waiting for it."""
+    timings.setdefault("finish", 0.0)
+    pending = None
+    for batch in batches:
+        clock = time.perf_counter()
+        jobs = [p.job for p in batch]
+        solved = solve_jobs(checkpoint, jobs, solver)
+        share = (time.perf_counter() - clock) / len(batch)
+        args = [(p, j, r, len(batch), share, context) for p, j, r in zip(batch, jobs, solved)]
+        if pool is None:
+            yield [_finished_output(*a) for a in args]
+            continue
+        futures = [pool.submit(_finished_output, *a) for a in args]
+        if pending is not None:
+            yield _collect(pending, timings)
+        pending = futures
+    if pending is not None:
+        yield _collect(pending, timings)
+
+
+def _collect(futures, timings) -> list:
+    clock = time.perf_counter()
+    done = [f.result() for f in futures]
+    timings["finish"] += time.perf_counter() - clock
+    return done
+
+
+def _finished_output(pair: Pair, job, solved, batch_size: int, seconds: float, context):
+    """:func:`_output` of a solved pair (:func:`batching.finish_job` first); runs in a host worker."""
+    return _output(finish_job(pair, job, solved, batch_size, seconds), *context)
+
+
+def _output(pr: PairResult, sources_by_clip, chars, limits, suffix, options, fps):
+    """``(row, file, bytes, plausible, source frames)`` of one retargeted pair, ready to write."""
+    src = sources_by_clip[pr.clip]
+    motion = at_rate(pr.result, fps or src.fps, src.fps).motion
+    char = chars[pr.character]
+    row = _row(pr, src, char, limits, suffix, motion, options)
+    data = motion_files.encode(motion, suffix, char.unit)
+    return row, row["output"], data, pr.result.plausibility.ok, pr.result.motion.num_frames
+
+
+def _prepare_clip(path, rest_from, targets, root_mode, solver, checkpoint=None):
+    """Read and prepare one clip and its pairs: ``(motion, prepared, skating cm/s, {character: job
+    or error message})``; runs in a host worker (its CPU checkpoint) or here (``checkpoint``)."""
+    checkpoint = checkpoint or host.checkpoint()
+    motion = rest_pose.on_reference(bvh.load(path), rest_from, str(path))
+    prepared = prepare_source(motion, checkpoint, "full", solver)
+    feet = [humanoid.JOINTS.index(f) for f in humanoid.FEET]
+    skating = 100.0 * metrics.foot_skating(prepared.motion.global_positions(), feet, prepared.motion.fps)
+    jobs = {}
+    for name, skeleton in targets:
+        try:
+            jobs[name] = prepare_pair(prepared, skeleton, root_mode)
+        except _ERRORS as err:
+            jobs[name] = _why(err, "character", name)
+    return motion, prepared, skating, jobs
+
+
+def _load_pairs(todo, checkpoint, solver, rows, result, suffix, rest_from=None, root_mode="stride", pool=None):
+    """Read and prepare each source once (in the host workers when there is a ``pool``), with its
+    pairs; a clip or character that fails becomes ``error`` rows."""
     pairs: list[Pair] = []
     sources_by_clip: dict[str, _Source] = {}
     by_clip: dict[str, list] = {}
     for clip, path, c, digest in todo:
         by_clip.setdefault(clip, [path, [], digest])[1].append(c)
-    feet = [humanoid.JOINTS.index(f) for f in humanoid.FEET]
+    tasks = {}
+    for clip, (path, chars, _) in by_clip.items():
+        usable = [(c.name, c.skeleton) for c in chars if c.skeleton is not None]
+        args = (path, rest_from, usable, root_mode, solver)
+        tasks[clip] = pool.submit(_prepare_clip, *args) if pool else args
     for clip, (path, chars, digest) in by_clip.items():
         try:
-            motion = rest_pose.on_reference(bvh.load(path), rest_from, str(path))
-            prepared = prepare_source(motion, checkpoint, "full", solver)
+            task = tasks[clip]
+            motion, prepared, skating, jobs = task.result() if pool else _prepare_clip(*task, checkpoint)
         except _ERRORS as err:
             for c in chars:
                 rows[(c.name, clip)] = _error_row(clip, c.name, str(path), c.origin, _why(err, "source", path), suffix)
                 result.failed += 1
             continue
-        pos = prepared.motion.global_positions()
-        skating = 100.0 * metrics.foot_skating(pos, feet, prepared.motion.fps)
         sources_by_clip[clip] = _Source(str(path), skating, motion.fps, digest)
         for c in chars:
-            if c.skeleton is None:
-                rows[(c.name, clip)] = _error_row(clip, c.name, str(path), c.origin, c.error, suffix)
+            job = jobs.get(c.name, c.error)
+            if isinstance(job, str):
+                rows[(c.name, clip)] = _error_row(clip, c.name, str(path), c.origin, job, suffix)
                 result.failed += 1
                 continue
-            pairs.append(Pair(clip, c.name, motion, c.skeleton, prepared.motion.num_frames, prepared))
+            pairs.append(Pair(clip, c.name, motion, c.skeleton, prepared.motion.num_frames, prepared, job))
     return pairs, sources_by_clip

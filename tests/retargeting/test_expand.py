@@ -156,6 +156,24 @@ def test_outputs_equal_single_pair_path(ckpt, library, tmp_path):
     assert "rig0" in job.summary() and "9 solved" in job.summary()
 
 
+@pytest.mark.slow
+def test_host_workers_and_padded_batches_write_what_one_process_writes(ckpt, library, tmp_path):
+    """expand as on a GPU (clips of 40 and 30 frames padded into one batch, reading and writing in
+    two spawned worker processes) writes the outputs and rows of the default CPU run."""
+    targets = _targets(library)
+    plain = ex.expand([str(library / "clips")], targets, tmp_path / "plain", ckpt, FAST)
+    gpu_like = ex.expand([str(library / "clips")], targets, tmp_path / "gpu", ckpt, FAST, host_workers=2, pad=True)
+    assert (plain.batches, gpu_like.batches) == (2, 1) and gpu_like.done == plain.done == 9
+    assert gpu_like.timings["finish"] >= 0 and gpu_like.source_frames == plain.source_frames
+    for a, b in zip(plain.rows, gpu_like.rows):
+        assert {k: a[k] for k in ("clip", "character", "steps", "stop_reason", "flag")} == {
+            k: b[k] for k in ("clip", "character", "steps", "stop_reason", "flag")
+        }
+        assert float(a["loss"]) == pytest.approx(float(b["loss"]), rel=1e-6)
+        first, second = (bvh.load(tmp_path / d / a["output"]).global_positions() for d in ("plain", "gpu"))
+        np.testing.assert_allclose(first, second, atol=2e-6)  # the files hold 6 decimals
+
+
 def test_resume_after_interruption_redoes_only_missing(ckpt, library, tmp_path):
     targets = _targets(library)
 

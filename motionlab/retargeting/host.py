@@ -1,0 +1,64 @@
+"""The host's share of a database expansion, in worker processes, so that a GPU does not wait.
+
+On a GPU the latent iteration of a batch of hundreds of (clip, character) pairs takes about as
+long as one CPU core needs to read, prepare, check and write a few dozen of them (BVH text,
+resampling, features, forward kinematics, the plausibility checks). :func:`pool` starts worker
+processes for that work; :func:`motionlab.retargeting.expand.expand` reads and prepares the
+clips there and finishes and encodes each batch's outputs there while the GPU solves the next
+batch. Each worker holds a CPU copy of the checkpoint (:func:`checkpoint`): preparing a clip
+needs its feature statistics, frame rate and float type. The workers are spawned, not forked,
+which is safe beside CUDA. Results are the same as in one process (a test checks it).
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import multiprocessing
+import os
+from collections.abc import Iterator
+from concurrent.futures import Executor, ProcessPoolExecutor
+from contextlib import contextmanager
+
+import torch
+
+from motionlab.retargeting.checkpoint import Checkpoint
+
+__all__ = ["MAX_WORKERS", "default_workers", "pool", "checkpoint"]
+
+MAX_WORKERS = 16
+"""Most worker processes :func:`default_workers` starts."""
+
+_CHECKPOINT: Checkpoint | None = None
+
+
+def default_workers(device: str | torch.device) -> int:
+    """0 on the CPU (its cores run the latent iteration); on a GPU every core but one, at most
+    :data:`MAX_WORKERS`."""
+    if torch.device(device).type == "cpu":
+        return 0
+    return max(0, min(MAX_WORKERS, (os.cpu_count() or 1) - 1))
+
+
+def _start(cpu_checkpoint: Checkpoint) -> None:
+    global _CHECKPOINT
+    torch.set_num_threads(1)  # many workers: one thread each
+    _CHECKPOINT = cpu_checkpoint
+
+
+def checkpoint() -> Checkpoint | None:
+    """This worker's CPU copy of the checkpoint (None outside a worker)."""
+    return _CHECKPOINT
+
+
+@contextmanager
+def pool(checkpoint: Checkpoint, workers: int) -> Iterator[Executor | None]:
+    """``workers`` spawned processes holding a CPU copy of ``checkpoint``; None when ``workers`` < 1
+    (the caller then does the work itself)."""
+    if workers < 1:
+        yield None
+        return
+    cpu = dataclasses.replace(checkpoint, model=copy.deepcopy(checkpoint.model).cpu())
+    context = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(workers, mp_context=context, initializer=_start, initargs=(cpu,)) as executor:
+        yield executor
