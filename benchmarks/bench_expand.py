@@ -22,6 +22,12 @@ Usage::
     python benchmarks/bench_expand.py --synthetic                                  # no real data
     python benchmarks/bench_expand.py --memory                                     # bytes per frame of a batch
     python benchmarks/bench_expand.py --verify OUT                                 # OUT's files == retarget's
+
+On a GPU (issue 40; ``docs/performance.md``): all of Aj's clips onto the six Table 1 characters,
+compared with a CPU run of the same pairs (``motionlab expand ... --device cpu -o REF``)::
+
+    python benchmarks/bench_expand.py --clips all --table1-characters --device cuda \
+        --skip-per-process --skip-ray --reference REF
 """
 
 from __future__ import annotations
@@ -52,7 +58,7 @@ def _inputs(args, folder: Path):
         from motionlab import synthetic
 
         (folder / "clips").mkdir()
-        clips = synthetic.dataset(args.clips, seed=7, num_frames=150)
+        clips = synthetic.dataset(10 if args.clips == "all" else int(args.clips), seed=7, num_frames=150)
         sources = [bvh.save(folder / "clips" / f"clip{i}.bvh", m) for i, m in enumerate(clips)]
         names = [f"char{i}" for i in range(args.characters)]
         skeletons = synthetic.character_set(args.characters, seed=3)
@@ -61,8 +67,13 @@ def _inputs(args, folder: Path):
         from motionlab.retargeting.evaluate import DEFAULT_ANIMATIONS, DEFAULT_TARGETS
 
         root = data.data_root() / "mixamo"
-        sources = [root / "Aj" / f"{a}.bvh" for a in DEFAULT_ANIMATIONS[: args.clips]]
-        real = list(DEFAULT_TARGETS[: max(args.characters - 1, 1)])
+        if args.clips == "all":
+            sources = sorted((root / "Aj").glob("*.bvh"))
+        else:
+            sources = [root / "Aj" / f"{a}.bvh" for a in DEFAULT_ANIMATIONS[: int(args.clips)]]
+        if args.table1_characters:
+            args.characters = len(DEFAULT_TARGETS)
+        real = list(DEFAULT_TARGETS[: len(DEFAULT_TARGETS) if args.table1_characters else max(args.characters - 1, 1)])
         names = real + list(ex.PRESETS)[: args.characters - len(real)]
         skeletons = [humanoid.to_canonical_skeleton(bvh.load(root / t / "Running.bvh").skeleton) for t in real]
         skeletons += [ex.characters(presets=[n])[0].skeleton for n in names[len(real) :]]
@@ -110,13 +121,17 @@ def _expand(sources, specs, out: Path, args, backend: str, threads=None):
     ckpt = retargeting.load_default(args.device, args.dtype)
     if ckpt.device.type == "cuda":
         torch.cuda.reset_peak_memory_stats(ckpt.device)
-    job = ex.expand(sources, ex.characters(*specs), out, ckpt, backend=backend, workers=2, threads=threads)
+    job = ex.expand(
+        sources, ex.characters(*specs), out, ckpt, backend=backend, workers=2, threads=threads,
+        host_workers=args.host_workers, pad=args.pad,
+    )  # fmt: skip
     split = ", ".join(f"{k} {v:.1f} s" for k, v in job.timings.items())
     memory = ""
     if ckpt.device.type == "cuda":
         memory = f", peak GPU memory {torch.cuda.max_memory_allocated(ckpt.device) / 2**20:.0f} MiB"
-    print(f"  {backend}{'' if threads is None else f' ({threads} threads)'} on {ckpt.device}: {job.batches} batches, "
-          f"{job.done} outputs, {job.throughput:.0f} source frames/s in expand; {split}{memory}")  # fmt: skip
+    print(f"  {backend}{'' if threads is None else f' ({threads} threads)'} on {ckpt.device} ({args.dtype}): "
+          f"{job.batches} batches, {job.done} outputs, {job.source_frames} source frames in {job.seconds:.1f} s = "
+          f"{job.throughput:.0f} source frames/s in expand; {split}{memory}")  # fmt: skip
     return time.perf_counter() - start, job
 
 
@@ -124,6 +139,22 @@ def _same(a: Path, b: Path) -> tuple[int, int]:
     files = sorted(p.relative_to(a) for p in a.rglob("*.bvh"))
     same = sum((b / f).is_file() and (b / f).read_bytes() == (a / f).read_bytes() for f in files)
     return same, len(files)
+
+
+def _compare(out: Path, reference: Path) -> None:
+    """Largest joint-position difference (cm) between OUT's outputs and REF's files of the same name."""
+    from motionlab.core import bvh
+
+    worst, count, where = 0.0, 0, ""
+    for ref in sorted(reference.rglob("*.bvh")):
+        mine = out / ref.relative_to(reference)
+        if mine.is_file():
+            d = 100 * float(np.abs(bvh.load(mine).global_positions() - bvh.load(ref).global_positions()).max())
+            worst, where = max((worst, where), (d, str(ref.relative_to(reference))))
+            count += 1
+    print(
+        f"outputs vs the reference {reference}: {count} files compared, largest joint difference {worst:.2g} cm ({where})"
+    )
 
 
 def _memory(args) -> None:
@@ -174,7 +205,20 @@ def _verify(out: Path) -> None:
 
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--clips", type=int, default=4, help="source clips (Aj's retarget_gt animations; default 4)")
+    p.add_argument(
+        "--clips", default="4", help="source clips: N of Aj's retarget_gt animations, or all of Aj's (default 4)"
+    )
+    p.add_argument("--table1-characters", action="store_true", help="the six Table 1 characters (no presets)")
+    p.add_argument(
+        "--host-workers", type=int, help="expand's host worker processes (default: none on the CPU, cores - 1 on a GPU)"
+    )
+    p.add_argument(
+        "--pad", action="store_true", default=None, help="pad pairs of other lengths into one batch (default: on a GPU)"
+    )
+    p.add_argument(
+        "--reference", metavar="REF", help="compare the local run's outputs with REF's files of the same names (cm)"
+    )
+    p.add_argument("--keep", metavar="DIR", help="copy the local run's outputs to DIR")
     p.add_argument("--characters", type=int, default=4, help="characters: real ones, then presets (default 4)")
     p.add_argument("--synthetic", action="store_true", help="synthetic clips and characters instead of MOTIONLAB_DATA")
     p.add_argument("--device", help="torch device for all three (default: cuda if available, else cpu)")
@@ -193,7 +237,8 @@ def main() -> None:
         return _memory(args)
     if args.verify:
         return _verify(Path(args.verify))
-    print(f"torch {torch.__version__}, {torch.get_num_threads()} threads, {os.cpu_count()} CPUs; {_load()}")
+    gpu = f", {torch.cuda.get_device_name()}" if torch.cuda.is_available() else ""
+    print(f"torch {torch.__version__}, {torch.get_num_threads()} threads, {os.cpu_count()} CPUs{gpu}; {_load()}")
     with tempfile.TemporaryDirectory() as d:
         d = Path(d)
         sources, specs = _inputs(args, d)
@@ -207,6 +252,12 @@ def main() -> None:
             results["one process per pair"] = _per_process(sources, specs, d / "per_process", args)
         t, job = _expand(sources, specs, d / "local", args, "local")
         results["local batched"] = t
+        if args.reference:
+            _compare(d / "local", Path(args.reference))
+        if args.keep:
+            import shutil
+
+            shutil.copytree(d / "local", args.keep, dirs_exist_ok=True)
         if not args.device or args.device == "cpu":
             t, job = _expand(sources, specs, d / "local2", args, "local", threads=2)
             results["local batched, 2 threads"] = t

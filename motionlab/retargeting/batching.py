@@ -136,7 +136,9 @@ def plan_batches(pairs: Sequence[Pair], max_frames: int, pad: bool = False) -> l
 
     ``pad=False``: pairs of equal length only, longest clips first, pairs kept in their given order
     within a length. ``pad=True``: pairs of any length, longest first (ties in their given order);
-    a batch's frames are its pairs × its longest pair's frames (the padded size).
+    a batch's frames are its pairs × its longest pair's frames (the padded size), and a batch's
+    shortest pair has at least half its longest one's frames, so that at most half of a batch is
+    padding.
 
     Raises
     ------
@@ -147,7 +149,8 @@ def plan_batches(pairs: Sequence[Pair], max_frames: int, pad: bool = False) -> l
     if pad:
         batches: list[list[Pair]] = []
         for p in sorted(pairs, key=lambda p: -p.frames):
-            if not batches or (len(batches[-1]) + 1) * batches[-1][0].frames > max_frames:
+            longest = batches[-1][0].frames if batches else 0
+            if not batches or (len(batches[-1]) + 1) * longest > max_frames or 2 * p.frames < longest:
                 batches.append([])
             batches[-1].append(p)
         return batches

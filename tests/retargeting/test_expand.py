@@ -259,6 +259,16 @@ def test_plan_batches_by_length_and_memory():
     assert len(plan_batches(pairs, max_frames=1)) == 5  # never less than one pair per batch
 
 
+def test_padded_batches_mix_lengths_longest_first_at_most_half_padding():
+    sk = humanoid.canonical_skeleton()
+    pairs = [Pair(f"c{i}", "x", None, sk, frames) for i, frames in enumerate([40, 30, 90, 40, 21, 19, 50])]
+    batches = plan_batches(pairs, max_frames=200, pad=True)
+    assert [[p.clip for p in b] for b in batches] == [["c2", "c6"], ["c0", "c3", "c1", "c4"], ["c5"]]
+    for b in batches:
+        assert len(b) * b[0].frames <= 200 and 2 * b[-1].frames >= b[0].frames
+    assert len(plan_batches(pairs, max_frames=1, pad=True)) == 7
+
+
 def test_ray_backend_without_ray_says_how_to_install(monkeypatch, library, tmp_path, capsys):
     monkeypatch.setitem(__import__("sys").modules, "ray", None)
     code = main(["expand", str(library / "clips"), "--preset", "tall", "-o", str(tmp_path), "--backend", "ray"])
