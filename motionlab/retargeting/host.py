@@ -6,8 +6,9 @@ resampling, features, forward kinematics, the plausibility checks). :func:`pool`
 processes for that work; :func:`motionlab.retargeting.expand.expand` reads and prepares the
 clips there and finishes and encodes each batch's outputs there while the GPU solves the next
 batch. Each worker holds a CPU copy of the checkpoint (:func:`checkpoint`): preparing a clip
-needs its feature statistics, frame rate and float type. The workers are spawned, not forked,
-which is safe beside CUDA. Results are the same as in one process (a test checks it).
+needs its feature statistics, frame rate and float type. The workers are forked from a fresh
+server process that has imported motionlab once (``forkserver``), never from this one, which is
+safe beside CUDA. Results are the same as in one process (a test checks it).
 """
 
 from __future__ import annotations
@@ -53,12 +54,13 @@ def checkpoint() -> Checkpoint | None:
 
 @contextmanager
 def pool(checkpoint: Checkpoint, workers: int) -> Iterator[Executor | None]:
-    """``workers`` spawned processes holding a CPU copy of ``checkpoint``; None when ``workers`` < 1
+    """``workers`` processes holding a CPU copy of ``checkpoint``; None when ``workers`` < 1
     (the caller then does the work itself)."""
     if workers < 1:
         yield None
         return
     cpu = dataclasses.replace(checkpoint, model=copy.deepcopy(checkpoint.model).cpu())
-    context = multiprocessing.get_context("spawn")
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload(["motionlab.retargeting.expand"])
     with ProcessPoolExecutor(workers, mp_context=context, initializer=_start, initargs=(cpu,)) as executor:
         yield executor

@@ -305,7 +305,7 @@ def test_cuda_evaluate_equals_the_cpu(clip, tmp_path):
     }
     for a, b in zip(res["cpu"], res["cuda"]):
         for k, v in a.items():
-            if isinstance(v, float):
+            if isinstance(v, float) and k != "time":  # wall time per clip differs between devices
                 assert v == pytest.approx(b[k], rel=1e-6, abs=1e-9), k
 
 
