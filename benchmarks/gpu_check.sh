@@ -8,7 +8,8 @@
 #      checkpoint is kept (OUT/motionlab_Aj.pt) so the CPU can evaluate the same network.
 # Usage: DATA=mixamo.tar.xz REF=ref_cpu.tar.xz OUT=folder bash benchmarks/gpu_check.sh
 # (DATA: a tar of MOTIONLAB_DATA's mixamo/ folder; REF: a tar of a folder ref_cpu/ written by
-# `motionlab expand ... --device cpu -o ref_cpu`). DEV=cpu CLIPS=1 EVAL=0 tries the script without a GPU.
+# `motionlab expand ... --device cpu -o ref_cpu`). STAGES picks stages (default: pytest expand64 expand32
+# table1; also profile: benchmarks/profile_expand_gpu.py). DEV=cpu CLIPS=1 tries the script without a GPU.
 set -u
 export PYTHONPATH=$PWD PYTHONUNBUFFERED=1
 PY=${PY:-python3}
@@ -22,16 +23,28 @@ $PY -c "import torch, numpy; print('torch', torch.__version__, 'numpy', numpy.__
 mkdir -p "$work/data" "$work/ref" "$OUT"
 tar xJf "$DATA" -C "$work/data" && tar xJf "$REF" -C "$work/ref" || exit 1
 export MOTIONLAB_DATA=$work/data
+STAGES=" ${STAGES:-pytest expand64 expand32 table1} "
+on() { [[ "$STAGES" == *" $1 "* ]]; }
+if on pytest; then
 stage pytest -m cuda
-timeout 150 $PY -m pytest -m cuda tests/retargeting/test_devices.py -q -p no:cacheprovider 2>&1 | tail -4
+timeout 150 $PY -m pytest -m cuda tests/retargeting/test_devices.py -q -p no:cacheprovider 2>&1 | tail -15
+fi
+if on profile; then
+    stage profile
+    timeout 240 $PY benchmarks/profile_expand_gpu.py --device "$DEV" $( [ "$CLIPS" = all ] || echo --clips "$CLIPS" )
+fi
+if on expand64; then
 stage expand float64
 timeout 200 $PY benchmarks/bench_expand.py --clips "$CLIPS" --table1-characters --device "$DEV" --skip-per-process \
     --skip-ray --reference "$work/ref/ref_cpu" --keep "$work/gpu_out"
 (cd "$work" && tar czf - gpu_out | split -b 15M - "$OUT/gpu_out.tgz.")
+fi
+if on expand32; then
 stage expand float32
 timeout 150 $PY benchmarks/bench_expand.py --clips "$CLIPS" --table1-characters --device "$DEV" --dtype float32 \
     --skip-per-process --skip-ray --reference "$work/ref/ref_cpu"
-if [ "${EVAL:-1}" = 1 ]; then
+fi
+if on table1; then
     stage "Table 1 on $DEV (trains the network there)"
     timeout 300 $PY -m motionlab evaluate --device "$DEV" --checkpoint "$OUT/motionlab_Aj.pt" --no-ablations -q \
         --csv "$OUT/table1_$DEV.csv" 2>&1 | tee "$OUT/table1_$DEV.txt"
