@@ -370,7 +370,8 @@ def project_latent(
         frame stands for (``min(t, length − 1)``), as in :func:`smoother`
 
     Each row is solved as if alone: a row stops (keeps its latent) once all its residuals are
-    below 1e-5 (≈ 0.001°), and the frames are computed in chunks of :data:`PROJECT_FRAMES`.
+    below 1e-5 (≈ 0.001°), and the frames are computed in chunks (:data:`PROJECT_FRAMES`, or on a
+    GPU as many as a quarter of its free memory holds, :data:`PROJECT_BYTES_PER_FRAME`).
 
     Returns
     -------
@@ -395,9 +396,23 @@ def project_latent(
 
 
 PROJECT_FRAMES = 2048
-"""Frames per chunk of :func:`project_latent`'s Jacobians: a frame's (88 × D) Jacobian, its
-88 × 88 normal matrix and their factor take about 0.3 MB in float64 (D = 128), so a chunk takes
-about 1.2 GB; per-frame results do not depend on the chunk."""
+"""Frames per chunk of :func:`project_latent`'s Jacobians on the CPU. A frame's (88 × D) Jacobian,
+the temporaries of :meth:`RetargetNet.rotation_jacobian`, its 88 × 88 normal matrix and their
+factor take up to :data:`PROJECT_BYTES_PER_FRAME`; per-frame results do not depend on the chunk."""
+
+PROJECT_BYTES_PER_FRAME = 1_000_000
+"""Bytes one frame of a Gauss–Newton chunk may take in float64 (D = 128; half in float32), rounded
+up from the tensors it builds. On a GPU a chunk takes up to a quarter of the free memory: fewer,
+larger chunks keep the GPU busy instead of waiting for the host to launch the next one."""
+
+
+def _chunk_frames(phi: torch.Tensor) -> int:
+    """Frames per Gauss–Newton chunk for ``phi``'s device and float type (:data:`PROJECT_FRAMES`)."""
+    if phi.device.type != "cuda":
+        return PROJECT_FRAMES
+    free, _ = torch.cuda.mem_get_info(phi.device)
+    per_frame = PROJECT_BYTES_PER_FRAME * phi.element_size() // 8
+    return max(PROJECT_FRAMES, int(0.25 * free // per_frame))
 
 
 def _gauss_newton_step(model, phi, target_rot, emb, damping) -> tuple[torch.Tensor, torch.Tensor]:
@@ -408,8 +423,9 @@ def _gauss_newton_step(model, phi, target_rot, emb, damping) -> tuple[torch.Tens
     emb_frames = emb[:, None, :].expand(N, T, emb.shape[-1]).reshape(N * T, -1)
     eye = torch.eye(4 * NUM_JOINTS, dtype=phi.dtype, device=phi.device)
     step, worst = torch.empty_like(flat), torch.empty(N * T, dtype=phi.dtype, device=phi.device)
-    for c in range(0, N * T, PROJECT_FRAMES):
-        part = slice(c, c + PROJECT_FRAMES)
+    chunk = _chunk_frames(phi)
+    for c in range(0, N * T, chunk):
+        part = slice(c, c + chunk)
         out, jac = model.rotation_jacobian(flat[part], emb_frames[part])
         goal = torch.where((out * target[part]).sum(-1, keepdim=True) < 0, -target[part], target[part])
         resid = (goal - out).reshape(out.shape[0], -1, 1)
@@ -793,12 +809,21 @@ def _steps(phi0: torch.Tensor, p: _Problem) -> _Steps:
     return _Steps(zeros.clone().requires_grad_(True), lr, grid, zeros.clone(), zeros, np.zeros(N, dtype=np.int64))
 
 
+def _rows_of(bounds: np.ndarray, groups: list) -> np.ndarray:
+    """The batch rows (int64) of ``groups``, in order: ``bounds[g]:bounds[g + 1]`` for each."""
+    groups = np.asarray(groups, dtype=np.int64)
+    starts, sizes = bounds[groups], bounds[groups + 1] - bounds[groups]
+    if (sizes == 1).all():
+        return starts.astype(np.int64)
+    return np.concatenate([np.arange(a, a + n) for a, n in zip(starts, sizes)]).astype(np.int64)
+
+
 def _losses(p: _Problem, phi0, embedding, smooth, steps: _Steps, active: list):
     """Decode the active groups' latents; ``(out, phi, group_loss (active,), values)`` where
     ``values[k]`` is ``[L_iter, each registered term's value]`` of active group k (means over its rows)."""
     groups, bounds, device, dtype = len(p.sizes), p.bounds, phi0.device, phi0.dtype
     everyone = len(active) == groups
-    rows = None if everyone else torch.cat([torch.arange(bounds[g], bounds[g + 1], device=device) for g in active])
+    rows = None if everyone else torch.as_tensor(_rows_of(bounds, active), device=device)
     pick = (lambda t: t) if everyone else (lambda t: None if t is None else t[rows])
     phi = pick(phi0) + smooth(pick(steps.delta), pick(p.index))
     offsets = p.offsets[rows] if p.per_row_offsets and not everyone else p.offsets
@@ -917,7 +942,7 @@ def _adam_step(p: _Problem, steps: _Steps, group_loss: torch.Tensor, active: lis
     steps.delta.grad = None
     (group_loss * keep).sum().backward()
     active = [g for k, g in enumerate(active) if k not in stopped]
-    rows = np.concatenate([np.arange(p.bounds[g], p.bounds[g + 1]) for g in active])
+    rows = _rows_of(p.bounds, active)
     steps.count[rows] += 1
     like = dict(dtype=steps.m.dtype, device=steps.m.device)
     (b1, b2), t = _BETAS, steps.count[rows]
