@@ -89,6 +89,9 @@ class Routes(Sequence):
     def __getitem__(self, k):
         return self._all()[k]
 
+    def __iter__(self):
+        return iter(self._all())
+
     def __eq__(self, other) -> bool:
         return isinstance(other, Sequence) and len(other) == self.count and list(self) == list(other)
 

@@ -55,7 +55,6 @@ import re
 from collections import deque
 from dataclasses import dataclass, field
 
-import networkx as nx
 import numpy as np
 
 from motionlab.motion_graphs.graph import GraphError, MotionGraph
@@ -256,6 +255,7 @@ class PoolWalker:
     alive: np.ndarray | None = None
     sparse: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
     price: np.ndarray | None = None
+    _out: tuple[np.ndarray, np.ndarray] | None = field(default=None, init=False, repr=False, compare=False)
 
     def jumps(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(src, dst, price)`` of every jump of the pool."""
@@ -273,10 +273,29 @@ class PoolWalker:
         return self.last_src - self.last_dst + 1
 
     def succ(self, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """All (from, to) moves out of ``frames`` (steps and jumps)."""
+        """All (from, to) moves out of ``frames`` (steps and jumps): first the steps, in the
+        order of ``frames``, then the jumps out of any of them, each once, in their order in
+        ``loop_src``. Costs the moves found, not the pool's jumps."""
+        frames = np.asarray(frames, dtype=np.int64)
         f = frames[self.step[frames]]
-        m = np.isin(self.loop_src, frames)
-        return np.concatenate([f, self.loop_src[m]]), np.concatenate([f + 1, self.loop_dst[m]])
+        order, head = self._by_source()
+        if frames.size > 1 and not np.all(frames[1:] > frames[:-1]):
+            frames = np.unique(frames)  # a frame given twice gives its jumps once
+        first, count = head[frames], head[frames + 1] - head[frames]
+        at = np.repeat(first - np.cumsum(count) + count, count) + np.arange(int(count.sum()))
+        jumps = np.sort(order[at])  # in their stored order
+        return np.concatenate([f, self.loop_src[jumps]]), np.concatenate([f + 1, self.loop_dst[jumps]])
+
+    def _by_source(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(order, head)``: the jumps ordered by source frame, those out of frame ``f`` at
+        ``order[head[f] : head[f + 1]]`` (made at the first call, then kept: the walker's jumps
+        are not to be replaced)."""
+        if self._out is None:
+            order = np.argsort(self.loop_src, kind="stable")
+            head = np.zeros(self.length + 1, dtype=np.int64)
+            np.cumsum(np.bincount(self.loop_src, minlength=self.length), out=head[1:])
+            self._out = (order, head)
+        return self._out
 
 
 def _pool_walker(graph: MotionGraph, clips: list[int], index: int = 0, cost=default_cost) -> PoolWalker:
@@ -284,10 +303,9 @@ def _pool_walker(graph: MotionGraph, clips: list[int], index: int = 0, cost=defa
     first, last = graph.clips[clips[0]], graph.clips[clips[-1]]
     st, sp = first.start, last.stop
     step = graph.next_in_clip()[st:sp].copy()
-    m = (graph.src >= st) & (graph.src < sp) & (graph.dst >= st) & (graph.dst < sp)
-    m &= graph.alive[graph.src] & graph.alive[graph.dst]
-    src, dst = graph.src[m] - st, graph.dst[m] - st
-    price = _prices(graph, np.flatnonzero(m), cost)
+    edges = _edges_within(graph, st, sp)
+    src, dst = _take(graph.src, edges) - st, _take(graph.dst, edges) - st
+    price = _prices(graph, edges, cost)
     # the main cycle: a jump back whose frames dst..src are all steps (one take, all alive)
     run = np.concatenate([[0], np.cumsum(step)])  # run[f] = steps among 0..f-1
     back = (dst <= src) & (run[src] - run[dst] == src - dst)
@@ -298,12 +316,61 @@ def _pool_walker(graph: MotionGraph, clips: list[int], index: int = 0, cost=defa
         last_src, last_dst = -1, -1
     offsets = np.array([graph.clips[c].start - st for c in clips], dtype=np.int64)
     # the SPARSE_JUMPS cheapest jumps into every frame (ties: the nearer pose, then source)
-    order = np.lexsort((src, graph.cost[m], price, dst))
-    few = order[np.arange(order.size) - np.searchsorted(dst[order], dst[order]) < SPARSE_JUMPS]
+    few = _cheapest_into(dst, (price, _take(graph.cost, edges), src), sp - st, SPARSE_JUMPS)
     return PoolWalker(
         index, sp - st, step, src, dst, last_src, last_dst, np.asarray(clips, dtype=np.int64), offsets,
         graph.alive[st:sp].copy(), (src[few], dst[few], price[few]), price,
     )  # fmt: skip
+
+
+def _take(a: np.ndarray, index: np.ndarray) -> np.ndarray:
+    """``a[index]``, read as a slice when ``index`` is a run of consecutive indices (a pool's
+    edges usually are: a slice of a mapped file reads its pages in order)."""
+    if index.size and index[-1] - index[0] + 1 == index.size:
+        return np.asarray(a[index[0] : index[-1] + 1])
+    return np.asarray(a[index])
+
+
+def _cheapest_into(dst: np.ndarray, keys: tuple, length: int, k: int) -> np.ndarray:
+    """Indices of the ``k`` least jumps into every frame, ordered by destination, then rank:
+    what ``np.lexsort((*keys[::-1], dst))`` lists first for each destination.
+
+    ``dst``: (E,) int in ``0 … length - 1``; ``keys``: (E,) arrays (no NaN), compared in turn,
+    then the index. Each rank is found by keeping, key after key, the jumps that equal their
+    destination's least value (one scatter per key, no sort of the E jumps).
+    """
+    index = np.arange(dst.size)
+    left, picked = index, []
+    for _ in range(k):
+        cand = left
+        for key in (*keys, index):
+            value, to = key[cand], dst[cand]
+            if value.size == 0 or value.min() == value.max():
+                continue  # one value (the default price): every jump is among the least
+            least = np.full(length, np.inf if key.dtype.kind == "f" else np.iinfo(key.dtype).max, dtype=key.dtype)
+            np.minimum.at(least, to, value)
+            cand = cand[value == least[to]]
+        picked.append(cand)  # one jump per destination that has one left
+        out = np.zeros(dst.size, dtype=bool)
+        out[cand] = True
+        left = left[~out[left]]
+    rank = np.concatenate([np.full(c.size, r) for r, c in enumerate(picked)])
+    chosen = np.concatenate(picked)
+    return chosen[np.lexsort((rank, dst[chosen]))]
+
+
+def _edges_within(graph: MotionGraph, st: int, sp: int) -> np.ndarray:
+    """Indices, ascending, of the edges between alive frames of ``st … sp - 1`` (global frames):
+    one pass over the sources, then the few edges found are checked."""
+    inside = (graph.src >= st) & (graph.src < sp)
+    if not inside.any():
+        return np.zeros(0, dtype=np.int64)
+    a = int(inside.argmax())
+    b = inside.size - int(inside[::-1].argmax())
+    edges = np.arange(a, b) if inside[a:b].all() else a + np.flatnonzero(inside[a:b])  # often one run
+    dst = _take(graph.dst, edges)
+    edges, dst = edges[(dst >= st) & (dst < sp)], dst[(dst >= st) & (dst < sp)]
+    return edges[graph.alive[_take(graph.src, edges)] & graph.alive[dst]]
 
 
 def pool_walker(graph: MotionGraph, behaviour: str, style: str, cost=default_cost) -> PoolWalker:
@@ -327,9 +394,13 @@ def _clip_walker(graph: MotionGraph, c: int, cost=default_cost) -> PoolWalker:
     return _pool_walker(graph, [c], c, cost)
 
 
-def _distances(cw: PoolWalker, start: int, targets: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def _distances(
+    cw: PoolWalker, start: int, targets: np.ndarray | None = None, any_target: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
     """Breadth-first search from ``start``: fewest moves to every frame (-1: unreachable) and
-    the parent of each reached frame. Stops early once every frame of ``targets`` is reached.
+    the parent of each reached frame. Stops early once every frame of ``targets`` is reached
+    (``any_target``: once any is; the nearest targets are then all reached, since a round
+    reaches every frame at its distance, and the frames farther than them are left at -1).
 
     Vectorised over the frontier; the number of rounds is the depth of the search.
     """
@@ -339,17 +410,28 @@ def _distances(cw: PoolWalker, start: int, targets: np.ndarray | None = None) ->
     frontier = np.array([start], dtype=np.int64)
     d = 0
     while frontier.size:
-        if targets is not None and np.all(dist[targets] >= 0):
-            break
+        if targets is not None:
+            hit = dist[targets] >= 0
+            if hit.all() or (any_target and hit.any()):
+                break
         a, b = cw.succ(frontier)
         new = dist[b] < 0
         a, b = a[new], b[new]
-        b, first = np.unique(b, return_index=True)
+        b, first = _first_of_each(b, cw.length)
         d += 1
         dist[b] = d
         parent[b] = a[first]
         frontier = b
     return dist, parent
+
+
+def _first_of_each(frames: np.ndarray, length: int) -> tuple[np.ndarray, np.ndarray]:
+    """``np.unique(frames, return_index=True)`` for frames in ``0 … length - 1``: the distinct
+    frames, ascending, and where each first occurs (one scatter, no sort)."""
+    first = np.full(length, frames.size, dtype=np.int64)
+    np.minimum.at(first, frames, np.arange(frames.size))
+    seen = np.flatnonzero(first < frames.size)
+    return seen, first[seen]
 
 
 def _path(cw: PoolWalker, start: int, targets, name: str) -> tuple[list[int], int]:
@@ -359,7 +441,7 @@ def _path(cw: PoolWalker, start: int, targets, name: str) -> tuple[list[int], in
     meeting a target, it stops with an error instead of walking on for ever.
     """
     targets = np.asarray(targets, dtype=np.int64)
-    dist, parent = _distances(cw, start, None)
+    dist, parent = _distances(cw, start, targets, any_target=True)
     d = np.where(dist[targets] >= 0, dist[targets], np.iinfo(np.int64).max)
     r = int(np.argmin(d))
     if dist[targets[r]] < 0:
@@ -601,23 +683,33 @@ def walk_to_exit(
     self-loop point instead; a pool of many takes has no single last self-loop point.
     ValueError when ``start`` or an exit lies outside the pool, or ``exits`` is empty.
     """
-    if not exits or not all(0 <= int(x) < cw.length for x in [start, *exits]):
+    ex = np.asarray(exits, dtype=np.int64).reshape(-1)
+    if not ex.size or not (0 <= int(start) < cw.length and np.all((ex >= 0) & (ex < cw.length))):
         raise ValueError(f"expected a start and at least one exit in 0..{cw.length - 1}, got {start} and {exits}")
-    frames, r = _path(cw, start, exits, name)
-    src, dst, price = cw.jumps()
-    moves = zip(frames[:-1], frames[1:])
-    paid = sum(float(price[(src == a) & (dst == b)].min()) for a, b in moves if not (b == a + 1 and cw.step[a]))
-    bound = len(frames) + paid  # what the shortest walk costs
+    frames, r = _path(cw, start, ex, name)
+    bound = len(frames) + _paid(cw, frames)  # what the shortest walk costs
     # a cheaper walk has fewer frames than ``bound`` (each frame costs one) and visits no frame
     # twice (a loop costs at least a frame), so it has at most ``cw.length`` frames
     rows = min(int(np.ceil(bound)), cw.length)
-    ex = np.asarray(exits, dtype=np.int64)
     reach = _reach(cw, start, rows, cw.sparse)
     cost = np.arange(1, rows + 1)[:, None] + reach[:, ex].astype(np.float64)
     c, k = np.unravel_index(int(np.argmin(cost)), cost.shape)  # shortest first, then the first exit
     if cost[c, k] < bound:
         frames, r = _backtrack(cw, reach, int(c), int(ex[k]), cw.sparse), int(k)
     return _runs(cw, frames), r, len(frames)
+
+
+def _paid(cw: PoolWalker, frames: list[int]) -> float:
+    """The price of the jumps of a walk through ``frames`` (a move that is not a step is a
+    jump; the cheapest of the jumps that make it)."""
+    src, dst, price = cw.jumps()
+    order, head = cw._by_source()
+    paid = 0.0
+    for a, b in zip(frames[:-1], frames[1:]):
+        if not (b == a + 1 and cw.step[a]):
+            out = order[head[a] : head[a + 1]]
+            paid += float(price[out[dst[out] == b]].min())
+    return paid
 
 
 def _next(cw: PoolWalker, f: int) -> int:
@@ -891,6 +983,8 @@ def search_standard(graph: MotionGraph, request, start_clip: int | None = None, 
     ValueError
         for a bad request (see :func:`parse_request`) or a bad ``cost``.
     """
+    import networkx as nx  # (imported here: the structured search does not need it)
+
     segs = _segments(request)
     g = graph.segment_graph()
     first, last, seg = graph.segments()
