@@ -240,7 +240,8 @@ class PoolWalker:
     ``price``: what each jump costs, frames on top of the frame it plays (``None``:
     :data:`JUMP_FRAMES` each, as :func:`default_cost`). ``sparse``: ``(src, dst, price)`` of the
     :data:`SPARSE_JUMPS` cheapest jumps into every frame (``None``: all jumps), which the search
-    tries first.
+    tries first. A walker keeps what its searches derive from these arrays (its jumps by source
+    and by destination): replace none of them once it has searched; make a new walker.
     """
 
     index: int
@@ -256,6 +257,7 @@ class PoolWalker:
     sparse: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
     price: np.ndarray | None = None
     _out: tuple[np.ndarray, np.ndarray] | None = field(default=None, init=False, repr=False, compare=False)
+    _prepared: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def jumps(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(src, dst, price)`` of every jump of the pool."""
@@ -495,43 +497,61 @@ def _reach(cw: PoolWalker, start: int, steps: int, jumps: Jumps | None = None) -
     ``jumps``: the jumps to use (default: all the walker's).
     """
     step_ok = cw.step[:-1]
-    src, dst, price = cw.jumps() if jumps is None else jumps
-    order = np.argsort(dst, kind="stable")
-    src, dst, price = src[order], dst[order], price[order]
-    rank = np.arange(dst.size) - np.searchsorted(dst, dst)  # k-th jump into its frame
-    if rank.size == 0 or rank.max() < SPARSE_JUMPS:
-        layers = [(src[rank == k], dst[rank == k], price[rank == k]) for k in range(SPARSE_JUMPS)]
-        return _reach_few(max(steps, 1), cw.length, start, step_ok, layers)
+    prep = _prepare(cw, jumps)
+    if prep[0] == "few":
+        return _reach_few(max(steps, 1), cw.length, start, step_ok, prep[1], prep[2])
+    _, src, price, heads, targets = prep
     out = np.full((max(steps, 1), cw.length), _UNREACHED, dtype=np.float32)
     out[0, start] = 0
-    if dst.size:
-        heads = np.flatnonzero(np.concatenate([[True], dst[1:] != dst[:-1]]))
-        targets = dst[heads]
     for c in range(1, steps):
         prev, cur = out[c - 1], out[c]
         cur[1:] = np.where(step_ok, prev[:-1], _UNREACHED)
-        if dst.size:
+        if src.size:
             via = np.minimum.reduceat(prev[src] + price, heads)
             cur[targets] = np.minimum(cur[targets], via)
     return out
 
 
-def _reach_few(steps: int, n: int, start: int, step_ok: np.ndarray, layers: list) -> np.ndarray:
-    """:func:`_reach` when few jumps enter each frame: ``layers[k]`` holds the k-th jump into
-    each frame (at most one per frame), so a row is one gather per layer, with no grouping.
+def _prepare(cw: PoolWalker, jumps: Jumps | None) -> tuple:
+    """What a row of :func:`_reach` gathers for ``jumps``: ``("few", src_of, price_of)``, the
+    k-th jump into each frame (source ``n``, never reached, where there is none) when at most
+    :data:`SPARSE_JUMPS` enter any frame, else ``("grouped", src, price, heads, targets)``, the
+    jumps by destination. Kept in the walker for its own jump sets (all, or ``cw.sparse``)."""
+    key = "all" if jumps is None else "sparse" if jumps is cw.sparse else None
+    if key in cw._prepared:
+        return cw._prepared[key]
+    src, dst, price = cw.jumps() if jumps is None else jumps
+    order = np.argsort(dst, kind="stable")
+    src, dst, price = src[order], dst[order], price[order]
+    rank = np.arange(dst.size) - np.searchsorted(dst, dst)  # k-th jump into its frame
+    n = cw.length
+    if rank.size == 0 or rank.max() < SPARSE_JUMPS:
+        src_of, price_of = [], []
+        for k in range(SPARSE_JUMPS):
+            s = np.full(n, n)
+            s[dst[rank == k]] = src[rank == k]
+            p = np.zeros(n, dtype=np.float32)
+            p[dst[rank == k]] = price[rank == k]
+            src_of.append(s)
+            price_of.append(p)
+        prep = ("few", src_of, price_of)
+    else:
+        heads = np.flatnonzero(np.concatenate([[True], dst[1:] != dst[:-1]]))
+        prep = ("grouped", src, price, heads, dst[heads])
+    if key is not None:
+        cw._prepared[key] = prep
+    return prep
+
+
+def _reach_few(steps: int, n: int, start: int, step_ok: np.ndarray, src_of: list, price_of: list) -> np.ndarray:
+    """:func:`_reach` when few jumps enter each frame: ``src_of[k]``, ``price_of[k]``: the k-th
+    jump into each frame (at most one per frame; source ``n`` where there is none), so a row is
+    one gather per layer, with no grouping.
 
     Returns a (steps, n) view of an array with one more column, always ``inf``: the frame a
     missing jump comes from."""
     out = np.full((steps, n + 1), _UNREACHED, dtype=np.float32)
     out[0, start] = 0
-    src_of, price_of = [], []
-    for src, dst, price in layers:
-        s = np.full(n, n)  # the jump into each frame, n (a frame that is never reached) if none
-        s[dst] = src
-        p = np.zeros(n, dtype=np.float32)
-        p[dst] = price
-        src_of.append(s)
-        price_of.append(p)
     via, other = np.empty(n, dtype=np.float32), np.empty(n, dtype=np.float32)
     for c in range(1, steps):
         prev, cur = out[c - 1], out[c]
