@@ -342,20 +342,20 @@ def _cheapest_into(dst: np.ndarray, keys: tuple, length: int, k: int) -> np.ndar
     destination's least value (one scatter per key, no sort of the E jumps).
     """
     index = np.arange(dst.size)
+    keys = [key for key in keys if key.size and key.min() != key.max()]  # one value: no jump beats another
     left, picked = index, []
     for _ in range(k):
-        cand = left
+        cand, to = left, dst if left is index else dst[left]
         for key in (*keys, index):
-            value, to = key[cand], dst[cand]
-            if value.size == 0 or value.min() == value.max():
-                continue  # one value (the default price): every jump is among the least
+            value = key if cand is index else key[cand]
             least = np.full(length, np.inf if key.dtype.kind == "f" else np.iinfo(key.dtype).max, dtype=key.dtype)
             np.minimum.at(least, to, value)
-            cand = cand[value == least[to]]
+            keep = value == least[to]
+            cand, to = cand[keep], to[keep]
         picked.append(cand)  # one jump per destination that has one left
         out = np.zeros(dst.size, dtype=bool)
         out[cand] = True
-        left = left[~out[left]]
+        left = np.flatnonzero(~out) if left is index else left[~out[left]]
     rank = np.concatenate([np.full(c.size, r) for r, c in enumerate(picked)])
     chosen = np.concatenate(picked)
     return chosen[np.lexsort((rank, dst[chosen]))]
