@@ -285,7 +285,13 @@ class PoolWalker:
             frames = np.unique(frames)  # a frame given twice gives its jumps once
         first, count = head[frames], head[frames + 1] - head[frames]
         at = np.repeat(first - np.cumsum(count) + count, count) + np.arange(int(count.sum()))
-        jumps = np.sort(order[at])  # in their stored order
+        jumps = order[at]
+        if jumps.size * 32 > order.size:  # in their stored order: a mark per jump beats a sort
+            mark = np.zeros(order.size, dtype=bool)
+            mark[jumps] = True
+            jumps = np.flatnonzero(mark)
+        else:
+            jumps.sort()
         return np.concatenate([f, self.loop_src[jumps]]), np.concatenate([f + 1, self.loop_dst[jumps]])
 
     def _by_source(self) -> tuple[np.ndarray, np.ndarray]:
