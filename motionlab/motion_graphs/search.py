@@ -442,25 +442,34 @@ def _first_of_each(frames: np.ndarray, length: int) -> tuple[np.ndarray, np.ndar
     return seen, first[seen]
 
 
-def _path(cw: PoolWalker, start: int, targets, name: str) -> tuple[list[int], int]:
-    """Frames of a shortest walk from ``start`` to the nearest of ``targets`` (the ``r``-th).
+def _distinct(targets) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct frames of ``targets`` in the order they first occur, and where each first
+    occurs: of tied targets, the first is the first of these."""
+    frames, first = np.unique(np.asarray(targets, dtype=np.int64), return_index=True)
+    order = np.argsort(first)
+    return frames[order], first[order]
+
+
+def _path(cw: PoolWalker, start: int, targets, name: str, distinct=None) -> tuple[list[int], int]:
+    """Frames of a shortest walk from ``start`` to the nearest of ``targets`` (the ``r``-th, the
+    first of the nearest). ``distinct``: ``_distinct(targets)``, when the caller keeps it.
 
     The *loop guard*: when the search has seen every frame reachable from ``start`` without
     meeting a target, it stops with an error instead of walking on for ever.
     """
-    targets = np.asarray(targets, dtype=np.int64)
-    dist, parent = _distances(cw, start, targets, any_target=True)
-    d = np.where(dist[targets] >= 0, dist[targets], np.iinfo(np.int64).max)
-    r = int(np.argmin(d))
-    if dist[targets[r]] < 0:
+    frames_of, first = _distinct(targets) if distinct is None else distinct
+    dist, parent = _distances(cw, start, frames_of, any_target=True)
+    d = np.where(dist[frames_of] >= 0, dist[frames_of], np.iinfo(np.int64).max)
+    u = int(np.argmin(d))
+    if dist[frames_of[u]] < 0:
         raise SearchError(
             f"loop guard: every frame of {name!r} reachable from frame {start} was visited "
             f"({int((dist >= 0).sum())} frames) without reaching the way on"
         )
-    frames = [int(targets[r])]
+    frames = [int(frames_of[u])]
     while frames[-1] != start:
         frames.append(int(parent[frames[-1]]))
-    return frames[::-1], r
+    return frames[::-1], int(first[u])
 
 
 def _runs(cw: PoolWalker | int, frames: list[int]) -> list[tuple[int, int, int]]:
@@ -710,18 +719,30 @@ def walk_to_exit(
     ValueError when ``start`` or an exit lies outside the pool, or ``exits`` is empty.
     """
     ex = np.asarray(exits, dtype=np.int64).reshape(-1)
+    _check_exits(cw, start, ex)
+    return _walk_to_exit(cw, start, _distinct(ex), name)
+
+
+def _check_exits(cw: PoolWalker, start: int, ex: np.ndarray) -> None:
     if not ex.size or not (0 <= int(start) < cw.length and np.all((ex >= 0) & (ex < cw.length))):
-        raise ValueError(f"expected a start and at least one exit in 0..{cw.length - 1}, got {start} and {exits}")
-    frames, r = _path(cw, start, ex, name)
+        raise ValueError(f"expected a start and at least one exit in 0..{cw.length - 1}, got {start} and {ex.tolist()}")
+
+
+def _walk_to_exit(
+    cw: PoolWalker, start: int, distinct: tuple, name: str
+) -> tuple[list[tuple[int, int, int]], int, int]:
+    """:func:`walk_to_exit` to the exits ``distinct = _distinct(exits)`` (checked)."""
+    frames, r = _path(cw, start, None, name, distinct)
     bound = len(frames) + _paid(cw, frames)  # what the shortest walk costs
     # a cheaper walk has fewer frames than ``bound`` (each frame costs one) and visits no frame
     # twice (a loop costs at least a frame), so it has at most ``cw.length`` frames
     rows = min(int(np.ceil(bound)), cw.length)
     reach = _reach(cw, start, rows, cw.sparse)
+    ex, first = distinct  # an exit frame given twice costs the same: its first index stands for it
     cost = np.arange(1, rows + 1)[:, None] + reach[:, ex].astype(np.float64)
     c, k = np.unravel_index(int(np.argmin(cost)), cost.shape)  # shortest first, then the first exit
     if cost[c, k] < bound:
-        frames, r = _backtrack(cw, reach, int(c), int(ex[k]), cw.sparse), int(k)
+        frames, r = _backtrack(cw, reach, int(c), int(ex[k]), cw.sparse), int(first[k])
     return _runs(cw, frames), r, len(frames)
 
 
@@ -785,6 +806,7 @@ class Planner:
         self.walkers: dict[tuple[str, str], PoolWalker] = {}
         self.links: dict[tuple[str, str], list[dict]] = {}
         self.memo: dict = {}
+        self.exits: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         for link in graph.table["links"]:
             self.links.setdefault(tuple(link["from"]), []).append(link)
 
@@ -878,8 +900,12 @@ class Planner:
             key = tuple(link["from"])
             cw = self.walker(key)
             routes = link["routes"]
-            exits = [r["exit"] for r in routes]
-            p, r, n = walk_to_exit(cw, enter, exits, f"{key[0]}/{key[1]}")
+            if id(link) not in self.exits:  # the link's exits, once
+                ex = np.array([r["exit"] for r in routes], dtype=np.int64)
+                _check_exits(cw, enter, ex)
+                self.exits[id(link)] = _distinct(ex)
+            _check_exits(cw, enter, self.exits[id(link)][0])
+            p, r, n = _walk_to_exit(cw, enter, self.exits[id(link)], f"{key[0]}/{key[1]}")
             route = routes[r]
             pieces.extend(p)
             pieces.extend(tuple(x) for x in route["pieces"])
