@@ -895,23 +895,24 @@ class Planner:
         return self.memo[key]
 
     def _onward(self, hops: list[dict], enter: int) -> tuple[list[tuple[int, int, int]], int, int]:
-        pieces, frames = [], 0
-        for link in hops:
-            key = tuple(link["from"])
-            cw = self.walker(key)
-            routes = link["routes"]
-            if id(link) not in self.exits:  # the link's exits, once
-                ex = np.array([r["exit"] for r in routes], dtype=np.int64)
-                _check_exits(cw, enter, ex)
-                self.exits[id(link)] = _distinct(ex)
-            _check_exits(cw, enter, self.exits[id(link)][0])
-            p, r, n = _walk_to_exit(cw, enter, self.exits[id(link)], f"{key[0]}/{key[1]}")
-            route = routes[r]
-            pieces.extend(p)
-            pieces.extend(tuple(x) for x in route["pieces"])
-            frames += n + route["frames"]
-            enter = route["enter"]
-        return pieces, frames, enter
+        """The first hop (the walk through its pool to the best of its routes, and the route),
+        then the rest through :meth:`onward`, so each (hops left, entry) is walked once."""
+        if not hops:
+            return [], 0, enter
+        link = hops[0]
+        key = tuple(link["from"])
+        cw = self.walker(key)
+        routes = link["routes"]
+        if id(link) not in self.exits:  # the link's exits, once
+            ex = np.array([r["exit"] for r in routes], dtype=np.int64)
+            _check_exits(cw, enter, ex)
+            self.exits[id(link)] = _distinct(ex)
+        _check_exits(cw, enter, self.exits[id(link)][0])
+        p, r, n = _walk_to_exit(cw, enter, self.exits[id(link)], f"{key[0]}/{key[1]}")
+        route = routes[r]
+        more, more_frames, final_enter = self.onward(hops[1:], route["enter"])
+        pieces = [*p, *(tuple(x) for x in route["pieces"]), *more]
+        return pieces, n + route["frames"] + more_frames, final_enter
 
     def search(self, request, progress: bool = False) -> SearchResult:
         """Meet a request on the planner's graph (see :func:`search`).
