@@ -22,8 +22,8 @@ from __future__ import annotations
 import importlib
 
 _SUBMODULES = frozenset(
-    ("clips", "cycles", "distance", "io", "naming", "registration", "report", "search", "segments", "stance_links",
-     "synthesis")
+    ("clips", "cycles", "distance", "graph", "io", "naming", "registration", "report", "search", "segments",
+     "stance_links", "structured", "synthesis")
 )  # fmt: skip
 _NAMES = {
     "ClipInfo": "graph", "GraphError": "graph", "MotionGraph": "graph", "build_standard": "graph",
