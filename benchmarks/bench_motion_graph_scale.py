@@ -6,13 +6,17 @@ Libraries (``--cases KIND:FRAMES ...``): ``session`` — the shared takes of eve
 125 k frames) repeated under new take numbers until the requested size exists; ``walk`` — the walk
 takes only (175 takes, 44 k frames). Below the shared size whole takes are drawn round-robin over
 the styles. Each case is built in a fresh process (its peak resident memory, ``ru_maxrss``, is its
-own) with ``--workers`` threads and saved as a ``.mlgraph`` file; then every request runs as its
-own ``motionlab graph-search`` command, timed from start to exit, with the command's peak
-resident memory (``getrusage(RUSAGE_CHILDREN)`` of a wrapper process with that one child); and
-``graph-info`` likewise.
+own) with ``--workers`` threads and saved as a ``.mlgraph`` file; then every request runs
+``--repeat`` times as its own ``motionlab graph-search`` command, timed from start to exit
+(start-up included), with the command's CPU seconds and peak resident memory
+(``getrusage(RUSAGE_CHILDREN)`` of a wrapper process with that one child); and ``graph-info``
+likewise. The last line per case says the slowest ``graph-search`` command and the largest peak
+against the goals. With ``--keep DIR`` the graph is written to ``DIR/KIND-FRAMES.mlgraph`` and,
+when that file exists already, used as it is (no build: only the commands run).
 
     python benchmarks/bench_motion_graph_scale.py                   # session:370000 walk:1000000
     python benchmarks/bench_motion_graph_scale.py --cases walk:1000 walk:10000   # quick
+    python benchmarks/bench_motion_graph_scale.py --cases session:370000 --keep /tmp/graphs  # then commands only
 
 Goals (issue 43): a session-sized build (370 k frames) <= 60 s and <= 1.5 GB on the 2-core
 machine, 1 M frames <= 3 GB; ``graph-search`` <= 2 s per command, start-up included, and
@@ -44,6 +48,7 @@ REQUESTS = {
     "walk": ("walk:normal:200,walk:elderly:200", "walk:normal:200,walk:active:200,walk:feminine:200"),
 }
 GOAL_SCC = 95.0
+GOAL_SEARCH_S, GOAL_SEARCH_GB = 2.0, 0.5
 
 
 def session(frames: int, behaviours: str = "walk"):
@@ -128,14 +133,16 @@ def _measured(cmd: list[str]) -> dict:
     return json.loads(p.stdout.strip().splitlines()[-1])
 
 
-def commands(graph: Path, kind: str, tmp: Path) -> list[tuple[str, dict]]:
-    """``graph-info`` and one ``graph-search`` per request of ``kind``, each a fresh command."""
+def commands(graph: Path, kind: str, tmp: Path, repeat: int) -> list[tuple[str, dict]]:
+    """``graph-info`` and ``repeat`` runs of one ``graph-search`` per request of ``kind``, each a
+    fresh command."""
     motionlab = [sys.executable, "-m", "motionlab.cli"]
     rows = [("graph-info", _measured([*motionlab, "graph-info", str(graph)]))]
     for k, req in enumerate(REQUESTS[kind]):
         out = tmp / f"search{k}.bvh"
-        rows.append((req, _measured([*motionlab, "graph-search", str(graph), "--request", req, "-o", str(out),
-                                     "--force", "-q"])))  # fmt: skip
+        for _ in range(repeat):
+            rows.append((req, _measured([*motionlab, "graph-search", str(graph), "--request", req, "-o", str(out),
+                                         "--force", "-q"])))  # fmt: skip
     req = REQUESTS[kind][-1]
     only = [sys.executable, "-c", GRAPH_COMMANDS_ONLY, "graph-search", str(graph), "--request", req, "-o",
             str(tmp / "only.bvh"), "--force", "-q"]  # fmt: skip
@@ -143,6 +150,19 @@ def commands(graph: Path, kind: str, tmp: Path) -> list[tuple[str, dict]]:
     imp = _measured([sys.executable, "-c", "import motionlab.cli as c; c.build_parser()"])
     rows.append(("(motionlab's start-up alone: importing every system's commands)", imp))
     return rows
+
+
+def search_verdict(rows: list[tuple[str, dict]], kind: str) -> str:
+    """The slowest ``graph-search`` command of ``rows`` and the largest peak, against the goals."""
+    runs = [m for name, m in rows if name in REQUESTS[kind]]
+    if not runs or any(m["rc"] != 0 for m in runs):
+        return "graph-search: a command failed (see the rows above)"
+    wall, gb = max(m["wall_s"] for m in runs), max(m["peak_gb"] for m in runs)
+    cpu = max(m["cpu_s"] for m in runs)
+    ok = wall <= GOAL_SEARCH_S and gb <= GOAL_SEARCH_GB
+    return (f"graph-search per command, start-up included ({len(runs)} commands): slowest {wall:.2f} s wall "
+            f"(most CPU {cpu:.2f} s), largest peak {gb:.2f} GB; goal <= {GOAL_SEARCH_S:g} s and "
+            f"<= {GOAL_SEARCH_GB:g} GB: {'met' if ok else 'NOT met'}")  # fmt: skip
 
 
 GRAPH_COMMANDS_ONLY = """import argparse, sys
@@ -157,31 +177,44 @@ except ValueError as e:  # CLIError, GraphError
 start-up imports every system, torch included)."""
 
 
-def run_case(case: str, workers: int) -> int:
+def build_in_child(case: str, graph: Path, workers: int) -> dict | None:
+    """Build ``case`` in a fresh process and save it to ``graph``; print its figures."""
+    kind = case.split(":")[0]
+    load = os.getloadavg()
+    p = subprocess.run([sys.executable, __file__, "--one", case, "--graph", str(graph), "--workers", str(workers)],
+                       capture_output=True, text=True)  # fmt: skip
+    if p.returncode != 0:
+        print(f"{case}: build failed\n{p.stderr[-3000:]}")
+        return None
+    r = json.loads(p.stdout.strip().splitlines()[-1])
+    print(f"\n## {kind} library, {r['frames']} frames, {r['takes']} takes, threshold {r['threshold_m']} m, "
+          f"{r['workers']} threads; load average before {load[0]:.1f}")  # fmt: skip
+    print(f"build {r['build_s']:.1f} s wall ({r['cpu_s']:.1f} s CPU), peak {r['peak_gb']:.2f} GB (whole process: "
+          f"library, build, report, save); {r['transitions']} transitions; file {r['file_mb']:.0f} MB")  # fmt: skip
+    from motionlab.motion_graphs.report import format_stages
+
+    print(format_stages(r["stages"]))
+    print(f"largest strongly connected component per behaviour (goal >= {GOAL_SCC:g}%):")
+    for b, v in sorted(r["behaviours"].items()):
+        print(f"  {b}: {v:.1f}% {'met' if v >= GOAL_SCC else 'NOT met'}")
+    return r
+
+
+def run_case(case: str, workers: int, keep: Path | None = None, repeat: int = 3) -> int:
     kind, frames = case.split(":")
     with tempfile.TemporaryDirectory() as d:
-        graph = Path(d) / "g.mlgraph"
-        load = os.getloadavg()
-        p = subprocess.run([sys.executable, __file__, "--one", case, "--graph", str(graph), "--workers", str(workers)],
-                           capture_output=True, text=True)  # fmt: skip
-        if p.returncode != 0:
-            print(f"{case}: build failed\n{p.stderr[-3000:]}")
+        graph = (keep or Path(d)) / (f"{kind}-{frames}.mlgraph" if keep else "g.mlgraph")
+        if keep and graph.is_file():
+            print(f"\n## {kind} library, {frames} frames: the graph kept in {graph} (not built again)")
+        elif build_in_child(case, graph, workers) is None:
             return 1
-        r = json.loads(p.stdout.strip().splitlines()[-1])
-        print(f"\n## {kind} library, {r['frames']} frames, {r['takes']} takes, threshold {r['threshold_m']} m, "
-              f"{r['workers']} threads; load average before {load[0]:.1f}")  # fmt: skip
-        print(f"build {r['build_s']:.1f} s wall ({r['cpu_s']:.1f} s CPU), peak {r['peak_gb']:.2f} GB (whole process: "
-              f"library, build, report, save); {r['transitions']} transitions; file {r['file_mb']:.0f} MB")  # fmt: skip
-        from motionlab.motion_graphs.report import format_stages
-
-        print(format_stages(r["stages"]))
-        print(f"largest strongly connected component per behaviour (goal >= {GOAL_SCC:g}%):")
-        for b, v in sorted(r["behaviours"].items()):
-            print(f"  {b}: {v:.1f}% {'met' if v >= GOAL_SCC else 'NOT met'}")
+        print(f"load average before the commands {os.getloadavg()[0]:.1f}")
         print("command | wall s (start-up included) | CPU s | peak GB | result")
-        for name, m in commands(graph, kind, Path(d)):
+        rows = commands(graph, kind, Path(d), repeat)
+        for name, m in rows:
             first = (m["out"].strip().splitlines() or m["err"].strip().splitlines() or [""])[0][:70]
             print(f"{name} | {m['wall_s']:.2f} | {m['cpu_s']:.2f} | {m['peak_gb']:.2f} | rc {m['rc']} {first}")
+        print(search_verdict(rows, kind))
         print(f"load average after {os.getloadavg()[0]:.1f}")
     return 0
 
@@ -190,6 +223,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cases", nargs="+", default=None, help="KIND:FRAMES, KIND session or walk")
     ap.add_argument("--workers", type=int, default=2, help="build threads (default 2, the machine's cores)")
+    ap.add_argument("--repeat", type=int, default=3, help="runs of each graph-search request (default 3)")
+    ap.add_argument("--keep", type=Path, help="folder for the graphs: KIND-FRAMES.mlgraph, used again when there")
     ap.add_argument("--one", help=argparse.SUPPRESS)
     ap.add_argument("--graph", help=argparse.SUPPRESS)
     ap.add_argument("--measure", help=argparse.SUPPRESS)
@@ -203,7 +238,9 @@ def main(argv=None) -> int:
         return 0
     cases = args.cases or (["walk:1000", "walk:10000"] if os.environ.get("MOTIONLAB_QUICK") else list(CASES))
     print(f"machine: {os.cpu_count()} CPUs, load average {os.getloadavg()}")
-    return max(run_case(c, args.workers) for c in cases)
+    if args.keep:
+        args.keep.mkdir(parents=True, exist_ok=True)
+    return max(run_case(c, args.workers, args.keep, max(args.repeat, 1)) for c in cases)
 
 
 if __name__ == "__main__":

@@ -17,32 +17,41 @@
 Taught in ``notebooks/05_motion_graphs.ipynb``.
 """
 
-from motionlab.motion_graphs import (
-    clips,
-    cycles,
-    distance,
-    io,
-    naming,
-    registration,
-    report,
-    search,
-    segments,
-    stance_links,
-    synthesis,
-)
-from motionlab.motion_graphs.graph import ClipInfo, GraphError, MotionGraph, build_standard
-from motionlab.motion_graphs.search import (
-    Planner,
-    SearchError,
-    SearchResult,
-    Segment,
-    default_cost,
-    parse_request,
-    search_standard,
-)
-from motionlab.motion_graphs.search import search as search_path
-from motionlab.motion_graphs.structured import build_structured, structure_rows
-from motionlab.motion_graphs.synthesis import synthesize, transition_quality
+from __future__ import annotations
+
+import importlib
+
+_SUBMODULES = frozenset(
+    ("clips", "cycles", "distance", "graph", "io", "naming", "registration", "report", "search", "segments",
+     "stance_links", "structured", "synthesis")
+)  # fmt: skip
+_NAMES = {
+    "ClipInfo": "graph", "GraphError": "graph", "MotionGraph": "graph", "build_standard": "graph",
+    "Planner": "search", "SearchError": "search", "SearchResult": "search", "Segment": "search",
+    "default_cost": "search", "parse_request": "search", "search_standard": "search", "search_path": "search",
+    "build_structured": "structured", "structure_rows": "structured",
+    "synthesize": "synthesis", "transition_quality": "synthesis",
+}  # fmt: skip
+"""Where each public name lives; a submodule is imported when one of its names is first used, so
+that a command importing one module (``graph-search``: io, search, synthesis) does not import
+the build's modules."""
+
+
+def __getattr__(name: str):
+    if name in _SUBMODULES:
+        return importlib.import_module(f"{__name__}.{name}")
+    if name in _NAMES:
+        value = getattr(
+            importlib.import_module(f"{__name__}.{_NAMES[name]}"), "search" if name == "search_path" else name
+        )
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
+
 
 __all__ = [
     "distance",

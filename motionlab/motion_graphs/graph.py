@@ -25,13 +25,16 @@ from __future__ import annotations
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
-import networkx as nx
 import numpy as np
 
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
 from motionlab.motion_graphs import distance as _distance
+
+if TYPE_CHECKING:
+    import networkx as nx
 
 __all__ = [
     "ClipInfo",
@@ -263,6 +266,8 @@ class MotionGraph:
 
     def segment_graph(self, alive: np.ndarray | None = None) -> nx.DiGraph:
         """The compressed graph: one node per segment (attributes clip, first, last, frames)."""
+        import networkx as nx  # (imported here: a search or a load does not need it, and it takes a while)
+
         alive = self.alive if alive is None else alive
         first, last, seg = self.segments(alive)
         g = nx.DiGraph()

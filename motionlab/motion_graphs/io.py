@@ -7,7 +7,9 @@ UTF-8 bytes of a JSON object — format version, fps, joint names, clips, struct
 info and the graph's :meth:`~.graph.MotionGraph.summary` — and the routes of the structure
 table's links as arrays ``route_*`` (read back as :class:`Routes`). Because the members are stored, not
 compressed, :func:`load` *maps* the arrays (``numpy.memmap``, copy-on-write) instead of reading
-them: opening a graph reads only its JSON, and a search reads only the pages it touches.
+them: opening a graph reads only its JSON, and a search reads only the pages it touches. Each
+member's data starts at a multiple of :data:`ALIGN` bytes (padding in its zip header), so the
+mapped arrays are aligned; files of this version written without the padding load as well.
 
 Files of the previous version (``motionlab-graph-2``, compressed) are still read, whole.
 
@@ -89,6 +91,9 @@ class Routes(Sequence):
     def __getitem__(self, k):
         return self._all()[k]
 
+    def __iter__(self):
+        return iter(self._all())
+
     def __eq__(self, other) -> bool:
         return isinstance(other, Sequence) and len(other) == self.count and list(self) == list(other)
 
@@ -145,7 +150,7 @@ def writer(graph: MotionGraph, summary: dict | None = None):
     meta["table"], route_arrays = _pack_routes(graph.table)
 
     def write(fh) -> None:
-        np.savez(
+        _write_aligned(
             fh,
             meta=np.frombuffer(json.dumps(_jsonable(meta)).encode("utf-8"), dtype=np.uint8),
             local_rot=np.asarray(graph.local_rot, dtype=np.float64),
@@ -161,6 +166,29 @@ def writer(graph: MotionGraph, summary: dict | None = None):
         )
 
     return write
+
+
+ALIGN = 64
+"""Bytes to which every array's data is aligned in the file (an ``.npy`` header pads the data
+to this from the member's start, and the member's data starts on it): a mapped array that is
+not aligned to its item size is read by NumPy's slow unaligned loops."""
+
+_PAD_ID = 0xD935
+"""Zip extra-field id of the padding (the one Android's ``zipalign`` writes; readers skip it)."""
+
+
+def _write_aligned(fh, **arrays: np.ndarray) -> None:
+    """``np.savez(fh, **arrays)`` (stored, zip64, no pickle) with each member's data starting at
+    a multiple of :data:`ALIGN` bytes in the file, padded by an extra field of its local header."""
+    with zipfile.ZipFile(fh, mode="w", compression=zipfile.ZIP_STORED, allowZip64=True) as z:
+        for name, a in arrays.items():
+            info = zipfile.ZipInfo(f"{name}.npy", date_time=(1980, 1, 1, 0, 0, 0))
+            info.compress_type, info.CRC, info.compress_size, info.file_size = zipfile.ZIP_STORED, 0, 0, 0
+            header = len(info.FileHeader(zip64=True)) + 4  # with the padding field's own 4 bytes
+            pad = -(z.fp.tell() + header) % ALIGN
+            info.extra = struct.pack("<HH", _PAD_ID, pad) + bytes(pad)
+            with z.open(info, mode="w", force_zip64=True) as f:
+                np.lib.format.write_array(f, np.asanyarray(a), allow_pickle=False)
 
 
 def save(path: str | os.PathLike, graph: MotionGraph, overwrite: bool = False, summary: dict | None = None) -> Path:

@@ -55,7 +55,6 @@ import re
 from collections import deque
 from dataclasses import dataclass, field
 
-import networkx as nx
 import numpy as np
 
 from motionlab.motion_graphs.graph import GraphError, MotionGraph
@@ -241,7 +240,8 @@ class PoolWalker:
     ``price``: what each jump costs, frames on top of the frame it plays (``None``:
     :data:`JUMP_FRAMES` each, as :func:`default_cost`). ``sparse``: ``(src, dst, price)`` of the
     :data:`SPARSE_JUMPS` cheapest jumps into every frame (``None``: all jumps), which the search
-    tries first.
+    tries first. A walker keeps what its searches derive from these arrays (its jumps by source
+    and by destination): replace none of them once it has searched; make a new walker.
     """
 
     index: int
@@ -256,6 +256,8 @@ class PoolWalker:
     alive: np.ndarray | None = None
     sparse: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
     price: np.ndarray | None = None
+    _out: tuple[np.ndarray, np.ndarray] | None = field(default=None, init=False, repr=False, compare=False)
+    _prepared: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def jumps(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(src, dst, price)`` of every jump of the pool."""
@@ -273,10 +275,35 @@ class PoolWalker:
         return self.last_src - self.last_dst + 1
 
     def succ(self, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """All (from, to) moves out of ``frames`` (steps and jumps)."""
+        """All (from, to) moves out of ``frames`` (steps and jumps): first the steps, in the
+        order of ``frames``, then the jumps out of any of them, each once, in their order in
+        ``loop_src``. Costs the moves found, not the pool's jumps."""
+        frames = np.asarray(frames, dtype=np.int64)
         f = frames[self.step[frames]]
-        m = np.isin(self.loop_src, frames)
-        return np.concatenate([f, self.loop_src[m]]), np.concatenate([f + 1, self.loop_dst[m]])
+        order, head = self._by_source()
+        if frames.size > 1 and not np.all(frames[1:] > frames[:-1]):
+            frames = np.unique(frames)  # a frame given twice gives its jumps once
+        first, count = head[frames], head[frames + 1] - head[frames]
+        at = np.repeat(first - np.cumsum(count) + count, count) + np.arange(int(count.sum()))
+        jumps = order[at]
+        if jumps.size * 32 > order.size:  # in their stored order: a mark per jump beats a sort
+            mark = np.zeros(order.size, dtype=bool)
+            mark[jumps] = True
+            jumps = np.flatnonzero(mark)
+        else:
+            jumps.sort()
+        return np.concatenate([f, self.loop_src[jumps]]), np.concatenate([f + 1, self.loop_dst[jumps]])
+
+    def _by_source(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(order, head)``: the jumps ordered by source frame, those out of frame ``f`` at
+        ``order[head[f] : head[f + 1]]`` (made at the first call, then kept: the walker's jumps
+        are not to be replaced)."""
+        if self._out is None:
+            order = np.argsort(self.loop_src, kind="stable")
+            head = np.zeros(self.length + 1, dtype=np.int64)
+            np.cumsum(np.bincount(self.loop_src, minlength=self.length), out=head[1:])
+            self._out = (order, head)
+        return self._out
 
 
 def _pool_walker(graph: MotionGraph, clips: list[int], index: int = 0, cost=default_cost) -> PoolWalker:
@@ -284,10 +311,9 @@ def _pool_walker(graph: MotionGraph, clips: list[int], index: int = 0, cost=defa
     first, last = graph.clips[clips[0]], graph.clips[clips[-1]]
     st, sp = first.start, last.stop
     step = graph.next_in_clip()[st:sp].copy()
-    m = (graph.src >= st) & (graph.src < sp) & (graph.dst >= st) & (graph.dst < sp)
-    m &= graph.alive[graph.src] & graph.alive[graph.dst]
-    src, dst = graph.src[m] - st, graph.dst[m] - st
-    price = _prices(graph, np.flatnonzero(m), cost)
+    edges = _edges_within(graph, st, sp)
+    src, dst = _take(graph.src, edges) - st, _take(graph.dst, edges) - st
+    price = _prices(graph, edges, cost)
     # the main cycle: a jump back whose frames dst..src are all steps (one take, all alive)
     run = np.concatenate([[0], np.cumsum(step)])  # run[f] = steps among 0..f-1
     back = (dst <= src) & (run[src] - run[dst] == src - dst)
@@ -298,12 +324,61 @@ def _pool_walker(graph: MotionGraph, clips: list[int], index: int = 0, cost=defa
         last_src, last_dst = -1, -1
     offsets = np.array([graph.clips[c].start - st for c in clips], dtype=np.int64)
     # the SPARSE_JUMPS cheapest jumps into every frame (ties: the nearer pose, then source)
-    order = np.lexsort((src, graph.cost[m], price, dst))
-    few = order[np.arange(order.size) - np.searchsorted(dst[order], dst[order]) < SPARSE_JUMPS]
+    few = _cheapest_into(dst, (price, _take(graph.cost, edges), src), sp - st, SPARSE_JUMPS)
     return PoolWalker(
         index, sp - st, step, src, dst, last_src, last_dst, np.asarray(clips, dtype=np.int64), offsets,
         graph.alive[st:sp].copy(), (src[few], dst[few], price[few]), price,
     )  # fmt: skip
+
+
+def _take(a: np.ndarray, index: np.ndarray) -> np.ndarray:
+    """``a[index]``, read as a slice when ``index`` is a run of consecutive indices (a pool's
+    edges usually are: a slice of a mapped file reads its pages in order)."""
+    if index.size and index[-1] - index[0] + 1 == index.size:
+        return np.asarray(a[index[0] : index[-1] + 1])
+    return np.asarray(a[index])
+
+
+def _cheapest_into(dst: np.ndarray, keys: tuple, length: int, k: int) -> np.ndarray:
+    """Indices of the ``k`` least jumps into every frame, ordered by destination, then rank:
+    what ``np.lexsort((*keys[::-1], dst))`` lists first for each destination.
+
+    ``dst``: (E,) int in ``0 … length - 1``; ``keys``: (E,) arrays (no NaN), compared in turn,
+    then the index. Each rank is found by keeping, key after key, the jumps that equal their
+    destination's least value (one scatter per key, no sort of the E jumps).
+    """
+    index = np.arange(dst.size)
+    keys = [key for key in keys if key.size and key.min() != key.max()]  # one value: no jump beats another
+    left, picked = index, []
+    for _ in range(k):
+        cand, to = left, dst if left is index else dst[left]
+        for key in (*keys, index):
+            value = key if cand is index else key[cand]
+            least = np.full(length, np.inf if key.dtype.kind == "f" else np.iinfo(key.dtype).max, dtype=key.dtype)
+            np.minimum.at(least, to, value)
+            keep = value == least[to]
+            cand, to = cand[keep], to[keep]
+        picked.append(cand)  # one jump per destination that has one left
+        out = np.zeros(dst.size, dtype=bool)
+        out[cand] = True
+        left = np.flatnonzero(~out) if left is index else left[~out[left]]
+    rank = np.concatenate([np.full(c.size, r) for r, c in enumerate(picked)])
+    chosen = np.concatenate(picked)
+    return chosen[np.lexsort((rank, dst[chosen]))]
+
+
+def _edges_within(graph: MotionGraph, st: int, sp: int) -> np.ndarray:
+    """Indices, ascending, of the edges between alive frames of ``st … sp - 1`` (global frames):
+    one pass over the sources, then the few edges found are checked."""
+    inside = (graph.src >= st) & (graph.src < sp)
+    if not inside.any():
+        return np.zeros(0, dtype=np.int64)
+    a = int(inside.argmax())
+    b = inside.size - int(inside[::-1].argmax())
+    edges = np.arange(a, b) if inside[a:b].all() else a + np.flatnonzero(inside[a:b])  # often one run
+    dst = _take(graph.dst, edges)
+    edges, dst = edges[(dst >= st) & (dst < sp)], dst[(dst >= st) & (dst < sp)]
+    return edges[graph.alive[_take(graph.src, edges)] & graph.alive[dst]]
 
 
 def pool_walker(graph: MotionGraph, behaviour: str, style: str, cost=default_cost) -> PoolWalker:
@@ -327,9 +402,13 @@ def _clip_walker(graph: MotionGraph, c: int, cost=default_cost) -> PoolWalker:
     return _pool_walker(graph, [c], c, cost)
 
 
-def _distances(cw: PoolWalker, start: int, targets: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def _distances(
+    cw: PoolWalker, start: int, targets: np.ndarray | None = None, any_target: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
     """Breadth-first search from ``start``: fewest moves to every frame (-1: unreachable) and
-    the parent of each reached frame. Stops early once every frame of ``targets`` is reached.
+    the parent of each reached frame. Stops early once every frame of ``targets`` is reached
+    (``any_target``: once any is; the nearest targets are then all reached, since a round
+    reaches every frame at its distance, and the frames farther than them are left at -1).
 
     Vectorised over the frontier; the number of rounds is the depth of the search.
     """
@@ -339,12 +418,14 @@ def _distances(cw: PoolWalker, start: int, targets: np.ndarray | None = None) ->
     frontier = np.array([start], dtype=np.int64)
     d = 0
     while frontier.size:
-        if targets is not None and np.all(dist[targets] >= 0):
-            break
+        if targets is not None:
+            hit = dist[targets] >= 0
+            if hit.all() or (any_target and hit.any()):
+                break
         a, b = cw.succ(frontier)
         new = dist[b] < 0
         a, b = a[new], b[new]
-        b, first = np.unique(b, return_index=True)
+        b, first = _first_of_each(b, cw.length)
         d += 1
         dist[b] = d
         parent[b] = a[first]
@@ -352,25 +433,43 @@ def _distances(cw: PoolWalker, start: int, targets: np.ndarray | None = None) ->
     return dist, parent
 
 
-def _path(cw: PoolWalker, start: int, targets, name: str) -> tuple[list[int], int]:
-    """Frames of a shortest walk from ``start`` to the nearest of ``targets`` (the ``r``-th).
+def _first_of_each(frames: np.ndarray, length: int) -> tuple[np.ndarray, np.ndarray]:
+    """``np.unique(frames, return_index=True)`` for frames in ``0 … length - 1``: the distinct
+    frames, ascending, and where each first occurs (one scatter, no sort)."""
+    first = np.full(length, frames.size, dtype=np.int64)
+    np.minimum.at(first, frames, np.arange(frames.size))
+    seen = np.flatnonzero(first < frames.size)
+    return seen, first[seen]
+
+
+def _distinct(targets) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct frames of ``targets`` in the order they first occur, and where each first
+    occurs: of tied targets, the first is the first of these."""
+    frames, first = np.unique(np.asarray(targets, dtype=np.int64), return_index=True)
+    order = np.argsort(first)
+    return frames[order], first[order]
+
+
+def _path(cw: PoolWalker, start: int, targets, name: str, distinct=None) -> tuple[list[int], int]:
+    """Frames of a shortest walk from ``start`` to the nearest of ``targets`` (the ``r``-th, the
+    first of the nearest). ``distinct``: ``_distinct(targets)``, when the caller keeps it.
 
     The *loop guard*: when the search has seen every frame reachable from ``start`` without
     meeting a target, it stops with an error instead of walking on for ever.
     """
-    targets = np.asarray(targets, dtype=np.int64)
-    dist, parent = _distances(cw, start, None)
-    d = np.where(dist[targets] >= 0, dist[targets], np.iinfo(np.int64).max)
-    r = int(np.argmin(d))
-    if dist[targets[r]] < 0:
+    frames_of, first = _distinct(targets) if distinct is None else distinct
+    dist, parent = _distances(cw, start, frames_of, any_target=True)
+    d = np.where(dist[frames_of] >= 0, dist[frames_of], np.iinfo(np.int64).max)
+    u = int(np.argmin(d))
+    if dist[frames_of[u]] < 0:
         raise SearchError(
             f"loop guard: every frame of {name!r} reachable from frame {start} was visited "
             f"({int((dist >= 0).sum())} frames) without reaching the way on"
         )
-    frames = [int(targets[r])]
+    frames = [int(frames_of[u])]
     while frames[-1] != start:
         frames.append(int(parent[frames[-1]]))
-    return frames[::-1], r
+    return frames[::-1], int(first[u])
 
 
 def _runs(cw: PoolWalker | int, frames: list[int]) -> list[tuple[int, int, int]]:
@@ -413,43 +512,61 @@ def _reach(cw: PoolWalker, start: int, steps: int, jumps: Jumps | None = None) -
     ``jumps``: the jumps to use (default: all the walker's).
     """
     step_ok = cw.step[:-1]
-    src, dst, price = cw.jumps() if jumps is None else jumps
-    order = np.argsort(dst, kind="stable")
-    src, dst, price = src[order], dst[order], price[order]
-    rank = np.arange(dst.size) - np.searchsorted(dst, dst)  # k-th jump into its frame
-    if rank.size == 0 or rank.max() < SPARSE_JUMPS:
-        layers = [(src[rank == k], dst[rank == k], price[rank == k]) for k in range(SPARSE_JUMPS)]
-        return _reach_few(max(steps, 1), cw.length, start, step_ok, layers)
+    prep = _prepare(cw, jumps)
+    if prep[0] == "few":
+        return _reach_few(max(steps, 1), cw.length, start, step_ok, prep[1], prep[2])
+    _, src, price, heads, targets = prep
     out = np.full((max(steps, 1), cw.length), _UNREACHED, dtype=np.float32)
     out[0, start] = 0
-    if dst.size:
-        heads = np.flatnonzero(np.concatenate([[True], dst[1:] != dst[:-1]]))
-        targets = dst[heads]
     for c in range(1, steps):
         prev, cur = out[c - 1], out[c]
         cur[1:] = np.where(step_ok, prev[:-1], _UNREACHED)
-        if dst.size:
+        if src.size:
             via = np.minimum.reduceat(prev[src] + price, heads)
             cur[targets] = np.minimum(cur[targets], via)
     return out
 
 
-def _reach_few(steps: int, n: int, start: int, step_ok: np.ndarray, layers: list) -> np.ndarray:
-    """:func:`_reach` when few jumps enter each frame: ``layers[k]`` holds the k-th jump into
-    each frame (at most one per frame), so a row is one gather per layer, with no grouping.
+def _prepare(cw: PoolWalker, jumps: Jumps | None) -> tuple:
+    """What a row of :func:`_reach` gathers for ``jumps``: ``("few", src_of, price_of)``, the
+    k-th jump into each frame (source ``n``, never reached, where there is none) when at most
+    :data:`SPARSE_JUMPS` enter any frame, else ``("grouped", src, price, heads, targets)``, the
+    jumps by destination. Kept in the walker for its own jump sets (all, or ``cw.sparse``)."""
+    key = "all" if jumps is None else "sparse" if jumps is cw.sparse else None
+    if key in cw._prepared:
+        return cw._prepared[key]
+    src, dst, price = cw.jumps() if jumps is None else jumps
+    order = np.argsort(dst, kind="stable")
+    src, dst, price = src[order], dst[order], price[order]
+    rank = np.arange(dst.size) - np.searchsorted(dst, dst)  # k-th jump into its frame
+    n = cw.length
+    if rank.size == 0 or rank.max() < SPARSE_JUMPS:
+        src_of, price_of = [], []
+        for k in range(SPARSE_JUMPS):
+            s = np.full(n, n)
+            s[dst[rank == k]] = src[rank == k]
+            p = np.zeros(n, dtype=np.float32)
+            p[dst[rank == k]] = price[rank == k]
+            src_of.append(s)
+            price_of.append(p)
+        prep = ("few", src_of, price_of)
+    else:
+        heads = np.flatnonzero(np.concatenate([[True], dst[1:] != dst[:-1]]))
+        prep = ("grouped", src, price, heads, dst[heads])
+    if key is not None:
+        cw._prepared[key] = prep
+    return prep
+
+
+def _reach_few(steps: int, n: int, start: int, step_ok: np.ndarray, src_of: list, price_of: list) -> np.ndarray:
+    """:func:`_reach` when few jumps enter each frame: ``src_of[k]``, ``price_of[k]``: the k-th
+    jump into each frame (at most one per frame; source ``n`` where there is none), so a row is
+    one gather per layer, with no grouping.
 
     Returns a (steps, n) view of an array with one more column, always ``inf``: the frame a
     missing jump comes from."""
     out = np.full((steps, n + 1), _UNREACHED, dtype=np.float32)
     out[0, start] = 0
-    src_of, price_of = [], []
-    for src, dst, price in layers:
-        s = np.full(n, n)  # the jump into each frame, n (a frame that is never reached) if none
-        s[dst] = src
-        p = np.zeros(n, dtype=np.float32)
-        p[dst] = price
-        src_of.append(s)
-        price_of.append(p)
     via, other = np.empty(n, dtype=np.float32), np.empty(n, dtype=np.float32)
     for c in range(1, steps):
         prev, cur = out[c - 1], out[c]
@@ -601,23 +718,45 @@ def walk_to_exit(
     self-loop point instead; a pool of many takes has no single last self-loop point.
     ValueError when ``start`` or an exit lies outside the pool, or ``exits`` is empty.
     """
-    if not exits or not all(0 <= int(x) < cw.length for x in [start, *exits]):
-        raise ValueError(f"expected a start and at least one exit in 0..{cw.length - 1}, got {start} and {exits}")
-    frames, r = _path(cw, start, exits, name)
-    src, dst, price = cw.jumps()
-    moves = zip(frames[:-1], frames[1:])
-    paid = sum(float(price[(src == a) & (dst == b)].min()) for a, b in moves if not (b == a + 1 and cw.step[a]))
-    bound = len(frames) + paid  # what the shortest walk costs
+    ex = np.asarray(exits, dtype=np.int64).reshape(-1)
+    _check_exits(cw, start, ex)
+    return _walk_to_exit(cw, start, _distinct(ex), name)
+
+
+def _check_exits(cw: PoolWalker, start: int, ex: np.ndarray) -> None:
+    if not ex.size or not (0 <= int(start) < cw.length and np.all((ex >= 0) & (ex < cw.length))):
+        raise ValueError(f"expected a start and at least one exit in 0..{cw.length - 1}, got {start} and {ex.tolist()}")
+
+
+def _walk_to_exit(
+    cw: PoolWalker, start: int, distinct: tuple, name: str
+) -> tuple[list[tuple[int, int, int]], int, int]:
+    """:func:`walk_to_exit` to the exits ``distinct = _distinct(exits)`` (checked)."""
+    frames, r = _path(cw, start, None, name, distinct)
+    bound = len(frames) + _paid(cw, frames)  # what the shortest walk costs
     # a cheaper walk has fewer frames than ``bound`` (each frame costs one) and visits no frame
     # twice (a loop costs at least a frame), so it has at most ``cw.length`` frames
     rows = min(int(np.ceil(bound)), cw.length)
-    ex = np.asarray(exits, dtype=np.int64)
     reach = _reach(cw, start, rows, cw.sparse)
+    ex, first = distinct  # an exit frame given twice costs the same: its first index stands for it
     cost = np.arange(1, rows + 1)[:, None] + reach[:, ex].astype(np.float64)
     c, k = np.unravel_index(int(np.argmin(cost)), cost.shape)  # shortest first, then the first exit
     if cost[c, k] < bound:
-        frames, r = _backtrack(cw, reach, int(c), int(ex[k]), cw.sparse), int(k)
+        frames, r = _backtrack(cw, reach, int(c), int(ex[k]), cw.sparse), int(first[k])
     return _runs(cw, frames), r, len(frames)
+
+
+def _paid(cw: PoolWalker, frames: list[int]) -> float:
+    """The price of the jumps of a walk through ``frames`` (a move that is not a step is a
+    jump; the cheapest of the jumps that make it)."""
+    src, dst, price = cw.jumps()
+    order, head = cw._by_source()
+    paid = 0.0
+    for a, b in zip(frames[:-1], frames[1:]):
+        if not (b == a + 1 and cw.step[a]):
+            out = order[head[a] : head[a + 1]]
+            paid += float(price[out[dst[out] == b]].min())
+    return paid
 
 
 def _next(cw: PoolWalker, f: int) -> int:
@@ -667,6 +806,7 @@ class Planner:
         self.walkers: dict[tuple[str, str], PoolWalker] = {}
         self.links: dict[tuple[str, str], list[dict]] = {}
         self.memo: dict = {}
+        self.exits: dict[int, tuple[np.ndarray, np.ndarray]] = {}
         for link in graph.table["links"]:
             self.links.setdefault(tuple(link["from"]), []).append(link)
 
@@ -755,19 +895,24 @@ class Planner:
         return self.memo[key]
 
     def _onward(self, hops: list[dict], enter: int) -> tuple[list[tuple[int, int, int]], int, int]:
-        pieces, frames = [], 0
-        for link in hops:
-            key = tuple(link["from"])
-            cw = self.walker(key)
-            routes = link["routes"]
-            exits = [r["exit"] for r in routes]
-            p, r, n = walk_to_exit(cw, enter, exits, f"{key[0]}/{key[1]}")
-            route = routes[r]
-            pieces.extend(p)
-            pieces.extend(tuple(x) for x in route["pieces"])
-            frames += n + route["frames"]
-            enter = route["enter"]
-        return pieces, frames, enter
+        """The first hop (the walk through its pool to the best of its routes, and the route),
+        then the rest through :meth:`onward`, so each (hops left, entry) is walked once."""
+        if not hops:
+            return [], 0, enter
+        link = hops[0]
+        key = tuple(link["from"])
+        cw = self.walker(key)
+        routes = link["routes"]
+        if id(link) not in self.exits:  # the link's exits, once
+            ex = np.array([r["exit"] for r in routes], dtype=np.int64)
+            _check_exits(cw, enter, ex)
+            self.exits[id(link)] = _distinct(ex)
+        _check_exits(cw, enter, self.exits[id(link)][0])
+        p, r, n = _walk_to_exit(cw, enter, self.exits[id(link)], f"{key[0]}/{key[1]}")
+        route = routes[r]
+        more, more_frames, final_enter = self.onward(hops[1:], route["enter"])
+        pieces = [*p, *(tuple(x) for x in route["pieces"]), *more]
+        return pieces, n + route["frames"] + more_frames, final_enter
 
     def search(self, request, progress: bool = False) -> SearchResult:
         """Meet a request on the planner's graph (see :func:`search`).
@@ -891,6 +1036,8 @@ def search_standard(graph: MotionGraph, request, start_clip: int | None = None, 
     ValueError
         for a bad request (see :func:`parse_request`) or a bad ``cost``.
     """
+    import networkx as nx  # (imported here: the structured search does not need it)
+
     segs = _segments(request)
     g = graph.segment_graph()
     first, last, seg = graph.segments()
