@@ -71,7 +71,6 @@ __all__ = [
     "REHEARSAL_SECONDS",
     "SIGNIFICANCE",
     "COUNT_TOLERANCE",
-    "RANGE_QUANTILES",
     "CountChoice",
     "count_choice",
     "MissingCount",
@@ -111,10 +110,6 @@ COUNT_TOLERANCE = 0.1
 """A count is right within this fraction of the true count, or one frame, whichever is more: what
 the rehearsal scores (:func:`count_choice`), and the least a count's range spans on each side
 (:class:`MissingCount`)."""
-
-RANGE_QUANTILES = (0.05, 0.95)
-"""The count's errors on the rehearsal cuts between these quantiles (a central 90% interval) widen
-its range (:func:`count_choice`)."""
 
 TRANSIENT = 0.2
 """Relative difference of the mean ground speeds on the two sides of a gap above which the body is
@@ -739,7 +734,7 @@ def estimate_counts(motion: Motion, steps_at, seconds: float = 1.0, takes=None) 
 
     The range holds every count within :data:`COUNT_TOLERANCE` of the estimate (or one frame), and
     where the count was rehearsed on cuts of the same length beside the gap (:func:`count_choice`),
-    also the counts its errors there (the :data:`RANGE_QUANTILES`) point to. With ``takes`` it is
+    also every count its errors there point to (the gap's count less each error). With ``takes`` it is
     that of the stream's own count widened to the tolerance about the mean with the recordings.
     Parameters and raises: those of :func:`estimate_missing`.
 
@@ -796,10 +791,11 @@ class CountChoice:
     count: float
     """The count used: the local one where ``p < SIGNIFICANCE`` and it has an answer, else the stride one."""
     low: int = 1
-    """The fewest frames likely missing: ``count`` less the :data:`RANGE_QUANTILES` of its errors on
-    the rehearsal cuts, rounded, at most ``count``'s tolerance (:data:`COUNT_TOLERANCE`) below it."""
+    """The fewest frames likely missing, at least 1: ``count`` less its largest error on the
+    rehearsal cuts (rounded), or less its tolerance (:data:`COUNT_TOLERANCE`) where that is lower."""
     high: int = 1
-    """The most frames likely missing, likewise."""
+    """The most frames likely missing: ``count`` less its smallest error on the rehearsal cuts, or
+    plus its tolerance where that is higher."""
 
 
 def count_choice(motion: Motion, t: int, start: int = 0, stop: int | None = None, seconds: float = 1.0) -> CountChoice:
@@ -839,9 +835,8 @@ def _choose(a: _Arrays, t: int, start: int, stop: int, seconds: float) -> CountC
     low, high = _tolerance(max(1, int(round(count))))
     if stride.size:  # the count's errors on the rehearsal cuts widen its range
         errors = (np.where(np.isfinite(local_at), local_at, stride) if use_local else stride) - m
-        q_low, q_high = np.quantile(errors, RANGE_QUANTILES)
-        low = min(low, max(1, int(math.floor(count - q_high + 0.5))))
-        high = max(high, int(math.floor(count - q_low + 0.5)))
+        low = min(low, max(1, int(math.floor(count - errors.max() + 0.5))))
+        high = max(high, int(math.floor(count - errors.min() + 0.5)))
     return CountChoice(n, local, stride_only, local_only, p, count, low, high)
 
 
