@@ -732,9 +732,10 @@ class MissingCount:
 def estimate_counts(motion: Motion, steps_at, seconds: float = 1.0, takes=None) -> list[MissingCount]:
     """:func:`estimate_missing`'s count at each step ``t → t+1`` in ``steps_at``, with its range.
 
-    The range holds every count within :data:`COUNT_TOLERANCE` of the estimate (or one frame), and
-    where the count was rehearsed on cuts of the same length beside the gap (:func:`count_choice`),
-    also every count its errors there point to (the gap's count less each error). With ``takes`` it is
+    The range holds every count within :data:`COUNT_TOLERANCE` of the estimate (or one frame), both
+    the stride and the local count (where they disagree, neither can be trusted alone), and where
+    the count was rehearsed on cuts of the same length beside the gap (:func:`count_choice`), every
+    count its errors there point to (the gap's count less each error). With ``takes`` it is
     that of the stream's own count widened to the tolerance about the mean with the recordings.
     Parameters and raises: those of :func:`estimate_missing`.
 
@@ -791,11 +792,12 @@ class CountChoice:
     count: float
     """The count used: the local one where ``p < SIGNIFICANCE`` and it has an answer, else the stride one."""
     low: int = 1
-    """The fewest frames likely missing, at least 1: ``count`` less its largest error on the
-    rehearsal cuts (rounded), or less its tolerance (:data:`COUNT_TOLERANCE`) where that is lower."""
+    """The fewest frames likely missing, at least 1: the least of ``count`` less its tolerance
+    (:data:`COUNT_TOLERANCE`), the stride and local counts (rounded) and ``count`` less its
+    largest error on the rehearsal cuts (rounded)."""
     high: int = 1
-    """The most frames likely missing: ``count`` less its smallest error on the rehearsal cuts, or
-    plus its tolerance where that is higher."""
+    """The most frames likely missing: the most of ``count`` plus its tolerance, the two counts
+    and ``count`` less its smallest error on the rehearsal cuts."""
 
 
 def count_choice(motion: Motion, t: int, start: int = 0, stop: int | None = None, seconds: float = 1.0) -> CountChoice:
@@ -833,6 +835,8 @@ def _choose(a: _Arrays, t: int, start: int, stop: int, seconds: float) -> CountC
     use_local = local is not None and p < SIGNIFICANCE
     count = local if use_local else n
     low, high = _tolerance(max(1, int(round(count))))
+    for other in (n, local) if local is not None else (n,):  # where the two counts disagree, both
+        low, high = min(low, max(1, int(round(other)))), max(high, int(round(other)))
     if stride.size:  # the count's errors on the rehearsal cuts widen its range
         errors = (np.where(np.isfinite(local_at), local_at, stride) if use_local else stride) - m
         low = min(low, max(1, int(math.floor(count - errors.max() + 0.5))))

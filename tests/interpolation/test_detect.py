@@ -362,8 +362,8 @@ def test_body_height_of_a_real_walk_is_its_standing_height(parts):
 
 def test_a_count_comes_with_the_range_it_is_likely_in():
     """``estimate_counts``: the count of ``estimate_missing`` and a range about it that spans at
-    least the tolerance the counts are scored with (10% or one frame); on issue 39's walk, where
-    the count is 7 for 6 missing frames, the range holds the 6."""
+    least the tolerance the counts are scored with (10% or one frame) and both the stride and the
+    local count; on issue 39's walk, where the count is 7 for 6 missing frames, the range holds the 6."""
     walk = bvh.load(require_data("bandai_namco", "dataset-1", "walk", "dataset-1_walk_normal_001.bvh"))
     cut = walk[np.r_[0:40, 46 : walk.num_frames]]
     (c,) = detect.estimate_counts(cut, [39])
@@ -372,6 +372,7 @@ def test_a_count_comes_with_the_range_it_is_likely_in():
     assert detect.detect_counts(cut) == [(39, c)] and detect.detect(cut) == [(39, c.count)]
     choice = detect.count_choice(cut, 39)
     assert (choice.low, choice.high) == (c.low, c.high)
+    assert all(c.low <= round(x) <= c.high for x in (choice.stride, choice.local))  # both counts in it
 
 
 @pytest.mark.parametrize(("count", "low", "high"), [(1, 1, 2), (6, 5, 7), (10, 9, 11), (20, 18, 22), (25, 23, 27)])
