@@ -26,7 +26,9 @@ steps below :data:`STEP_FLOOR` are never flagged.
 covers across the gap against the motion on both sides (step cycle, mean speed, step phase, or
 the speeds at the gap's edges, chosen per gap by :func:`count_choice`), and optionally the time
 other recordings of the action need between the poses that bound it (:mod:`.recorded`).
-Timestamps, where the input has them, give the count exactly (:func:`~.gaps.timestamp_gaps`).
+Timestamps, where the input has them, give the count exactly (:func:`~.gaps.timestamp_gaps`);
+without them each count is an estimate, given with the range it is likely in
+(:func:`estimate_counts`), which ``motionlab fill-gaps`` states.
 
 How these rules do on the shared data: ``docs/results_interpolation.md`` (``python -m
 experiments.interpolation.check_gaps``). Taught in ``notebooks/06_keypose_interpolation.ipynb``;
