@@ -19,8 +19,8 @@ Printed per rig family:
 * **root error**: joint 0's world position in the filled frames against the removed frames, mean
   and worst (cm as loaded; Bandai Namco and Mixamo files load in metres, CMU and Xia at their
   files' scale, whose bodies are about 0.23 units high), and the worst also in % of the body
-  height (the first frame's highest minus lowest joint of the reference joint's subtree,
-  :func:`motionlab.interpolation.alignment.reference_joint`). Where the recording holds joint 0
+  height (:func:`motionlab.interpolation.detect.body_height`: the vertical extent of the
+  reference joint's subtree, the body, median over the take). Where the recording holds joint 0
   still, the rule says it stays still: the error must be 0;
 * **reference joint**: the same for the joint that carries the body (joint 0 where it moves, the
   hips of the Bandai Namco rigs), mean;
@@ -52,6 +52,7 @@ import numpy as np
 from motionlab import data
 from motionlab.cli import main as cli
 from motionlab.core import bvh
+from motionlab.interpolation import detect
 from motionlab.interpolation.alignment import reference_joint
 
 TAKES = {
@@ -92,17 +93,12 @@ class Cut:
 
 
 def _fill_gaps(gap: Path, out: Path, *extra: str) -> None:
-    """``motionlab fill-gaps gap -o out`` with ``extra`` options, its output swallowed."""
-    with contextlib.redirect_stdout(io.StringIO()):
+    """``motionlab fill-gaps gap -o out`` with ``extra`` options, its output (and its warning that
+    a count is estimated) swallowed."""
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
         code = cli(["fill-gaps", str(gap), "-o", str(out), "--force", "-q", *extra])
     if code != 0:
         raise RuntimeError(f"fill-gaps {gap} {' '.join(extra)} exited {code}")
-
-
-def body_height(motion) -> float:
-    """Highest minus lowest joint of the reference joint's subtree in the first frame."""
-    pos = motion[:1].global_positions()[0]
-    return float(np.ptp(pos[motion.skeleton.subtree(reference_joint(motion)), 1]))
 
 
 def run_cut(motion, take: str, start: int, n: int, folder: Path) -> Cut:
@@ -127,7 +123,16 @@ def run_cut(motion, take: str, start: int, n: int, folder: Path) -> Cut:
     counted = bvh.load(out).num_frames - len(keep)
     still = bool(np.ptp(motion.root_pos, axis=0).max() <= 1e-6)
     return Cut(
-        take, start, n, body_height(motion), still, err[:, 0], err[:, ref], float(jump), float(err.max()), counted
+        take,
+        start,
+        n,
+        detect.body_height(motion),
+        still,
+        err[:, 0],
+        err[:, ref],
+        float(jump),
+        float(err.max()),
+        counted,
     )
 
 

@@ -1,6 +1,6 @@
 """Gap detection, missing counts and the root across gaps, measured on the shared real mocap.
 
-    MOTIONLAB_DATA=/path/to/shared/data python -m experiments.interpolation.check_gaps [--quick]
+    MOTIONLAB_DATA=/path/to/shared/data python -m experiments.interpolation.check_gaps [--quick] [--parts 1,2,3]
 
 1. **False gaps**: every clean BVH under ``$MOTIONLAB_DATA`` through the detector that
    ``motionlab fill-gaps`` uses without a graph (:func:`motionlab.interpolation.detect.consecutive_gaps`);
@@ -365,24 +365,33 @@ def main(argv=None) -> int:
                     help="also every walk take, a cut every EVERY frames (e.g. 30; minutes)")  # fmt: skip
     ap.add_argument("--dense-takes", action="store_true",
                     help="in --dense, also the count with the other takes of the action (several more minutes)")  # fmt: skip
+    ap.add_argument("--parts", default="1,2,3,4,5,6,7",
+                    help="which parts, comma-separated (default: all; part 4 only with --dense)")  # fmt: skip
     args = ap.parse_args(argv)
+    wanted = set(args.parts.split(","))
     root = data_root()
     t0 = time.perf_counter()
-    false_gaps(root)
-    print("2. frames removed from real walks and runs (detector and fill of `motionlab fill-gaps`):")
-    rng = np.random.default_rng(0)
+    if "1" in wanted:
+        false_gaps(root)
     other_takes = OtherTakes(root)
-    for name, files in sets(root, args.quick).items():
-        removed_frames(name, files, rng, other_takes)
-    graph_tracking(root, args.quick, np.random.default_rng(1))
-    if args.dense:
+    if "2" in wanted:
+        print("2. frames removed from real walks and runs (detector and fill of `motionlab fill-gaps`):")
+        rng = np.random.default_rng(0)
+        for name, files in sets(root, args.quick).items():
+            removed_frames(name, files, rng, other_takes)
+    if "3" in wanted:
+        graph_tracking(root, args.quick, np.random.default_rng(1))
+    if args.dense and "4" in wanted:
         dense(root, args.dense, other_takes if args.dense_takes else None)
-    other_sources(root, np.random.default_rng(5), cuts=1 if args.quick else 4)
     cuts = 1 if args.quick else 4
-    other_sources(root, np.random.default_rng(7), cuts, FRESH_SOURCES,
-                  f"6. starts, stops and padded clips, {cuts} cuts of 10/20/30 frames per clip:")  # fmt: skip
-    other_sources(root, np.random.default_rng(11), cuts, UNSCORED_SOURCES,
-                  f"7. other locomotion, {cuts} cuts of 10/20/30 frames per clip:")  # fmt: skip
+    if "5" in wanted:
+        other_sources(root, np.random.default_rng(5), cuts)
+    if "6" in wanted:
+        other_sources(root, np.random.default_rng(7), cuts, FRESH_SOURCES,
+                      f"6. starts, stops and padded clips, {cuts} cuts of 10/20/30 frames per clip:")  # fmt: skip
+    if "7" in wanted:
+        other_sources(root, np.random.default_rng(11), cuts, UNSCORED_SOURCES,
+                      f"7. other locomotion, {cuts} cuts of 10/20/30 frames per clip:")  # fmt: skip
     print(f"total time {time.perf_counter() - t0:.1f} s")
     return 0
 

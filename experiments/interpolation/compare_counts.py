@@ -1,6 +1,7 @@
 """The missing count alone, on the cuts of ``check_gaps`` (parts 2, 5, 6 and 7), at any commit.
 
     MOTIONLAB_DATA=/path/to/shared/data python -m experiments.interpolation.compare_counts [--quick] [--cuts 4]
+    MOTIONLAB_DATA=/path/to/shared/data python -m experiments.interpolation.compare_counts --families 150
 
 The counts of ``motionlab fill-gaps`` without ``--times`` (:func:`motionlab.interpolation.detect.detect`,
 the stream alone), nothing filled: a cheap check of a change to the count rules. The cuts are
@@ -8,6 +9,15 @@ the stream alone), nothing filled: a cheap check of a change to the count rules.
 and 7 with seeds 5, 7 and 11, ``--cuts`` places per clip and count of 10, 20 and 30 frames), so
 run at two commits it compares their counts on the same cuts. Prints per set: cuts, gaps found,
 counts exact, counts within 10% or one frame, and the mean absolute difference from the truth.
+
+``--families N``: instead, ``N`` seeded cuts of 1 to 30 frames per rig family (``FAMILIES``: held-out
+takes, none in ``check_gaps``' CHOOSE set, on which the count rules were chosen), each at a random
+place of a random take of the family (at least 20 frames left on each side). Per family, of the
+gaps found: how often the count (:func:`motionlab.interpolation.detect.count_choice`), the stride
+count and the local count (the stride count where it has none) are exact, and how often the range
+that ``fill-gaps`` states without ``--times`` (:func:`motionlab.interpolation.detect.estimate_counts`,
+for one gap without ``--takes`` that of ``count_choice``) holds the true count, and how wide it is; *wrong and unflagged* is a count that is not exact and
+whose range does not hold the truth either.
 """
 
 from __future__ import annotations
@@ -54,15 +64,87 @@ def part2(root, quick: bool) -> dict[str, list]:
     return out
 
 
+FAMILIES = {
+    "Bandai Namco dataset-1 (walks, dashes, runs; 30 fps)": [
+        "bandai_namco/dataset-1/walk/*.bvh",
+        "bandai_namco/dataset-1/dash/*.bvh",
+        "bandai_namco/dataset-1/run/*.bvh",
+    ],
+    "Bandai Namco dataset-2 (6 walk styles, runs, right turns; 30 fps)": [
+        "bandai_namco/sessions/walk/dataset-2_walk_[!n]*_00[12].bvh",
+        "bandai_namco/dataset-2/run/dataset-2_run_normal_00[23].bvh",
+        "bandai_namco/dataset-2/walk-turn-right/*.bvh",
+    ],
+    "Xia (walks, runs; 120 fps)": ["xia/walk/*.bvh", "xia/run/*.bvh"],
+    "CMU (start, walk, stop; 120 fps)": ["cmu/131/*.bvh"],
+    "Mixamo (walks, an injured turning walk, quick steps; 60 fps)": [
+        "mixamo/Aj/Catwalk_Walk.bvh",
+        "mixamo_ganimator/*/Walk-In-Circle.bvh",
+        "mixamo/*/Injured_Walk_Left_Turn.bvh",
+        "mixamo/Aj/Quick_Steps.bvh",
+    ],
+}
+"""Rig family -> held-out takes (globs under the data folder) for ``--families``."""
+
+
+def family_cuts(root, patterns: list[str], cuts: int, rng):
+    """``cuts`` seeded ``(motion, first removed frame, frames removed)``: 1 to 30 frames at a
+    random place (20 frames kept on each side) of a random take matching ``patterns``."""
+    files = sorted({f for p in patterns for f in root.glob(p)})
+    loaded = {}
+    out = []
+    while files and len(out) < cuts:
+        f = files[int(rng.integers(len(files)))]
+        m = loaded.setdefault(f, bvh.load(f))
+        n = int(rng.integers(1, 31))
+        if m.num_frames - n - 20 > 20:
+            out.append((m, int(rng.integers(20, m.num_frames - n - 20)), n))
+    return out
+
+
+def _family_line(cuts) -> str:
+    """Counts and ranges of one family's ``cuts`` (the gaps found), one line."""
+    rows = []
+    for m, s, n in cuts:
+        g = gap_eval.cut(m, s, n)
+        if s - 1 not in detect.consecutive_gaps(g):
+            continue
+        c = detect.count_choice(g, s - 1)  # one gap, no takes: the count and range of estimate_counts
+        local = c.stride if c.local is None else c.local
+        rows.append((n, max(1, round(c.count)), max(1, round(c.stride)), max(1, round(local)), c.low, c.high))
+    x = np.array(rows, dtype=np.float64).reshape(-1, 6)
+    n, count, stride, local, low, high = x.T
+    inside = (low <= n) & (n <= high)
+    share = lambda a: f"{np.mean(a):.1%}" if len(a) else "-"  # noqa: E731
+    return (
+        f"{len(cuts)} cuts, {len(x)} found; exact: count {share(count == n)}, stride count {share(stride == n)}, "
+        f"local count {share(local == n)}; within 10% or 1 frame {share(np.abs(count - n) <= np.maximum(1, 0.1 * n))}; "
+        f"range holds the truth {share(inside)}, mean width {np.mean(high - low + 1) if len(x) else 0:.1f} frames; "
+        f"wrong and unflagged {share((count != n) & ~inside)}"
+    )
+
+
+def families(root, cuts: int) -> None:
+    """``--families``: one line per rig family of ``FAMILIES`` (seed 39, one generator)."""
+    rng = np.random.default_rng(39)
+    for label, patterns in FAMILIES.items():
+        print(f"{label}: {_family_line(family_cuts(root, patterns, cuts, rng))}", flush=True)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="a sixth of part 2's clips, one place per clip in parts 5-7")
     ap.add_argument("--cuts", type=int, default=4, help="places per clip and count in parts 5-7 (check_gaps: 4)")
     ap.add_argument("--parts", default="2,5,6,7", help="which parts, comma-separated (default: all four)")
+    ap.add_argument("--families", type=int, default=0, metavar="N",
+                    help="instead: N cuts of 1-30 frames per rig family, counts and their ranges")  # fmt: skip
     args = ap.parse_args(argv)
     wanted = set(args.parts.split(","))
     root = check_gaps.data_root()
     t0 = time.perf_counter()
+    if args.families:
+        families(root, args.families)
+        wanted = set()
     for name, cuts in part2(root, args.quick).items() if "2" in wanted else ():
         print(f"part 2 {name}: {_score(cuts)}", flush=True)
     cuts = 1 if args.quick else args.cuts

@@ -25,7 +25,10 @@ Where the capture logged each frame's time, ``--times FILE`` (one time in second
 :func:`motionlab.interpolation.gaps.load_times`) gives the gaps and their counts exactly
 (:func:`~motionlab.interpolation.gaps.timestamp_gaps`): no rule, no estimate. The times are
 checked against the file's ``Frame Time`` first: times in another unit (milliseconds), or ones
-that would make the clip more than :data:`MAX_GROWTH` times longer, are refused.
+that would make the clip more than :data:`MAX_GROWTH` times longer, are refused. Without
+``--times`` the counts are estimates (the motion cannot say how fast the body moved inside a gap),
+and a warning on stderr says so, with the range each count is likely in
+(:func:`motionlab.interpolation.detect.estimate_counts`).
 A clean clip (nothing found) is copied byte for byte. A report lists every gap and how it was
 filled.
 """
@@ -33,6 +36,7 @@ filled.
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from motionlab import cli_args
@@ -235,6 +239,25 @@ def _check_args(args: argparse.Namespace):
     return delta, src, dst
 
 
+SHOWN_RANGES = 5
+"""How many gaps' count ranges the warning of an estimated count lists by name."""
+
+
+def _warn_estimated(src, counted) -> None:
+    """On stderr: the missing counts were estimated from the motion, each with the range it is
+    likely in (:func:`motionlab.interpolation.detect.estimate_counts`), and how to get them exact."""
+    if not counted:
+        return
+    shown = [f"{c.count} frames after frame {t} (likely {c.low} to {c.high})" for t, c in counted[:SHOWN_RANGES]]
+    if len(counted) > SHOWN_RANGES:
+        shown.append(f"and {len(counted) - SHOWN_RANGES} more gaps")
+    print(
+        f"warning: {src}: how many frames are missing is estimated from the motion, which cannot tell it "
+        f"exactly: {', '.join(shown)}; pass --times FILE (the capture's frame times) for exact counts",
+        file=sys.stderr,
+    )
+
+
 def run_fill_gaps(args: argparse.Namespace) -> int:
     """detect dropped frames in a BVH file and fill them (SLERP, Hermite or action-graph guided)
 
@@ -262,9 +285,11 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
     else:
         takes = _takes(args.takes, src, motion) if args.takes else None
         try:
-            missing = detect.detect(motion, graph=graph, delta=delta, takes=takes)
+            counted = detect.detect_counts(motion, graph=graph, delta=delta, takes=takes)
         except ValueError as e:
             raise CLIError(str(e)) from None
+        missing = [(t, c.count) for t, c in counted]
+        _warn_estimated(src, counted)
     if not args.quiet:
         print(f"{src}: {motion.num_frames} frames at {motion.fps:g} fps")
     nothing = (

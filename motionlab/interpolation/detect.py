@@ -26,7 +26,9 @@ steps below :data:`STEP_FLOOR` are never flagged.
 covers across the gap against the motion on both sides (step cycle, mean speed, step phase, or
 the speeds at the gap's edges, chosen per gap by :func:`count_choice`), and optionally the time
 other recordings of the action need between the poses that bound it (:mod:`.recorded`).
-Timestamps, where the input has them, give the count exactly (:func:`~.gaps.timestamp_gaps`).
+Timestamps, where the input has them, give the count exactly (:func:`~.gaps.timestamp_gaps`);
+without them each count is an estimate, given with the range it is likely in
+(:func:`estimate_counts`), which ``motionlab fill-gaps`` states.
 
 How these rules do on the shared data: ``docs/results_interpolation.md`` (``python -m
 experiments.interpolation.check_gaps``). Taught in ``notebooks/06_keypose_interpolation.ipynb``;
@@ -59,6 +61,7 @@ __all__ = [
     "TRACK_RATES",
     "track_features",
     "check_delta",
+    "HEIGHT_FRAMES",
     "body_height",
     "joint_steps",
     "consecutive_ratio",
@@ -69,9 +72,13 @@ __all__ = [
     "LOCAL_SECONDS",
     "REHEARSAL_SECONDS",
     "SIGNIFICANCE",
+    "COUNT_TOLERANCE",
     "CountChoice",
     "count_choice",
+    "MissingCount",
+    "estimate_counts",
     "estimate_missing",
+    "detect_counts",
     "detect",
 ]
 
@@ -100,6 +107,11 @@ frame exactly: a held pose, as in Mixamo clips padded to 60 frames with copies o
 pose (:func:`held_steps`; :func:`.demo.trim_frozen` trims such a tail off the action clips).
 Held frames carry no speed and no timing, so the counts read nothing from them
 (:func:`count_choice`)."""
+
+COUNT_TOLERANCE = 0.1
+"""A count is right within this fraction of the true count, or one frame, whichever is more: what
+the rehearsal scores (:func:`count_choice`), and the least a count's range spans on each side
+(:class:`MissingCount`)."""
 
 TRANSIENT = 0.2
 """Relative difference of the mean ground speeds on the two sides of a gap above which the body is
@@ -133,10 +145,35 @@ def check_delta(delta, name: str = "delta") -> float:
     return value
 
 
+HEIGHT_FRAMES = 101
+"""Frames, evenly spaced over the clip, that :func:`body_height` measures the body in."""
+
+
 def body_height(motion: Motion) -> float:
-    """Highest minus lowest joint of the first frame (metres), at least 1 cm."""
-    pos = motion[:1].global_positions()[0]
-    return max(float(np.ptp(pos[:, 1])), float(np.ptp(pos, axis=0).max()) * 0.5, 0.01)
+    """The body's height in the clip (metres, at least 1 cm).
+
+    Measured on the body alone: the reference joint (:func:`~.alignment.reference_joint`, the joint
+    that carries the character) and the joints below it; not the end sites, which some exporters
+    place well off the body (a hat's or hair's tip). A marker above the reference joint, such as a
+    root joint left on the floor at the origin while the hips carry the walker, is not part of the
+    body, so where the walker is in the capture volume does not change the height. In each of :data:`HEIGHT_FRAMES` frames evenly
+    spaced over the clip, the body's highest point minus its lowest (Y up), or half its largest
+    extent along any axis where that is more (a body lying down); the median over those frames.
+
+    Parameters
+    ----------
+    motion : Motion with at least one frame
+
+    Returns
+    -------
+    float, metres: for a body that stands or walks, the height from its lowest joint (a toe) to its
+    highest (the head top where the rig has a joint there, else the head joint).
+    """
+    frames = np.unique(np.linspace(0, motion.num_frames - 1, HEIGHT_FRAMES).round().astype(np.int64))
+    body = motion.skeleton.subtree(reference_joint(motion))  # (J,) mask
+    extent = np.ptp(motion[frames].global_positions()[:, body], axis=1)  # (F, 3)
+    per_frame = np.maximum(extent[:, 1], 0.5 * extent.max(axis=1))
+    return max(float(np.median(per_frame)), 0.01)
 
 
 def _positions(motion: Motion) -> np.ndarray:
@@ -658,6 +695,10 @@ def estimate_missing(motion: Motion, steps_at, seconds: float = 1.0, takes=None)
       and how long the recordings need from the pose before the gap to the pose after it,
       time-scaled to the stream (:func:`~.recorded.recorded_missing`).
 
+    The count is an estimate: the stream alone cannot tell how fast the body moved inside the gap
+    (frame times can, :func:`~.gaps.timestamp_gaps`). :func:`estimate_counts` gives each count with
+    the range it is likely in.
+
     Parameters
     ----------
     motion : Motion, the stream with the frames already missing (nothing inserted)
@@ -674,6 +715,36 @@ def estimate_missing(motion: Motion, steps_at, seconds: float = 1.0, takes=None)
     ValueError
         if a step lies outside ``0 … T-2``.
     """
+    return [c.count for c in estimate_counts(motion, steps_at, seconds, takes)]
+
+
+@dataclass(frozen=True)
+class MissingCount:
+    """How many frames went missing in one gap (:func:`estimate_counts`): the estimate and the
+    range ``low … high`` (inclusive) it is likely in."""
+
+    count: int
+    """The estimate, at least 1 (what :func:`estimate_missing` gives)."""
+    low: int
+    """The fewest frames likely missing, at least 1."""
+    high: int
+    """The most frames likely missing."""
+
+
+def estimate_counts(motion: Motion, steps_at, seconds: float = 1.0, takes=None) -> list[MissingCount]:
+    """:func:`estimate_missing`'s count at each step ``t → t+1`` in ``steps_at``, with its range.
+
+    The range holds every count within :data:`COUNT_TOLERANCE` of the estimate (or one frame), both
+    the stride and the local count (where they disagree, neither can be trusted alone), and where
+    the count was rehearsed on cuts of the same length beside the gap (:func:`count_choice`), every
+    count its errors there point to (the gap's count less each error). With ``takes`` it is
+    that of the stream's own count widened to the tolerance about the mean with the recordings.
+    Parameters and raises: those of :func:`estimate_missing`.
+
+    Returns
+    -------
+    list of :class:`MissingCount`, in the order of ``sorted(steps_at)``
+    """
     at = sorted(int(t) for t in steps_at)
     if not at:
         return []
@@ -687,12 +758,21 @@ def estimate_missing(motion: Motion, steps_at, seconds: float = 1.0, takes=None)
     for t in at:
         start = max([g + 1 for g in at if g < t], default=0)  # known steps between neighbouring gaps
         stop = min([g for g in at if g > t], default=len(arrays.gstep))
-        n = _choose(arrays, t, start, stop, seconds).count
+        choice = _choose(arrays, t, start, stop, seconds)
+        n, low, high = choice.count, choice.low, choice.high
         if takes is not None:
             rec = recorded_missing(motion, t, takes, n, start, stop)
             n = n if rec is None else 0.5 * (n + rec[0])
-        out.append(max(1, int(round(n))))
+        count = max(1, int(round(n)))
+        band = _tolerance(count)
+        out.append(MissingCount(count, min(low, band[0]), max(high, band[1])))
     return out
+
+
+def _tolerance(count: int) -> tuple[int, int]:
+    """The counts within :data:`COUNT_TOLERANCE` of ``count`` or one frame of it, at least 1."""
+    tol = max(1.0, COUNT_TOLERANCE * count)
+    return max(1, int(math.ceil(count - tol - 1e-9))), int(math.floor(count + tol + 1e-9))
 
 
 @dataclass
@@ -706,13 +786,20 @@ class CountChoice:
     """The local count (a quadratic through the edge speeds); ``None`` where it has no answer or
     the body does not travel."""
     stride_only: int
-    """Rehearsal cuts that only the stride count got within 10% (or one frame)."""
+    """Rehearsal cuts that only the stride count got within :data:`COUNT_TOLERANCE` (or one frame)."""
     local_only: int
-    """Rehearsal cuts that only the local count got within 10% (or one frame)."""
+    """Rehearsal cuts that only the local count got within :data:`COUNT_TOLERANCE` (or one frame)."""
     p: float
     """One-sided sign test of ``local_only`` against ``stride_only``."""
     count: float
     """The count used: the local one where ``p < SIGNIFICANCE`` and it has an answer, else the stride one."""
+    low: int = 1
+    """The fewest frames likely missing, at least 1: the least of ``count`` less its tolerance
+    (:data:`COUNT_TOLERANCE`), the stride and local counts (rounded) and ``count`` less its
+    largest error on the rehearsal cuts (rounded)."""
+    high: int = 1
+    """The most frames likely missing: the most of ``count`` plus its tolerance, the two counts
+    and ``count`` less its smallest error on the rehearsal cuts."""
 
 
 def count_choice(motion: Motion, t: int, start: int = 0, stop: int | None = None, seconds: float = 1.0) -> CountChoice:
@@ -737,15 +824,26 @@ def count_choice(motion: Motion, t: int, start: int = 0, stop: int | None = None
 def _choose(a: _Arrays, t: int, start: int, stop: int, seconds: float) -> CountChoice:
     start, stop = _moving_bounds(a, t, start, stop)
     n, arc = _stride_count(a, t, start, stop, seconds)
-    if arc is None:  # the body does not travel: the joint-step ratio, nothing to rehearse
-        return CountChoice(n, None, 0, 0, 1.0, n)
-    local = _local_count(a.gstep, t, start, stop, arc, n, a.fps)
-    if local is None:  # no local count for this gap: nothing to rehearse it against
-        return CountChoice(n, None, 0, 0, 1.0, n)
-    stride_only, local_only = _rehearse(a, t, start, stop, max(1, int(round(n))), seconds)
-    p = _sign_test(local_only, stride_only)
-    count = local if p < SIGNIFICANCE else n
-    return CountChoice(n, local, stride_only, local_only, p, count)
+    local = None if arc is None else _local_count(a.gstep, t, start, stop, arc, n, a.fps)
+    m = max(1, int(round(n)))
+    stride, local_at, travels = _rehearse(a, t, start, stop, m, seconds)
+    stride_only, local_only, p = 0, 0, 1.0
+    if local is not None:  # the rehearsal chooses between the two counts
+        tol = max(1.0, COUNT_TOLERANCE * m)
+        hit_stride = travels & (np.abs(np.round(stride) - m) <= tol)
+        hit_local = travels & (np.abs(np.round(local_at) - m) <= tol)  # NaN: no hit
+        stride_only, local_only = int(np.sum(hit_stride & ~hit_local)), int(np.sum(hit_local & ~hit_stride))
+        p = _sign_test(local_only, stride_only)
+    use_local = local is not None and p < SIGNIFICANCE
+    count = local if use_local else n
+    low, high = _tolerance(max(1, int(round(count))))
+    for other in (n, local) if local is not None else (n,):  # where the two counts disagree, both
+        low, high = min(low, max(1, int(round(other)))), max(high, int(round(other)))
+    if stride.size:  # the count's errors on the rehearsal cuts widen its range
+        errors = (np.where(np.isfinite(local_at), local_at, stride) if use_local else stride) - m
+        low = min(low, max(1, int(math.floor(count - errors.max() + 0.5))))
+        high = max(high, int(math.floor(count - errors.min() + 0.5)))
+    return CountChoice(n, local, stride_only, local_only, p, count, low, high)
 
 
 def _moving_bounds(a: _Arrays, t: int, start: int, stop: int) -> tuple[int, int]:
@@ -862,37 +960,35 @@ def _local_count(gstep: np.ndarray, t: int, start: int, stop: int, arc: float, g
 
 
 def _rehearse(a: _Arrays, t: int, start: int, stop: int, m: int, seconds: float = 1.0):
-    """How often the stride and the local counts get a gap of ``m`` frames right, rehearsed on the
-    known frames beside the real gap at step ``t → t+1`` (known steps ``start … stop``).
+    """Both counts of gaps of ``m`` frames rehearsed on the known frames beside the real gap at step
+    ``t → t+1`` (known steps ``start … stop``).
 
     On each side (up to ``REHEARSAL_SECONDS``; never across the gap) ``m`` frames are cut out at
     every place that leaves ``LOCAL_SECONDS`` (at least three frames) of known frames on both sides
     of the cut, and both counts are made for each cut as for a real gap (a loop over cuts, each
-    count vectorised over its frames). A cut where the body does not travel is left out. The cuts
-    overlap, so they are not independent trials: the sign test of :func:`estimate_missing` on them
-    overstates the evidence, and its 5% is nominal.
+    count vectorised over its frames). The cuts overlap, so they are not independent trials: the
+    sign test of :func:`estimate_missing` on them overstates the evidence, and its 5% is nominal.
 
     Returns
     -------
-    (stride_only, local_only): how many cuts only the stride count, and only the local count, got
-    within 10% (or one frame) of ``m``
+    stride : ndarray (C,), the stride count of each cut (the joint-step ratio where the body does
+        not travel)
+    local : ndarray (C,), the local count of each cut, NaN where it has none
+    travels : ndarray (C,) bool, whether the body travels at the cut
     """
     far = int(round(REHEARSAL_SECONDS * a.fps))
     edge = max(3, int(round(LOCAL_SECONDS * a.fps)))  # what the local count fits on
-    tol = max(1.0, 0.1 * m)
-    wins = np.zeros(2, dtype=np.int64)
+    counts = []
     for lo, hi in ((max(start, t - far), t + 1), (t + 1, min(stop + 1, t + 1 + far))):
         for p in range(lo + edge - 1, hi - m - edge):  # frames p+1 … p+m cut out
             keep = np.r_[lo : p + 1, p + 1 + m : hi]
             sub = a.without(keep)
             tp = p - lo
             n, arc = _stride_count(sub, tp, 0, len(sub.gstep), seconds)
-            if arc is None:
-                continue
-            local = _local_count(sub.gstep, tp, 0, len(sub.gstep), arc, n, a.fps)
-            hit = abs(round(n) - m) <= tol, local is not None and abs(round(local) - m) <= tol
-            wins += [hit[0] and not hit[1], hit[1] and not hit[0]]
-    return int(wins[0]), int(wins[1])
+            local = None if arc is None else _local_count(sub.gstep, tp, 0, len(sub.gstep), arc, n, a.fps)
+            counts.append((n, np.nan if local is None else local, arc is not None))
+    x = np.asarray(counts, dtype=np.float64).reshape(-1, 3)
+    return x[:, 0], x[:, 1], x[:, 2] > 0
 
 
 def _sign_test(wins: int, losses: int) -> float:
@@ -901,12 +997,18 @@ def _sign_test(wins: int, losses: int) -> float:
     return sum(math.comb(k, i) for i in range(wins, k + 1)) / 2.0**k
 
 
-def detect(motion: Motion, graph=None, delta: float | None = None, takes=None) -> list[tuple[int, int]]:
-    """Dropped frames as ``(after frame t, estimated missing count)``, ready for
-    :func:`~.gaps.insert_missing`: :func:`graph_gaps` with a graph, :func:`consecutive_gaps`
-    without, counts from :func:`estimate_missing` (with the other recordings ``takes`` if given)."""
+def detect_counts(motion: Motion, graph=None, delta: float | None = None, takes=None) -> list[tuple[int, MissingCount]]:
+    """Dropped frames as ``(after frame t, missing count with its range)``: :func:`graph_gaps` with a
+    graph, :func:`consecutive_gaps` without, counts from :func:`estimate_counts` (with the other
+    recordings ``takes`` if given). Raises what those raise."""
     if graph is not None:
         at = graph_gaps(motion, graph, delta)
     else:
         at = consecutive_gaps(motion, DELTA if delta is None else delta)
-    return list(zip(at, estimate_missing(motion, at, takes=takes)))
+    return list(zip(at, estimate_counts(motion, at, takes=takes)))
+
+
+def detect(motion: Motion, graph=None, delta: float | None = None, takes=None) -> list[tuple[int, int]]:
+    """Dropped frames as ``(after frame t, estimated missing count)``, ready for
+    :func:`~.gaps.insert_missing`: :func:`detect_counts` without the ranges."""
+    return [(t, c.count) for t, c in detect_counts(motion, graph, delta, takes)]

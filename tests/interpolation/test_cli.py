@@ -7,6 +7,7 @@ import pytest
 
 from motionlab.cli import main
 from motionlab.core import bvh
+from tests.conftest import require_data
 
 from .conftest import toy_motion
 
@@ -152,6 +153,28 @@ def test_fill_gaps_reads_the_counts_from_frame_times(dropped, tmp_path, capsys):
     assert main(["fill-gaps", str(clean), "-o", str(copy), "--times", str(regular)]) == 0
     assert "no dropped frames in the times of" in capsys.readouterr().out
     assert copy.read_bytes() == clean.read_bytes()
+    capsys.readouterr()
+    assert main(["fill-gaps", str(dropped), "-o", str(out), "--times", str(times), "--force"]) == 0
+    assert "estimated" not in capsys.readouterr().err  # counts from the times are exact
+
+
+def test_fill_gaps_says_an_estimated_count_is_one(tmp_path, capsys):
+    """Issue 39: a real walk without frames 40-45 (6 frames), filled without ``--times``. The
+    motion alone counts 7 there (the stride count 6.1, the local count 6.9, and the rehearsal
+    picks the local one); the command must not pass that off as exact: a warning gives the range
+    the count is likely in, which holds the true 6, and points to ``--times``."""
+    walk = bvh.load(require_data("bandai_namco", "dataset-1", "walk", "dataset-1_walk_normal_001.bvh"))
+    gap, out = tmp_path / "gap.bvh", tmp_path / "out.bvh"
+    bvh.save(gap, walk[np.r_[0:40, 46 : walk.num_frames]])
+    assert main(["fill-gaps", str(gap), "-o", str(out), "-q"]) == 0
+    err = capsys.readouterr().err
+    found = re.search(
+        r"warning: .*gap\.bvh: .*estimated.* (\d+) frames after frame 39 \(likely (\d+) to (\d+)\).*--times", err
+    )
+    assert found, err
+    count, low, high = map(int, found.groups())
+    assert low <= 6 <= high and low <= count <= high
+    assert bvh.load(out).num_frames == walk.num_frames - 6 + count
 
 
 def test_fill_gaps_refuses_frame_times_that_do_not_fit(dropped, tmp_path, capsys):

@@ -321,3 +321,61 @@ def test_local_count_is_exact_where_the_speed_changes_linearly():
     m.root_pos[:, 2] = 0.02 * k + 0.5 * 0.0004 * k**2  # metres: 0.6 m/s at frame 0, speeding up 0.36 m/s² at 30 fps
     choice = detect.count_choice(m[np.r_[0:60, 68:120]], 59)  # frames 60 … 67 dropped
     assert choice.local == pytest.approx(8.0, abs=1e-6)
+
+
+def test_body_height_ignores_where_the_walker_is_in_the_capture_volume():
+    """Bandai Namco rigs leave ``joint_Root`` on the floor at the origin while the hips carry the
+    walker: the height is the body's, the same wherever the walker is (it was read off the distance
+    to that marker, 2.1 m for this walk)."""
+    m = bvh.load(require_data("bandai_namco", "dataset-1", "walk", "dataset-1_walk_normal_001.bvh"))
+    lp = m.translations().copy()
+    lp[:, reference_joint(m)] += np.array([3.0, 0.0, 3.0])
+    assert detect.body_height(m.copy(local_pos=lp)) == pytest.approx(detect.body_height(m), rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    "parts",
+    [
+        ("bandai_namco", "dataset-1", "walk", "dataset-1_walk_normal_001.bvh"),
+        ("bandai_namco", "dataset-2", "walk", "dataset-2_walk_normal_001.bvh"),
+        ("bandai_namco", "sessions", "walk", "dataset-2_walk_elderly_002.bvh"),
+        ("mixamo", "Aj", "Catwalk_Walk.bvh"),
+        ("mixamo_ganimator", "Joe", "Walk-In-Circle.bvh"),
+        ("cmu", "131", "131_01.bvh"),
+        ("xia", "walk", "neutral_01_000.bvh"),
+    ],
+)
+def test_body_height_of_a_real_walk_is_its_standing_height(parts):
+    """On every rig family the height of a walk is the standing body's, within 5%: where the rest
+    pose stands upright (Mixamo, CMU, Xia), its height; on the Bandai Namco rigs, whose rest pose
+    does not, the head joint above the lowest toe in the first frame, where the walker stands."""
+    m = bvh.load(require_data(*parts))
+    sk = m.skeleton
+    if parts[0] == "bandai_namco":
+        pos = m[:1].global_positions()[0]
+        toes = [sk.index("Toes_L"), sk.index("Toes_R")]
+        standing = pos[sk.index("Head"), 1] - pos[toes, 1].min()
+    else:
+        standing = sk.height()
+    assert detect.body_height(m) == pytest.approx(standing, rel=0.05)
+
+
+def test_a_count_comes_with_the_range_it_is_likely_in():
+    """``estimate_counts``: the count of ``estimate_missing`` and a range about it that spans at
+    least the tolerance the counts are scored with (10% or one frame) and both the stride and the
+    local count; on issue 39's walk, where the count is 7 for 6 missing frames, the range holds the 6."""
+    walk = bvh.load(require_data("bandai_namco", "dataset-1", "walk", "dataset-1_walk_normal_001.bvh"))
+    cut = walk[np.r_[0:40, 46 : walk.num_frames]]
+    (c,) = detect.estimate_counts(cut, [39])
+    assert [c.count] == detect.estimate_missing(cut, [39])
+    assert c.low <= 6 <= c.high and c.low <= c.count - 1 and c.high >= c.count + 1
+    assert detect.detect_counts(cut) == [(39, c)] and detect.detect(cut) == [(39, c.count)]
+    choice = detect.count_choice(cut, 39)
+    assert (choice.low, choice.high) == (c.low, c.high)
+    assert all(c.low <= round(x) <= c.high for x in (choice.stride, choice.local))  # both counts in it
+
+
+@pytest.mark.parametrize(("count", "low", "high"), [(1, 1, 2), (6, 5, 7), (10, 9, 11), (20, 18, 22), (25, 23, 27)])
+def test_the_least_range_of_a_count_is_its_tolerance(count, low, high):
+    """Known answers: within 10% of the count or one frame, whichever is more, never below 1."""
+    assert detect._tolerance(count) == (low, high)
