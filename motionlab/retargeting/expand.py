@@ -8,9 +8,11 @@ with ``output_format="glb"``) plus ``OUT/manifest.csv``, one row per (clip, char
     job = expand(["Aj/*.bvh"], characters("Kaya/Running.bvh", "long_legs"), "out/")
     print(job.summary())
 
-* **Batched.** The network is loaded once; pairs of equal length are solved together
+* **Batched.** The network is loaded once; on the CPU pairs of equal length are solved together
   (:mod:`motionlab.retargeting.batching`), each output bit-for-bit what ``motionlab retarget``
-  writes for that pair.
+  writes for that pair. On a GPU pairs of any length share a batch (padded, ``pad``) and worker
+  processes read the clips and finish and encode the outputs while the GPU solves
+  (:mod:`motionlab.retargeting.host`, ``host_workers``).
 * **Resumable and safe.** Every BVH is written to a temporary file; the manifest (rewritten
   atomically) records a batch's rows *before* its files are renamed into place. A rerun keeps
   an output only when its file exists and its row's SHA-256 of the source file
