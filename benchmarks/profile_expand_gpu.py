@@ -2,9 +2,8 @@
 
 Prepares all of Aj's clips × the six Table 1 characters as ``expand`` does (host workers), plans
 the padded batches, then times the latent iteration of every batch (``batching.solve_jobs``,
-device synchronised) under four settings: as shipped; Gauss–Newton start in one chunk per batch
-(``solver.PROJECT_FRAMES`` raised); the temporal smoothing as one single-channel convolution
-over rows × channels instead of a grouped one; both. Then it profiles the batch with the most
+device synchronised) with the Gauss–Newton start in chunks as large as free memory allows (as
+shipped) and in chunks of ``solver.PROJECT_FRAMES`` frames (as on the CPU). Then it profiles the batch with the most
 rows: Python (cProfile, top functions by own time) and the device (``torch.profiler``: top
 operators by device time, kernel launches per step). Results of the variants are compared with
 the shipped ones (largest joint difference, cm).
@@ -31,23 +30,6 @@ from motionlab.retargeting import expand as ex
 from motionlab.retargeting.evaluate import DEFAULT_TARGETS
 
 
-def _flat_smoother(sigma, channels, dtype, device):
-    """The shipped filter computed as one single-channel convolution over rows × channels."""
-    radius = max(int(round(3 * sigma)), 1)
-    t = torch.arange(-radius, radius + 1, dtype=dtype, device=device)
-    kernel = torch.exp(-0.5 * (t / sigma) ** 2)
-    kernel = (kernel / kernel.sum()).view(1, 1, -1)
-
-    def apply(d, index=None):
-        if index is not None:
-            d = d.gather(1, index[..., None].expand(-1, -1, d.shape[-1]))
-        N, T, D = d.shape
-        x = torch.nn.functional.pad(d.transpose(1, 2).reshape(N * D, 1, T), (radius, radius), mode="replicate")
-        return torch.nn.functional.conv1d(x, kernel).reshape(N, D, T).transpose(1, 2)
-
-    return apply
-
-
 def _pairs(ckpt, clips: int):
     root = data.data_root() / "mixamo"
     chars = ex.characters(*[f"{n}={root / n / 'Running.bvh'}" for n in DEFAULT_TARGETS])
@@ -55,7 +37,7 @@ def _pairs(ckpt, clips: int):
     targets = [(c.name, c.skeleton) for c in chars]
     cfg = solver.SolverConfig()
     with host.pool(ckpt, host.default_workers(ckpt.device)) as pool:
-        prepared = [pool.submit(ex._prepare_clip, p, None, targets, "stride", cfg) for p in paths]
+        prepared = [pool.submit(ex.prepare_clip, p, None, targets, "stride", cfg) for p in paths]
         pairs = []
         for p, f in zip(paths, prepared):
             motion, prep, _, jobs = f.result()
@@ -92,24 +74,19 @@ def main(argv=None) -> None:
     frames = sum(p.frames for p in pairs)
     print(f"{len(pairs)} pairs, {frames} frames prepared in {time.perf_counter() - clock:.1f} s; batches (rows x frames): "
           + ", ".join(f"{len(b)}x{b[0].frames}" for b in batches))  # fmt: skip
-    shipped = (solver.PROJECT_FRAMES, solver._smoother)
-    variants = {
-        "shipped": shipped,
-        "one chunk": (10**9, shipped[1]),
-        "flat smoothing": (shipped[0], _flat_smoother),
-        "both": (10**9, _flat_smoother),
-    }
+    shipped = solver.PROJECT_BYTES_PER_FRAME
+    variants = {"chunks by free memory": shipped, f"chunks of {solver.PROJECT_FRAMES}": 10**15}
     reference = None
-    for name, (chunk, smooth) in variants.items():
-        solver.PROJECT_FRAMES, solver._smoother = chunk, smooth
+    for name, per_frame in variants.items():
+        solver.PROJECT_BYTES_PER_FRAME = per_frame
         out, seconds = _run(ckpt, batches)
         pos = np.concatenate([r.positions[0].reshape(-1) for r in out])
-        diff = "" if reference is None else f"; vs shipped {100 * np.abs(pos - reference).max():.2g} cm"
+        diff = "" if reference is None else f"; vs the first {100 * np.abs(pos - reference).max():.2g} cm"
         reference = pos if reference is None else reference
         steps = max(r.steps for r in out)
-        print(f"{name:<15} solve {sum(seconds):6.2f} s = {frames / sum(seconds):7.0f} frames/s; per batch "
+        print(f"{name:<22} solve {sum(seconds):6.2f} s = {frames / sum(seconds):7.0f} frames/s; per batch "
               + " ".join(f"{s:.2f}" for s in seconds) + f"; most steps {steps}{diff}")  # fmt: skip
-    solver.PROJECT_FRAMES, solver._smoother = shipped
+    solver.PROJECT_BYTES_PER_FRAME = shipped
     widest = max(batches, key=len)
     prof = cProfile.Profile()
     prof.enable()

@@ -90,6 +90,7 @@ __all__ = [
     "options_digest",
     "ExpandResult",
     "expand",
+    "prepare_clip",
 ]
 
 PRESETS: dict[str, dict[str, float]] = {
@@ -788,9 +789,15 @@ def _output(pr: PairResult, sources_by_clip, chars, limits, suffix, options, fps
     return row, row["output"], data, pr.result.plausibility.ok, pr.result.motion.num_frames
 
 
-def _prepare_clip(path, rest_from, targets, root_mode, solver, checkpoint=None):
-    """Read and prepare one clip and its pairs: ``(motion, prepared, skating cm/s, {character: job
-    or error message})``; runs in a host worker (its CPU checkpoint) or here (``checkpoint``)."""
+def prepare_clip(path, rest_from, targets, root_mode, solver, checkpoint=None):
+    """Read and prepare one source clip and its pairs, as :func:`expand` does.
+
+    ``targets`` is a list of ``(character name, canonical Skeleton)``; ``rest_from`` as for
+    :func:`expand`. Runs in a host worker (:func:`host.checkpoint`, the worker's CPU copy) or in
+    this process with ``checkpoint`` given. Returns ``(motion, prepared, skating cm/s, {character:
+    PreparedPair or error message})``; raises what reading or preparing the source raises
+    (``ValueError``, ``OSError``, …).
+    """
     checkpoint = checkpoint or host.checkpoint()
     motion = rest_pose.on_reference(bvh.load(path), rest_from, str(path))
     prepared = prepare_source(motion, checkpoint, "full", solver)
@@ -817,11 +824,11 @@ def _load_pairs(todo, checkpoint, solver, rows, result, suffix, rest_from=None, 
     for clip, (path, chars, _) in by_clip.items():
         usable = [(c.name, c.skeleton) for c in chars if c.skeleton is not None]
         args = (path, rest_from, usable, root_mode, solver)
-        tasks[clip] = pool.submit(_prepare_clip, *args) if pool else args
+        tasks[clip] = pool.submit(prepare_clip, *args) if pool else args
     for clip, (path, chars, digest) in by_clip.items():
         try:
             task = tasks[clip]
-            motion, prepared, skating, jobs = task.result() if pool else _prepare_clip(*task, checkpoint)
+            motion, prepared, skating, jobs = task.result() if pool else prepare_clip(*task, checkpoint)
         except _ERRORS as err:
             for c in chars:
                 rows[(c.name, clip)] = _error_row(clip, c.name, str(path), c.origin, _why(err, "source", path), suffix)
