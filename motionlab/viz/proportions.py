@@ -7,6 +7,12 @@ skeleton goes to a solver, a callable ``solve(skeleton) -> Motion`` (or ``-> (Mo
 with a loss history), and the view updates: the source character on the left, the new one on
 the right, and a small plot of the feet's height over the clip (and the solver's loss).
 
+A slow solver (the latent iteration takes one to two seconds) would leave the old character on
+screen meanwhile; so, on a slider release, the editor first shows a *preview* -- the motion of
+:func:`copy_rotation_solver` on the new skeleton, with the status line saying so -- and then the
+solver's result replaces it. :meth:`ProportionEditor.update` (called from code) shows only the
+solver's result.
+
 The solver is injected, so ``viz`` imports none of the three systems: pass
 :func:`motionlab.retargeting.proportions.proportion_solver` for the latent iteration. The default,
 :func:`copy_rotation_solver`, is a dependency-free stand-in that copies the local rotations,
@@ -90,7 +96,8 @@ def copy_rotation_solver(source: Motion) -> Callable[[Skeleton], Motion]:
     down so its lowest foot point is where the source's was (never below the ground).
 
     Works without torch or a trained network; feet may slide or float where the proportions
-    change a lot (that is what the latent solver fixes).
+    change a lot (that is what the latent solver fixes). The returned function carries
+    ``is_stand_in = True``, so :class:`ProportionEditor` shows no preview of it.
     """
     source = canonical_source(source)
     source_floor = max(float(feet_height(source).min()), 0.0)
@@ -106,6 +113,7 @@ def copy_rotation_solver(source: Motion) -> Callable[[Skeleton], Motion]:
         root = root + np.array([0.0, lift, 0.0])
         return moved.copy(root_pos=root)
 
+    solve.is_stand_in = True
     return solve
 
 
@@ -137,12 +145,16 @@ class ProportionEditor:
         :func:`motionlab.retargeting.proportions.proportion_solver`
     backend : Jupyter view, ``"static"``/``"trame"``/None, see :class:`~motionlab.viz.player.Player`
     slider_range : (low, high) of the group sliders
+    preview : on a slider release, show :func:`copy_rotation_solver`'s motion on the new skeleton
+        before the solver's; default: True unless ``solve`` is None or is
+        :func:`copy_rotation_solver`'s (marked ``solve.is_stand_in = True``)
     **scene_options : window_size, camera, trails, ... for the 3D view
 
     Attributes
     ----------
     skeleton, motion, history : the current new character, its motion and the solver history
-    timings : seconds of the last update: ``solve``, ``view`` (3D + plot) and ``total``
+    timings : seconds of the last update: ``solve``, ``view`` (3D + plot) and ``total``, and
+        ``preview`` (from the release to the preview on screen) when a preview was shown
     widget : the layout to display
     """
 
@@ -152,6 +164,7 @@ class ProportionEditor:
         solve: Solver | None = None,
         backend: str | None = None,
         slider_range: tuple[float, float] = (0.5, 1.6),
+        preview: bool | None = None,
         **scene_options,
     ) -> None:
         """Check the solver and the slider range (the widgets are built on display).
@@ -167,6 +180,9 @@ class ProportionEditor:
         self.source = canonical_source(source)
         self.base = self.source.skeleton
         self.solve = solve if solve is not None else copy_rotation_solver(self.source)
+        if preview is None:  # no preview of the stand-in by itself
+            preview = solve is not None and not getattr(solve, "is_stand_in", False)
+        self._preview = copy_rotation_solver(self.source) if preview else None
         if not callable(self.solve):
             raise ValueError(f"solve must be callable as solve(skeleton), got {type(self.solve).__name__}")
         low, high = (float(v) for v in slider_range)
@@ -251,12 +267,19 @@ class ProportionEditor:
 
     def _apply_queued(self) -> None:
         self._queued = False
-        self._apply()
+        self._apply(preview=self._preview is not None)
 
-    def _apply(self) -> Motion:
+    def _apply(self, preview: bool = False) -> Motion:
         start = time.perf_counter()
         self.status.value = "solving..."
         skeleton = humanoid.scale_bones(self.base, **self.factors)
+        shown = None
+        if preview:  # the stand-in's motion on the new skeleton while the solver runs
+            self.player.scene.set_motion(1, self._preview(skeleton))
+            self.player.refresh()
+            self.status.value = f"height {skeleton.height():.2f} m · preview (copied rotations) · solving..."
+            shown = time.perf_counter() - start
+        begin = time.perf_counter()
         motion, history = _split(self.solve(skeleton))
         solved = time.perf_counter()
         self.skeleton, self.motion, self.history = skeleton, motion, history
@@ -264,7 +287,9 @@ class ProportionEditor:
         self.player.refresh()
         self._plot_feet()
         end = time.perf_counter()
-        self.timings = {"solve": solved - start, "view": end - solved, "total": end - start}
+        self.timings = {"solve": solved - begin, "view": end - solved, "total": end - start}
+        if shown is not None:
+            self.timings["preview"] = shown
         self.status.value = (
             f"height {skeleton.height():.2f} m · solved in {self.timings['solve']:.2f} s · "
             f"view in {self.timings['view']:.2f} s"

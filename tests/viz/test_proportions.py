@@ -134,3 +134,48 @@ def test_the_latent_solver_is_injected_from_retargeting(can_render):
         1.2 * source.skeleton.bone_lengths()[source.skeleton.index("LeftLeg")]
     )
     assert len(history["loss"]) >= 1
+
+
+def test_release_shows_the_preview_before_a_given_solver_runs(can_render):
+    """A slow solver: the new skeleton is on screen (copied rotations) while it runs."""
+    source = stepping_motion(12)
+    base_solve = copy_rotation_solver(source)
+    seen, editors = [], []
+
+    def solve(skeleton):
+        if editors:  # not the first solve, inside the constructor
+            ed = editors[0]
+            seen.append((ed.player.scene.actors[1].motion.skeleton, ed.player.view.value, ed.status.value))
+        return base_solve(skeleton), {"loss": [1.0, 0.5]}
+
+    ed = ProportionEditor(source, solve=solve, **VIEW)
+    editors.append(ed)
+    try:
+        before = ed.player.view.value
+        ed.sliders["legs"].value = 1.4  # a release
+        ((shown_skeleton, shown_view, status),) = seen
+        assert shown_skeleton is not ed.base
+        assert _bone(shown_skeleton, "LeftLeg") == pytest.approx(1.4 * _bone(ed.base, "LeftLeg"))
+        assert shown_view != before, "the preview picture was sent before the solver ran"
+        assert "preview" in status
+        assert set(ed.timings) == {"solve", "view", "total", "preview"}
+        assert ed.motion.skeleton is ed.skeleton and "solved in" in ed.status.value
+        seen.clear()
+        ed.update(legs=0.8)  # from code: the solver's result only
+        ((shown_skeleton, _, _),) = seen
+        assert _bone(shown_skeleton, "LeftLeg") == pytest.approx(1.4 * _bone(ed.base, "LeftLeg"))
+        assert "preview" not in ed.timings
+    finally:
+        ed.close()
+
+
+def test_preview_can_be_switched_off(can_render):
+    source = stepping_motion(6)
+    base_solve = copy_rotation_solver(source)
+    for kwargs in ({"solve": lambda sk: base_solve(sk), "preview": False}, {"solve": base_solve}, {}):
+        ed = ProportionEditor(source, **kwargs, **VIEW)
+        try:
+            ed.sliders["legs"].value = 1.2
+            assert set(ed.timings) == {"solve", "view", "total"}, kwargs
+        finally:
+            ed.close()
