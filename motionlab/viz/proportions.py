@@ -7,7 +7,7 @@ skeleton goes to a solver, a callable ``solve(skeleton) -> Motion`` (or ``-> (Mo
 with a loss history), and the view updates: the source character on the left, the new one on
 the right, and a small plot of the feet's height over the clip (and the solver's loss).
 
-A slow solver (the latent iteration takes one to two seconds) would leave the old character on
+A slow solver (the latent iteration) would leave the old character on
 screen meanwhile; so, on a slider release, the editor first shows a *preview* -- the motion of
 :func:`copy_rotation_solver` on the new skeleton, with the status line saying so -- and then the
 solver's result replaces it. :meth:`ProportionEditor.update` (called from code) shows only the
