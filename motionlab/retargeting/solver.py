@@ -351,6 +351,10 @@ def project_latent(
     each quaternion's sign matched to the current output. ``μ = damping × mean diag(JᵀJ)`` keeps
     the step small where the decoder is insensitive.
 
+    Each row is solved as if alone: a row stops (keeps its latent) once all its residuals are
+    below 1e-5 (≈ 0.001°), and the frames are computed in chunks (:data:`PROJECT_FRAMES`, or on a
+    GPU as many as a quarter of its free memory holds, :data:`PROJECT_BYTES_PER_FRAME`).
+
     Parameters
     ----------
     model : the network (not modified)
@@ -368,10 +372,6 @@ def project_latent(
         start still reaches the target's fastest details
     index : Tensor (N, T) of int, optional   for rows padded beyond their length: the frame each
         frame stands for (``min(t, length − 1)``), as in :func:`smoother`
-
-    Each row is solved as if alone: a row stops (keeps its latent) once all its residuals are
-    below 1e-5 (≈ 0.001°), and the frames are computed in chunks (:data:`PROJECT_FRAMES`, or on a
-    GPU as many as a quarter of its free memory holds, :data:`PROJECT_BYTES_PER_FRAME`).
 
     Returns
     -------
