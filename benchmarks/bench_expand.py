@@ -207,10 +207,19 @@ def _verify(out: Path) -> None:
           f"{len(list(out.rglob('*.bvh')))} BVH files, {len(rows)} ok rows")  # fmt: skip
 
 
+def _clips(text: str) -> str:
+    if text != "all" and not (text.isdigit() and int(text) > 0):
+        raise argparse.ArgumentTypeError(f"expected a positive number of clips or 'all', got {text!r}")
+    return text
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument(
-        "--clips", default="4", help="source clips: N of Aj's retarget_gt animations, or all of Aj's (default 4)"
+        "--clips",
+        default="4",
+        type=_clips,
+        help="source clips: N of Aj's retarget_gt animations, or all of Aj's (default 4)",
     )
     p.add_argument("--table1-characters", action="store_true", help="the six Table 1 characters (no presets)")
     p.add_argument(

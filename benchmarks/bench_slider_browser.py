@@ -47,7 +47,12 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
-from tests.browser.check_notebook_in_chromium import _free_port, _start_lab, _wait_for_server  # noqa: E402
+from tests.browser.check_notebook_in_chromium import (  # noqa: E402
+    _free_port,
+    _start_lab,
+    _wait_for_server,
+    run_all_cells,
+)
 
 SENTINEL = "EDITOR READY"
 
@@ -103,27 +108,7 @@ def _open_and_run(page, url: str, timeout_s: float) -> None:
     page.goto(url, wait_until="domcontentloaded", timeout=60_000)
     page.wait_for_selector(".jp-Notebook .jp-Cell", timeout=60_000)
     page.wait_for_function("() => document.body.innerText.includes('| Idle')", timeout=60_000, polling=500)
-    news = page.locator(".jp-toast-button", has_text="No")
-    if news.count():
-        news.first.click()
-    for _attempt in range(3):
-        page.locator(".lm-MenuBar-itemLabel", has_text="Run").first.click(timeout=10_000)
-        page.locator(".lm-Menu-itemLabel", has_text="Run All Cells").first.click(timeout=10_000)
-        try:
-            page.wait_for_function(
-                "() => [...document.querySelectorAll('.jp-InputPrompt')].some(e => /\\[(\\*|\\d+)\\]/.test(e.innerText))",
-                timeout=15_000,
-                polling=500,
-            )
-            break
-        except Exception:
-            page.keyboard.press("Escape")
-    page.wait_for_function(
-        "s => [...document.querySelectorAll('.jp-OutputArea-output')].some(e => e.innerText.includes(s))",
-        arg=SENTINEL,
-        timeout=timeout_s * 1000,
-        polling=500,
-    )
+    run_all_cells(page, SENTINEL, timeout_s)
     page.wait_for_function("() => document.body.innerText.includes('| Idle')", timeout=60_000, polling=250)
 
 

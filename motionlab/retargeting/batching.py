@@ -13,7 +13,7 @@ sequence (no windows, no seams, as in the single-pair path). By default (the CPU
 :func:`plan_batches` groups pairs by length (one clip onto all characters always qualifies;
 clips of equal length join them) and cuts each group so that a batch holds at most
 ``max_frames`` frames, chosen from memory by :func:`batch_frames`. With ``pad=True`` (``expand``
-on a GPU, where a step costs about the same for ten sequences as for a thousand) pairs of any
+on a GPU, whose steps cost little more for many sequences than for a few) pairs of any
 length share a batch, longest first, each padded to the batch's longest
 (:func:`motionlab.retargeting.solver.solve_many` with ``lengths``: a padded sequence's result is
 the one it gets alone, a test checks it).
@@ -32,7 +32,6 @@ import torch
 from motionlab.core import humanoid, metrics
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
-from motionlab.retargeting import terms
 from motionlab.retargeting.checkpoint import Checkpoint
 from motionlab.retargeting.pipeline import (
     PreparedPair,
@@ -210,14 +209,10 @@ def solve_jobs(
     """The latent iteration of every job in one batch (:func:`~motionlab.retargeting.solver.solve_many`);
     jobs of other lengths are padded to the longest (``lengths``).
 
-    Raises ``ValueError`` when the lengths differ and a registered term does not honour padded
-    frames (:func:`motionlab.retargeting.terms.unpadded`).
+    Raises ``ValueError`` (from ``solve_many``) when the lengths differ and a registered term does
+    not honour padded frames (:func:`motionlab.retargeting.terms.unpadded`).
     """
     lengths = [j.source.x.shape[1] for j in jobs]
-    if len(set(lengths)) > 1 and terms.unpadded():
-        raise ValueError(
-            f"a batch needs pairs of one length, got lengths {sorted(set(lengths))} (terms {list(terms.unpadded())} do not honour padding)"
-        )
     T = max(lengths)
     x = _stacked([j.source.x for j in jobs], T)
     return solve_many(

@@ -1,8 +1,8 @@
 """The host's share of a database expansion, in worker processes, so that a GPU does not wait.
 
-On a GPU the latent iteration of a batch of hundreds of (clip, character) pairs takes about as
-long as one CPU core needs to read, prepare, check and write a few dozen of them (BVH text,
-resampling, features, forward kinematics, the plausibility checks). :func:`pool` starts worker
+Reading, preparing, checking and writing a pair (BVH text, resampling, features, forward
+kinematics, the plausibility checks) is CPU work done pair by pair, while a GPU solves a whole
+batch at once (``docs/performance.md`` gives the split of the time). :func:`pool` starts worker
 processes for that work; :func:`motionlab.retargeting.expand.expand` reads and prepares the
 clips there and finishes and encodes each batch's outputs there while the GPU solves the next
 batch. Each worker holds a CPU copy of the checkpoint (:func:`checkpoint`): preparing a clip

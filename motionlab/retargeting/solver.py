@@ -624,7 +624,7 @@ def solve_many(
 
     Parameters are those of :func:`solve` (``offsets`` usually (N, 22, 3): one skeleton per
     sequence), and ``lengths`` (N,), optional: sequence ``i`` is its first ``lengths[i]`` frames,
-    the rest of its row padding (any values). Padded frames count in no term
+    the rest of its row padding (any finite values; ``batching.solve_jobs`` repeats the last frame). Padded frames count in no term
     (:attr:`terms.TermInputs.frames`) and the smoothing filter treats a row's last real frame as
     its end, so a padded sequence gives the result it gives alone, cut to its length. Returns one
     :class:`SolverResult` per sequence, arrays with a leading axis of 1 and ``lengths[i]`` frames;

@@ -124,6 +124,32 @@ def _pixels(png: bytes):
     return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"))
 
 
+def run_all_cells(page, sentinel: str, timeout_s: float) -> None:
+    """In an open JupyterLab notebook: Run > Run All Cells (retried until a cell starts), then wait
+    until an output shows ``sentinel`` (``timeout_s`` seconds at most)."""
+    news = page.locator(".jp-toast-button", has_text="No")  # "get notified about Jupyter news?"
+    if news.count():
+        news.first.click()
+    for _attempt in range(3):
+        page.locator(".lm-MenuBar-itemLabel", has_text="Run").first.click(timeout=10_000)  # menu bar: Run
+        page.locator(".lm-Menu-itemLabel", has_text="Run All Cells").first.click(timeout=10_000)
+        try:  # a cell shows [*] or a number once execution started
+            page.wait_for_function(
+                "() => [...document.querySelectorAll('.jp-InputPrompt')].some(e => /\\[(\\*|\\d+)\\]/.test(e.innerText))",
+                timeout=15_000,
+                polling=500,
+            )
+            break
+        except Exception:
+            page.keyboard.press("Escape")
+    page.wait_for_function(
+        "s => [...document.querySelectorAll('.jp-OutputArea-output')].some(e => e.innerText.includes(s))",
+        arg=sentinel,
+        timeout=timeout_s * 1000,
+        polling=500,
+    )
+
+
 def _run_in_browser(url: str, out: Path, backend: str, timeout_s: float) -> dict:
     from playwright.sync_api import sync_playwright
 
@@ -142,27 +168,7 @@ def _run_in_browser(url: str, out: Path, backend: str, timeout_s: float) -> dict
             "() => document.body.innerText.includes('| Idle')", timeout=60_000, polling=500
         )
         report["opened_s"] = round(time.time() - start, 1)
-        news = page.locator(".jp-toast-button", has_text="No")  # "get notified about Jupyter news?"
-        if news.count():
-            news.first.click()
-        for _attempt in range(3):
-            page.locator(".lm-MenuBar-itemLabel", has_text="Run").first.click(timeout=10_000)  # menu bar: Run
-            page.locator(".lm-Menu-itemLabel", has_text="Run All Cells").first.click(timeout=10_000)
-            try:  # a cell shows [*] or a number once execution started
-                page.wait_for_function(
-                    "() => [...document.querySelectorAll('.jp-InputPrompt')].some(e => /\\[(\\*|\\d+)\\]/.test(e.innerText))",
-                    timeout=15_000,
-                    polling=500,
-                )
-                break
-            except Exception:
-                page.keyboard.press("Escape")
-        page.wait_for_function(
-            "s => [...document.querySelectorAll('.jp-OutputArea-output')].some(e => e.innerText.includes(s))",
-            arg=SENTINEL,
-            timeout=timeout_s * 1000,
-            polling=1000,
-        )
+        run_all_cells(page, SENTINEL, timeout_s)
         report["ran_s"] = round(time.time() - start, 1)
         errors = page.eval_on_selector_all(
             ".jp-OutputArea-output[data-mime-type='application/vnd.jupyter.stderr']", "els => els.map(e => e.innerText)"
