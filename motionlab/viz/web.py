@@ -3,7 +3,10 @@
 :func:`player` returns an HTML output holding the joint positions of one or more motions (as
 JSON) and a small script (``web_player.js``): play/pause, a time slider, orbit (drag) and zoom
 (wheel), skeletons overlaid or side by side in the notebooks' colours
-(:data:`motionlab.viz.scene.PALETTE`). The page must provide three.js as ``window.THREE``:
+(:data:`motionlab.viz.scene.PALETTE`). It draws with three.js when the page has it as
+``window.THREE``, and otherwise, after waiting two seconds for it, on the browser's own 2D canvas
+(the same camera and controls; bones as flat strokes, far ones first), so a player shows the
+motion wherever its script runs. three.js comes from:
 
 * the documentation site does: ``scripts/build_docs.sh`` vendors three.js from npm into the site
   (``scripts/vendor_three.sh`` writes ``build/web/three.min.js``), so a page with a player works

@@ -25,7 +25,10 @@ What it does:
    screenshot and one taken 0.5, 0.87 or 1.16 s after it, kept in ``--out/players/``, and in every
    one of those shots the skeletons must be in view: some figure pixels (saturated colours, not the
    grey floor and background), none on the canvas edge. Every notebook that shows motion
-   (:data:`MOTION_NOTEBOOKS`) must have a working player.
+   (:data:`MOTION_NOTEBOOKS`) must have a working player, drawn by three.js;
+7. writes a page with one player and no three.js (as a notebook in JupyterLab where
+   ``scripts/vendor_three.sh`` never ran) and checks it the same way: it must draw on the
+   browser's 2D canvas, move, and keep the figures in view.
 
 Exit status 0 when every check passed, 1 otherwise.
 """
@@ -160,15 +163,17 @@ def _in_view(shots: list[bytes]) -> str:
     return ""
 
 
-def _check_player(browser, rel: str, out: Path, timeout_ms: int = 20_000) -> dict:
-    """Open ``rel`` from file:// (network blocked), start its first player and watch it move."""
+def _check_player(browser, rel: str, out: Path, timeout_ms: int = 20_000, site: Path = SITE) -> dict:
+    """Open ``site / rel`` from file:// (network blocked), start its first player and watch it move;
+    a player drawn by three.js must have a WebGL context, one drawn on the 2D canvas (no three.js on
+    the page) is checked the same way otherwise."""
     page = browser.new_page(viewport={"width": 1200, "height": 900})
     errors: list[str] = []
     page.on("pageerror", lambda e: errors.append(str(e)))
     page.route("**/*", lambda r: r.continue_() if r.request.url.startswith("file://") else r.abort())
     result: dict = {"page": rel, "ok": False}
     try:
-        page.goto((SITE / rel).as_uri(), wait_until="load", timeout=timeout_ms)
+        page.goto((site / rel).as_uri(), wait_until="load", timeout=timeout_ms)
         result["players"] = page.locator(".motionlab-player").count()
         player = page.locator(".motionlab-player").first
         player.scroll_into_view_if_needed()
@@ -178,7 +183,10 @@ def _check_player(browser, rel: str, out: Path, timeout_ms: int = 20_000) -> dic
             result["why"] = "player did not start: " + (player.locator(".motionlab-message").text_content() or "")
             return result
         canvas = player.locator("canvas")
-        result["webgl"] = canvas.evaluate("c => !!(c.getContext('webgl2') || c.getContext('webgl'))")
+        result["renderer"] = player.get_attribute("data-renderer")
+        result["webgl"] = result["renderer"] == "canvas" or canvas.evaluate(
+            "c => !!(c.getContext('webgl2') || c.getContext('webgl'))"
+        )
         player.locator("button.motionlab-play").click()
         page.wait_for_timeout(200)
         stem = Path(rel).stem
@@ -272,6 +280,7 @@ def check(out: Path, timeout_ms: int = 30_000) -> dict:
             for name, count in sorted(report["players_per_notebook"].items()):
                 if count:
                     report["players"].append(_check_player(browser, f"notebooks/{name}.html", out))
+            report["player_without_three_js"] = _check_player(browser, _page_without_three_js(out), out, site=out)
             browser.close()
         for page_rel, href in sorted(links):
             target_url, fragment = urldefrag(href)
@@ -285,7 +294,7 @@ def check(out: Path, timeout_ms: int = 30_000) -> dict:
         server.shutdown()
     missing_figures = [n for n in stored if report["figures_per_notebook"].get(n, 0) == 0]
     report["stored_notebooks_without_figures"] = missing_figures
-    working = {Path(p["page"]).stem for p in report["players"] if p["ok"]}
+    working = {Path(p["page"]).stem for p in report["players"] if p["ok"] and p.get("renderer") == "three"}
     report["motion_notebooks_without_a_working_player"] = [n for n in MOTION_NOTEBOOKS if n not in working]
     report["seconds"] = round(time.time() - start, 1)
     report["ok"] = (
@@ -294,8 +303,27 @@ def check(out: Path, timeout_ms: int = 30_000) -> dict:
         and not report["broken_links"]
         and not missing_figures
         and not report["motion_notebooks_without_a_working_player"]
+        and report["player_without_three_js"]["ok"]
+        and report["player_without_three_js"].get("renderer") == "canvas"
     )
     return report
+
+
+def _page_without_three_js(out: Path) -> str:
+    """Write a page holding one player and no three.js (as in JupyterLab where none was vendored):
+    a synthetic walker 1.75 m tall beside a 1.3x-legs one; returns its name in ``out``."""
+    from motionlab import synthetic
+    from motionlab.core import humanoid
+    from motionlab.viz import web
+
+    sk = humanoid.canonical_skeleton(1.75)
+    walks = [
+        synthetic.generate("walk", s, num_frames=90, fps=30, seed=i)
+        for i, s in enumerate((sk, humanoid.scale_bones(sk, legs=1.3)))
+    ]
+    fragment = web.player_html(walks, names=["walker", "long legs"], spacing=1.0, three_js=None)
+    (out / "player_without_three_js.html").write_text(f"<!doctype html><html><body>{fragment}</body></html>")
+    return "player_without_three_js.html"
 
 
 def main(argv: list[str] | None = None) -> int:

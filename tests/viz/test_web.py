@@ -133,3 +133,5 @@ def test_without_a_vendored_three_js_the_notebook_player_still_renders(walks, tm
     out = web.player(walks[0]).data
     assert "motionlab-player" in out and "var THREE" not in out
     assert "not trusted" in out  # the line shown where no script runs (a reopened notebook)
+    assert 'start("canvas")' in out  # without three.js it draws on the 2D canvas (checked in a browser by
+    # tests/browser/check_docs_site.py, "player_without_three_js")
