@@ -68,14 +68,17 @@ class ClipLabel:
 
 
 MIXAMO_AJ: dict[str, str] = {
-    "Idle": "idle_normal",
+    "Ready_Idle": "idle_normal",
     "Catwalk_Walk": "walk_catwalk",
     "Catwalk_Idle_To_Walk_Forward": "idle_normal_to_walk_catwalk",
-    "Running": "run_normal",
+    "Running": "dive-roll_normal",
     "Jumping": "jump_normal",
     "Standing_Land_To_Standing_Idle": "jump_normal_to_idle_normal",
 }
-"""Mixamo Aj clips of the shared data as behaviour/style names (land → idle, idle → walk)."""
+"""Mixamo Aj clips of the shared data as behaviour/style names (land → idle, idle → walk), named
+by what they show rather than by their file names: ``Running`` is a run into a dive roll (the hips
+drop to a tenth of their standing height) and ``Idle`` a crouch, so the standing idle that the two
+transition clips start and end in is ``Ready_Idle``."""
 
 _BANDAI = re.compile(r"^dataset-\d+_(?P<b>[a-z0-9-]+)_(?P<s>[a-z0-9-]+)_(?P<take>\d+)$", re.IGNORECASE)
 _TOKEN = r"[A-Za-z0-9-]+"
