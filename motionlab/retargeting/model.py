@@ -319,15 +319,15 @@ class RetargetNet(nn.Module):
         jacobian : Tensor (M, 88, D)
         """
         M, D = phi.shape
+        eye = torch.eye(4, dtype=phi.dtype, device=phi.device)
 
-        def tangent(u: torch.Tensor, length: torch.Tensor, du: torch.Tensor) -> torch.Tensor:
-            # d unit(r) = (du − u ⟨u, du⟩) / ‖r‖ for du (M, J, 4, D)
-            return (du - u[..., :, None] * torch.einsum("mjb,mjbd->mjd", u, du)[..., None, :]) / length[..., None]
+        def tangent(u: torch.Tensor, length: torch.Tensor) -> torch.Tensor:
+            # d unit(r) = (I − u uᵀ) / ‖r‖ dr, as (M, J, 4, 4) matrices
+            return (eye - u[..., :, None] * u[..., None, :]) / length[..., None]
 
         r = self.f_qlinear(phi).reshape(M, NUM_JOINTS, 4)
         rlen = torch.sqrt((r * r).sum(-1, keepdim=True))
         q = r / rlen
-        jq = tangent(q, rlen, self.f_qlinear.weight.reshape(1, NUM_JOINTS, 4, D))
         if self.use_correction:
             first, act, last = self.f_delta
             h = first(torch.cat([phi, embedding.expand(M, -1)], dim=-1))  # (M, H)
@@ -336,17 +336,18 @@ class RetargetNet(nn.Module):
             p = s / slen
             slope = torch.where(h > 0, torch.ones_like(h), torch.full_like(h, act.negative_slope))
             ds = (slope[:, None, :] * last.weight[None]) @ first.weight[:, :D]  # (M, 88, D)
-            jp = tangent(p, slen, ds.reshape(M, NUM_JOINTS, 4, D))
         else:
             p = tq.IDENTITY.to(phi).expand(M, NUM_JOINTS, 4)
-            jp = None
         w, x, y, z = q.unbind(-1)
         left = torch.stack([w, -x, -y, -z, x, w, -z, y, y, z, w, -x, z, -y, x, w], -1).reshape(M, NUM_JOINTS, 4, 4)
         w, x, y, z = p.unbind(-1)
         right = torch.stack([w, -x, -y, -z, x, w, z, -y, y, -z, w, x, z, y, -x, w], -1).reshape(M, NUM_JOINTS, 4, 4)
-        jac = torch.einsum("mjab,mjbd->mjad", right, jq)  # R(p) dq for every frame, joint and latent channel
-        if jp is not None:
-            jac = jac + torch.einsum("mjab,mjbd->mjad", left, jp)  # + L(q) dp
+        # the 4 × 4 factors multiplied first, then one product with each (4 × D) block; R(p) dq
+        # joint-major, so that each joint's block of F_qlinear's weight is shared by all frames
+        dq = (right @ tangent(q, rlen)).transpose(0, 1) @ self.f_qlinear.weight.reshape(NUM_JOINTS, 1, 4, D)
+        jac = dq.transpose(0, 1)  # (M, J, 4, D)
+        if self.use_correction:
+            jac = jac + (left @ tangent(p, slen)) @ ds.reshape(M, NUM_JOINTS, 4, D)  # + L(q) dp
         return tq.mul(q, p), jac.reshape(M, 4 * NUM_JOINTS, D)
 
     def decode(self, phi: torch.Tensor, offsets: torch.Tensor, embedding: torch.Tensor | None = None) -> Decoded:
