@@ -334,20 +334,20 @@ class RetargetNet(nn.Module):
             s = last(act(h)).reshape(M, NUM_JOINTS, 4)
             slen = torch.sqrt((s * s).sum(-1, keepdim=True))
             p = s / slen
-            slope = torch.where(h > 0, torch.ones_like(h), torch.full_like(h, act.negative_slope))
-            ds = (slope[:, None, :] * last.weight[None]) @ first.weight[:, :D]  # (M, 88, D)
+            slope = torch.where(h > 0, torch.ones_like(h), torch.full_like(h, act.negative_slope))  # σ'(h)
         else:
             p = tq.IDENTITY.to(phi).expand(M, NUM_JOINTS, 4)
         w, x, y, z = q.unbind(-1)
         left = torch.stack([w, -x, -y, -z, x, w, -z, y, y, z, w, -x, z, -y, x, w], -1).reshape(M, NUM_JOINTS, 4, 4)
         w, x, y, z = p.unbind(-1)
         right = torch.stack([w, -x, -y, -z, x, w, z, -y, y, -z, w, x, z, y, -x, w], -1).reshape(M, NUM_JOINTS, 4, 4)
-        # the 4 × 4 factors multiplied first, then one product with each (4 × D) block; R(p) dq
-        # joint-major, so that each joint's block of F_qlinear's weight is shared by all frames
-        dq = (right @ tangent(q, rlen)).transpose(0, 1) @ self.f_qlinear.weight.reshape(NUM_JOINTS, 1, 4, D)
-        jac = dq.transpose(0, 1)  # (M, J, 4, D)
-        if self.use_correction:
-            jac = jac + (left @ tangent(p, slen)) @ ds.reshape(M, NUM_JOINTS, 4, D)  # + L(q) dp
+        # R(p) dq: the 4 × 4 factors multiplied first, then each joint's (4 × D) block of F_qlinear's weight
+        jac = torch.einsum("mjab,jbd->mjad", right @ tangent(q, rlen), self.f_qlinear.weight.reshape(NUM_JOINTS, 4, D))
+        jac = jac.reshape(M * 4 * NUM_JOINTS, D)
+        if self.use_correction:  # + L(q) dp = (L(q) T(p) V diag(σ'(h))) U_φ dφ, the last product one matrix product
+            lv = torch.einsum("mjab,jbh->mjah", left @ tangent(p, slen), last.weight.reshape(NUM_JOINTS, 4, -1))
+            lvs = (lv * slope[:, None, None, :]).reshape(M * 4 * NUM_JOINTS, -1)
+            jac = torch.addmm(jac, lvs, first.weight[:, :D])
         return tq.mul(q, p), jac.reshape(M, 4 * NUM_JOINTS, D)
 
     def decode(self, phi: torch.Tensor, offsets: torch.Tensor, embedding: torch.Tensor | None = None) -> Decoded:

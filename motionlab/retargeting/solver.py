@@ -352,8 +352,8 @@ def project_latent(
     the step small where the decoder is insensitive.
 
     Each row is solved as if alone: a row stops (keeps its latent) once all its residuals are
-    below 1e-5 (≈ 0.001°), and the frames are computed in chunks (:data:`PROJECT_FRAMES`, or on a
-    GPU as many as a quarter of its free memory holds, :data:`PROJECT_BYTES_PER_FRAME`).
+    below 1e-5 (≈ 0.001°), and the frames are computed in chunks (:data:`PROJECT_FRAMES` on the
+    CPU; on a GPU as many as a quarter of its free memory holds, :data:`PROJECT_BYTES_PER_FRAME`).
 
     Parameters
     ----------
@@ -395,10 +395,14 @@ def project_latent(
     return out
 
 
-PROJECT_FRAMES = 2048
-"""Frames per chunk of :func:`project_latent`'s Jacobians on the CPU. A frame's (88 × D) Jacobian,
-the temporaries of :meth:`RetargetNet.rotation_jacobian`, its 88 × 88 normal matrix and their
-factor take up to :data:`PROJECT_BYTES_PER_FRAME`; per-frame results do not depend on the chunk."""
+PROJECT_FRAMES = 32
+"""Frames per chunk of :func:`project_latent`'s Jacobians on the CPU. Per-frame results do not
+depend on the chunk; a small chunk keeps a chunk's Jacobians (88 × D per frame, 90 kB in float64
+for D = 128) and the temporaries that build them in the processor's caches between one operation
+and the next (``python benchmarks/bench_slider.py --chunks`` measures the choice, ``docs/performance.md``)."""
+
+PROJECT_GPU_FRAMES = 2048
+"""The fewest frames of a Gauss–Newton chunk on a GPU (see :data:`PROJECT_BYTES_PER_FRAME`)."""
 
 PROJECT_BYTES_PER_FRAME = 1_000_000
 """Bytes one frame of a Gauss–Newton chunk may take in float64 (D = 128; half in float32), rounded
@@ -407,12 +411,13 @@ larger chunks keep the GPU busy instead of waiting for the host to launch the ne
 
 
 def _chunk_frames(phi: torch.Tensor) -> int:
-    """Frames per Gauss–Newton chunk for ``phi``'s device and float type (:data:`PROJECT_FRAMES`)."""
+    """Frames per Gauss–Newton chunk for ``phi``'s device and float type: :data:`PROJECT_FRAMES` on
+    the CPU, on a GPU at least :data:`PROJECT_GPU_FRAMES`."""
     if phi.device.type != "cuda":
         return PROJECT_FRAMES
     free, _ = torch.cuda.mem_get_info(phi.device)
     per_frame = PROJECT_BYTES_PER_FRAME * phi.element_size() // 8
-    return max(PROJECT_FRAMES, int(0.25 * free // per_frame))
+    return max(PROJECT_GPU_FRAMES, int(0.25 * free // per_frame))
 
 
 def _gauss_newton_step(model, phi, target_rot, emb, damping) -> tuple[torch.Tensor, torch.Tensor]:
