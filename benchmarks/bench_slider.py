@@ -10,10 +10,13 @@
    result compared with a fresh ``retarget(..., "full")`` of the same skeleton (largest joint
    difference, metres, must be 0).
 
-Prints the 1-minute load average before and after. Usage (repository root)::
+Prints the load average before and after. ``--code DIR`` imports motionlab from another
+checkout (e.g. ``git worktree add /tmp/old <commit>``) to time an older version the same way
+(part 2 only). Usage (repository root)::
 
-    python benchmarks/bench_slider.py            # the slider's solve
-    python benchmarks/bench_slider.py --chunks   # the chunk sweep
+    python benchmarks/bench_slider.py                      # the slider's solve
+    python benchmarks/bench_slider.py --code /tmp/old      # ... with an older motionlab
+    python benchmarks/bench_slider.py --chunks             # the chunk sweep
 """
 
 from __future__ import annotations
@@ -28,13 +31,6 @@ from pathlib import Path
 import numpy as np
 import torch
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from motionlab import retargeting, synthetic  # noqa: E402
-from motionlab.core import humanoid, threads  # noqa: E402
-from motionlab.retargeting import solver  # noqa: E402
-from motionlab.retargeting.proportions import proportion_solver  # noqa: E402
-
 CHUNKS = (16, 32, 64, 128, 256, 2048)
 
 
@@ -43,6 +39,9 @@ def _load() -> str:
 
 
 def _round_inputs(ckpt, clip, skeleton):
+    from motionlab import retargeting
+    from motionlab.retargeting import solver
+
     """The arguments of the solver's first Gauss–Newton round for ``clip`` on ``skeleton``."""
     seen = []
     real = solver._gauss_newton_step
@@ -61,6 +60,10 @@ def _round_inputs(ckpt, clip, skeleton):
 
 def chunks(ckpt, repeats: int) -> None:
     """Part 1: one Gauss–Newton round per chunk size, three problem sizes."""
+    from motionlab import synthetic
+    from motionlab.core import humanoid, threads
+    from motionlab.retargeting import solver
+
     skeleton = humanoid.canonical_skeleton()
     target = humanoid.scale_bones(skeleton, legs=1.3, arms=0.8)
     walk = _round_inputs(ckpt, synthetic.generate("walk", skeleton, 120, 30.0, seed=1), target)
@@ -98,11 +101,19 @@ def chunks(ckpt, repeats: int) -> None:
 
 def slider(ckpt, repeats: int) -> None:
     """Part 2: the editor's solve per release, and the same result as a fresh retarget."""
+    import motionlab
+    from motionlab import retargeting, synthetic
+    from motionlab.core import humanoid
+    from motionlab.retargeting.proportions import proportion_solver
+
     skeleton = humanoid.canonical_skeleton()
     clip = synthetic.generate("walk", skeleton, 120, 30.0, seed=1)  # as notebook 04
     solve = proportion_solver(clip, max_steps=30)
     config = retargeting.SolverConfig(max_steps=30)
-    print(f"part 2: notebook 04's legs slider, solve per release; load before {_load()}")
+    print(
+        f"part 2: notebook 04's legs slider, solve per release (motionlab from {Path(motionlab.__file__).parents[1]})"
+    )
+    print(f"load before {_load()}")
     seconds, worst = [], 0.0
     for k in range(repeats + 1):
         target = humanoid.scale_bones(skeleton, legs=1.3 + 0.05 * (k % 7), arms=0.8)
@@ -123,7 +134,13 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--chunks", action="store_true", help="part 1: the Gauss-Newton chunk sweep")
     parser.add_argument("--repeats", type=int, default=7, help="rounds per chunk size, or timed releases (default 7)")
+    parser.add_argument(
+        "--code", type=Path, default=Path(__file__).resolve().parents[1], help="motionlab checkout to import"
+    )
     args = parser.parse_args(argv)
+    sys.path.insert(0, str(args.code.resolve()))
+    from motionlab import retargeting
+
     ckpt = retargeting.load_default()
     if args.chunks:
         chunks(ckpt, args.repeats)
