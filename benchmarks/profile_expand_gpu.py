@@ -3,7 +3,7 @@
 Prepares all of Aj's clips × the six Table 1 characters as ``expand`` does (host workers), plans
 the padded batches, then times the latent iteration of every batch (``batching.solve_jobs``,
 device synchronised) with the Gauss–Newton start in chunks as large as free memory allows (as
-shipped) and in chunks of ``solver.PROJECT_FRAMES`` frames (as on the CPU). Then it profiles the batch with the most
+shipped) and in chunks of ``solver.PROJECT_GPU_FRAMES`` frames (the least a GPU chunk holds). Then it profiles the batch with the most
 rows: Python (cProfile, top functions by own time) and the device (``torch.profiler``: top
 operators by device time, kernel launches per step). Results of the variants are compared with
 the shipped ones (largest joint difference, cm).
@@ -75,7 +75,7 @@ def main(argv=None) -> None:
     print(f"{len(pairs)} pairs, {frames} frames prepared in {time.perf_counter() - clock:.1f} s; batches (rows x frames): "
           + ", ".join(f"{len(b)}x{b[0].frames}" for b in batches))  # fmt: skip
     shipped = solver.PROJECT_BYTES_PER_FRAME
-    variants = {"chunks by free memory": shipped, f"chunks of {solver.PROJECT_FRAMES}": 10**15}
+    variants = {"chunks by free memory": shipped, f"chunks of {solver.PROJECT_GPU_FRAMES}": 10**15}
     reference = None
     for name, per_frame in variants.items():
         solver.PROJECT_BYTES_PER_FRAME = per_frame

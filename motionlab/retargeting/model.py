@@ -216,6 +216,18 @@ class _Encoder(nn.Module):
         return self.net(x.transpose(1, 2)).transpose(1, 2)
 
 
+def _left_matrix(q: torch.Tensor) -> torch.Tensor:
+    """L(q) (..., 4, 4): ``q ⊗ x = L(q) x`` for quaternions (..., 4), w first."""
+    w, x, y, z = q.unbind(-1)
+    return torch.stack([w, -x, -y, -z, x, w, -z, y, y, z, w, -x, z, -y, x, w], -1).reshape(q.shape + (4,))
+
+
+def _right_matrix(p: torch.Tensor) -> torch.Tensor:
+    """R(p) (..., 4, 4): ``x ⊗ p = R(p) x`` for quaternions (..., 4), w first."""
+    w, x, y, z = p.unbind(-1)
+    return torch.stack([w, -x, -y, -z, x, w, z, -y, y, -z, w, x, z, y, -x, w], -1).reshape(p.shape + (4,))
+
+
 class RetargetNet(nn.Module):
     """F_enc, F_qlinear, F_skel and F_Δ, with the decoder that combines them (paper A, §2.2 and Fig. 3).
 
@@ -299,7 +311,9 @@ class RetargetNet(nn.Module):
             s = s[:, None]
         return fk_by_level(local_rot, s, humanoid.PARENTS)
 
-    def rotation_jacobian(self, phi: torch.Tensor, embedding: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    def rotation_jacobian(
+        self, phi: torch.Tensor, embedding: torch.Tensor, tangent: bool = False
+    ) -> tuple[torch.Tensor, torch.Tensor]:
         """Per-frame decoded rotations ``q ⊗ q_Δ`` and their Jacobian with respect to the latent.
 
         Eqs. 10–13 act on each frame alone, so frame ``t``'s rotations depend on ``φ_t`` only and
@@ -308,46 +322,54 @@ class RetargetNet(nn.Module):
         ``ds = V diag(σ'(h)) U_φ dφ`` for F_Δ (``h`` its hidden layer), and
         ``d(q ⊗ p) = L(q) dp + R(p) dq`` for the Hamilton product (L, R: its 4×4 matrices).
 
+        Each decoded quaternion ``o`` is a unit one, so ``oᵀ do = 0``: its 4 rows of the Jacobian
+        hold 3 numbers' worth. ``tangent=True`` gives those 3 rows, the vector part of ``o* ⊗ do``
+        (an orthonormal basis of the quaternions orthogonal to ``o``): 66 rows instead of 88, the
+        same ``JᵀJ``.
+
         Parameters
         ----------
         phi : Tensor (M, D)         latents of M frames
         embedding : Tensor (M, E) or (1, E)   the skeleton embedding S̄' for each frame
+        tangent : bool              the Jacobian in each quaternion's tangent basis (above)
 
         Returns
         -------
         rotations : Tensor (M, 22, 4)
-        jacobian : Tensor (M, 88, D)
+        jacobian : Tensor (M, 88, D), or (M, 66, D) with ``tangent``
         """
         M, D = phi.shape
+        eye = torch.eye(4, dtype=phi.dtype, device=phi.device)
 
-        def tangent(u: torch.Tensor, length: torch.Tensor, du: torch.Tensor) -> torch.Tensor:
-            # d unit(r) = (du − u ⟨u, du⟩) / ‖r‖ for du (M, J, 4, D)
-            return (du - u[..., :, None] * torch.einsum("mjb,mjbd->mjd", u, du)[..., None, :]) / length[..., None]
+        def tangent_map(u: torch.Tensor, length: torch.Tensor) -> torch.Tensor:
+            # d unit(r) = (I − u uᵀ) / ‖r‖ dr, as (M, J, 4, 4) matrices
+            return (eye - u[..., :, None] * u[..., None, :]) / length[..., None]
 
         r = self.f_qlinear(phi).reshape(M, NUM_JOINTS, 4)
         rlen = torch.sqrt((r * r).sum(-1, keepdim=True))
         q = r / rlen
-        jq = tangent(q, rlen, self.f_qlinear.weight.reshape(1, NUM_JOINTS, 4, D))
         if self.use_correction:
             first, act, last = self.f_delta
             h = first(torch.cat([phi, embedding.expand(M, -1)], dim=-1))  # (M, H)
             s = last(act(h)).reshape(M, NUM_JOINTS, 4)
             slen = torch.sqrt((s * s).sum(-1, keepdim=True))
             p = s / slen
-            slope = torch.where(h > 0, torch.ones_like(h), torch.full_like(h, act.negative_slope))
-            ds = (slope[:, None, :] * last.weight[None]) @ first.weight[:, :D]  # (M, 88, D)
-            jp = tangent(p, slen, ds.reshape(M, NUM_JOINTS, 4, D))
+            slope = torch.where(h > 0, torch.ones_like(h), torch.full_like(h, act.negative_slope))  # σ'(h)
         else:
             p = tq.IDENTITY.to(phi).expand(M, NUM_JOINTS, 4)
-            jp = None
-        w, x, y, z = q.unbind(-1)
-        left = torch.stack([w, -x, -y, -z, x, w, -z, y, y, z, w, -x, z, -y, x, w], -1).reshape(M, NUM_JOINTS, 4, 4)
-        w, x, y, z = p.unbind(-1)
-        right = torch.stack([w, -x, -y, -z, x, w, z, -y, y, -z, w, x, z, y, -x, w], -1).reshape(M, NUM_JOINTS, 4, 4)
-        jac = torch.einsum("mjab,mjbd->mjad", right, jq)  # R(p) dq for every frame, joint and latent channel
-        if jp is not None:
-            jac = jac + torch.einsum("mjab,mjbd->mjad", left, jp)  # + L(q) dp
-        return tq.mul(q, p), jac.reshape(M, 4 * NUM_JOINTS, D)
+        out = tq.mul(q, p)
+        fq = _right_matrix(p) @ tangent_map(q, rlen)  # d(q ⊗ p) = fq dr + fp ds
+        fp = _left_matrix(q) @ tangent_map(p, slen) if self.use_correction else None
+        if tangent:  # the rows of L(o*) past the first: o* ⊗ do has no real part
+            basis = _left_matrix(tq.conj(out))[..., 1:, :]
+            fq, fp = basis @ fq, None if fp is None else basis @ fp
+        rows = fq.shape[-2] * NUM_JOINTS
+        # R(p) dq: the small factors multiplied first, then each joint's (4 × D) block of F_qlinear's weight
+        jac = torch.einsum("mjab,jbd->mjad", fq, self.f_qlinear.weight.reshape(NUM_JOINTS, 4, D)).reshape(M * rows, D)
+        if fp is not None:  # + L(q) dp = (L(q) T(p) V diag(σ'(h))) U_φ dφ, the last product one matrix product
+            lv = torch.einsum("mjab,jbh->mjah", fp, last.weight.reshape(NUM_JOINTS, 4, -1))
+            jac = torch.addmm(jac, (lv * slope[:, None, None, :]).reshape(M * rows, -1), first.weight[:, :D])
+        return out, jac.reshape(M, rows, D)
 
     def decode(self, phi: torch.Tensor, offsets: torch.Tensor, embedding: torch.Tensor | None = None) -> Decoded:
         """The whole decoder on skeleton ``offsets`` (J, 3) or (B, J, 3) from the latent φ (B, T, D).

@@ -74,6 +74,7 @@ import numpy as np
 import torch
 from tqdm.auto import tqdm
 
+from motionlab.core import quat_torch as tq
 from motionlab.core import threads
 from motionlab.retargeting import losses, terms
 from motionlab.retargeting.contacts import CONTACT_JOINTS
@@ -346,14 +347,16 @@ def project_latent(
     are per-frame layers), so the angle term can be solved frame by frame: with ``g(φ_t)`` the 88
     numbers of the 22 decoded quaternions and ``J_t`` its Jacobian (88 × D,
     :meth:`RetargetNet.rotation_jacobian`), each round takes the damped Gauss–Newton
-    (Levenberg–Marquardt) step ``φ_t ← φ_t + (J_tᵀ J_t + μ I)⁻¹ J_tᵀ (q*_t − g(φ_t))``, solved in
-    its 88 × 88 dual form, where ``q*_t`` is the target with
-    each quaternion's sign matched to the current output. ``μ = damping × mean diag(JᵀJ)`` keeps
-    the step small where the decoder is insensitive.
+    (Levenberg–Marquardt) step ``φ_t ← φ_t + (J_tᵀ J_t + μ I)⁻¹ J_tᵀ (q*_t − g(φ_t))``, where
+    ``q*_t`` is the target with each quaternion's sign matched to the current output.
+    ``μ = damping × mean diag(JJᵀ)`` (the mean over the 88 rows) keeps the step small where the
+    decoder is insensitive. The step is solved in its dual form ``J_tᵀ (J_t J_tᵀ + μ I)⁻¹ r``, with
+    ``J_t`` and ``r`` in each decoded quaternion's tangent basis (``rotation_jacobian(...,
+    tangent=True)``): 66 × 66 instead of 88 × 88, the same step (the 22 rows left out are 0).
 
     Each row is solved as if alone: a row stops (keeps its latent) once all its residuals are
-    below 1e-5 (≈ 0.001°), and the frames are computed in chunks (:data:`PROJECT_FRAMES`, or on a
-    GPU as many as a quarter of its free memory holds, :data:`PROJECT_BYTES_PER_FRAME`).
+    below 1e-5 (≈ 0.001°), and the frames are computed in chunks (:data:`PROJECT_FRAMES` on the
+    CPU; on a GPU as many as a quarter of its free memory holds, :data:`PROJECT_BYTES_PER_FRAME`).
 
     Parameters
     ----------
@@ -395,10 +398,14 @@ def project_latent(
     return out
 
 
-PROJECT_FRAMES = 2048
-"""Frames per chunk of :func:`project_latent`'s Jacobians on the CPU. A frame's (88 × D) Jacobian,
-the temporaries of :meth:`RetargetNet.rotation_jacobian`, its 88 × 88 normal matrix and their
-factor take up to :data:`PROJECT_BYTES_PER_FRAME`; per-frame results do not depend on the chunk."""
+PROJECT_FRAMES = 32
+"""Frames per chunk of :func:`project_latent`'s Jacobians on the CPU. Per-frame results do not
+depend on the chunk; a small chunk keeps a chunk's Jacobians (66 × D per frame, 68 kB in float64
+for D = 128) and the temporaries that build them in the processor's caches between one operation
+and the next (``python benchmarks/bench_slider.py --chunks`` measures the choice, ``docs/performance.md``)."""
+
+PROJECT_GPU_FRAMES = 2048
+"""The fewest frames of a Gauss–Newton chunk on a GPU (see :data:`PROJECT_BYTES_PER_FRAME`)."""
 
 PROJECT_BYTES_PER_FRAME = 1_000_000
 """Bytes one frame of a Gauss–Newton chunk may take in float64 (D = 128; half in float32), rounded
@@ -407,12 +414,13 @@ larger chunks keep the GPU busy instead of waiting for the host to launch the ne
 
 
 def _chunk_frames(phi: torch.Tensor) -> int:
-    """Frames per Gauss–Newton chunk for ``phi``'s device and float type (:data:`PROJECT_FRAMES`)."""
+    """Frames per Gauss–Newton chunk for ``phi``'s device and float type: :data:`PROJECT_FRAMES` on
+    the CPU, on a GPU at least :data:`PROJECT_GPU_FRAMES`."""
     if phi.device.type != "cuda":
         return PROJECT_FRAMES
     free, _ = torch.cuda.mem_get_info(phi.device)
     per_frame = PROJECT_BYTES_PER_FRAME * phi.element_size() // 8
-    return max(PROJECT_FRAMES, int(0.25 * free // per_frame))
+    return max(PROJECT_GPU_FRAMES, int(0.25 * free // per_frame))
 
 
 def _gauss_newton_step(model, phi, target_rot, emb, damping) -> tuple[torch.Tensor, torch.Tensor]:
@@ -421,18 +429,20 @@ def _gauss_newton_step(model, phi, target_rot, emb, damping) -> tuple[torch.Tens
     N, T, D = phi.shape
     flat, target = phi.reshape(N * T, D), target_rot.reshape(N * T, NUM_JOINTS, 4)
     emb_frames = emb[:, None, :].expand(N, T, emb.shape[-1]).reshape(N * T, -1)
-    eye = torch.eye(4 * NUM_JOINTS, dtype=phi.dtype, device=phi.device)
+    eye = torch.eye(3 * NUM_JOINTS, dtype=phi.dtype, device=phi.device)
     step, worst = torch.empty_like(flat), torch.empty(N * T, dtype=phi.dtype, device=phi.device)
     chunk = _chunk_frames(phi)
     for c in range(0, N * T, chunk):
         part = slice(c, c + chunk)
-        out, jac = model.rotation_jacobian(flat[part], emb_frames[part])
+        out, jac = model.rotation_jacobian(flat[part], emb_frames[part], tangent=True)  # (m, 66, D)
         goal = torch.where((out * target[part]).sum(-1, keepdim=True) < 0, -target[part], target[part])
-        resid = (goal - out).reshape(out.shape[0], -1, 1)
+        resid = goal - out
         worst[part] = resid.abs().amax(dim=(1, 2))
-        # (JᵀJ + μI)⁻¹ Jᵀ r = Jᵀ (J Jᵀ + μI)⁻¹ r: an 88 × 88 system per frame instead of D × D
+        # Jᵀ r with J in each quaternion's tangent basis: the same step (the rows left out are 0)
+        resid = tq.mul(tq.conj(out), resid)[..., 1:].reshape(out.shape[0], -1, 1)
+        # (JᵀJ + μI)⁻¹ Jᵀ r = Jᵀ (J Jᵀ + μI)⁻¹ r: a 66 × 66 system per frame instead of D × D
         jjt = jac @ jac.transpose(1, 2)
-        mu = damping * jjt.diagonal(dim1=1, dim2=2).mean(-1).clamp_min(1e-12)
+        mu = damping * (jjt.diagonal(dim1=1, dim2=2).sum(-1) / (4 * NUM_JOINTS)).clamp_min(1e-12)  # mean over 88
         chol = torch.linalg.cholesky(jjt + mu[:, None, None] * eye)  # symmetric positive definite
         step[part] = (jac.transpose(1, 2) @ torch.cholesky_solve(resid, chol))[..., 0]
     return step.reshape(N, T, D), worst.reshape(N, T).amax(1) < 1e-5

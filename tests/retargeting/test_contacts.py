@@ -131,6 +131,35 @@ def test_rotation_jacobian_matches_autograd():
             model.use_correction = True
 
 
+def test_the_tangent_jacobian_keeps_every_direction_the_rotations_move_in():
+    """``tangent=True``: 3 rows per joint, the vector part of ``o* ⊗ dJ``; the 4th row (along the
+    unit quaternion o) is 0, so JᵀJ, and with it the Gauss–Newton step, is that of the 88 rows."""
+    from motionlab.core import quat_torch as tq
+
+    model = retargeting.load_default().model
+    torch.manual_seed(1)
+    phi = torch.randn(5, model.config.latent, dtype=torch.float64)
+    emb = model.skeleton_embedding(torch.tensor(retargeting.load_default().skeleton.offsets))
+    for correction in (True, False):
+        model.use_correction = correction
+        try:
+            rot, full = model.rotation_jacobian(phi, emb)
+            rot_t, jac_t = model.rotation_jacobian(phi, emb, tangent=True)
+            assert jac_t.shape == (5, 66, model.config.latent)
+            torch.testing.assert_close(rot_t, rot, atol=0, rtol=0)
+            blocks = full.reshape(5, 22, 4, -1)
+            along = (rot[..., None] * blocks).sum(-2)  # oᵀ dJ per joint
+            assert along.abs().max() < 1e-12
+            projected = tq.mul(tq.conj(rot)[..., None, :].expand(-1, -1, blocks.shape[-1], -1),
+                               blocks.transpose(-1, -2))[..., 1:]  # fmt: skip
+            torch.testing.assert_close(jac_t, projected.transpose(-1, -2).reshape(5, 66, -1), atol=1e-12, rtol=0)
+            torch.testing.assert_close(
+                jac_t.transpose(1, 2) @ jac_t, full.transpose(1, 2) @ full, atol=1e-10, rtol=1e-12
+            )
+        finally:
+            model.use_correction = True
+
+
 def test_projection_reaches_the_source_rotations():
     ckpt = retargeting.load_default()
     motion = preprocess.prepare(synthetic.generate("walk", num_frames=90, fps=ckpt.fps), ckpt.fps)

@@ -184,3 +184,32 @@ def test_a_float32_network_projects_every_family():
     clips = rig_matrix.family_clips(data.data_root(), seconds=1.5)
     result = pipeline.retarget(clips["xia"], clips["mixamo"], ckpt, "full", SolverConfig(max_steps=2))
     assert result.history["angle"][0] < 1e-2
+
+
+def test_the_gauss_newton_start_does_not_depend_on_the_chunk(monkeypatch):
+    """Aj's Jumping onto Goblin: the start in chunks of PROJECT_FRAMES frames (several chunks
+    and a short last one) is the start in one chunk, to the last bit."""
+    from motionlab import retargeting
+    from motionlab.core import bvh
+    from motionlab.retargeting import pipeline, solver
+    from tests.conftest import require_data
+
+    root = require_data("mixamo")
+    ckpt = retargeting.load_default("cpu")
+    src = pipeline.prepare_source(bvh.load(root / "Aj" / "Jumping.bvh"), ckpt, "full")
+    pair = pipeline.prepare_pair(src, bvh.load(root / "Goblin_m" / "Run_Arc_Left.bvh").skeleton)
+    frames = src.x.shape[1]
+    assert frames > 2 * solver.PROJECT_FRAMES and frames % solver.PROJECT_FRAMES, "the clip must span chunks"
+    cfg = SolverConfig()
+    starts = []
+    for chunk in (solver.PROJECT_FRAMES, 10**9):
+        monkeypatch.setattr(solver, "PROJECT_FRAMES", chunk)
+        with torch.no_grad():
+            phi0 = ckpt.model.encode(src.x)
+            smooth = solver.smoother(cfg.smooth_sigma, phi0.shape[-1], phi0.dtype)
+            starts.append(
+                solver.project_latent(
+                    ckpt.model, phi0, src.theta, pair.offsets, cfg.project_iters, None, smooth, cfg.project_exact
+                )
+            )
+    assert torch.equal(starts[0], starts[1])
