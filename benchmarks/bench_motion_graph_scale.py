@@ -44,6 +44,10 @@ REQUESTS = {
         "walk:normal:200,walk:elderly:200",
         "walk:normal:100,wave-both-hands:normal:60,walk:normal:100",
         "walk:active:100,raise-up-both-hands:feminine:60",
+        # crossing pools entered at hundreds of frames (11.2 s and 2.7 s per command before
+        # the walks from all entries at once)
+        "wave-both-hands:youthful:500,raise-up-both-hands:elderly:90,walk:exhausted:2000",
+        "raise-up-both-hands:normal:40,raise-up-both-hands:active:40,wave-both-hands:masculine:300",
     ),
     "walk": ("walk:normal:200,walk:elderly:200", "walk:normal:200,walk:active:200,walk:feminine:200"),
 }

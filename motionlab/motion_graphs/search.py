@@ -51,7 +51,6 @@ Taught in ``notebooks/05_motion_graphs.ipynb``.
 
 from __future__ import annotations
 
-import heapq
 import re
 from collections import deque
 from dataclasses import dataclass, field
@@ -1125,7 +1124,9 @@ class Planner:
             return  # (a bad search cost) onward raises it where a walk per entry would
         if ex is None:
             return  # the exits are out of the pool: onward raises
-        todo = [e for e in dict.fromkeys(int(e) for e in enters) if 0 <= e < cw.length and (id(link), e) not in self.walks]
+        todo = [
+            e for e in dict.fromkeys(int(e) for e in enters) if 0 <= e < cw.length and (id(link), e) not in self.walks
+        ]
         found = _walks_to_exit(cw, todo, ex, f"{link['from'][0]}/{link['from'][1]}")
         self.walks.update({(id(link), e): w for e, w in found.items()})
         nxt = [link["routes"][w[0]]["enter"] for w in found.values() if not isinstance(w, Exception)]
@@ -1177,7 +1178,12 @@ class Planner:
         return n + route["frames"] + more_frames, final_enter
 
     def onward_pieces(self, hops: list[dict], enter: int) -> list[tuple[int, int, int]]:
-        """The pieces of :meth:`onward`'s way: each hop's walk (:func:`walk_to_exit`), then its route."""
+        """The pieces of :meth:`onward`'s way: each hop's walk (:func:`walk_to_exit`), then its route.
+
+        Raises
+        ------
+        GraphError (internal) when a walk disagrees with what :meth:`onward` counted.
+        """
         out = []
         for link in hops:
             cw, ex = self.walker(tuple(link["from"])), self._exits(link)
