@@ -113,12 +113,25 @@ def build_case(kind: str, frames: int, out: Path, workers: int) -> dict:
         summary = g.summary()
     with clock("save"):
         io.save(out, g, overwrite=True, summary=summary)
-    return dict(
+    return dict(edges_sha=edges_sha(g),
         kind=kind, frames=g.num_frames, takes=len(motions), threshold_m=rms, workers=workers, build_s=build_s,
         cpu_s=(c1.ru_utime + c1.ru_stime) - (c0.ru_utime + c0.ru_stime), transitions=summary["transitions"],
         peak_gb=_gb(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss), file_mb=out.stat().st_size / 1e6,
         stages=clock.rows, behaviours={b: v["percent"] for b, v in rep["behaviours"].items()},
     )  # fmt: skip
+
+
+def edges_sha(g) -> str:
+    """SHA-256 of the graph's alive frames, edges, costs and edge kinds (as
+    ``tests/motion_graphs/test_build_scale.py`` hashes them): equal hashes, the same graph."""
+    import hashlib
+
+    import numpy as np
+
+    h = hashlib.sha256()
+    for a in (g.alive, g.src, g.dst, g.cost, g.kind):
+        h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()
 
 
 def measure(cmd: list[str]) -> dict:
@@ -195,6 +208,7 @@ def build_in_child(case: str, graph: Path, workers: int) -> dict | None:
           f"{r['workers']} threads; load average before {load[0]:.1f}")  # fmt: skip
     print(f"build {r['build_s']:.1f} s wall ({r['cpu_s']:.1f} s CPU), peak {r['peak_gb']:.2f} GB (whole process: "
           f"library, build, report, save); {r['transitions']} transitions; file {r['file_mb']:.0f} MB")  # fmt: skip
+    print(f"edges SHA-256 (alive, src, dst, cost, kind): {r['edges_sha']}")
     from motionlab.motion_graphs.report import format_stages
 
     print(format_stages(r["stages"]))

@@ -46,6 +46,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 
@@ -218,13 +219,27 @@ def block_cells(available: int | None = None) -> int:
     temporaries take at most 1/16 of ``available`` bytes (default: the memory the system reports
     available), and never fewer than 65,536. The candidates do not depend on it."""
     if available is None:
+        available = _available_memory()
+    return int(min(BLOCK_CELLS, max(1 << 16, available // (_MEMORY_SHARE * _BYTES_PER_CELL))))
+
+
+_MEMORY_SECONDS = 1.0  # the memory available is read again after this long
+_memory_read: list = [-np.inf, 0]  # (when, bytes)
+
+
+def _available_memory() -> int:
+    """The memory the system reports available, bytes, read at most once a second (reading it
+    costs about as much as comparing two short takes)."""
+    now = time.monotonic()
+    if now - _memory_read[0] > _MEMORY_SECONDS:
         try:
             import psutil
 
-            available = int(psutil.virtual_memory().available)
+            _memory_read[1] = int(psutil.virtual_memory().available)
         except (ImportError, OSError):  # pragma: no cover - psutil is a dependency
-            available = BLOCK_CELLS * _BYTES_PER_CELL * _MEMORY_SHARE
-    return int(min(BLOCK_CELLS, max(1 << 16, available // (_MEMORY_SHARE * _BYTES_PER_CELL))))
+            _memory_read[1] = BLOCK_CELLS * _BYTES_PER_CELL * _MEMORY_SHARE
+        _memory_read[0] = now
+    return _memory_read[1]
 
 
 def _block(fa: CloudFeatures, fb: CloudFeatures, rows: slice, right: np.ndarray, yb: np.ndarray) -> np.ndarray:
@@ -261,6 +276,22 @@ def _right(fb: CloudFeatures) -> tuple[np.ndarray, np.ndarray]:
     # a = [cx|cz]·[cx'|cz'],  b = [cx|cz]·[cz'|-cx']
     right = np.concatenate([fb.centred, np.concatenate([cz, -cx], axis=1)], axis=0).T  # (2n, 2 Tb)
     return np.ascontiguousarray(right), np.ascontiguousarray(fb.height.T)
+
+
+_RIGHT_KEPT_ROWS = 1024
+"""Clips of at most this many frames keep their right-hand factors (:func:`_right`, about
+7 kB a frame) in their features, for their next comparison (a take meets itself and its
+neighbours); longer ones make them again."""
+
+
+def _right_of(fb: CloudFeatures) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_right` of all of ``fb``, kept in ``fb`` when it is short (the same arrays)."""
+    if len(fb) > _RIGHT_KEPT_ROWS:
+        return _right(fb)
+    kept = fb.__dict__.get("_right_kept")
+    if kept is None:
+        kept = fb.__dict__["_right_kept"] = _right(fb)
+    return kept
 
 
 def distance_blocks(
@@ -399,7 +430,7 @@ def candidates(
     if len(sub_a) == 0 or len(sub_b) == 0:
         empty = np.zeros(0, dtype=np.int64)
         return empty, empty, np.zeros(0)
-    right, yb = _right(sub_b)
+    right, yb = _right_of(fb) if (c0_, c1_) == (0, len(fb)) else _right(sub_b)
     n_rows = block_rows or max(1, block_cells() // max(len(sub_b), 1))
     out_i, out_j, out_c = [], [], []
     T = len(sub_a)
