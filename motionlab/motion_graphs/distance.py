@@ -278,22 +278,6 @@ def _right(fb: CloudFeatures) -> tuple[np.ndarray, np.ndarray]:
     return np.ascontiguousarray(right), np.ascontiguousarray(fb.height.T)
 
 
-_RIGHT_KEPT_ROWS = 1024
-"""Clips of at most this many frames keep their right-hand factors (:func:`_right`, about
-7 kB a frame) in their features, for their next comparison (a take meets itself and its
-neighbours); longer ones make them again."""
-
-
-def _right_of(fb: CloudFeatures) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`_right` of all of ``fb``, kept in ``fb`` when it is short (the same arrays)."""
-    if len(fb) > _RIGHT_KEPT_ROWS:
-        return _right(fb)
-    kept = fb.__dict__.get("_right_kept")
-    if kept is None:
-        kept = fb.__dict__["_right_kept"] = _right(fb)
-    return kept
-
-
 def distance_blocks(
     a, b, window: int = DEFAULT_WINDOW, block_rows: int | None = None
 ) -> Iterator[tuple[int, np.ndarray]]:
@@ -430,7 +414,7 @@ def candidates(
     if len(sub_a) == 0 or len(sub_b) == 0:
         empty = np.zeros(0, dtype=np.int64)
         return empty, empty, np.zeros(0)
-    right, yb = _right_of(fb) if (c0_, c1_) == (0, len(fb)) else _right(sub_b)
+    right, yb = _right(sub_b)
     n_rows = block_rows or max(1, block_cells() // max(len(sub_b), 1))
     out_i, out_j, out_c = [], [], []
     T = len(sub_a)
