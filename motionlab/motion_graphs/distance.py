@@ -228,8 +228,8 @@ _memory_read: list = [-np.inf, 0]  # (when, bytes)
 
 
 def _available_memory() -> int:
-    """The memory the system reports available, bytes, read at most once a second (reading it
-    costs about as much as comparing two short takes)."""
+    """The memory the system reports available, bytes, read at most once every
+    :data:`_MEMORY_SECONDS` (a build compares thousands of clip pairs)."""
     now = time.monotonic()
     if now - _memory_read[0] > _MEMORY_SECONDS:
         try:
