@@ -750,46 +750,64 @@ def _walks_to_exit(cw: PoolWalker, starts, distinct: tuple, name: str) -> dict:
     """What :func:`_walk_to_exit` gives from each of ``starts`` (to the exits ``distinct``,
     checked), without its pieces: ``start -> (r, frames)``, or the :class:`SearchError` it raises.
 
-    Each start keeps its own breadth-first walk (:func:`_path`, the bound); the cheapest walks
-    from all starts come from one search backwards from the exits (:func:`_back_costs`) instead of
-    one reach table per start. That search adds whole numbers, so it is used when the walker's
-    prices are whole numbers whose sums float32 holds exactly (the reach table's sums then equal
-    it); otherwise each start is walked as :func:`_walk_to_exit` does."""
-    out: dict = {}
+    The cheapest walks from all starts come from one search backwards from the exits
+    (:func:`_back_costs`) instead of one reach table per start; each start's breadth-first walk
+    (its bound) is walked forwards when the starts are few (at most one pass over the pool's
+    frames each costs no more than one pass over its jumps), else bounded by one breadth-first
+    search backwards (:func:`_nearest_back`) and walked only where the bounds do not decide.
+    The backward searches add whole numbers, so they are used when the walker's prices are
+    whole numbers whose sums float32 holds exactly (the reach table's sums then equal them);
+    otherwise each start is walked as :func:`_walk_to_exit` does."""
     starts = list(dict.fromkeys(int(x) for x in starts))
-    jumps = cw.jumps() if cw.sparse is None else cw.sparse
     price = cw.jumps()[2]
     whole = not price.size or (np.all(price == np.round(price)) and float(price.max()) * cw.length < 2**24)
-    if not starts or not whole:  # prices not whole numbers: the reach table's own float sums decide
+    if not whole:  # the reach table's own float sums decide
+        return {s: _walk_or_error(cw, s, distinct, name) for s in starts}
+
+    def forward(s):  # the breadth-first walk from s alone: (r, frames, bound), or its error
+        try:
+            frames, r = _path(cw, s, None, name, distinct)
+        except SearchError as e:
+            return e
+        return r, len(frames), len(frames) + _paid(cw, frames)
+
+    walked, nearest, bounds = {}, {}, {}
+    if len(starts) * cw.length <= cw.loop_src.size:
+        walked = {s: forward(s) for s in starts}
+        for s, w in walked.items():
+            if not isinstance(w, Exception):
+                nearest[s], bounds[s] = w[:2], (w[2], w[2])
+    else:
+        moves, k_of, lo, hi = _nearest_back(cw, distinct[0], starts)
         for s in starts:
-            try:
-                out[s] = _walk_to_exit(cw, s, distinct, name)[1:]
-            except SearchError as e:
-                out[s] = e
-        return out
-    # the nearest exit of every start, and the least and most its breadth-first walk can pay
-    moves, k_of, lo, hi = _nearest_back(cw, distinct[0], starts)
-    best = _back_costs(cw, jumps, distinct[0], starts, max(moves[s] + 1 + hi[s] for s in starts))
-    exact = []
+            if moves[s] >= 0:
+                nearest[s] = (int(distinct[1][k_of[s]]), int(moves[s]) + 1)
+                bounds[s] = (moves[s] + 1 + lo[s], moves[s] + 1 + hi[s])
+    jumps = cw.jumps() if cw.sparse is None else cw.sparse
+    best = _back_costs(cw, jumps, distinct[0], list(bounds), max((b[1] for b in bounds.values()), default=0))
+    out: dict = {}
     for s in starts:
+        if s not in bounds:  # no exit reachable: the forward walk's loop-guard error
+            out[s] = walked[s] if s in walked else forward(s)
+            continue
         cost = best[s][0] + 1 if s in best else np.inf  # the cheapest walk's frames and prices
-        if moves[s] < 0 or moves[s] + 1 + lo[s] <= cost < moves[s] + 1 + hi[s]:
-            exact.append(s)  # no exit, or the breadth-first walk's price decides: walk it
-        elif cost < moves[s] + 1 + lo[s]:
-            out[s] = (int(distinct[1][best[s][2]]), best[s][1] + 1)
-        else:
-            out[s] = (int(distinct[1][k_of[s]]), moves[s] + 1)
-    for s, (k, n_moves, paid, seen) in zip(exact, _nearest_exits(cw, exact, distinct[0])):
-        if k < 0:
-            out[s] = SearchError(
-                f"loop guard: every frame of {name!r} reachable from frame {s} was visited "
-                f"({seen} frames) without reaching the way on"
-            )
-        elif s in best and best[s][0] + 1 < n_moves + 1 + paid:
-            out[s] = (int(distinct[1][best[s][2]]), best[s][1] + 1)
-        else:
-            out[s] = (int(distinct[1][k]), n_moves + 1)
+        cheapest = (int(distinct[1][best[s][2]]), best[s][1] + 1) if s in best else None
+        if cost < bounds[s][0]:
+            out[s] = cheapest
+        elif cost >= bounds[s][1]:
+            out[s] = nearest[s]
+        else:  # the breadth-first walk's own price decides
+            w = walked[s] if s in walked else forward(s)
+            out[s] = cheapest if cost < w[2] else w[:2]
     return out
+
+
+def _walk_or_error(cw: PoolWalker, s: int, distinct: tuple, name: str):
+    """``_walk_to_exit(...)[1:]``, or the :class:`SearchError` it raises."""
+    try:
+        return _walk_to_exit(cw, s, distinct, name)[1:]
+    except SearchError as e:
+        return e
 
 
 def _nearest_back(cw: PoolWalker, exits: np.ndarray, starts: list[int]):
@@ -834,76 +852,15 @@ def _nearest_back(cw: PoolWalker, exits: np.ndarray, starts: list[int]):
     return moves, k_of, lo, hi
 
 
-_BFS_CELLS = 1 << 25
-"""Most (start, frame) cells :func:`_nearest_exits` marks at once (a byte each)."""
-
-
-def _nearest_exits(cw: PoolWalker, starts: list[int], exits: np.ndarray) -> list[tuple[int, int, float, int]]:
-    """:func:`_path` and :func:`_paid` from every one of ``starts`` at once, one breadth-first
-    round for all of them: per start ``(k, moves, paid, seen)``, the nearest exit
-    ``exits[k]`` (the first of the nearest), the moves to it, the price of the jumps of
-    :func:`_path`'s walk to it and the frames seen (``k = -1``: no exit reachable).
-
-    A frame's parent is :func:`_distances`': the frame before it when that frame was reached in
-    the round before and steps to it, else the source of its first jump (in the walker's order)
-    from that round; the price of each walk is summed in its order, as :func:`_paid`.
-    """
-    n, out = cw.length, []
-    per = max(1, _BFS_CELLS // max(n, 1))
-    for a in range(0, len(starts), per):
-        out += _nearest_exits_some(cw, np.asarray(starts[a : a + per], dtype=np.int64), exits)
-    return out
-
-
-def _nearest_exits_some(cw: PoolWalker, starts: np.ndarray, exits: np.ndarray) -> list:
-    n, m = cw.length, starts.size
-    order, head = cw._by_source()
-    least = _pair_least(cw)
-    which = np.full(n, -1, dtype=np.int64)
-    which[exits[::-1]] = np.arange(exits.size)[::-1]  # frame -> its first index among the exits
-    seen_at = np.zeros((m, n), dtype=bool)
-    k_of, moves_of = np.full(m, -1, dtype=np.int64), np.zeros(m, dtype=np.int64)
-    paid_of, seen = np.zeros(m), np.ones(m, dtype=np.int64)
-    sid, f, paid = np.arange(m), starts.copy(), np.zeros(m)
-    seen_at[sid, f] = True
-    d = 0
-    while sid.size:
-        hit = which[f] >= 0
-        if hit.any():
-            k = np.full(m, exits.size, dtype=np.int64)
-            np.minimum.at(k, sid[hit], which[f[hit]])
-            done = np.flatnonzero(k < exits.size)
-            k_of[done], moves_of[done] = k[done], d
-            at = hit & (which[f] == k[sid])
-            paid_of[sid[at]] = paid[at]
-            keep = k[sid] == exits.size
-            sid, f, paid = sid[keep], f[keep], paid[keep]
-        ok = cw.step[f]
-        count = head[f + 1] - head[f]
-        jumps = order[np.repeat(head[f] - np.cumsum(count) + count, count) + np.arange(int(count.sum()))]
-        to_sid = np.concatenate([sid[ok], np.repeat(sid, count)])
-        to = np.concatenate([f[ok] + 1, cw.loop_dst[jumps]])
-        rank = np.concatenate([np.full(int(ok.sum()), -1), jumps])  # a step before any jump
-        to_paid = np.concatenate([paid[ok], np.repeat(paid, count) + least[jumps]])
-        new = ~seen_at[to_sid, to]
-        to_sid, to, rank, to_paid = to_sid[new], to[new], rank[new], to_paid[new]
-        cell = to_sid * n + to
-        pick = np.lexsort((rank, cell))
-        pick = pick[np.concatenate([[True], cell[pick][1:] != cell[pick][:-1]])] if pick.size else pick
-        sid, f, paid = to_sid[pick], to[pick], to_paid[pick]
-        seen_at[sid, f] = True
-        seen += np.bincount(sid, minlength=m)
-        d += 1
-    return list(zip(k_of.tolist(), moves_of.tolist(), paid_of.tolist(), seen.tolist()))
-
-
 def _pair_least(cw: PoolWalker) -> np.ndarray:
     """Per jump, the least price (float64) of the jumps with its source and destination (what
     :func:`_paid` charges for the move); kept in the walker."""
     if "pair_least" not in cw._prepared:
         src, dst, price = cw.jumps()
         least = np.zeros(src.size)
-        if src.size:
+        if src.size and price.min() == price.max():
+            least[:] = price[0]  # one price: every pair's least
+        elif src.size:
             pair = src.astype(np.int64) * cw.length + dst
             o = np.lexsort((price, pair))
             head = np.concatenate([[True], pair[o][1:] != pair[o][:-1]])
@@ -1099,8 +1056,10 @@ class Planner:
             first, rest = plan[0], plan[1:]
             self._prefetch(rest, [route["enter"] for route in first["routes"]])
             seen, options = set(), []
+            rest_key = tuple(id(h) for h in rest)  # onward's cache key, made once for every route
             for route in first["routes"]:
-                more_frames, final_enter = self.onward(rest, route["enter"])
+                got = self.memo.get((rest_key, route["enter"]))
+                more_frames, final_enter = got if got is not None else self.onward(rest, route["enter"])
                 sig = (route["exit"], route["frames"] + more_frames)
                 if sig in seen:  # same exit, same length: one is enough (routes come best first)
                     continue

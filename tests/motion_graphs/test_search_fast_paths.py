@@ -227,23 +227,25 @@ def _same(a, b):
 
 @pytest.mark.parametrize("whole", [True, False])
 @pytest.mark.parametrize("seed", range(40))
-def test_walks_from_all_entries_equal_one_walk_per_entry(seed, whole, monkeypatch):
+def test_walks_from_all_entries_equal_one_walk_per_entry(seed, whole):
     """Every entry of random pools (ties, repeated jumps, frames no exit can be reached from):
     the same exit and frame count, or the same loop-guard error, as a walk from that entry alone;
-    prices whole (the backward searches) or not (one walk per entry). Entries are walked in
-    batches of a few, as a large pool would be."""
+    prices whole (the searches from all entries, backwards from the exits for many entries,
+    forwards for one) or not (one walk per entry)."""
     rng = np.random.default_rng(seed)
     n = int(rng.integers(5, 70))
     step = rng.random(n) < rng.uniform(0.5, 0.95)
     step[-1] = False
-    jumps = int(rng.integers(0, 4 * n))
+    jumps = int(rng.integers(0, 4 * n)) if seed % 2 else int(rng.integers(n, 6 * n))
     src, dst = rng.integers(0, n, jumps), rng.integers(0, n, jumps)
     price = (rng.integers(0, 12, jumps) if whole else rng.uniform(0, 5, jumps)).astype(np.float32)
     few = search._cheapest_into(dst, (price, src), n, search.SPARSE_JUMPS)
     cw = search.PoolWalker(0, n, step, src, dst, -1, -1, price=price, sparse=(src[few], dst[few], price[few]))
     distinct = search._distinct(rng.integers(0, n, int(rng.integers(1, 6))))
-    monkeypatch.setattr(search, "_BFS_CELLS", 3 * n)
-    _same(search._walks_to_exit(cw, range(n), distinct, "pool"), _one_by_one(cw, range(n), distinct, "pool"))
+    want = _one_by_one(cw, range(n), distinct, "pool")
+    _same(search._walks_to_exit(cw, range(n), distinct, "pool"), want)  # many entries: backwards
+    for s in range(n):  # one entry (fewer frames than jumps): forwards
+        _same(search._walks_to_exit(cw, [s], distinct, "pool"), {s: want[s]})
 
 
 def test_searches_equal_one_walk_per_entry(sgraph, monkeypatch):
