@@ -364,18 +364,17 @@ def _minima_under(d: np.ndarray, first: int, count: int, threshold: float) -> tu
         below = d[first + count] if first + count < d.shape[0] else None
         return np.nonzero(local_minima(core, above, below) & (core < threshold))
     ii, jj = np.nonzero(core < threshold)
-    value = core[ii, jj]
     rows, cols = d.shape
+    padded = np.full((rows + 2, cols + 2), np.inf)  # cells beyond d's edges: inf, no constraint
+    padded[1:-1, 1:-1] = d
+    at = (ii + first + 1) * (cols + 2) + (jj + 1)  # each cell in the padded array, flat
+    flat = padded.reshape(-1)
+    value = flat[at]
     keep = np.ones(ii.size, dtype=bool)
     for di in (-1, 0, 1):
-        r = ii + first + di
-        r_ok = (r >= 0) & (r < rows)
         for dj in (-1, 0, 1):
-            if di == 0 and dj == 0:
-                continue
-            c = jj + dj
-            ok = r_ok & (c >= 0) & (c < cols)
-            keep &= ~ok | (value <= d[np.where(ok, r, 0), np.where(ok, c, 0)])
+            if di or dj:
+                keep &= value <= flat[at + di * (cols + 2) + dj]
     return ii[keep], jj[keep]
 
 
