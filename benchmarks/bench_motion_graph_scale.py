@@ -6,7 +6,8 @@ Libraries (``--cases KIND:FRAMES ...``): ``session`` — the shared takes of eve
 125 k frames) repeated under new take numbers until the requested size exists; ``walk`` — the walk
 takes only (175 takes, 44 k frames). Below the shared size whole takes are drawn round-robin over
 the styles. Each case is built in a fresh process (its peak resident memory, ``ru_maxrss``, is its
-own) with ``--workers`` threads and saved as a ``.mlgraph`` file; then every request runs
+own) with ``--workers`` threads and saved as a ``.mlgraph`` file (its edges SHA-256 printed:
+equal hashes, the same graph); then every request runs
 ``--repeat`` times as its own ``motionlab graph-search`` command, timed from start to exit
 (start-up included), with the command's CPU seconds and peak resident memory
 (``getrusage(RUSAGE_CHILDREN)`` of a wrapper process with that one child); and ``graph-info``
