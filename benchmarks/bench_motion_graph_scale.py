@@ -6,7 +6,8 @@ Libraries (``--cases KIND:FRAMES ...``): ``session`` — the shared takes of eve
 125 k frames) repeated under new take numbers until the requested size exists; ``walk`` — the walk
 takes only (175 takes, 44 k frames). Below the shared size whole takes are drawn round-robin over
 the styles. Each case is built in a fresh process (its peak resident memory, ``ru_maxrss``, is its
-own) with ``--workers`` threads and saved as a ``.mlgraph`` file; then every request runs
+own) with ``--workers`` threads and saved as a ``.mlgraph`` file (its edges SHA-256 printed:
+equal hashes, the same graph); then every request runs
 ``--repeat`` times as its own ``motionlab graph-search`` command, timed from start to exit
 (start-up included), with the command's CPU seconds and peak resident memory
 (``getrusage(RUSAGE_CHILDREN)`` of a wrapper process with that one child); and ``graph-info``
@@ -44,6 +45,10 @@ REQUESTS = {
         "walk:normal:200,walk:elderly:200",
         "walk:normal:100,wave-both-hands:normal:60,walk:normal:100",
         "walk:active:100,raise-up-both-hands:feminine:60",
+        # crossing pools entered at hundreds of frames (11.2 s and 2.7 s per command before
+        # the walks from all entries at once)
+        "wave-both-hands:youthful:500,raise-up-both-hands:elderly:90,walk:exhausted:2000",
+        "raise-up-both-hands:normal:40,raise-up-both-hands:active:40,wave-both-hands:masculine:300",
     ),
     "walk": ("walk:normal:200,walk:elderly:200", "walk:normal:200,walk:active:200,walk:feminine:200"),
 }
@@ -109,12 +114,25 @@ def build_case(kind: str, frames: int, out: Path, workers: int) -> dict:
         summary = g.summary()
     with clock("save"):
         io.save(out, g, overwrite=True, summary=summary)
-    return dict(
+    return dict(edges_sha=edges_sha(g),
         kind=kind, frames=g.num_frames, takes=len(motions), threshold_m=rms, workers=workers, build_s=build_s,
         cpu_s=(c1.ru_utime + c1.ru_stime) - (c0.ru_utime + c0.ru_stime), transitions=summary["transitions"],
         peak_gb=_gb(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss), file_mb=out.stat().st_size / 1e6,
         stages=clock.rows, behaviours={b: v["percent"] for b, v in rep["behaviours"].items()},
     )  # fmt: skip
+
+
+def edges_sha(g) -> str:
+    """SHA-256 of the graph's alive frames, edges, costs and edge kinds (as
+    ``tests/motion_graphs/test_build_scale.py`` hashes them): equal hashes, the same graph."""
+    import hashlib
+
+    import numpy as np
+
+    h = hashlib.sha256()
+    for a in (g.alive, g.src, g.dst, g.cost, g.kind):
+        h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()
 
 
 def measure(cmd: list[str]) -> dict:
@@ -191,6 +209,7 @@ def build_in_child(case: str, graph: Path, workers: int) -> dict | None:
           f"{r['workers']} threads; load average before {load[0]:.1f}")  # fmt: skip
     print(f"build {r['build_s']:.1f} s wall ({r['cpu_s']:.1f} s CPU), peak {r['peak_gb']:.2f} GB (whole process: "
           f"library, build, report, save); {r['transitions']} transitions; file {r['file_mb']:.0f} MB")  # fmt: skip
+    print(f"edges SHA-256 (alive, src, dst, cost, kind): {r['edges_sha']}")
     from motionlab.motion_graphs.report import format_stages
 
     print(format_stages(r["stages"]))

@@ -46,6 +46,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 
@@ -218,13 +219,27 @@ def block_cells(available: int | None = None) -> int:
     temporaries take at most 1/16 of ``available`` bytes (default: the memory the system reports
     available), and never fewer than 65,536. The candidates do not depend on it."""
     if available is None:
+        available = _available_memory()
+    return int(min(BLOCK_CELLS, max(1 << 16, available // (_MEMORY_SHARE * _BYTES_PER_CELL))))
+
+
+_MEMORY_SECONDS = 1.0  # the memory available is read again after this long
+_memory_read: list = [-np.inf, 0]  # (when, bytes)
+
+
+def _available_memory() -> int:
+    """The memory the system reports available, bytes, read at most once every
+    :data:`_MEMORY_SECONDS` (a build compares thousands of clip pairs)."""
+    now = time.monotonic()
+    if now - _memory_read[0] > _MEMORY_SECONDS:
         try:
             import psutil
 
-            available = int(psutil.virtual_memory().available)
+            _memory_read[1] = int(psutil.virtual_memory().available)
         except (ImportError, OSError):  # pragma: no cover - psutil is a dependency
-            available = BLOCK_CELLS * _BYTES_PER_CELL * _MEMORY_SHARE
-    return int(min(BLOCK_CELLS, max(1 << 16, available // (_MEMORY_SHARE * _BYTES_PER_CELL))))
+            _memory_read[1] = BLOCK_CELLS * _BYTES_PER_CELL * _MEMORY_SHARE
+        _memory_read[0] = now
+    return _memory_read[1]
 
 
 def _block(fa: CloudFeatures, fb: CloudFeatures, rows: slice, right: np.ndarray, yb: np.ndarray) -> np.ndarray:
@@ -349,18 +364,17 @@ def _minima_under(d: np.ndarray, first: int, count: int, threshold: float) -> tu
         below = d[first + count] if first + count < d.shape[0] else None
         return np.nonzero(local_minima(core, above, below) & (core < threshold))
     ii, jj = np.nonzero(core < threshold)
-    value = core[ii, jj]
     rows, cols = d.shape
+    padded = np.full((rows + 2, cols + 2), np.inf)  # cells beyond d's edges: inf, no constraint
+    padded[1:-1, 1:-1] = d
+    at = (ii + first + 1) * (cols + 2) + (jj + 1)  # each cell in the padded array, flat
+    flat = padded.reshape(-1)
+    value = flat[at]
     keep = np.ones(ii.size, dtype=bool)
     for di in (-1, 0, 1):
-        r = ii + first + di
-        r_ok = (r >= 0) & (r < rows)
         for dj in (-1, 0, 1):
-            if di == 0 and dj == 0:
-                continue
-            c = jj + dj
-            ok = r_ok & (c >= 0) & (c < cols)
-            keep &= ~ok | (value <= d[np.where(ok, r, 0), np.where(ok, c, 0)])
+            if di or dj:
+                keep &= value <= flat[at + di * (cols + 2) + dj]
     return ii[keep], jj[keep]
 
 

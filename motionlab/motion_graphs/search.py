@@ -746,6 +746,183 @@ def _walk_to_exit(
     return _runs(cw, frames), r, len(frames)
 
 
+def _walks_to_exit(cw: PoolWalker, starts, distinct: tuple, name: str) -> dict:
+    """What :func:`_walk_to_exit` gives from each of ``starts`` (to the exits ``distinct``,
+    checked), without its pieces: ``start -> (r, frames)``, or the :class:`SearchError` it raises.
+
+    The cheapest walks from all starts come from one search backwards from the exits
+    (:func:`_back_costs`) instead of one reach table per start; each start's breadth-first walk
+    (its bound) is walked forwards when the starts are few (at most one pass over the pool's
+    frames each costs no more than one pass over its jumps), else bounded by one breadth-first
+    search backwards (:func:`_nearest_back`) and walked only where the bounds do not decide.
+    The backward searches add whole numbers, so they are used when the walker's prices are
+    whole numbers whose sums float32 holds exactly (the reach table's sums then equal them);
+    otherwise each start is walked as :func:`_walk_to_exit` does."""
+    starts = list(dict.fromkeys(int(x) for x in starts))
+    price = cw.jumps()[2]
+    whole = not price.size or (np.all(price == np.round(price)) and float(price.max()) * cw.length < 2**24)
+    if not whole:  # the reach table's own float sums decide
+        return {s: _walk_or_error(cw, s, distinct, name) for s in starts}
+
+    def forward(s):  # the breadth-first walk from s alone: (r, frames, bound), or its error
+        try:
+            frames, r = _path(cw, s, None, name, distinct)
+        except SearchError as e:
+            return e
+        return r, len(frames), len(frames) + _paid(cw, frames)
+
+    walked, nearest, bounds = {}, {}, {}
+    if len(starts) * cw.length <= cw.loop_src.size:
+        walked = {s: forward(s) for s in starts}
+        for s, w in walked.items():
+            if not isinstance(w, Exception):
+                nearest[s], bounds[s] = w[:2], (w[2], w[2])
+    else:
+        moves, k_of, lo, hi = _nearest_back(cw, distinct[0], starts)
+        for s in starts:
+            if moves[s] >= 0:
+                nearest[s] = (int(distinct[1][k_of[s]]), int(moves[s]) + 1)
+                bounds[s] = (moves[s] + 1 + lo[s], moves[s] + 1 + hi[s])
+    jumps = cw.jumps() if cw.sparse is None else cw.sparse
+    best = _back_costs(cw, jumps, distinct[0], list(bounds), max((b[1] for b in bounds.values()), default=0))
+    out: dict = {}
+    for s in starts:
+        if s not in bounds:  # no exit reachable: the forward walk's loop-guard error
+            out[s] = walked[s] if s in walked else forward(s)
+            continue
+        cost = best[s][0] + 1 if s in best else np.inf  # the cheapest walk's frames and prices
+        cheapest = (int(distinct[1][best[s][2]]), best[s][1] + 1) if s in best else None
+        if cost < bounds[s][0]:
+            out[s] = cheapest
+        elif cost >= bounds[s][1]:
+            out[s] = nearest[s]
+        else:  # the breadth-first walk's own price decides
+            w = walked[s] if s in walked else forward(s)
+            out[s] = cheapest if cost < w[2] else w[:2]
+    return out
+
+
+def _walk_or_error(cw: PoolWalker, s: int, distinct: tuple, name: str):
+    """``_walk_to_exit(...)[1:]``, or the :class:`SearchError` it raises."""
+    try:
+        return _walk_to_exit(cw, s, distinct, name)[1:]
+    except SearchError as e:
+        return e
+
+
+def _nearest_back(cw: PoolWalker, exits: np.ndarray, starts: list[int]):
+    """A breadth-first search backwards from ``exits`` over all the walker's moves, until every
+    frame of ``starts`` is reached: per frame (arrays over the pool) the fewest moves to an
+    exit (-1: none, or not searched), the first of the nearest exits (index ``k`` into
+    ``exits``), and the least and the most that a walk of that many moves to that exit pays
+    for its jumps (:func:`_paid`'s price per move)."""
+    n = cw.length
+    if "into" not in cw._prepared:
+        order = np.argsort(cw.loop_dst, kind="stable")
+        head = np.zeros(n + 1, dtype=np.int64)
+        np.cumsum(np.bincount(cw.loop_dst, minlength=n), out=head[1:])
+        src = cw.loop_src[order]
+        is_step = (cw.loop_dst[order] == src + 1) & cw.step[src]
+        cw._prepared["into"] = (head, src, np.where(is_step, 0.0, _pair_least(cw)[order]))
+    head, into, pay = cw._prepared["into"]
+    moves, k_of = np.full(n, -1, dtype=np.int64), np.full(n, -1, dtype=np.int64)
+    lo, hi = np.zeros(n), np.zeros(n)
+    moves[exits], k_of[exits] = 0, np.arange(exits.size)
+    frontier, want, d = exits.astype(np.int64), np.asarray(starts, dtype=np.int64), 0
+    while frontier.size and (moves[want] < 0).any():
+        g = frontier[frontier > 0]
+        g = g[cw.step[g - 1]]
+        count = head[frontier + 1] - head[frontier]
+        at = np.repeat(head[frontier] - np.cumsum(count) + count, count) + np.arange(int(count.sum()))
+        f = np.concatenate([g - 1, into[at]])
+        g = np.concatenate([g, np.repeat(frontier, count)])
+        p = np.concatenate([np.zeros(f.size - at.size), pay[at]])
+        new = moves[f] < 0
+        f, g, p = f[new], g[new], p[new]
+        d += 1
+        k = np.full(n, exits.size, dtype=np.int64)
+        np.minimum.at(k, f, k_of[g])
+        on = k_of[g] == k[f]  # moves towards the first of the nearest exits
+        f, low, high = f[on], p[on] + lo[g[on]], p[on] + hi[g[on]]
+        frontier = np.unique(f)
+        moves[frontier], k_of[frontier] = d, k[frontier]
+        lo[frontier], hi[frontier] = np.inf, -np.inf
+        np.minimum.at(lo, f, low)
+        np.maximum.at(hi, f, high)
+    return moves, k_of, lo, hi
+
+
+def _pair_least(cw: PoolWalker) -> np.ndarray:
+    """Per jump, the least price (float64) of the jumps with its source and destination (what
+    :func:`_paid` charges for the move); kept in the walker."""
+    if "pair_least" not in cw._prepared:
+        src, dst, price = cw.jumps()
+        least = np.zeros(src.size)
+        if src.size and price.min() == price.max():
+            least[:] = price[0]  # one price: every pair's least
+        elif src.size:
+            pair = src.astype(np.int64) * cw.length + dst
+            o = np.lexsort((price, pair))
+            head = np.concatenate([[True], pair[o][1:] != pair[o][:-1]])
+            group = np.cumsum(head) - 1
+            least[o] = price[o][head][group].astype(np.float64)
+        cw._prepared["pair_least"] = least
+    return cw._prepared["pair_least"]
+
+
+def _back_costs(cw: PoolWalker, jumps: Jumps, exits: np.ndarray, wanted, cutoff: float) -> dict:
+    """Dijkstra's search backwards from ``exits`` over the steps and ``jumps`` (whole-number
+    prices): ``frame -> (cost, moves, k)``, the least ``(cost, moves, k)`` (compared in that
+    order) over the walks from the frame to exit ``exits[k]``, a move costing one plus its
+    price. Stops once every frame of ``wanted`` is settled, or at costs of ``cutoff - 1`` and
+    more (a frame not returned has no walk cheaper than that).
+
+    The costs are whole numbers, so the frames are settled cost by cost (Dial's buckets), all
+    frames of one cost at once: each takes the least ``(moves, k)`` among its moves into frames
+    settled before."""
+    src, dst, price = jumps
+    n = cw.length
+    if "back" not in cw._prepared:  # the jumps into each frame
+        order = np.argsort(dst, kind="stable")
+        head = np.zeros(n + 1, dtype=np.int64)
+        np.cumsum(np.bincount(dst, minlength=n), out=head[1:])
+        cw._prepared["back"] = (head, src[order].astype(np.int64), price[order].astype(np.int64) + 1)
+    head, into, weight = cw._prepared["back"]
+    big = exits.size + 1  # (moves, k) as one number: moves * big + k
+    settled = np.full(n, -1, dtype=np.int64)  # cost, -1 before settled
+    key_of = np.zeros(n, dtype=np.int64)
+    buckets: dict[int, list] = {0: [(exits.astype(np.int64), np.arange(exits.size, dtype=np.int64))]}
+    want = np.asarray(list(wanted), dtype=np.int64)
+    cost = 0
+    while buckets and (settled[want] < 0).any() and cost + 1 < cutoff:
+        cost = min(buckets)
+        if cost + 1 >= cutoff:
+            break
+        f, key = (np.concatenate(x) for x in zip(*buckets.pop(cost)))
+        new = settled[f] < 0
+        f, key = f[new], key[new]
+        if not f.size:
+            continue
+        least = np.full(n, np.iinfo(np.int64).max, dtype=np.int64)
+        np.minimum.at(least, f, key)
+        g = np.unique(f)
+        settled[g], key_of[g] = cost, least[g]
+        step_from = g[(g > 0)]
+        step_from = step_from[cw.step[step_from - 1]]
+        buckets.setdefault(cost + 1, []).append((step_from - 1, key_of[step_from] + big))
+        count = head[g + 1] - head[g]
+        at = np.repeat(head[g] - np.cumsum(count) + count, count) + np.arange(int(count.sum()))
+        w, k2 = weight[at], np.repeat(key_of[g], count) + big
+        for level in np.unique(w).tolist():
+            on = w == level
+            buckets.setdefault(cost + level, []).append((into[at[on]], k2[on]))
+    done = np.unique(want[settled[want] >= 0])
+    return {
+        int(f): (int(c), int(q // big), int(q % big))
+        for f, c, q in zip(done.tolist(), settled[done].tolist(), key_of[done].tolist())
+    }
+
+
 def _paid(cw: PoolWalker, frames: list[int]) -> float:
     """The price of the jumps of a walk through ``frames`` (a move that is not a step is a
     jump; the cheapest of the jumps that make it)."""
@@ -806,7 +983,9 @@ class Planner:
         self.walkers: dict[tuple[str, str], PoolWalker] = {}
         self.links: dict[tuple[str, str], list[dict]] = {}
         self.memo: dict = {}
-        self.exits: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self.exits: dict[int, tuple[np.ndarray, np.ndarray] | None] = {}
+        self.walks: dict[tuple[int, int], tuple[int, int] | SearchError] = {}
+        self.checked: set[int] = set()
         for link in graph.table["links"]:
             self.links.setdefault(tuple(link["from"]), []).append(link)
 
@@ -869,50 +1048,111 @@ class Planner:
         return out[::-1]
 
     def options(self, plan: list[dict]):
-        """Every way out along ``plan``: (route, pieces after it, their frames, final entry),
-        the frames each spends after leaving the clip, and each exit frame (cached)."""
+        """Every way out along ``plan``: (route, its frames and those after it, final entry),
+        the frames each spends after leaving the clip, and each exit frame (cached). The pieces
+        after a route: :meth:`onward_pieces`."""
         key = tuple(id(h) for h in plan)
         if key not in self.memo:
             first, rest = plan[0], plan[1:]
+            self._prefetch(rest, [route["enter"] for route in first["routes"]])
             seen, options = set(), []
+            rest_key = tuple(id(h) for h in rest)  # onward's cache key, made once for every route
             for route in first["routes"]:
-                more, more_frames, final_enter = self.onward(rest, route["enter"])
+                got = self.memo.get((rest_key, route["enter"]))
+                more_frames, final_enter = got if got is not None else self.onward(rest, route["enter"])
                 sig = (route["exit"], route["frames"] + more_frames)
                 if sig in seen:  # same exit, same length: one is enough (routes come best first)
                     continue
                 seen.add(sig)
-                options.append((route, more, more_frames, final_enter))
-            spent = np.array([o[0]["frames"] + o[2] for o in options])
+                options.append((route, more_frames, final_enter))
+            spent = np.array([o[0]["frames"] + o[1] for o in options])
             exits = [o[0]["exit"] for o in options]
             self.memo[key] = (options, spent, exits)
         return self.memo[key]
 
-    def onward(self, hops: list[dict], enter: int) -> tuple[list[tuple[int, int, int]], int, int]:
-        """Pass through the basic clips between hops; returns pieces, frames and the final entry."""
+    def _prefetch(self, hops: list[dict], enters) -> None:
+        """The walks through the pool of ``hops[0]`` from all of ``enters`` at once
+        (:func:`_walks_to_exit`), then those of the next hops from where they lead, kept for
+        :meth:`onward`, which checks and raises in the order a walk per entry would."""
+        if not hops:
+            return
+        link = hops[0]
+        try:
+            cw, ex = self.walker(tuple(link["from"])), self._exits(link)
+        except ValueError:
+            return  # (a bad search cost) onward raises it where a walk per entry would
+        if ex is None:
+            return  # the exits are out of the pool: onward raises
+        todo = [
+            e for e in dict.fromkeys(int(e) for e in enters) if 0 <= e < cw.length and (id(link), e) not in self.walks
+        ]
+        found = _walks_to_exit(cw, todo, ex, f"{link['from'][0]}/{link['from'][1]}")
+        self.walks.update({(id(link), e): w for e, w in found.items()})
+        nxt = [link["routes"][w[0]]["enter"] for w in found.values() if not isinstance(w, Exception)]
+        self._prefetch(hops[1:], nxt)
+
+    def _exits(self, link: dict):
+        """``_distinct`` of the link's exit frames (``None`` when one lies outside its pool)."""
+        if id(link) not in self.exits:
+            ex = np.array([r["exit"] for r in link["routes"]], dtype=np.int64)
+            cw = self.walker(tuple(link["from"]))
+            self.exits[id(link)] = _distinct(ex) if ex.size and np.all((ex >= 0) & (ex < cw.length)) else None
+        return self.exits[id(link)]
+
+    def onward(self, hops: list[dict], enter: int) -> tuple[int, int]:
+        """Pass through the basic clips between hops: the frames played after ``enter`` and the
+        final entry (cached)."""
         key = (tuple(id(h) for h in hops), enter)
         if key not in self.memo:
             self.memo[key] = self._onward(hops, enter)
         return self.memo[key]
 
-    def _onward(self, hops: list[dict], enter: int) -> tuple[list[tuple[int, int, int]], int, int]:
+    def _onward(self, hops: list[dict], enter: int) -> tuple[int, int]:
         """The first hop (the walk through its pool to the best of its routes, and the route),
-        then the rest through :meth:`onward`, so each (hops left, entry) is walked once."""
+        then the rest through :meth:`onward`, so each (hops left, entry) is walked once.
+
+        Raises
+        ------
+        SearchError (the loop guard) or ValueError (an entry or exit outside the pool), as
+        :func:`walk_to_exit`.
+        """
         if not hops:
-            return [], 0, enter
+            return 0, enter
         link = hops[0]
         key = tuple(link["from"])
         cw = self.walker(key)
-        routes = link["routes"]
-        if id(link) not in self.exits:  # the link's exits, once
-            ex = np.array([r["exit"] for r in routes], dtype=np.int64)
-            _check_exits(cw, enter, ex)
-            self.exits[id(link)] = _distinct(ex)
-        _check_exits(cw, enter, self.exits[id(link)][0])
-        p, r, n = _walk_to_exit(cw, enter, self.exits[id(link)], f"{key[0]}/{key[1]}")
-        route = routes[r]
-        more, more_frames, final_enter = self.onward(hops[1:], route["enter"])
-        pieces = [*p, *(tuple(x) for x in route["pieces"]), *more]
-        return pieces, n + route["frames"] + more_frames, final_enter
+        ex = self._exits(link)
+        if ex is None or id(link) not in self.checked:  # the link's exits as recorded, first
+            _check_exits(cw, enter, np.array([r["exit"] for r in link["routes"]], dtype=np.int64))
+            self.checked.add(id(link))
+        _check_exits(cw, enter, ex[0])
+        if (id(link), enter) not in self.walks:
+            self._prefetch(hops, [enter])
+        walk = self.walks[(id(link), enter)]
+        if isinstance(walk, Exception):
+            raise walk
+        r, n = walk
+        route = link["routes"][r]
+        more_frames, final_enter = self.onward(hops[1:], route["enter"])
+        return n + route["frames"] + more_frames, final_enter
+
+    def onward_pieces(self, hops: list[dict], enter: int) -> list[tuple[int, int, int]]:
+        """The pieces of :meth:`onward`'s way: each hop's walk (:func:`walk_to_exit`), then its route.
+
+        Raises
+        ------
+        GraphError (internal) when a walk disagrees with what :meth:`onward` counted.
+        """
+        out = []
+        for link in hops:
+            cw, ex = self.walker(tuple(link["from"])), self._exits(link)
+            p, r, n = _walk_to_exit(cw, enter, ex, f"{link['from'][0]}/{link['from'][1]}")
+            if (r, n) != self.walks[(id(link), enter)]:
+                raise GraphError("internal: the walks from all entries disagree with the walk from one")
+            route = link["routes"][r]
+            out += [*p, *(tuple(x) for x in route["pieces"])]
+            enter = route["enter"]
+        return out
 
     def search(self, request, progress: bool = False) -> SearchResult:
         """Meet a request on the planner's graph (see :func:`search`).
@@ -957,10 +1197,10 @@ class Planner:
             options, _, exits = self.options(plans[k])
             own = np.array([seg.frames - o[0]["frames"] for o in options])  # the route out counts here
             p, r, n = _walk(cw, enter, np.maximum(own, 1).tolist(), exits, name, slack)
-            route, more, more_frames, enter = options[r]
+            route, more_frames, enter = options[r]
             pieces.extend(p)
             pieces.extend(tuple(x) for x in route["pieces"])
-            pieces.extend(more)
+            pieces.extend(self.onward_pieces(plans[k][1:], route["enter"]))
             achieved.append(n + route["frames"])
             passing[k] = more_frames
         if bar is not None:

@@ -204,3 +204,69 @@ def test_a_search_command_does_not_import_networkx():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+# ------------------------------------------------------------------ walks from all entries at once
+def _one_by_one(cw, starts, distinct, name):
+    """The reference: :func:`search._walk_to_exit` from each entry on its own."""
+    out = {}
+    for s in dict.fromkeys(int(x) for x in starts):
+        try:
+            out[s] = search._walk_to_exit(cw, s, distinct, name)[1:]
+        except search.SearchError as e:
+            out[s] = e
+    return out
+
+
+def _same(a, b):
+    assert a.keys() == b.keys()
+    for s in a:
+        x, y = a[s], b[s]
+        assert (str(x) if isinstance(x, Exception) else x) == (str(y) if isinstance(y, Exception) else y), s
+
+
+@pytest.mark.parametrize("whole", [True, False])
+@pytest.mark.parametrize("seed", range(40))
+def test_walks_from_all_entries_equal_one_walk_per_entry(seed, whole):
+    """Every entry of random pools (ties, repeated jumps, frames no exit can be reached from):
+    the same exit and frame count, or the same loop-guard error, as a walk from that entry alone;
+    prices whole (the searches from all entries, backwards from the exits for many entries,
+    forwards for one) or not (one walk per entry)."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(5, 70))
+    step = rng.random(n) < rng.uniform(0.5, 0.95)
+    step[-1] = False
+    jumps = int(rng.integers(0, 4 * n)) if seed % 2 else int(rng.integers(n, 6 * n))
+    src, dst = rng.integers(0, n, jumps), rng.integers(0, n, jumps)
+    price = (rng.integers(0, 12, jumps) if whole else rng.uniform(0, 5, jumps)).astype(np.float32)
+    few = search._cheapest_into(dst, (price, src), n, search.SPARSE_JUMPS)
+    cw = search.PoolWalker(0, n, step, src, dst, -1, -1, price=price, sparse=(src[few], dst[few], price[few]))
+    distinct = search._distinct(rng.integers(0, n, int(rng.integers(1, 6))))
+    want = _one_by_one(cw, range(n), distinct, "pool")
+    _same(search._walks_to_exit(cw, range(n), distinct, "pool"), want)  # many entries: backwards
+    for s in range(n):  # one entry (fewer frames than jumps): forwards
+        _same(search._walks_to_exit(cw, [s], distinct, "pool"), {s: want[s]})
+
+
+def test_searches_equal_one_walk_per_entry(sgraph, monkeypatch):
+    """Whole searches on the synthetic graph: the same answers as when each crossed pool is
+    walked from each entry on its own."""
+    requests = (*SYNTHETIC_REQUESTS, "walk:happy:120,run:normal:100,walk:happy:90", "run:normal:300,walk:happy:60")
+    new = _answers(sgraph, requests)
+    monkeypatch.setattr(search, "_walks_to_exit", _one_by_one)
+    assert new == _answers(sgraph, requests)
+
+
+def test_a_crossed_pool_is_walked_once_not_per_entry(sgraph, monkeypatch):
+    """walk/happy to run/normal crosses the walk/normal pool, entered at several frames: the
+    walk through it (:func:`search._walk_to_exit`, with its reach table) runs once, for the way
+    chosen, not once per entry frame."""
+    request = "walk:happy:120,run:normal:100"
+    planner = search.Planner(sgraph)
+    plan = planner.hops(*[planner.check(s) for s in search.parse_request(request)])
+    assert len(plan) == 2 and len({r["enter"] for r in plan[0]["routes"]}) >= 3
+    calls = []
+    walk = search._walk_to_exit
+    monkeypatch.setattr(search, "_walk_to_exit", lambda *a: calls.append(a[1]) or walk(*a))
+    assert search.search(sgraph, request).achieved
+    assert len(calls) == 1
