@@ -14,8 +14,9 @@ network's rate, its planted frames):
 
 Prints the failing share of each (overall and per character) with the failing checks named, the
 knee bend and foot pitch of each character's own rest pose (the canonical standing pose,
-:mod:`motionlab.core.rest_pose`, turns the legs straight down), and the pairs that fail. ``--checkpoint`` picks the network (default: the shipped one; Table 1's
-is ``motionlab evaluate``'s, trained on Aj's other clips).
+:mod:`motionlab.core.rest_pose`, turns the legs straight down), and the pairs that fail.
+``--checkpoint`` picks the network (default: the shipped one; Table 1's is ``motionlab
+evaluate``'s, trained on Aj's other clips).
 """
 
 from __future__ import annotations
