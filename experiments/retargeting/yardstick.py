@@ -12,11 +12,11 @@ network's rate, its planted frames):
 * **motionlab**: the full method's output of the same pair (:func:`pipeline.retarget`, Table 1's
   protocol: the target's skeleton alone, the default root), whose check the pipeline made.
 
-``--straight-legs`` (a study) gives motionlab B's standing skeleton with every thigh and shin
-straight down at rest (lengths kept; world positions of a pose do not depend on the rest pose,
-only what its joint rotations mean). Prints the failing share of each (overall and per character) with the failing checks named,
-and the pairs that fail. ``--checkpoint`` picks the network (default: the shipped one; Table 1's
-is ``motionlab evaluate``'s, trained on Aj's other clips).
+Prints the failing share of each (overall and per character) with the failing checks named, the
+knee bend and foot pitch of each character's own rest pose (the canonical standing pose,
+:mod:`motionlab.core.rest_pose`, turns the legs straight down), and the pairs that fail.
+``--checkpoint`` picks the network (default: the shipped one; Table 1's is ``motionlab
+evaluate``'s, trained on Aj's other clips).
 """
 
 from __future__ import annotations
@@ -41,31 +41,19 @@ def _cut(motion, n: int):
     )
 
 
-def straight_legs(skeleton):
-    """``skeleton`` with every thigh and shin straight down at rest, lengths kept (a study)."""
-    offsets = skeleton.offsets.copy()
-    for side in ("Left", "Right"):
-        for joint in (side + "Leg", side + "Foot"):
-            j = humanoid.JOINTS.index(joint)
-            offsets[j] = [0.0, -np.linalg.norm(offsets[j]), 0.0]
-    return skeleton.with_offsets(offsets)
-
-
-def check_pair(ckpt, source, src: pipeline.PreparedSource, gt_rig, straight: bool = False) -> tuple:
-    """(ground truth's Plausibility, motionlab's Plausibility, motionlab's deepest joint) of one
-    pair; ``straight``: motionlab's target is B's standing skeleton with :func:`straight_legs`."""
+def check_pair(ckpt, source, src: pipeline.PreparedSource, gt_rig) -> tuple:
+    """(ground truth's Plausibility, motionlab's Plausibility, motionlab's deepest joint) of one pair."""
     gt = preprocess.prepare(gt_rig, ckpt.fps, stand=True)
     n = min(gt.num_frames, src.motion.num_frames)
     planted = src.planted[0].cpu().numpy()[:n]
     truth = plausibility.check(gt.global_positions()[:n], gt.skeleton, _cut(src.motion, n), planted)
-    target = straight_legs(gt.skeleton) if straight else gt_rig.skeleton
-    out = retargeting.retarget(source, target, ckpt, "full")
+    out = retargeting.retarget(source, gt_rig.skeleton, ckpt, "full")
     deepest = humanoid.JOINTS[int(np.argmin(out.positions[..., 1].min(axis=0)))]
     return truth, out.plausibility, deepest
 
 
 def rest_angles(skeleton) -> tuple[float, float]:
-    """The standing rest pose's knee bend (angle between thigh and shin) and the foot's pitch
+    """A canonical skeleton's rest knee bend (angle between thigh and shin) and the foot's pitch
     (ankle → toe below the horizontal), degrees, mean of both legs."""
     rest, j = skeleton.rest_positions(), humanoid.JOINTS.index
     knee, pitch = [], []
@@ -90,11 +78,6 @@ def main(argv=None) -> None:
     ap.add_argument("--checkpoint", help="network (default: the shipped one)")
     ap.add_argument("--targets", nargs="+", default=list(evaluate.DEFAULT_TARGETS))
     ap.add_argument("--animations", nargs="+", default=list(evaluate.DEFAULT_ANIMATIONS))
-    ap.add_argument(
-        "--straight-legs",
-        action="store_true",
-        help="a study: motionlab's targets with thighs and shins straight at rest",
-    )
     args = ap.parse_args(argv)
     start = time.perf_counter()
     ckpt = ckpt_io.load(args.checkpoint) if args.checkpoint else retargeting.load_default()
@@ -106,12 +89,11 @@ def main(argv=None) -> None:
         src = pipeline.prepare_source(source, ckpt, "full")
         for target in args.targets:
             rig = bvh.load(folder / target / f"{anim}.bvh")
-            results[target, anim] = check_pair(ckpt, source, src, rig, args.straight_legs)
-            shares[target] = rest_angles(preprocess.prepare(rig, ckpt.fps, stand=True).skeleton)
-        shares[evaluate.DEFAULT_SOURCE] = rest_angles(src.motion.skeleton)
-    legs = "; motionlab's targets with straight legs at rest" if args.straight_legs else ""
-    print(f"network: {args.checkpoint or 'shipped default'}{legs}")
-    print(f"{'character':<14} {'ground truth fails':<34} {'motionlab fails':<34} rest knee bend, foot pitch (deg)")
+            results[target, anim] = check_pair(ckpt, source, src, rig)
+            shares[target] = rest_angles(humanoid.to_canonical_skeleton(rig.skeleton))
+        shares[evaluate.DEFAULT_SOURCE] = rest_angles(humanoid.to_canonical_skeleton(source.skeleton))
+    print(f"network: {args.checkpoint or 'shipped default'}")
+    print(f"{'character':<14} {'ground truth fails':<34} {'motionlab fails':<34} own rest: knee bend, foot pitch (deg)")
     for target in args.targets + ["all"]:
         pairs = [v for (t, _), v in results.items() if target in ("all", t)]
         knee, pitch = shares.get(target, shares[evaluate.DEFAULT_SOURCE])

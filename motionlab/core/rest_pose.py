@@ -19,14 +19,19 @@ network's offsets) or compares joint rotations across rigs needs one convention.
    (``reference=``, ``source="file"``, the command line's ``--rest-from FILE.bvh``). When the
    rest offsets fail and there is no motion, or no frame is upright within the tolerance,
    :class:`RestPoseError` names the joint, what was expected and :data:`REST_FROM_HINT`.
-2. **The T-pose's bone directions** (:func:`motionlab.core.humanoid.canonical_skeleton`) for
-   each bone of the legs, spine and arms (:data:`STRAIGHTENED`) that points more than
-   :data:`TOLERANCE_DEG` away from them; bones within it keep the rig's own direction, so
-   a T- or near-T-pose rig (every Mixamo character) is left exactly as it was. Then the legs
-   stand straight below the hips: a pose taken from the motion gets thighs and shins straight
-   down (a frame's stride is not a stance); rest offsets lose only a sideways spread of more
-   than :data:`SPREAD_DEG` (an A-stance is a rigging convention, not how the performer stands),
-   and keep a bend of the knees forward or back, which is the character's own stance.
+2. **The T-pose's bone directions** (:func:`motionlab.core.humanoid.canonical_skeleton`): every
+   thigh and shin straight down, on every rig and from every source; each other bone of the spine
+   and arms (:data:`STRAIGHTENED`) that points more than :data:`TOLERANCE_DEG` away from its
+   T-pose direction is turned onto it, and bones within it keep the rig's own direction. A rig
+   whose legs already point straight down and whose other bones lie within the tolerance is left
+   exactly as it was.
+
+The principle: the canonical standing pose is where identity rotations mean the same pose on
+every rig. The network's character stands straight-legged, so a rotation copied or decoded from
+another rig bends a leg by the same angle only when both rest legs are straight. A knee bent at
+rest (or an A-stance's sideways spread) is a rigging choice, not the performer's stance: nothing
+of the motion is lost by removing it, because the motion is re-expressed on the new rest with
+its world positions unchanged.
 
 The motion is re-expressed on the new rest offsets with world positions unchanged: with
 ``A_j`` the rotation that carries joint ``j``'s child offsets from the old rest to the new one,
@@ -48,7 +53,6 @@ from motionlab.core.skeleton import Skeleton
 
 __all__ = [
     "TOLERANCE_DEG",
-    "SPREAD_DEG",
     "STRAIGHTENED",
     "REST_FROM_HINT",
     "RestPoseError",
@@ -65,17 +69,14 @@ STRAIGHTENED: tuple[str, ...] = (
     "LeftLeg", "LeftFoot", "RightLeg", "RightFoot", "Spine1", "Spine2",
     "LeftForeArm", "LeftHand", "RightForeArm", "RightHand",
 )  # fmt: skip
-"""Canonical joints whose incoming bone is turned onto the T-pose direction when it is further away
-than :data:`TOLERANCE_DEG` (feet, clavicles and the neck keep the rig's own shape)."""
+"""Canonical joints whose incoming bone is turned onto the T-pose direction: thighs and shins always
+(:data:`_LEGS`), the others when further away than :data:`TOLERANCE_DEG` (feet, clavicles and the
+neck keep the rig's own shape)."""
 
 _J = humanoid.JOINTS
 _UPRIGHT = ("Neck", "LeftLeg", "LeftFoot", "RightLeg", "RightFoot")  # Hips→Neck up; thighs, shins down
 _WHAT = ("Hips->Neck (spine) up", "LeftUpLeg->LeftLeg (thigh) down", "LeftLeg->LeftFoot (shin) down",
          "RightUpLeg->RightLeg (thigh) down", "RightLeg->RightFoot (shin) down")  # fmt: skip
-
-
-SPREAD_DEG = 10.0
-"""Largest sideways spread (degrees from vertical, in the left-right plane) of a rest thigh or shin that is kept."""
 _LEGS = ("LeftLeg", "LeftFoot", "RightLeg", "RightFoot")  # thighs and shins (incoming bones)
 
 
@@ -159,11 +160,11 @@ def _two_vector_turn(lead: np.ndarray, across: np.ndarray, lead_goal: np.ndarray
     return quat.normalize(quat.from_matrix(frame(lead_goal, across_goal) @ frame(lead, across).T))
 
 
-def _straighten(offsets: np.ndarray, legs_down: bool, every: bool = False) -> tuple[np.ndarray, tuple[str, ...]]:
+def _straighten(offsets: np.ndarray, every: bool = False) -> tuple[np.ndarray, tuple[str, ...]]:
     """Per-joint rotations (22, 4) turning bones onto the T-pose (module docstring, stage 2), and
-    the names of the joints whose incoming bone turned; ``legs_down``: thighs and shins straight down;
-    ``every``: every bone onto the T-pose's direction (a branching joint turns by its :data:`_LEAD`
-    child's bone, its other children follow rigidly)."""
+    the names of the joints whose incoming bone turned; ``every``: every bone onto the T-pose's
+    direction (a branching joint turns by its :data:`_LEAD` child's bone, its other children follow
+    rigidly)."""
     ref = humanoid.canonical_skeleton().offsets.copy()
     turn = np.tile(quat.IDENTITY, (len(_J), 1))
     names = []
@@ -179,12 +180,8 @@ def _straighten(offsets: np.ndarray, legs_down: bool, every: bool = False) -> tu
                 turn[p] = _two_vector_turn(o, across, goal, ref[left] - ref[right])
                 names.append(name)
             continue
-        if not every and _angle(o, ref[c]) <= TOLERANCE_DEG:
-            if name in _LEGS and not legs_down:
-                spread = np.degrees(np.arctan2(abs(o[0]), -o[1]))
-                goal = o * np.array([0.0, 1.0, 1.0]) if spread > SPREAD_DEG else o
-            elif name not in _LEGS:
-                goal = o
+        if not every and name not in _LEGS and _angle(o, goal) <= TOLERANCE_DEG:
+            goal = o
         if goal is not o and _angle(o, goal) > 1e-9:
             turn[p] = quat.between(o, goal)
             names.append(name)
@@ -251,14 +248,14 @@ def _pose_turn(motion: Motion, what: str, family: str | None) -> tuple[np.ndarra
         # the profile's rule: bone lengths from the rest offsets, every bone along the T-pose; the joint
         # frames (twist about each bone) from the most upright frame of this take, whatever its pose
         first, frame, worst = _standing_turn(motion, what, check=False)
-        second, names = _straighten(_turned_offsets(offsets, first), legs_down=True, every=True)
+        second, names = _straighten(_turned_offsets(offsets, first), every=True)
         return quat.mul(second, first), StandingPose("profile", frame, names, worst, family or "")
     worst = float(_uprightness(motion.skeleton.rest_positions())[0])
     first, source, frame = np.tile(quat.IDENTITY, (len(_J), 1)), "rest", -1
     if not worst <= TOLERANCE_DEG:
         first, frame, worst = _standing_turn(motion, what)
         source = "motion"
-    second, names = _straighten(_turned_offsets(offsets, first), legs_down=source == "motion")
+    second, names = _straighten(_turned_offsets(offsets, first))
     return quat.mul(second, first), StandingPose(source, frame, names, worst, family or "")
 
 

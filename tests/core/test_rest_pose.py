@@ -75,6 +75,45 @@ def test_arms_down_and_spread_legs_are_turned_onto_the_t_pose():
     np.testing.assert_allclose(same, 1.0, atol=1e-9)
 
 
+def _knee_bend(skeleton: Skeleton) -> float:
+    """Largest angle (degrees) between thigh and shin at rest, of both legs."""
+    rest, j = skeleton.rest_positions(), humanoid.JOINTS.index
+    thighs = np.stack([rest[j(s + "Leg")] - rest[j(s + "UpLeg")] for s in ("Left", "Right")])
+    shins = np.stack([rest[j(s + "Foot")] - rest[j(s + "Leg")] for s in ("Left", "Right")])
+    cos = (thighs * shins).sum(-1) / np.linalg.norm(thighs, axis=-1) / np.linalg.norm(shins, axis=-1)
+    return float(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))).max())
+
+
+def test_a_knee_bent_at_rest_stands_straight_legged():
+    """A rest knee bend within the tolerance (Goblin_m's kind) is a rigging choice: the standing
+    pose has thighs and shins straight down; a rig whose legs already are is left as it is."""
+    walk = _walk()
+    turn = np.tile([1.0, 0, 0, 0], (22, 1))
+    for side in ("Left", "Right"):
+        turn[humanoid.JOINTS.index(f"{side}UpLeg")] = quat.from_axis_angle([1.0, 0.0, 0.0], np.radians(15))
+        turn[humanoid.JOINTS.index(f"{side}Leg")] = quat.from_axis_angle([1.0, 0.0, 0.0], -np.radians(15))
+    bent = _repose(walk, turn)
+    assert _knee_bend(bent.skeleton) == pytest.approx(30.0)
+    out, pose = rest_pose.standing(bent)
+    assert pose.source == "rest" and {"LeftLeg", "LeftFoot", "RightLeg", "RightFoot"} <= set(pose.straightened)
+    assert _knee_bend(out.skeleton) < 1e-6
+    np.testing.assert_allclose(out.skeleton.offsets[1:], walk.skeleton.offsets[1:], atol=1e-9)
+    np.testing.assert_allclose(out.global_positions(), walk.global_positions(), atol=1e-9)
+    for character in synthetic.character_set(3, seed=1):  # straight legs at rest: untouched
+        motion = synthetic.generate("walk", character, num_frames=10, fps=60, seed=0)
+        assert rest_pose.standing(motion)[0] is motion
+
+
+def test_goblin_stands_straight_legged_with_its_motion_kept():
+    """Goblin_m's rest bends the knee about 43 deg; its standing pose does not, and the world motion stays."""
+    motion = humanoid.to_canonical(bvh.load(require_data("mixamo", "Goblin_m", "Jumping.bvh")))
+    assert _knee_bend(motion.skeleton) > 40.0
+    out, pose = rest_pose.standing(motion, family=humanoid.family(motion.skeleton))
+    assert pose.source == "rest" and _knee_bend(out.skeleton) < 1e-6
+    np.testing.assert_allclose(out.skeleton.bone_lengths(), motion.skeleton.bone_lengths(), atol=1e-9)
+    np.testing.assert_allclose(out.global_positions(), motion.global_positions(), atol=1e-6)
+
+
 def test_no_standing_pose_is_a_named_error():
     lying = _lying(_walk(10))
     crawl = lying.copy(local_rot=np.tile(quat.normalize(lying.local_rot[:1] * 0 + [1.0, 0, 0, 0]), (10, 1, 1)))
