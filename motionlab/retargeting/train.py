@@ -8,6 +8,15 @@
 
 Training is reproducible under ``TrainConfig.seed`` (weights, batch order, augmentation).
 
+**The same weights on every CPU (``TrainConfig.grid``, on by default).** Another CPU's kernels add
+in another order, so gradients differ in their last bits, and Adam, which divides each gradient by
+its own running size, lets such differences grow over a thousand steps. As in the latent iteration
+(:func:`motionlab.retargeting.solver.step_grid`), the initial weights are rounded to
+``step_grid(lr)`` and every parameter, after each Adam step, to ``step_grid(lr_t)`` (``lr_t`` the
+step's learning rate, a power of two about 2⁻¹² of it), and the skeleton augmentation's scale
+factors to :data:`DRAW_GRID`: last-bit differences are rounded away instead of growing
+(``docs/reproducibility.md``, ``python -m experiments.retargeting.reproducibility --training``).
+
 **Skeleton augmentation (our addition, on by default).** With one training character, F_skel
 only ever sees one input, so what F_Δ does for another skeleton is undefined. Each training
 window is therefore also decoded on a randomly re-proportioned copy of A's skeleton (legs,
@@ -43,6 +52,7 @@ from motionlab.retargeting import devices, losses
 from motionlab.retargeting.checkpoint import DTYPES, Checkpoint
 from motionlab.retargeting.features import clip_features
 from motionlab.retargeting.model import NUM_JOINTS, ModelConfig, RetargetNet
+from motionlab.retargeting.solver import step_grid
 
 __all__ = [
     "TrainingSet",
@@ -53,7 +63,13 @@ __all__ = [
     "turned_window",
     "train",
     "pick_device",
+    "DRAW_GRID",
+    "snap",
 ]
+
+DRAW_GRID = 2.0**-20
+"""Spacing the skeleton augmentation's scale factors are rounded to (with ``TrainConfig.grid``):
+``exp`` may differ in its last bit between SIMD widths; a factor on this grid does not."""
 
 _DRAWS = {"dtype": torch.float32, "device": "cpu"}
 """Random draws (skeleton and pose augmentation) come from a CPU generator in float32, then move to
@@ -192,6 +208,9 @@ class TrainConfig:
     device : str or None    None: CUDA when available, else CPU
     dtype : str             ``"float64"`` (default: the same numbers on every CPU, to the digits
                             the notebooks print) or ``"float32"`` (faster on a GPU)
+    grid : bool             round the initial weights and every parameter after each step to
+                            ``step_grid(lr_t)``, and augmentation factors to :data:`DRAW_GRID`: the
+                            same weights under every numeric back end (see the module docstring)
     """
 
     steps: int = 1500
@@ -208,6 +227,7 @@ class TrainConfig:
     log_every: int = 10
     device: str | None = None
     dtype: str = "float64"
+    grid: bool = True
 
     def __post_init__(self) -> None:
         if self.dtype not in DTYPES:
@@ -251,6 +271,8 @@ def random_offsets(base: torch.Tensor, batch: int, cfg: TrainConfig, generator: 
     mask = torch.as_tensor(idx >= 0, device="cpu")
     per_joint[:, mask] = g[:, torch.as_tensor(idx[idx >= 0], device="cpu")]
     factor = torch.exp(per_joint + overall)
+    if cfg.grid:  # exp's last bit differs between SIMD widths; the rounded factor does not
+        factor = torch.round(factor / DRAW_GRID) * DRAW_GRID
     return base[None] * factor[..., None].to(base)
 
 
@@ -342,6 +364,14 @@ def _batch(w: _Windows, cfg: TrainConfig, gen: torch.Generator):
     return x, rot, target, offsets
 
 
+@torch.no_grad()
+def snap(model: torch.nn.Module, lr: float) -> None:
+    """Round every parameter of ``model``, in place, to the grid ``step_grid(lr)`` (see the module docstring)."""
+    g = step_grid(lr)
+    for p in model.parameters():
+        p.copy_(torch.round(p / g) * g)
+
+
 def train(
     data: TrainingSet | Sequence[Motion],
     config: TrainConfig | None = None,
@@ -375,6 +405,8 @@ def train(
         model = RetargetNet(model_config)
     model = model.to(device=device, dtype=dtype)
     model.train()
+    if cfg.grid:
+        snap(model, cfg.lr)
     windows = _windows(data, dtype, device)
     opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, cfg.steps, eta_min=cfg.lr / 10)
@@ -395,6 +427,8 @@ def train(
         opt.zero_grad(set_to_none=True)
         loss.backward()
         opt.step()
+        if cfg.grid:
+            snap(model, opt.param_groups[0]["lr"])
         sched.step()
         with torch.no_grad():  # on the device: no host sync but at the logged steps
             running = loss.detach() if running is None else 0.95 * running + 0.05 * loss.detach()
