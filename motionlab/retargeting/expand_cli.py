@@ -48,7 +48,7 @@ def _cmd_expand(args) -> int:
     except ValueError as e:
         raise CLIError(str(e)) from None
     try:
-        real_source = any(real.is_real_file(p) for p in ex.find_sources(args.sources))
+        real_source = any(real.is_real_file(p) for _, p in ex.find_sources(args.sources))
     except OSError as e:
         raise CLIError(str(e)) from None
     ckpt = cli_options.network_checkpoint(args, real_source)
