@@ -17,9 +17,9 @@ trained on them. So the network for real motion is trained on the user's machine
 names and bytes, the training and network settings, the source of the modules that compute the
 training, and torch's version. A changed clip, setting or training code is a new key, never an
 old network. It is written atomically, and a lock file (POSIX ``flock``) makes a second process
-wait for the first one's training instead of training again. With :attr:`TrainConfig.grid` the
-weights are the same on every CPU (``docs/reproducibility.md``); training always runs on the CPU,
-so the cached network is the same whatever device it is loaded on.
+wait for the first one's training instead of training again. Training runs on the CPU, in a child
+process under one pinned numeric back end (:data:`PINNED_BACK_END`), so the cached network is the
+same on every machine and whatever device it is loaded on (``docs/reproducibility.md``).
 
 **Which network for which source** (:func:`choose`): the network trained on motion of the source's
 kind — the real network for real mocap when the course data is there, the shipped one for
@@ -29,6 +29,7 @@ motionlab's synthetic motion or when the course data is missing (``docs/rigs.md`
 from __future__ import annotations
 
 import contextlib
+import csv
 import hashlib
 import json
 import os
@@ -45,8 +46,11 @@ from motionlab.retargeting.model import ModelConfig
 
 __all__ = [
     "CACHE_ENV",
-    "SOURCE",
+    "DEFAULT_SOURCE",
+    "DEFAULT_ANIMATIONS",
+    "training_clips",
     "NETWORKS",
+    "PINNED_BACK_END",
     "cache_dir",
     "training_paths",
     "train_config",
@@ -62,8 +66,29 @@ __all__ = [
 ]
 
 CACHE_ENV = "MOTIONLAB_CACHE"
-SOURCE = "Aj"
-"""The character whose clips train the real network (the source of Table 1)."""
+DEFAULT_SOURCE = "Aj"
+"""The character whose clips train the real network: the source of Table 1."""
+DEFAULT_ANIMATIONS = (
+    "Running", "Jumping", "Body_Jab_Cross", "Standing_To_Crouch", "Catwalk_Idle_To_Walk_Forward",
+    "Run_Arc_Left", "Injured_Walk_Left_Turn", "Standing_Turn_Right_90", "Jazz_Dancing",
+    "Standing_Land_To_Standing_Idle",
+)  # fmt: skip
+"""The 10 ``retarget_gt`` animations of the shared Mixamo data."""
+
+PINNED_BACK_END = {
+    "ATEN_CPU_CAPABILITY": "avx2",
+    "MKL_CBWR": "COMPATIBLE",
+    "OMP_NUM_THREADS": "1",
+    "MKL_NUM_THREADS": "1",
+    "OPENBLAS_NUM_THREADS": "1",
+    "OPENBLAS_CORETYPE": "Haswell",
+    "NPY_DISABLE_CPU_FEATURES": "X86_V4 AVX512_ICL AVX512_SPR",
+}
+"""The numeric back end the cached network is trained under (a child process): torch's AVX2
+kernels, MKL's compatible path, OpenBLAS's Haswell kernels, numpy without AVX-512, one thread —
+the settings of CI's second test pass. The same kernels on every x86 CPU with AVX2 give the same
+weights; the grid of ``TrainConfig.grid`` alone does not survive a change of kernels over a
+training's 10⁸ parameter updates (``docs/reproducibility.md``)."""
 NETWORKS = ("auto", "real", "synthetic")
 """The choices of :func:`choose` (and the CLI's ``--network``)."""
 TRAINING_CODE = (
@@ -87,6 +112,47 @@ def cache_dir() -> Path:
     return Path(value).expanduser() if value else Path.home() / ".cache" / "motionlab"
 
 
+def training_clips(
+    folder: str | Path, source: str = DEFAULT_SOURCE, exclude: Sequence[str] = DEFAULT_ANIMATIONS
+) -> list[Path]:
+    """A's training clips in ``folder``.
+
+    If a ``manifest.csv`` with ``path``, ``purpose`` and ``subject`` columns sits in the folder or
+    its parent (the shared data does), the rows with ``purpose == "train_character"`` and
+    ``subject == source`` inside ``folder`` are used; otherwise every ``<source>/*.bvh`` whose
+    stem is not in ``exclude``. Evaluated animations are always excluded.
+
+    Raises
+    ------
+    FileNotFoundError when the source's folder is missing or holds no training clip.
+    """
+    folder = Path(folder)
+    excluded = {e.lower() for e in exclude}
+    for manifest in (folder / "manifest.csv", folder.parent / "manifest.csv"):
+        if manifest.is_file():
+            with open(manifest, newline="") as f:
+                rows = list(csv.DictReader(f))
+            if rows and {"path", "purpose", "subject"} <= set(rows[0]):
+                paths = [
+                    (manifest.parent / r["path"]).resolve()
+                    for r in rows
+                    if r["purpose"] == "train_character" and r["subject"] == source
+                ]
+                paths = [
+                    p for p in paths
+                    if p.is_file() and p.is_relative_to(folder.resolve()) and p.stem.lower() not in excluded
+                ]  # fmt: skip
+                if paths:
+                    return sorted(paths)
+    src = folder / source
+    if not src.is_dir():
+        raise FileNotFoundError(f"no folder {src} (expected <Character>/<Animation>.bvh under {folder})")
+    paths = sorted(p for p in src.glob("*.bvh") if p.stem.lower() not in excluded)
+    if not paths:
+        raise FileNotFoundError(f"no training clips for {source!r} in {src} (all excluded or none present)")
+    return paths
+
+
 def training_paths() -> list[Path]:
     """Aj's Mixamo clips in ``MOTIONLAB_DATA`` but Table 1's 10 (:func:`.evaluate.training_clips`).
 
@@ -96,15 +162,14 @@ def training_paths() -> list[Path]:
     data or Aj's clips are missing.
     """
     from motionlab import data
-    from motionlab.retargeting.evaluate import DEFAULT_ANIMATIONS, training_clips
 
     root = data.data_root()  # raises DataNotFound with the how-to
-    if not (root / "mixamo" / SOURCE).is_dir():
+    if not (root / "mixamo" / DEFAULT_SOURCE).is_dir():
         raise data.DataNotFound(
-            f"the network for real motion is trained on {SOURCE}'s Mixamo clips, but {root / 'mixamo' / SOURCE} "
+            f"the network for real motion is trained on {DEFAULT_SOURCE}'s Mixamo clips, but {root / 'mixamo' / DEFAULT_SOURCE} "
             f"is missing: {data.HOW_TO}"
         )
-    return training_clips(root / "mixamo", SOURCE, DEFAULT_ANIMATIONS)
+    return training_clips(root / "mixamo", DEFAULT_SOURCE, DEFAULT_ANIMATIONS)
 
 
 def train_config(**changes):
@@ -142,7 +207,7 @@ def _memo_key(paths, config, model_config) -> str:
     return _KEYS[memo]
 
 
-def cached_path(key: str, name: str = SOURCE) -> Path:
+def cached_path(key: str, name: str = DEFAULT_SOURCE) -> Path:
     """Where the network of ``key`` is cached: ``cache_dir()/retarget_<name>_<key[:16]>.pt``."""
     return cache_dir() / f"retarget_{name.lower()}_{key[:16]}.pt"
 
@@ -175,6 +240,55 @@ def _load_cached(path: Path, device, dtype: str) -> Checkpoint:
         raise ck.CheckpointError(f"{e}; delete {path} and it is trained again") from None
 
 
+def _train_and_save(paths, config, model_config, path: Path, key: str, progress: bool) -> None:
+    """Train on ``paths`` and write the checkpoint to ``path`` (atomic; refuses an existing file)."""
+    from motionlab.core import bvh
+    from motionlab.retargeting.train import train
+
+    ckpt, _ = train([bvh.load(p) for p in paths], config, model_config, progress=progress)
+    ckpt.info["source"] = [Path(p).name for p in paths]
+    ckpt.info["cache_key"] = key
+    ck.save(path, ckpt, overwrite=False)
+
+
+def _train_pinned(paths, config, model_config, path: Path, key: str, progress: bool) -> None:
+    """:func:`_train_and_save` in a child process under :data:`PINNED_BACK_END`.
+
+    Raises
+    ------
+    RuntimeError with the child's last error lines when it fails.
+    """
+    import subprocess
+
+    job = {
+        "paths": [str(p) for p in paths],
+        "config": asdict(config),
+        "model": (model_config or ModelConfig()).to_dict(),
+        "path": str(path),
+        "key": key,
+        "progress": progress,
+    }
+    env = dict(os.environ, **PINNED_BACK_END)
+    code = "import sys; from motionlab.retargeting import real; real._child(sys.stdin.read())"
+    done = subprocess.run(
+        [sys.executable, "-c", code], input=json.dumps(job), env=env, stderr=subprocess.PIPE, text=True
+    )
+    if done.returncode:
+        raise RuntimeError(f"training the network failed:\n{done.stderr[-3000:]}")
+    if progress and done.stderr:
+        print(done.stderr, file=sys.stderr, end="", flush=True)
+
+
+def _child(text: str) -> None:
+    """The child process of :func:`_train_pinned`: ``text`` is its job as JSON."""
+    from motionlab.retargeting.train import TrainConfig
+
+    job = json.loads(text)
+    model = ModelConfig(**job["model"])
+    config = TrainConfig(**job["config"])
+    _train_and_save(job["paths"], config, model, Path(job["path"]), job["key"], job["progress"])
+
+
 def trained(
     paths: Sequence[str | os.PathLike],
     config=None,
@@ -182,22 +296,22 @@ def trained(
     device=None,
     dtype: str = "float64",
     progress: bool = True,
-    name: str = SOURCE,
+    name: str = DEFAULT_SOURCE,
+    pinned: bool = True,
 ) -> Checkpoint:
     """The network trained on the clips ``paths`` (one character) with ``config``: from the cache
     when :func:`cache_key` has it, else trained (under a lock), cached atomically, and returned.
 
     ``device`` and ``dtype`` are where and how the returned network computes
-    (:func:`.checkpoint.load`); the training runs on ``config.device``. With ``progress`` a line
-    says that it trains once and where it caches, and a bar shows the training.
+    (:func:`.checkpoint.load`); the training runs on ``config.device``, with ``pinned`` in a child
+    process under :data:`PINNED_BACK_END` (the same weights on every x86 CPU with AVX2). With
+    ``progress`` a line says that it trains once and where it caches, and a bar shows the training.
 
     Raises
     ------
-    FileNotFoundError for a missing clip; CheckpointError naming a damaged cached file.
+    FileNotFoundError for a missing clip; CheckpointError naming a damaged cached file;
+    RuntimeError when the pinned child process fails.
     """
-    from motionlab.core import bvh
-    from motionlab.retargeting.train import train
-
     config = config or train_config()
     key = _memo_key(paths, config, model_config)
     path = cached_path(key, name)
@@ -212,10 +326,7 @@ def trained(
             f"training the retargeting network on {len(paths)} clips of {name} once ({config.steps} steps on the "
             f"{config.device or 'default device'}, minutes); it is cached in {path}"
         )
-        ckpt, _ = train([bvh.load(p) for p in paths], config, model_config, progress=progress)
-        ckpt.info["source"] = [Path(p).name for p in paths]
-        ckpt.info["cache_key"] = key
-        ck.save(path, ckpt, overwrite=False)
+        (_train_pinned if pinned else _train_and_save)(paths, config, model_config, path, key, progress)
     return _load_cached(path, device, dtype)
 
 
@@ -234,7 +345,7 @@ def available() -> bool:
     """True when the course data holds the clips :func:`load_real` trains on."""
     from motionlab import data
 
-    return data.has_data("mixamo", SOURCE)
+    return data.has_data("mixamo", DEFAULT_SOURCE)
 
 
 def choose(network: str = "auto", real_source: bool = True) -> str:
@@ -255,7 +366,7 @@ def choose(network: str = "auto", real_source: bool = True) -> str:
     if network == "real" and not available():
         from motionlab import data
 
-        raise data.DataNotFound(f"the real network is trained on {SOURCE}'s Mixamo clips: {data.HOW_TO}")
+        raise data.DataNotFound(f"the real network is trained on {DEFAULT_SOURCE}'s Mixamo clips: {data.HOW_TO}")
     if network != "auto":
         return network
     return "real" if real_source and available() else "synthetic"
@@ -304,7 +415,7 @@ def for_source(
     if which == "real":
         ckpt = load_real(device, dtype, progress)
         why = "real mocap source" if network == "auto" else "asked for"
-        line = f"network: trained on {SOURCE}'s real clips, cached in {cache_dir()} ({why})"
+        line = f"network: trained on {DEFAULT_SOURCE}'s real clips, cached in {cache_dir()} ({why})"
         return ckpt, line
     from motionlab.retargeting import load_default
 

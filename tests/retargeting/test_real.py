@@ -54,11 +54,11 @@ def _same_weights(a, b) -> bool:
 
 
 def test_a_miss_trains_and_caches_a_hit_loads(clips, trainings, tmp_path):
-    first = real.trained(clips, FAST, TINY, progress=False)
+    first = real.trained(clips, FAST, TINY, progress=False, pinned=False)
     path = real.cached_path(real.cache_key(clips, FAST, TINY))
     assert trainings == [1] and path.is_file() and path.parent == tmp_path / "cache"
     assert first.info["cache_key"] == real.cache_key(clips, FAST, TINY)
-    second = real.trained(clips, FAST, TINY, progress=False)
+    second = real.trained(clips, FAST, TINY, progress=False, pinned=False)
     assert trainings == [1]  # no second training
     assert _same_weights(first, second)
 
@@ -74,10 +74,10 @@ def test_the_key_changes_with_clips_settings_and_network(clips):
 
 
 def test_a_changed_clip_is_trained_again(clips, trainings):
-    real.trained(clips, FAST, TINY, progress=False)
+    real.trained(clips, FAST, TINY, progress=False, pinned=False)
     text = clips[1].read_text().rstrip("\n").rsplit("\n", 1)[0] + "\n"  # one frame fewer
     clips[1].write_text(text.replace("Frames: 150", "Frames: 149"))
-    real.trained(clips, FAST, TINY, progress=False)
+    real.trained(clips, FAST, TINY, progress=False, pinned=False)
     assert trainings == [1, 1]
 
 
@@ -89,7 +89,9 @@ def test_a_second_process_waits_for_the_first_and_does_not_train(clips, training
     got = {}
     with open(path.with_suffix(".lock"), "a") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)  # "the first process", training
-        waiter = threading.Thread(target=lambda: got.update(ckpt=real.trained(clips, FAST, TINY, progress=False)))
+        waiter = threading.Thread(
+            target=lambda: got.update(ckpt=real.trained(clips, FAST, TINY, progress=False, pinned=False))
+        )
         waiter.start()
         time.sleep(1.0)
         assert waiter.is_alive() and not got  # it waits for the lock
@@ -104,12 +106,28 @@ def test_a_second_process_waits_for_the_first_and_does_not_train(clips, training
     assert _same_weights(got["ckpt"], done)
 
 
+@pytest.mark.slow
+def test_pinned_training_runs_in_a_child_and_gives_the_same_weights_again(clips, tmp_path, monkeypatch):
+    first = real.trained(clips, FAST, TINY, progress=False)
+    assert first.info["cache_key"] == real.cache_key(clips, FAST, TINY)
+    monkeypatch.setenv(real.CACHE_ENV, str(tmp_path / "another_cache"))
+    again = real.trained(clips, FAST, TINY, progress=False)
+    assert _same_weights(first, again)
+
+
+def test_a_failing_child_is_reported(clips, monkeypatch):
+    monkeypatch.setattr(real.sys, "executable", real.sys.executable + "-missing")
+    with pytest.raises(OSError):  # no such interpreter: nothing cached
+        real.trained(clips, FAST, TINY, progress=False)
+    assert not real.cached_path(real.cache_key(clips, FAST, TINY)).exists()
+
+
 def test_a_damaged_cache_file_is_named(clips):
     path = real.cached_path(real.cache_key(clips, FAST, TINY))
     path.parent.mkdir(parents=True)
     path.write_bytes(b"not a checkpoint")
     with pytest.raises(ck.CheckpointError, match="delete .* and it is trained again"):
-        real.trained(clips, FAST, TINY, progress=False)
+        real.trained(clips, FAST, TINY, progress=False, pinned=False)
 
 
 def test_without_the_course_data_load_real_names_motionlab_data(tmp_path, monkeypatch):
