@@ -8,26 +8,16 @@
 
 Training is reproducible under ``TrainConfig.seed`` (weights, batch order, augmentation).
 
-**The same weights on every CPU (``TrainConfig.grid``, on by default).** Another CPU's kernels add
-in another order, so gradients differ in their last bits, and Adam, which divides each gradient by
-its own running size, lets such differences grow over a thousand steps. As in the latent iteration
-(:func:`motionlab.retargeting.solver.step_grid`), the initial weights are rounded to
+**Weights on a grid (``TrainConfig.grid``, on by default).** Another numeric back end adds in
+another order, so gradients differ in their last bits, and Adam, which divides each gradient by
+its own running size, lets such differences grow over a thousand steps. As in the latent
+iteration (:func:`motionlab.retargeting.solver.step_grid`), the initial weights are rounded to
 ``step_grid(lr)`` and every parameter, after each Adam step, to ``step_grid(lr_t)`` (``lr_t`` the
-step's learning rate, a power of two about 2⁻¹² of it), and the skeleton augmentation's scale
-factors to :data:`DRAW_GRID`: last-bit differences are rounded away instead of growing
+step's learning rate: a power of two about 2⁻¹² of it), and the skeleton augmentation's scale
+factors to :data:`DRAW_GRID`. Rare last-bit differences are then rounded away instead of growing;
+a change of kernels (scalar against SIMD) differs too often over a training's updates, which is
+why :func:`motionlab.retargeting.real.load_real` trains under one pinned back end
 (``docs/reproducibility.md``, ``python -m experiments.retargeting.reproducibility --training``).
-
-**Skeleton augmentation (our addition, on by default).** With one training character, F_skel
-only ever sees one input, so what F_Δ does for another skeleton is undefined. Each training
-window is therefore also decoded on a randomly re-proportioned copy of A's skeleton (legs,
-arms, spine, neck and overall size scaled independently), with the target positions computed
-by FK of A's own rotations on that skeleton. This uses A's data only and teaches F_Δ to leave
-rotations alone when only proportions change; the latent iteration then adapts the motion.
-``augment=False`` gives the paper's plain setting.
-
-**Mirrored clips (our addition, on by default).** :func:`training_set` also adds every clip
-mirrored left↔right (:func:`mirrored`): twice the poses from the same recording
-(``benchmarks/bench_retarget.py`` prints its effect on held-back clips).
 
 Taught in ``notebooks/02_training_autoencoder.ipynb``.
 """
@@ -209,8 +199,8 @@ class TrainConfig:
     dtype : str             ``"float64"`` (default: the same numbers on every CPU, to the digits
                             the notebooks print) or ``"float32"`` (faster on a GPU)
     grid : bool             round the initial weights and every parameter after each step to
-                            ``step_grid(lr_t)``, and augmentation factors to :data:`DRAW_GRID`: the
-                            same weights under every numeric back end (see the module docstring)
+                            ``step_grid(lr_t)``, and augmentation factors to :data:`DRAW_GRID`, so
+                            that rare last-bit differences do not grow (see the module docstring)
     """
 
     steps: int = 1500
@@ -372,6 +362,18 @@ def snap(model: torch.nn.Module, lr: float) -> None:
         p.copy_(torch.round(p / g) * g)
 
 
+def _initial_model(model_config: ModelConfig | None, cfg: TrainConfig, device: torch.device) -> RetargetNet:
+    """The untrained network in training mode on ``device``, its weights drawn on the CPU (one seed,
+    one network on every device) and, with ``cfg.grid``, rounded to ``step_grid(cfg.lr)``."""
+    with torch.device("cpu"):
+        model = RetargetNet(model_config)
+    model = model.to(device=device, dtype=DTYPES[cfg.dtype])
+    model.train()
+    if cfg.grid:
+        snap(model, cfg.lr)
+    return model
+
+
 def train(
     data: TrainingSet | Sequence[Motion],
     config: TrainConfig | None = None,
@@ -401,12 +403,7 @@ def train(
     torch.manual_seed(cfg.seed)
     gen = torch.Generator().manual_seed(cfg.seed)
     dtype = DTYPES[cfg.dtype]
-    with torch.device("cpu"):  # initial weights drawn on the CPU: one seed, one network on every device
-        model = RetargetNet(model_config)
-    model = model.to(device=device, dtype=dtype)
-    model.train()
-    if cfg.grid:
-        snap(model, cfg.lr)
+    model = _initial_model(model_config, cfg, device)
     windows = _windows(data, dtype, device)
     opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, cfg.steps, eta_min=cfg.lr / 10)
