@@ -47,10 +47,7 @@ def _cmd_expand(args) -> int:
         ex.check_output_layout(args.output, ex.find_sources(args.sources), targets, "." + args.format)
     except ValueError as e:
         raise CLIError(str(e)) from None
-    try:
-        real_source = any(real.is_real_file(p) for _, p in ex.find_sources(args.sources))
-    except OSError as e:
-        raise CLIError(str(e)) from None
+    real_source = real.any_real_file([p for _, p in ex.find_sources(args.sources)])
     ckpt = cli_options.network_checkpoint(args, real_source)
     job = ex.expand(
         args.sources,

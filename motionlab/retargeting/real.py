@@ -61,7 +61,7 @@ __all__ = [
     "available",
     "choose",
     "is_real_rig",
-    "is_real_file",
+    "any_real_file",
     "for_source",
 ]
 
@@ -380,24 +380,21 @@ def is_real_rig(skeleton) -> bool:
     return not humanoid.is_canonical(skeleton)
 
 
-def is_real_file(path: str | os.PathLike) -> bool:
-    """:func:`is_real_rig` of a BVH file's rig, from the joint names of its HIERARCHY alone.
+def any_real_file(paths: Sequence[str | os.PathLike]) -> bool:
+    """True when one of the BVH files ``paths`` is a recorded clip (:func:`is_real_rig`) whose rig
+    maps onto the humanoid; files that cannot be read or mapped do not count. Reads the files in
+    order and stops at the first such clip."""
+    from motionlab.core import bvh, humanoid
 
-    Raises
-    ------
-    OSError when the file cannot be read.
-    """
-    from motionlab.core import humanoid
-
-    names = []
-    with open(path, encoding="utf-8", errors="replace") as f:
-        for line in f:
-            words = line.split()
-            if words and words[0] == "MOTION":
-                break
-            if len(words) >= 2 and words[0] in ("ROOT", "JOINT"):
-                names.append(humanoid.strip_prefix(words[1]))
-    return tuple(names) != humanoid.JOINTS
+    for p in paths:
+        try:
+            skeleton = bvh.load(p).skeleton
+            humanoid.find_mapping(skeleton)
+        except (OSError, ValueError):  # BVHError and RigMappingError are ValueErrors
+            continue
+        if is_real_rig(skeleton):
+            return True
+    return False
 
 
 def for_source(

@@ -157,9 +157,11 @@ def test_the_auto_rule(tmp_path):
         real.choose("shipped")
     m = synthetic.dataset(1, seed=0, num_frames=30)[0]
     bvh.save(tmp_path / "synthetic.bvh", m)
-    assert not real.is_real_rig(m.skeleton) and not real.is_real_file(tmp_path / "synthetic.bvh")
+    (tmp_path / "garbage.bvh").write_text("HIERARCHY\nROOT Hips\n{\n")  # unreadable: not a recorded clip
+    assert not real.is_real_rig(m.skeleton)
+    assert not real.any_real_file([tmp_path / "garbage.bvh", tmp_path / "synthetic.bvh", tmp_path / "missing.bvh"])
     aj = require_data("mixamo", "Aj", "Running.bvh")
-    assert real.is_real_rig(bvh.load(aj).skeleton) and real.is_real_file(aj)
+    assert real.is_real_rig(bvh.load(aj).skeleton) and real.any_real_file([tmp_path / "garbage.bvh", aj])
     assert real.choose("auto", real_source=True) == "real"
 
 
