@@ -270,13 +270,11 @@ def _train_pinned(paths, config, model_config, path: Path, key: str, progress: b
     }
     env = dict(os.environ, **PINNED_BACK_END)
     code = "import sys; from motionlab.retargeting import real; real._child(sys.stdin.read())"
-    done = subprocess.run(
-        [sys.executable, "-c", code], input=json.dumps(job), env=env, stderr=subprocess.PIPE, text=True
-    )
+    errors = None if progress else subprocess.PIPE  # with progress the child's bar shows as it runs
+    done = subprocess.run([sys.executable, "-c", code], input=json.dumps(job), env=env, stderr=errors, text=True)
     if done.returncode:
-        raise RuntimeError(f"training the network failed:\n{done.stderr[-3000:]}")
-    if progress and done.stderr:
-        print(done.stderr, file=sys.stderr, end="", flush=True)
+        said = (done.stderr or "")[-3000:]
+        raise RuntimeError(f"training the network failed (exit status {done.returncode}); {said or 'see above'}")
 
 
 def _child(text: str) -> None:
