@@ -13,7 +13,8 @@ without it (spacing 2⁻⁶⁰ of a step: no rounding in practice).
 
 ``--training`` trains the same network under each back end instead (a small synthetic set with
 ``TrainConfig.grid`` on and off; with ``--real`` also the network of ``retargeting.load_real``,
-Aj's clips with evaluate's settings, grid on, whose back-end-A run is the cached one), and prints how many parameter tensors differ
+Aj's clips with evaluate's settings, grid on: the cached network, trained under
+``real.PINNED_BACK_END``, against a second training in a child process under back end B), and prints how many parameter tensors differ
 between the back ends, the largest difference, the final loss and the mean joint error of the
 trained network on clips it never saw. Back end C (torch and numpy without SIMD kernels) is a
 harsher check for a machine whose own kernels are back end B's.
@@ -171,7 +172,7 @@ def _compare_weights(path_a: str, path_b: str) -> tuple[int, int, float]:
     return len(differ), len(a), largest
 
 
-def training(real: bool) -> None:
+def training(real: bool, small: bool = True) -> None:
     """Prints, per training run and grid setting, whether back ends B and C give back end A's weights."""
     import tempfile
 
@@ -183,8 +184,10 @@ def training(real: bool) -> None:
     print(
         f"small: {SMALL['clips']} synthetic clips, {SMALL['steps']} steps of {SMALL['batch_size']} windows; held out: 4 other synthetic clips"
     )
-    print("real: retargeting.load_real's network (Aj's clips but Table 1's 10, evaluate's settings), grid on,")
-    print("      back end A from the cache (trained in this process if missing), B trained; held out: those 10")
+    print("real: retargeting.load_real's network (Aj's clips but Table 1's 10, evaluate's settings, grid on):")
+    print(
+        "      A = the cached one (trained under real.PINNED_BACK_END), B = trained again in a child; held out: those 10"
+    )
     head = f"{'run':6s} {'grid':>4s} {'back end':>8s} {'differing tensors':>18s} {'max |diff|':>11s} {'final loss':>11s} {'held-out cm':>11s} {'train s':>8s}"
     print(head)
     print("-" * len(head))
@@ -192,7 +195,7 @@ def training(real: bool) -> None:
         real_paths = {k: os.path.join(tmp, f"real_{k}.pt") for k in "AB"}
         if real:  # minutes per run: back end B trains beside the rest; A is the cached network
             other = _start_child(OTHER_BACK_END, ("real", True, real_paths["B"]))
-        for grid in (True, False):
+        for grid in (True, False) if small else ():
             paths = {k: os.path.join(tmp, f"small_{grid}_{k}.pt") for k in "ABC"}
             for k, env in {"A": {}, "B": OTHER_BACK_END, "C": NO_SIMD}.items():
                 _row("small", grid, k, _child(env, False, ("small", grid, paths[k])), paths)
@@ -233,9 +236,10 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--training", action="store_true", help="compare trained weights instead of iterations")
     parser.add_argument("--real", action="store_true", help="with --training: also the real network (minutes)")
+    parser.add_argument("--no-small", action="store_true", help="with --training --real: the real network only")
     args = parser.parse_args(argv)
     if args.training:
-        training(args.real)
+        training(args.real, small=not args.no_small)
         return 0
     print("back end A: this machine's; back end B:", ", ".join(f"{k}={v}" for k, v in OTHER_BACK_END.items()))
     print("* held out: run only after the grids were chosen")
