@@ -417,7 +417,9 @@ def for_source(
     if network != "auto":
         why = "asked for"
     elif real_source:
-        why = f"real mocap source, but no course data: {CACHE_ENV.replace('CACHE', 'DATA')} is not set"
+        from motionlab import data
+
+        why = f"real mocap source, but {data.ENV_VAR} does not hold the course data's mixamo/{DEFAULT_SOURCE}"
     else:
         why = "source on motionlab's synthetic (canonical 22-joint) rig"
     return load_default(device, dtype), f"network: the shipped one, trained on motionlab's synthetic motion ({why})"
