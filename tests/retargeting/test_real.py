@@ -198,3 +198,15 @@ def test_the_real_network_reconstructs_held_out_real_clips_better_than_the_shipp
     ours, shipped = real.load_real("cpu", progress=False), load_default("cpu")
     assert not any(p.stem in DEFAULT_ANIMATIONS for p in real.training_paths())
     assert _held_out_error(ours, held) < 0.5 * _held_out_error(shipped, held)
+
+
+def test_the_cli_says_which_network_it_uses(tmp_path, capsys):
+    from motionlab import cli
+
+    src = tmp_path / "walk.bvh"
+    bvh.save(src, synthetic.dataset(1, seed=0, num_frames=60)[0])
+    argv = ["retarget", str(src), "--scale-legs", "1.2", "-o", str(tmp_path / "out.bvh"), "--steps", "2"]
+    assert cli.main(argv) == 0
+    assert "network: the shipped one" in capsys.readouterr().out  # a source on motionlab's synthetic rig
+    assert cli.main(argv + ["--force", "--checkpoint", str(tmp_path / "none.pt"), "--network", "synthetic"]) != 0
+    assert "not both" in capsys.readouterr().err
