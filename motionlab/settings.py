@@ -2,6 +2,9 @@
 
 ``MOTIONLAB_DATA``
     folder of real BVH files (see :mod:`motionlab.data`).
+``MOTIONLAB_CACHE``
+    folder of the network trained on real motion on first use (default ``~/.cache/motionlab``;
+    see :mod:`motionlab.retargeting.real`).
 ``MOTIONLAB_QUICK``
     when set to 1/true/yes, notebooks and long-running demos use a reduced mode
     (fewer training steps, fewer clips) through the same code path. CI sets it.
@@ -17,7 +20,10 @@ _TRUE = {"1", "true", "yes", "on"}
 
 
 def quick_mode() -> bool:
-    """True when ``MOTIONLAB_QUICK`` asks for the reduced (CI) mode."""
+    """True when ``MOTIONLAB_CACHE``
+    folder of the network trained on real motion on first use (default ``~/.cache/motionlab``;
+    see :mod:`motionlab.retargeting.real`).
+``MOTIONLAB_QUICK`` asks for the reduced (CI) mode."""
     return os.environ.get("MOTIONLAB_QUICK", "").strip().lower() in _TRUE
 
 

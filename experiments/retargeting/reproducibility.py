@@ -9,6 +9,15 @@ without it (spacing 2⁻⁶⁰ of a step: no rounding in practice).
 
     MOTIONLAB_DATA=/path/to/shared/data python -m experiments.retargeting.reproducibility
     python -m experiments.retargeting.reproducibility            # synthetic clips only
+    python -m experiments.retargeting.reproducibility --training [--real]
+
+``--training`` trains the same network under each back end instead (a small synthetic set with
+``TrainConfig.grid`` on and off; with ``--real`` also the network of ``retargeting.load_real``,
+Aj's clips with evaluate's settings, grid on: the cached network, trained under
+``real.PINNED_BACK_END``, against a second training in a child process under back end B), and prints how many parameter tensors differ
+between the back ends, the largest difference, the final loss and the mean joint error of the
+trained network on clips it never saw. Back end C (torch and numpy without SIMD kernels) is a
+harsher check for a machine whose own kernels are back end B's.
 
 The pairs: Aj's clips of the ``retarget_gt`` set onto other Mixamo characters when the course
 data is there (:data:`CHOSEN_ON`, looked at while the grids were chosen, and :data:`HELD_OUT`,
@@ -44,6 +53,14 @@ HELD_OUT = [
 ]
 """Pairs run only after the choice, to check it."""
 REAL_PAIRS = CHOSEN_ON + HELD_OUT
+NO_SIMD = {
+    **OTHER_BACK_END,
+    "ATEN_CPU_CAPABILITY": "default",
+    "NPY_DISABLE_CPU_FEATURES": "X86_V3 X86_V4 AVX512_ICL AVX512_SPR",
+}
+"""Back end C: torch's and numpy's scalar kernels, one thread."""
+SMALL = {"clips": 8, "steps": 200, "batch_size": 16}
+"""The small training run: synthetic clips (seed 0), Adam steps, windows per step."""
 
 
 def _pairs() -> list[tuple[str, str]]:
@@ -79,16 +96,151 @@ def _run_pairs(grid_off: bool) -> list[dict]:
     return out
 
 
-def _child(env_extra: dict, grid_off: bool) -> list[dict]:
+def _held_out_error(ckpt, motions) -> float:
+    """Mean joint-position error (cm) of the network's reconstruction of ``motions`` on their own skeleton."""
+    import numpy as np
+    import torch
+
+    from motionlab.core import preprocess
+    from motionlab.retargeting.features import clip_features
+
+    err = []
+    for m in motions:
+        c = preprocess.prepare(m, ckpt.fps)
+        f = clip_features(c)
+        x = torch.tensor(ckpt.stats.normalize(f.x), dtype=ckpt.dtype)[None]
+        offsets = torch.tensor(c.skeleton.offsets, dtype=ckpt.dtype)
+        offsets[0] = 0.0  # as in training: the root's offset zeroed
+        with torch.no_grad():
+            out = ckpt.model(x, offsets[None])
+        err.append(np.linalg.norm(out.positions[0].numpy() - f.positions, axis=-1).ravel())
+    return 100 * float(np.concatenate(err).mean())
+
+
+def _train_weights(which: str, grid: bool, path: str) -> dict:
+    """Runs in the child process: trains ``which`` ("small" or "real"), saves the weights to ``path``."""
+    import torch
+
+    from motionlab import synthetic
+    from motionlab.retargeting.train import TrainConfig, train
+
+    if which == "small":
+        motions, held = synthetic.dataset(SMALL["clips"], seed=0), synthetic.dataset(4, seed=321)
+        cfg = TrainConfig(steps=SMALL["steps"], batch_size=SMALL["batch_size"], device="cpu", grid=grid)
+    else:
+        from motionlab import data
+        from motionlab.core import bvh
+        from motionlab.retargeting import real
+        from motionlab.retargeting.evaluate import DEFAULT_ANIMATIONS
+
+        motions = [bvh.load(p) for p in real.training_paths()]
+        held = [bvh.load(data.clip_path("mixamo", "Aj", a)) for a in DEFAULT_ANIMATIONS]
+        cfg = real.train_config(device="cpu", grid=grid)
+    ckpt, history = train(motions, cfg, progress=False)
+    torch.save(ckpt.model.state_dict(), path)
+    return {"loss": history[-1]["loss"], "held_out_cm": _held_out_error(ckpt, held), "seconds": ckpt.info["seconds"]}
+
+
+def _start_child(env_extra: dict, training: tuple | None = None, grid_off: bool = False) -> subprocess.Popen:
     env = dict(os.environ, **env_extra)
     repo = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-    code = f"import json, sys; sys.path.insert(0, {repo!r}); from experiments.retargeting import reproducibility as b; print(json.dumps(b._run_pairs({grid_off})))"
-    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
-    return json.loads(done.stdout.strip().splitlines()[-1])
+    call = f"b._train_weights{training!r}" if training else f"b._run_pairs({grid_off})"
+    code = f"import json, sys; sys.path.insert(0, {repo!r}); from experiments.retargeting import reproducibility as b; print(json.dumps({call}))"
+    return subprocess.Popen(
+        [sys.executable, "-c", code], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+
+
+def _finish_child(child: subprocess.Popen) -> list[dict] | dict:
+    out, err = child.communicate()
+    if child.returncode:
+        raise RuntimeError(f"the child process failed:\n{err}")
+    return json.loads(out.strip().splitlines()[-1])
+
+
+def _child(env_extra: dict, grid_off: bool, training: tuple | None = None) -> list[dict] | dict:
+    return _finish_child(_start_child(env_extra, training, grid_off))
+
+
+def _compare_weights(path_a: str, path_b: str) -> tuple[int, int, float]:
+    """(parameter tensors that differ, of how many, largest absolute difference) between two saved state dicts."""
+    import torch
+
+    a, b = torch.load(path_a), torch.load(path_b)
+    differ = [k for k in a if not torch.equal(a[k], b[k])]
+    largest = max((float((a[k] - b[k]).abs().max()) for k in differ), default=0.0)
+    return len(differ), len(a), largest
+
+
+def training(real: bool, small: bool = True) -> None:
+    """Prints, per training run and grid setting, whether back ends B and C give back end A's weights."""
+    import tempfile
+
+    print("back end A: this machine's; B:", ", ".join(f"{k}={v}" for k, v in OTHER_BACK_END.items()))
+    print(
+        "back end C: B with ATEN_CPU_CAPABILITY=default, NPY_DISABLE_CPU_FEATURES="
+        + NO_SIMD["NPY_DISABLE_CPU_FEATURES"]
+    )
+    print(
+        f"small: {SMALL['clips']} synthetic clips, {SMALL['steps']} steps of {SMALL['batch_size']} windows; held out: 4 other synthetic clips"
+    )
+    print("real: retargeting.load_real's network (Aj's clips but Table 1's 10, evaluate's settings, grid on):")
+    print(
+        "      A = the cached one (trained under real.PINNED_BACK_END), B = trained again in a child; held out: those 10"
+    )
+    head = f"{'run':6s} {'grid':>4s} {'back end':>8s} {'differing tensors':>18s} {'max |diff|':>11s} {'final loss':>11s} {'held-out cm':>11s} {'train s':>8s}"
+    print(head)
+    print("-" * len(head))
+    with tempfile.TemporaryDirectory() as tmp:
+        real_paths = {k: os.path.join(tmp, f"real_{k}.pt") for k in "AB"}
+        if real:  # minutes per run: back end B trains beside the rest; A is the cached network
+            other = _start_child(OTHER_BACK_END, ("real", True, real_paths["B"]))
+        for grid in (True, False) if small else ():
+            paths = {k: os.path.join(tmp, f"small_{grid}_{k}.pt") for k in "ABC"}
+            for k, env in {"A": {}, "B": OTHER_BACK_END, "C": NO_SIMD}.items():
+                _row("small", grid, k, _child(env, False, ("small", grid, paths[k])), paths)
+        if real:
+            _row("real", True, "A", _real_cached(real_paths["A"]), real_paths)
+            _row("real", True, "B", _finish_child(other), real_paths)
+
+
+def _real_cached(path: str) -> dict:
+    """Back end A of the real run: ``retargeting.load_real``'s network (this process's back end)."""
+    import torch
+
+    from motionlab import data
+    from motionlab.core import bvh
+    from motionlab.retargeting import real
+    from motionlab.retargeting.evaluate import DEFAULT_ANIMATIONS
+
+    ckpt = real.load_real("cpu")
+    torch.save(ckpt.model.state_dict(), path)
+    held = [bvh.load(data.clip_path("mixamo", "Aj", a)) for a in DEFAULT_ANIMATIONS]
+    return {
+        "loss": ckpt.info["final_loss"],
+        "held_out_cm": _held_out_error(ckpt, held),
+        "seconds": ckpt.info["seconds"],
+    }
+
+
+def _row(which: str, grid: bool, k: str, r: dict, paths: dict) -> None:
+    n, total, largest = _compare_weights(paths["A"], paths[k])
+    print(
+        f"{which:6s} {'on' if grid else 'off':>4s} {k:>8s} {f'{n} of {total}':>18s} {largest:11.1e} "
+        f"{r['loss']:11.6g} {r['held_out_cm']:11.4f} {r['seconds']:8.0f}",
+        flush=True,
+    )
 
 
 def main(argv=None) -> int:
-    argparse.ArgumentParser(description=__doc__.split("\n\n")[0]).parse_args(argv)
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--training", action="store_true", help="compare trained weights instead of iterations")
+    parser.add_argument("--real", action="store_true", help="with --training: also the real network (minutes)")
+    parser.add_argument("--no-small", action="store_true", help="with --training --real: the real network only")
+    args = parser.parse_args(argv)
+    if args.training:
+        training(args.real, small=not args.no_small)
+        return 0
     print("back end A: this machine's; back end B:", ", ".join(f"{k}={v}" for k, v in OTHER_BACK_END.items()))
     print("* held out: run only after the grids were chosen")
     print(f"{'pair':44s} {'grid':>5s} {'steps A':>10s} {'steps B':>10s} {'max rel. loss difference':>25s}")

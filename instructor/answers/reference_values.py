@@ -31,7 +31,7 @@ def main() -> None:
     )
     source = run
     target = demo.trim_frozen(bvh.load(data.clip_path("mixamo", "Mousey_m", "Run_Arc_Left"))).skeleton
-    ckpt = retargeting.load_default()
+    ckpt = retargeting.load_real()  # notebook 03's network on the course data
     for name in ("encoder_start", "contact_weight", "foot_weight", "theta_directions"):
         print(f"03 {name:19s} {ex.EXPERIMENTS[name].reference(source, target, ckpt):.2f}")
     from motionlab import synthetic

@@ -9,6 +9,7 @@ match the source and the feet stay above the ground.
   iteration's loss terms as named objects (the registry a new term joins);
 * :mod:`.devices` — the default torch device and its checks;
 * :mod:`.train` — training on one character; :mod:`.checkpoint` — save / load;
+  :mod:`.real` — the network trained on real motion, trained on first use and cached;
 * :mod:`.solver` — the latent iteration; :mod:`.baselines` — copy-rotation;
 * :mod:`.pipeline` — a Motion onto a target skeleton, end to end;
 * :mod:`.evaluate` — Table 1 on real data; :mod:`.cli` — ``motionlab retarget/train/evaluate``.
@@ -19,6 +20,13 @@ package on its own synthetic data), so retargeting works without training first.
 with::
 
     motionlab train --synthetic 300 --seed 0 -o motionlab/assets/retarget_default.pt --force
+
+``load_real()`` returns the network trained on real motion (Aj's Mixamo clips but Table 1's 10,
+the network ``motionlab evaluate`` uses), trained from ``MOTIONLAB_DATA`` on first use and cached
+(:mod:`.real`: the data's licences do not allow shipping it). Paper A trains on the source
+character's own motion, so :func:`retarget` without a checkpoint uses it for a recorded source
+when the course data is there, and the shipped network for motionlab's synthetic rig or without
+the data (:func:`.real.for_source`).
 
 Taught in ``notebooks/02_training_autoencoder.ipynb`` and ``03_latent_iteration.ipynb``.
 """
@@ -31,12 +39,14 @@ from motionlab.retargeting.baselines import copy_rotation
 from motionlab.retargeting.checkpoint import Checkpoint, CheckpointError, load, save
 from motionlab.retargeting.model import ModelConfig, RetargetNet
 from motionlab.retargeting.pipeline import RetargetResult, retarget
+from motionlab.retargeting.real import load_real
 from motionlab.retargeting.solver import SolverConfig, SolverResult, solve
 from motionlab.retargeting.train import TrainConfig, train, training_set
 
 __all__ = [
     "DEFAULT_CHECKPOINT",
     "load_default",
+    "load_real",
     "Checkpoint",
     "CheckpointError",
     "load",

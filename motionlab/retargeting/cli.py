@@ -11,8 +11,8 @@ Examples::
 
 from __future__ import annotations
 
+import dataclasses
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -61,6 +61,7 @@ def _cmd_retarget(args) -> int:
     written as BVH (OUTPUT ending in .bvh) or binary glTF 2.0 (.glb).
     """
     from motionlab.core import files, humanoid, motion_files, rest_pose
+    from motionlab.retargeting import real
     from motionlab.retargeting.pipeline import retarget
 
     cli_options.check_device(args.device)
@@ -93,7 +94,7 @@ def _cmd_retarget(args) -> int:
         target = humanoid.scale_bones(target, **scales)
     if not args.target and all(v == 1.0 for v in scales.values()):
         raise CLIError("give --target TARGET.bvh and/or a --scale-* factor: otherwise the target is the source itself")
-    ckpt = None if args.method == "copy" else cli_options.load_checkpoint(args.checkpoint, args.device)
+    ckpt = None if args.method == "copy" else cli_options.network_checkpoint(args, real.is_real_rig(source.skeleton))
     result = retarget(
         source,
         target,
@@ -215,14 +216,17 @@ def _check_characters_and_animations(args, folder: Path, animations: list[str]) 
             raise CLIError(f"--animations {anim}: none of the targets {', '.join(args.targets)} has {anim}.bvh")
 
 
-def _fold_checkpoint(args, folder: Path, fpath: Path, left_out: list[str]):
-    """The network of one fold: loaded from ``fpath``, or trained on the source's clips but ``left_out`` and saved there."""
+def _fold_checkpoint(args, folder: Path, fpath: Path | None, left_out: list[str]):
+    """The network of one fold: without --checkpoint (``fpath`` None) the cached network trained on the
+    source's clips but ``left_out`` (:func:`motionlab.retargeting.real.trained`); else loaded from
+    ``fpath``, or trained and saved there."""
     from motionlab.core import bvh
     from motionlab.retargeting import checkpoint as ck
+    from motionlab.retargeting import real
     from motionlab.retargeting.evaluate import training_clips
-    from motionlab.retargeting.train import TrainConfig, train
+    from motionlab.retargeting.train import train
 
-    if fpath.is_file() and not args.retrain:
+    if fpath is not None and fpath.is_file() and not args.retrain:
         ckpt = cli_options.load_checkpoint(str(fpath), args.device)
         if not args.quiet:
             print(f"using checkpoint {fpath}")
@@ -231,13 +235,15 @@ def _fold_checkpoint(args, folder: Path, fpath: Path, left_out: list[str]):
         clips = training_clips(folder, args.source, left_out)
     except FileNotFoundError as e:
         raise CLIError(str(e)) from None
+    cfg = real.train_config(steps=args.train_steps, seed=args.seed)  # on the CPU: one network on every machine
+    if fpath is None:
+        try:
+            return real.trained(clips, cfg, device=args.device, progress=not args.quiet, name=args.source)
+        except ck.CheckpointError as e:
+            raise CLIError(str(e)) from None
     if not args.quiet:
         print(f"training on {len(clips)} clips of {args.source} (none of the {len(left_out)} evaluated) -> {fpath}")
-    ckpt, _ = train(
-        [bvh.load(p) for p in clips],
-        TrainConfig(steps=args.train_steps, seed=args.seed, device=args.device),
-        progress=not args.quiet,
-    )
+    ckpt, _ = train([bvh.load(p) for p in clips], dataclasses.replace(cfg, device=args.device), progress=not args.quiet)
     ck.save(fpath, ckpt)
     return ckpt
 
@@ -261,8 +267,8 @@ def _cmd_evaluate(args) -> int:
     """reproduce Table 1 (retargeting vs real clips) on a <Character>/<Animation>.bvh folder
 
     Retarget SOURCE's clips onto each target's T-pose skeleton and compare with the targets' real clips:
-    copy-rotation baseline, network without iteration, full method. Trains the network on SOURCE's other clips first
-    if the checkpoint does not exist.
+    copy-rotation baseline, network without iteration, full method. The network is trained on SOURCE's other clips
+    once and cached (without --checkpoint), or loaded from --checkpoint (trained and saved there if missing).
     """
     from motionlab import data as mdata
     from motionlab.retargeting.evaluate import Evaluation, evaluate, rows_with_root
@@ -274,15 +280,17 @@ def _cmd_evaluate(args) -> int:
         raise CLIError(f"data folder {folder} not found")
     if args.folds < 1:
         raise CLIError(f"--folds must be >= 1, got {args.folds}")
-    path = Path(args.checkpoint) if args.checkpoint else Path(tempfile.gettempdir()) / f"motionlab_{args.source}.pt"
+    if args.retrain and not args.checkpoint:
+        raise CLIError("--retrain needs --checkpoint: without it the network is cached under its clips and settings")
     animations = _animations(args, folder)
     _check_characters_and_animations(args, folder, animations)
     if args.folds > len(animations):
         raise CLIError(f"--folds {args.folds} is more than the {len(animations)} animations evaluated")
     # leave animations out: fold k is evaluated by a network trained without the fold's animations
     folds = [animations[k :: args.folds] for k in range(args.folds)]
-    fold_paths = [_fold_path(path, k, args.folds) for k in range(args.folds)]
-    trained = [("--checkpoint", p) for p in fold_paths if args.retrain or not p.is_file()]
+    path = Path(args.checkpoint) if args.checkpoint else None
+    fold_paths = [_fold_path(path, k, args.folds) if path else None for k in range(args.folds)]
+    trained = [("--checkpoint", p) for p in fold_paths if p and (args.retrain or not p.is_file())]
     check_outputs(trained, force=True, inputs=[("--csv", args.csv)])  # a checkpoint to train is written later
     result = Evaluation(rows=[])
     for fold, fpath in zip(folds, fold_paths):
@@ -334,7 +342,7 @@ def _add_retarget(subparsers) -> None:
             default="full",
             help="full = latent iteration (default); network = no iteration; copy = copy rotations",
         )
-        p.add_argument("--checkpoint", help="trained network (default: the shipped one)")
+        cli_options.add_network(p, "a source")
         p.add_argument(
             "--root",
             choices=ROOT_MODES,
@@ -410,9 +418,11 @@ def _add_evaluate(subparsers) -> None:
         p.add_argument("--animations", nargs="+", help="clip stems (default: the 10 retarget_gt animations)")
         p.add_argument("--all-animations", action="store_true", help="use every animation shared by source and targets")
         p.add_argument(
-            "--checkpoint", help="checkpoint to use, trained there if missing (default: <tmp>/motionlab_<source>.pt)"
+            "--checkpoint",
+            help="checkpoint to use, trained there if missing (default: the network trained on the source's other "
+            "clips, cached: $MOTIONLAB_CACHE or ~/.cache/motionlab)",
         )
-        p.add_argument("--retrain", action="store_true", help="train even if the checkpoint exists")
+        p.add_argument("--retrain", action="store_true", help="train even if the --checkpoint file exists")
         p.add_argument(
             "--folds",
             type=positive_int,

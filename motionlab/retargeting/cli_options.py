@@ -19,6 +19,8 @@ __all__ = [
     "ROOT_MODES",
     "check_device",
     "load_checkpoint",
+    "add_network",
+    "network_checkpoint",
     "solver_config",
     "add_solver_args",
     "add_rest_from",
@@ -73,6 +75,49 @@ def load_checkpoint(path: str | None, device: str | None):
         return retargeting.load(path, device) if path else retargeting.load_default(device)
     except retargeting.CheckpointError as e:
         raise CLIError(str(e)) from None
+
+
+def add_network(p, what: str) -> None:
+    """``--checkpoint PATH`` and ``--network {auto,real,synthetic}`` (:func:`network_checkpoint`)."""
+    from motionlab.retargeting.real import NETWORKS
+
+    p.add_argument("--checkpoint", help="trained network file (default: chosen by --network)")
+    p.add_argument(
+        "--network",
+        choices=NETWORKS,
+        default="auto",
+        help="without --checkpoint: real (trained on Aj's clips of MOTIONLAB_DATA on first use, then cached), "
+        f"synthetic (the shipped network), or auto (default): real for {what} on a recorded rig when the course "
+        "data is there, else synthetic (docs/rigs.md)",
+    )
+
+
+def network_checkpoint(args, real_source: bool):
+    """The network of ``--checkpoint`` or ``--network`` (:func:`.real.for_source`) on ``--device``;
+    prints which one unless ``--quiet``.
+
+    Raises
+    ------
+    CLIError for both options at once, a bad checkpoint file, or ``--network real`` without the course data.
+    """
+    from motionlab import data
+    from motionlab.retargeting import real
+    from motionlab.retargeting.checkpoint import CheckpointError
+
+    if args.checkpoint:
+        if args.network != "auto":
+            raise CLIError(f"give --checkpoint or --network {args.network}, not both")
+        return load_checkpoint(args.checkpoint, args.device)
+    check_device(args.device)
+    try:
+        ckpt, line = real.for_source(real_source, args.network, args.device, progress=not args.quiet)
+    except data.DataNotFound as e:
+        raise CLIError(f"--network {args.network}: {e}") from None
+    except CheckpointError as e:
+        raise CLIError(str(e)) from None
+    if not args.quiet:
+        print(line)
+    return ckpt
 
 
 def solver_config(args):

@@ -40,7 +40,6 @@ Taught in ``notebooks/03_latent_iteration.ipynb``.
 
 from __future__ import annotations
 
-import csv
 import dataclasses
 import warnings
 from collections.abc import Sequence
@@ -54,6 +53,7 @@ from motionlab.core import humanoid, metrics, preprocess
 from motionlab.retargeting import terms
 from motionlab.retargeting.checkpoint import Checkpoint
 from motionlab.retargeting.pipeline import retarget, source_contacts
+from motionlab.retargeting.real import DEFAULT_ANIMATIONS, DEFAULT_SOURCE, training_clips
 from motionlab.retargeting.solver import SolverConfig
 
 __all__ = [
@@ -69,15 +69,7 @@ __all__ = [
     "evaluate",
 ]
 
-DEFAULT_SOURCE = "Aj"
 DEFAULT_TARGETS = ("BigVegas", "Kaya", "SportyGranny", "Goblin_m", "Mousey_m", "Vampire_m")
-DEFAULT_ANIMATIONS = (
-    "Running", "Jumping", "Body_Jab_Cross", "Standing_To_Crouch", "Catwalk_Idle_To_Walk_Forward",
-    "Run_Arc_Left", "Injured_Walk_Left_Turn", "Standing_Turn_Right_90", "Jazz_Dancing",
-    "Standing_Land_To_Standing_Idle",
-)  # fmt: skip
-"""The 10 ``retarget_gt`` animations of the shared Mixamo data."""
-
 ROWS: tuple[tuple[str, str, str], ...] = (
     ("copy rotations, root x leg length", "copy", "legs"),
     ("copy rotations, our root", "copy", "stride"),
@@ -112,47 +104,6 @@ def _load(path: Path):
     from motionlab.core import bvh  # imported here: the BVH module is optional for the rest
 
     return bvh.load(path)
-
-
-def training_clips(
-    folder: str | Path, source: str = DEFAULT_SOURCE, exclude: Sequence[str] = DEFAULT_ANIMATIONS
-) -> list[Path]:
-    """A's training clips in ``folder``.
-
-    If a ``manifest.csv`` with ``path``, ``purpose`` and ``subject`` columns sits in the folder or
-    its parent (the shared data does), the rows with ``purpose == "train_character"`` and
-    ``subject == source`` inside ``folder`` are used; otherwise every ``<source>/*.bvh`` whose
-    stem is not in ``exclude``. Evaluated animations are always excluded.
-
-    Raises
-    ------
-    FileNotFoundError when the source's folder is missing or holds no training clip.
-    """
-    folder = Path(folder)
-    excluded = {e.lower() for e in exclude}
-    for manifest in (folder / "manifest.csv", folder.parent / "manifest.csv"):
-        if manifest.is_file():
-            with open(manifest, newline="") as f:
-                rows = list(csv.DictReader(f))
-            if rows and {"path", "purpose", "subject"} <= set(rows[0]):
-                paths = [
-                    (manifest.parent / r["path"]).resolve()
-                    for r in rows
-                    if r["purpose"] == "train_character" and r["subject"] == source
-                ]
-                paths = [
-                    p for p in paths
-                    if p.is_file() and p.is_relative_to(folder.resolve()) and p.stem.lower() not in excluded
-                ]  # fmt: skip
-                if paths:
-                    return sorted(paths)
-    src = folder / source
-    if not src.is_dir():
-        raise FileNotFoundError(f"no folder {src} (expected <Character>/<Animation>.bvh under {folder})")
-    paths = sorted(p for p in src.glob("*.bvh") if p.stem.lower() not in excluded)
-    if not paths:
-        raise FileNotFoundError(f"no training clips for {source!r} in {src} (all excluded or none present)")
-    return paths
 
 
 def shared_animations(folder: str | Path, source: str, targets: Sequence[str]) -> list[str]:

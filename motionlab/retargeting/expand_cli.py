@@ -28,6 +28,7 @@ def _cmd_expand(args) -> int:
     missing. Exit status 1 when some pair failed (see the manifest's error column).
     """
     from motionlab.retargeting import expand as ex
+    from motionlab.retargeting import real
 
     cli_options.check_device(args.device)
     if args.backend == "ray":
@@ -46,7 +47,8 @@ def _cmd_expand(args) -> int:
         ex.check_output_layout(args.output, ex.find_sources(args.sources), targets, "." + args.format)
     except ValueError as e:
         raise CLIError(str(e)) from None
-    ckpt = cli_options.load_checkpoint(args.checkpoint, args.device)
+    real_source = real.any_real_file([p for _, p in ex.find_sources(args.sources)])
+    ckpt = cli_options.network_checkpoint(args, real_source)
     job = ex.expand(
         args.sources,
         targets,
@@ -114,7 +116,7 @@ def register(subparsers) -> None:
         p.add_argument(
             "--format", choices=("bvh", "glb"), default="bvh", help="output files: bvh (default) or glb (glTF 2.0)"
         )
-        p.add_argument("--checkpoint", help="trained network (default: the shipped one)")
+        cli_options.add_network(p, "sources")
         p.add_argument("--root", choices=ROOT_MODES, default="stride", help="root trajectory rule (as in retarget)")
         p.add_argument("--batch-frames", type=positive_int, help="frames per solver batch (default: from free memory)")
         p.add_argument(

@@ -433,8 +433,9 @@ def retarget(
     ----------
     source : Motion of character A on any rig :func:`humanoid.find_mapping` recognises
     target : B's rig (Skeleton) or a Motion on it; only its rest pose is used
-    checkpoint : trained network (default: :func:`motionlab.retargeting.load_default`);
-        not needed for ``method="copy"``
+    checkpoint : trained network (default: :func:`motionlab.retargeting.real.for_source`'s choice:
+        the network trained on real mocap for a recorded source when the course data is there,
+        else the shipped one); not needed for ``method="copy"``
     method : ``"full"`` (latent iteration), ``"network"`` (no iteration) or ``"copy"``
     solver : settings of the latent iteration
     root_mode : ``"stride"`` (default), ``"hips"`` or ``"legs"``: how A's root trajectory is scaled
@@ -465,9 +466,9 @@ def retarget(
     check_motion(source, "source motion")
     target = target_skeleton(target)  # a bad target fails before any work
     if method != "copy" and checkpoint is None:
-        from motionlab.retargeting import load_default
+        from motionlab.retargeting import real
 
-        checkpoint = load_default()
+        checkpoint, _ = real.for_source(real.is_real_rig(source.skeleton))
     solver = solver or SolverConfig()
     pair = prepare_pair(prepare_source(source, checkpoint, method, solver), target, root_mode)
     history: dict = {}

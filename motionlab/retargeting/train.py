@@ -8,17 +8,16 @@
 
 Training is reproducible under ``TrainConfig.seed`` (weights, batch order, augmentation).
 
-**Skeleton augmentation (our addition, on by default).** With one training character, F_skel
-only ever sees one input, so what F_Δ does for another skeleton is undefined. Each training
-window is therefore also decoded on a randomly re-proportioned copy of A's skeleton (legs,
-arms, spine, neck and overall size scaled independently), with the target positions computed
-by FK of A's own rotations on that skeleton. This uses A's data only and teaches F_Δ to leave
-rotations alone when only proportions change; the latent iteration then adapts the motion.
-``augment=False`` gives the paper's plain setting.
-
-**Mirrored clips (our addition, on by default).** :func:`training_set` also adds every clip
-mirrored left↔right (:func:`mirrored`): twice the poses from the same recording
-(``benchmarks/bench_retarget.py`` prints its effect on held-back clips).
+**Weights on a grid (``TrainConfig.grid``, on by default).** Another numeric back end adds in
+another order, so gradients differ in their last bits, and Adam, which divides each gradient by
+its own running size, lets such differences grow over a thousand steps. As in the latent
+iteration (:func:`motionlab.retargeting.solver.step_grid`), the initial weights are rounded to
+``step_grid(lr)`` and every parameter, after each Adam step, to ``step_grid(lr_t)`` (``lr_t`` the
+step's learning rate: a power of two about 2⁻¹² of it), and the skeleton augmentation's scale
+factors to :data:`DRAW_GRID`. Rare last-bit differences are then rounded away instead of growing;
+a change of kernels (scalar against SIMD) differs too often over a training's updates, which is
+why :func:`motionlab.retargeting.real.load_real` trains under one pinned back end
+(``docs/reproducibility.md``, ``python -m experiments.retargeting.reproducibility --training``).
 
 Taught in ``notebooks/02_training_autoencoder.ipynb``.
 """
@@ -43,6 +42,7 @@ from motionlab.retargeting import devices, losses
 from motionlab.retargeting.checkpoint import DTYPES, Checkpoint
 from motionlab.retargeting.features import clip_features
 from motionlab.retargeting.model import NUM_JOINTS, ModelConfig, RetargetNet
+from motionlab.retargeting.solver import step_grid
 
 __all__ = [
     "TrainingSet",
@@ -53,7 +53,13 @@ __all__ = [
     "turned_window",
     "train",
     "pick_device",
+    "DRAW_GRID",
+    "snap",
 ]
+
+DRAW_GRID = 2.0**-20
+"""Spacing the skeleton augmentation's scale factors are rounded to (with ``TrainConfig.grid``):
+``exp`` may differ in its last bit between SIMD widths; a factor on this grid does not."""
 
 _DRAWS = {"dtype": torch.float32, "device": "cpu"}
 """Random draws (skeleton and pose augmentation) come from a CPU generator in float32, then move to
@@ -192,6 +198,9 @@ class TrainConfig:
     device : str or None    None: CUDA when available, else CPU
     dtype : str             ``"float64"`` (default: the same numbers on every CPU, to the digits
                             the notebooks print) or ``"float32"`` (faster on a GPU)
+    grid : bool             round the initial weights and every parameter after each step to
+                            ``step_grid(lr_t)``, and augmentation factors to :data:`DRAW_GRID`, so
+                            that rare last-bit differences do not grow (see the module docstring)
     """
 
     steps: int = 1500
@@ -208,6 +217,7 @@ class TrainConfig:
     log_every: int = 10
     device: str | None = None
     dtype: str = "float64"
+    grid: bool = True
 
     def __post_init__(self) -> None:
         if self.dtype not in DTYPES:
@@ -251,6 +261,8 @@ def random_offsets(base: torch.Tensor, batch: int, cfg: TrainConfig, generator: 
     mask = torch.as_tensor(idx >= 0, device="cpu")
     per_joint[:, mask] = g[:, torch.as_tensor(idx[idx >= 0], device="cpu")]
     factor = torch.exp(per_joint + overall)
+    if cfg.grid:  # exp's last bit differs between SIMD widths; the rounded factor does not
+        factor = torch.round(factor / DRAW_GRID) * DRAW_GRID
     return base[None] * factor[..., None].to(base)
 
 
@@ -342,6 +354,26 @@ def _batch(w: _Windows, cfg: TrainConfig, gen: torch.Generator):
     return x, rot, target, offsets
 
 
+@torch.no_grad()
+def snap(model: torch.nn.Module, lr: float) -> None:
+    """Round every parameter of ``model``, in place, to the grid ``step_grid(lr)`` (see the module docstring)."""
+    g = step_grid(lr)
+    for p in model.parameters():
+        p.copy_(torch.round(p / g) * g)
+
+
+def _initial_model(model_config: ModelConfig | None, cfg: TrainConfig, device: torch.device) -> RetargetNet:
+    """The untrained network in training mode on ``device``, its weights drawn on the CPU (one seed,
+    one network on every device) and, with ``cfg.grid``, rounded to ``step_grid(cfg.lr)``."""
+    with torch.device("cpu"):
+        model = RetargetNet(model_config)
+    model = model.to(device=device, dtype=DTYPES[cfg.dtype])
+    model.train()
+    if cfg.grid:
+        snap(model, cfg.lr)
+    return model
+
+
 def train(
     data: TrainingSet | Sequence[Motion],
     config: TrainConfig | None = None,
@@ -371,10 +403,7 @@ def train(
     torch.manual_seed(cfg.seed)
     gen = torch.Generator().manual_seed(cfg.seed)
     dtype = DTYPES[cfg.dtype]
-    with torch.device("cpu"):  # initial weights drawn on the CPU: one seed, one network on every device
-        model = RetargetNet(model_config)
-    model = model.to(device=device, dtype=dtype)
-    model.train()
+    model = _initial_model(model_config, cfg, device)
     windows = _windows(data, dtype, device)
     opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, cfg.steps, eta_min=cfg.lr / 10)
@@ -395,6 +424,8 @@ def train(
         opt.zero_grad(set_to_none=True)
         loss.backward()
         opt.step()
+        if cfg.grid:
+            snap(model, opt.param_groups[0]["lr"])
         sched.step()
         with torch.no_grad():  # on the device: no host sync but at the logged steps
             running = loss.detach() if running is None else 0.95 * running + 0.05 * loss.detach()

@@ -36,6 +36,8 @@ def _stop(*args, **kwargs):
 
 _WORK = (  # where each command's long work begins
     "motionlab.retargeting.cli_options.load_checkpoint",
+    "motionlab.retargeting.cli_options.network_checkpoint",
+    "motionlab.retargeting.real.trained",
     "motionlab.retargeting.pipeline.retarget",
     "motionlab.retargeting.train.training_set",
     "motionlab.retargeting.train.train",

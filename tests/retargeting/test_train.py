@@ -126,3 +126,30 @@ def test_mixed_characters_and_bad_config_are_refused(clips):
         TrainConfig(augment=2.0)
     with pytest.raises(ValueError, match="pose_augment"):
         TrainConfig(augment=0.5, pose_augment=0.75)
+
+
+def _nudged_training(data, grid: bool, nudge: bool, monkeypatch):
+    """Trained weights, the loss scaled by 1 + 2⁻⁴⁸ when ``nudge``: gradients that differ in their
+    last bits, as another CPU's kernels give."""
+    from motionlab.retargeting import losses
+
+    recon = losses.recon_loss
+    factor = 1.0 + 2.0**-48 if nudge else 1.0
+    monkeypatch.setattr(losses, "recon_loss", lambda *a, **k: recon(*a, **k) * factor)
+    cfg = TrainConfig(steps=20, batch_size=2, seed=3, device="cpu", grid=grid)
+    ckpt, _ = train(data, cfg, TINY, progress=False)
+    return ckpt.model.state_dict()
+
+
+@pytest.mark.slow
+def test_the_grid_rounds_last_bit_differences_away(data, monkeypatch):
+    from motionlab.retargeting.solver import step_grid
+
+    plain, nudged = (_nudged_training(data, True, n, monkeypatch) for n in (False, True))
+    for k in plain:
+        assert torch.equal(plain[k], nudged[k]), k
+    g = step_grid(TrainConfig().lr / 10)  # the cosine schedule's floor: every step's grid is a multiple of it
+    for k, v in plain.items():
+        assert torch.equal(torch.round(v / g) * g, v), k
+    plain, nudged = (_nudged_training(data, False, n, monkeypatch) for n in (False, True))
+    assert any(not torch.equal(plain[k], nudged[k]) for k in plain)  # without the grid they differ
