@@ -20,10 +20,7 @@ _TRUE = {"1", "true", "yes", "on"}
 
 
 def quick_mode() -> bool:
-    """True when ``MOTIONLAB_CACHE``
-    folder of the network trained on real motion on first use (default ``~/.cache/motionlab``;
-    see :mod:`motionlab.retargeting.real`).
-``MOTIONLAB_QUICK`` asks for the reduced (CI) mode."""
+    """True when ``MOTIONLAB_QUICK`` asks for the reduced (CI) mode."""
     return os.environ.get("MOTIONLAB_QUICK", "").strip().lower() in _TRUE
 
 
