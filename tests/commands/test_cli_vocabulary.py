@@ -52,6 +52,7 @@ VOCABULARY = {
     "--seed": ("seed", "seed", "random seed"),
     "--device": ("device", "text", "torch device"),
     "--checkpoint": ("checkpoint", "text", "the retargeting network's checkpoint file"),
+    "--network": ("network", "text", "which retargeting network: auto, real or synthetic"),
     "--canonical": ("canonical", "flag", "reduce the rig to the canonical 22 joints"),
     "--keep-implausible": ("keep_implausible", "flag", "keep outputs that fail the plausibility check"),
     "--characters": ("characters", "text", "target characters given as rigs (expand)"),
@@ -82,6 +83,7 @@ SAME_CHOICES = {
     "--root": ("stride", "hips", "legs", "contacts"),
     "--gap-root": ("stride", "hermite", "linear"),
     "--backend": ("local", "ray"),
+    "--network": ("auto", "real", "synthetic"),
 }
 SYNTHETIC = {"train": "non_negative_int", "graph-build": "flag"}  # both: built-in synthetic clips instead of files
 
