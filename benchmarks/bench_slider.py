@@ -1,7 +1,7 @@
 """Notebook 04's legs slider in the kernel: the latent solve per release, and the Gauss–Newton chunk.
 
 1. ``--chunks``: seconds of one Gauss–Newton round of the solver's start
-   (``solver._gauss_newton_step``) for chunks of 16 … 2048 frames, on the inputs of notebook 04's
+   (``solver.gauss_newton_step``) for chunks of 16 … 2048 frames, on the inputs of notebook 04's
    slider (120-frame walk, 239 frames at the network's rate, one row) and on two held-out sizes:
    a 960-frame clip and a batch of 8 rows of 239 frames; each median of ``--repeats`` rounds,
    sizes interleaved. It also checks that the round's step does not depend on the chunk.
@@ -44,17 +44,17 @@ def _round_inputs(ckpt, clip, skeleton):
 
     """The arguments of the solver's first Gauss–Newton round for ``clip`` on ``skeleton``."""
     seen = []
-    real = solver._gauss_newton_step
+    real = solver.gauss_newton_step
 
     def spy(*args):
         seen.append(args)
         return real(*args)
 
-    solver._gauss_newton_step = spy
+    solver.gauss_newton_step = spy
     try:
         retargeting.retarget(clip, skeleton, ckpt, "full", solver=retargeting.SolverConfig(max_steps=0))
     finally:
-        solver._gauss_newton_step = real
+        solver.gauss_newton_step = real
     return seen[0]
 
 
@@ -78,17 +78,17 @@ def chunks(ckpt, repeats: int) -> None:
         with torch.no_grad(), threads.torch_threads(1):
             for name, args in cases.items():
                 solver.PROJECT_FRAMES = 10**9
-                reference = solver._gauss_newton_step(*args)[0]
+                reference = solver.gauss_newton_step(*args)[0]
                 for c in CHUNKS:
                     solver.PROJECT_FRAMES = c
-                    same = bool(torch.equal(solver._gauss_newton_step(*args)[0], reference))
+                    same = bool(torch.equal(solver.gauss_newton_step(*args)[0], reference))
                     rows[(name, c)] = ([], same)
             for _ in range(repeats):
                 for name, args in cases.items():
                     for c in CHUNKS:
                         solver.PROJECT_FRAMES = c
                         start = time.perf_counter()
-                        solver._gauss_newton_step(*args)
+                        solver.gauss_newton_step(*args)
                         rows[(name, c)][0].append(time.perf_counter() - start)
     finally:
         solver.PROJECT_FRAMES = shipped

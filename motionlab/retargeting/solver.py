@@ -90,6 +90,7 @@ __all__ = [
     "sequence_losses",
     "sequence_terms",
     "project_latent",
+    "gauss_newton_step",
     "world_feet",
     "solve",
     "solve_many",
@@ -388,7 +389,7 @@ def project_latent(
         out = phi.clone()
         alive = torch.arange(N, device=phi.device)
         for k in range(iters):
-            step, done = _gauss_newton_step(model, out[alive], target_rot[alive], emb[alive], damping)
+            step, done = gauss_newton_step(model, out[alive], target_rot[alive], emb[alive], damping)
             alive, step = alive[~done], step[~done]  # a row whose residuals are all tiny is finished
             if len(alive) == 0:
                 break
@@ -423,9 +424,14 @@ def _chunk_frames(phi: torch.Tensor) -> int:
     return max(PROJECT_GPU_FRAMES, int(0.25 * free // per_frame))
 
 
-def _gauss_newton_step(model, phi, target_rot, emb, damping) -> tuple[torch.Tensor, torch.Tensor]:
+def gauss_newton_step(model, phi, target_rot, emb, damping) -> tuple[torch.Tensor, torch.Tensor]:
     """One damped Gauss–Newton step (N, T, D) of :func:`project_latent` for each row, unsmoothed,
-    and which rows (N,) have every residual below 1e-5 already."""
+    and which rows (N,) have every residual below 1e-5 already (bool).
+
+    ``phi`` (N, T, D) latents, ``target_rot`` (N, T, 22, 4) the rotations to decode, ``emb`` (N, E)
+    the skeleton embeddings, ``damping`` the relative damping μ; frames are solved in chunks of
+    :data:`PROJECT_FRAMES` on the CPU (sized by free memory on a GPU), with the same result.
+    """
     N, T, D = phi.shape
     flat, target = phi.reshape(N * T, D), target_rot.reshape(N * T, NUM_JOINTS, 4)
     emb_frames = emb[:, None, :].expand(N, T, emb.shape[-1]).reshape(N * T, -1)
