@@ -90,10 +90,17 @@ def main(argv=None) -> None:
     ap.add_argument("--source-fps", type=float, help="with --methods: resample every source clip to this rate")
     ap.add_argument("--flags", action="store_true", help="old and new skating flag on held-out clips instead")
     ap.add_argument("--gn-damping", type=float, help="with --methods: the Gauss-Newton start's relative damping")
+    ap.add_argument(
+        "--network",
+        choices=("synthetic", "real"),
+        default="synthetic",
+        help="the shipped network (default) or the one trained on Aj's real clips (retargeting.load_real)",
+    )
     args = ap.parse_args(argv)
+    network = retargeting.load_real if args.network == "real" else retargeting.load_default
     if args.flags:
         start = time.perf_counter()
-        skating_flags(data.data_root(), retargeting.load_default())
+        skating_flags(data.data_root(), network())
         print(f"{time.perf_counter() - start:.0f} s")
         return
     root = data.data_root() if data.has_data() else None
@@ -104,10 +111,10 @@ def main(argv=None) -> None:
         if args.source_fps:
             clips = {name: clip.resample(args.source_fps) for name, clip in clips.items()}
         config = SolverConfig() if args.gn_damping is None else SolverConfig(project_damping=args.gn_damping)
-        method_slides(clips, retargeting.load_default(), pairs, config)
+        method_slides(clips, network(), pairs, config)
         print(f"{time.perf_counter() - start:.0f} s")
         return
-    rows = rig_matrix.pair_matrix(clips, retargeting.load_default(), pairs=pairs)
+    rows = rig_matrix.pair_matrix(clips, network(), pairs=pairs)
     print(rig_matrix.table(rows))
     print(f"{len(rows)} pairs, {sum(r['ok'] for r in rows)} plausible, {time.perf_counter() - start:.0f} s")
 
