@@ -51,6 +51,7 @@ ENV = {
     "PYVISTA_JUPYTER_BACKEND": "static",
     "VTK_DEFAULT_OPENGL_WINDOW": "vtkEGLRenderWindow",
     "PYTHONHASHSEED": "0",
+    "MOTIONLAB_WEB_EMBED": "0",  # no three.js copy in the web players' outputs: the docs site has it, JupyterLab draws on the 2D canvas
 }
 
 

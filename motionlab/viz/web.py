@@ -227,7 +227,7 @@ def player_html(
         if not path.is_file():
             raise FileNotFoundError(f"three.js file {path} not found")
         library = f"<script>if (!window.THREE) {{\n{path.read_text(encoding='utf-8')}\n}}</script>\n"
-    script = _TEMPLATE.read_text(encoding="utf-8").replace("__PLAYER_ID__", player_id)
+    script = _compact(_TEMPLATE.read_text(encoding="utf-8")).replace("__PLAYER_ID__", player_id)
     button = "padding:0.15em 0.8em;border:1px solid #aab;border-radius:4px;background:#fff;cursor:pointer"
     return (
         f'<div class="motionlab-player" id="{player_id}" style="max-width:900px;font:13px sans-serif">\n'
@@ -244,6 +244,13 @@ def player_html(
         f'<script type="application/json" class="motionlab-data">{payload}</script>\n'
         f"{library}<script>\n{script}</script>\n</div>"
     )
+
+
+def _compact(script: str) -> str:
+    """``script`` without indentation, blank lines and whole-line ``//`` comments (the player's
+    source keeps no string or comment spanning lines, so its meaning is unchanged)."""
+    lines = (line.strip() for line in script.splitlines())
+    return "\n".join(line for line in lines if line and not line.startswith("//"))
 
 
 def _auto_three_js() -> Path | None:
