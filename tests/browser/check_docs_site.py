@@ -173,7 +173,7 @@ def _check_player(browser, rel: str, out: Path, timeout_ms: int = 20_000, site: 
     page.route("**/*", lambda r: r.continue_() if r.request.url.startswith("file://") else r.abort())
     result: dict = {"page": rel, "ok": False}
     try:
-        page.goto((site / rel).as_uri(), wait_until="load", timeout=timeout_ms)
+        page.goto((site / rel).resolve().as_uri(), wait_until="load", timeout=timeout_ms)
         result["players"] = page.locator(".motionlab-player").count()
         player = page.locator(".motionlab-player").first
         player.scroll_into_view_if_needed()
