@@ -154,7 +154,7 @@ def training_clips(
 
 
 def training_paths() -> list[Path]:
-    """Aj's Mixamo clips in ``MOTIONLAB_DATA`` but Table 1's 10 (:func:`.evaluate.training_clips`).
+    """Aj's Mixamo clips in ``MOTIONLAB_DATA`` but Table 1's 10 (:func:`training_clips`).
 
     Raises
     ------

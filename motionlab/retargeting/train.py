@@ -8,6 +8,18 @@
 
 Training is reproducible under ``TrainConfig.seed`` (weights, batch order, augmentation).
 
+**Skeleton augmentation (our addition, on by default).** With one training character, F_skel
+only ever sees one input, so what F_Δ does for another skeleton is undefined. Each training
+window is therefore also decoded on a randomly re-proportioned copy of A's skeleton (legs,
+arms, spine, neck and overall size scaled independently), with the target positions computed
+by FK of A's own rotations on that skeleton. This uses A's data only and teaches F_Δ to leave
+rotations alone when only proportions change; the latent iteration then adapts the motion.
+``augment=False`` gives the paper's plain setting.
+
+**Mirrored clips (our addition, on by default).** :func:`training_set` also adds every clip
+mirrored left↔right (:func:`mirrored`): twice the poses from the same recording
+(``benchmarks/bench_retarget.py`` prints its effect on held-back clips).
+
 **Weights on a grid (``TrainConfig.grid``, on by default).** Another numeric back end adds in
 another order, so gradients differ in their last bits, and Adam, which divides each gradient by
 its own running size, lets such differences grow over a thousand steps. As in the latent
