@@ -223,7 +223,9 @@ def main() -> None:
     )
     p.add_argument("--table1-characters", action="store_true", help="the six Table 1 characters (no presets)")
     p.add_argument(
-        "--host-workers", type=int, help="expand's host worker processes (default: none on the CPU, cores - 1 on a GPU)"
+        "--host-workers",
+        type=int,
+        help="expand's host worker processes (default: none on the CPU, cores - 1 but at most 4 on a GPU)",
     )
     p.add_argument(
         "--pad", action="store_true", default=None, help="pad pairs of other lengths into one batch (default: on a GPU)"

@@ -3,12 +3,16 @@ quick mode), the numbers quoted in this folder's model answers.
 
     MOTIONLAB_DATA=/path/to/data MOTIONLAB_QUICK=1 python instructor/answers/reference_values.py
 
-02 and 07 depend on the network and job each notebook runs, and are left to their checks.
+02's values depend on the network notebook 02 trains: they are computed from the checkpoint it
+saves (``02_aj_quick.pt`` in ``motionlab_notebooks/`` of the temporary folder), so run notebook 02
+first; without that file they are skipped with a line that says so.
 """
 
 from __future__ import annotations
 
+import tempfile
 import warnings
+from pathlib import Path
 
 from motionlab import data, retargeting
 from motionlab import exercises as ex
@@ -29,6 +33,7 @@ def main() -> None:
     print(
         f"01 ex1 hips_heading    {ex.hips_heading.reference(preprocess.prepare(run, fps=60).global_positions()):.1f} deg"
     )
+    _notebook_02(data.clip_path("mixamo", "Aj", "Run_Arc_Left"))
     source = run
     target = demo.trim_frozen(bvh.load(data.clip_path("mixamo", "Mousey_m", "Run_Arc_Left"))).skeleton
     ckpt = retargeting.load_real()  # notebook 03's network on the course data
@@ -60,6 +65,30 @@ def main() -> None:
     print(f"06 ex2 walk_spacing    {ex.walk_spacing.reference(pwalk):.0f} frames")
     print(f"06 ex3 smallest_gap    {ex.smallest_gap.reference(walk6)} frames")
     print(f"06 ex4 key_frames      {ex.key_frames.reference(behaviours):.2f}")
+    _notebook_07(ckpt)
+
+
+def _notebook_02(held_out_path) -> None:
+    """02's two experiments on the network notebook 02 saved (quick mode) and its held-out clip."""
+    saved = Path(tempfile.gettempdir()) / "motionlab_notebooks" / "02_aj_quick.pt"
+    if not saved.is_file():
+        print(f"02 (skipped: run notebook 02 in quick mode first; it saves {saved})")
+        return
+    loaded = retargeting.load(saved, "cpu")
+    held_out = demo.trim_frozen(bvh.load(held_out_path))
+    print(f"02 ex1 q_delta_legs    {ex.q_delta_legs.reference(loaded, held_out):.3f} deg")
+    print(f"02 ex2 no_correction   {ex.no_correction.reference(loaded, held_out):.2f} cm")
+
+
+def _notebook_07(ckpt) -> None:
+    """07's experiment on the notebook's inputs: Jumping without its frozen tail, 20 steps (quick)."""
+    from motionlab.retargeting.solver import SolverConfig
+
+    jumping = demo.trim_frozen(bvh.load(data.clip_path("mixamo", "Aj", "Jumping")))
+    with tempfile.TemporaryDirectory() as folder:
+        clip_path = bvh.save(Path(folder) / "Jumping.bvh", jumping)
+        lowest = ex.arm_length.reference(str(clip_path), ckpt, SolverConfig(max_steps=20))
+    print(f"07 ex1 arm_length      {lowest:.3f} of the leg")
 
 
 if __name__ == "__main__":

@@ -603,7 +603,7 @@ def expand(
         (:func:`rest_pose.on_reference`, ``--rest-from``; pass the same to :func:`characters`)
     host_workers : processes that read and prepare the clips and finish and encode the outputs
         while the network solves (:mod:`motionlab.retargeting.host`); default
-        :func:`host.default_workers`: none on the CPU, every core but one on a GPU
+        :func:`host.default_workers`: none on the CPU, every core but one on a GPU (at most 4)
     pad : let pairs of other lengths share a batch (:func:`batching.plan_batches`); default: on a
         GPU, when every registered term honours padding (:func:`terms.unpadded`)
 

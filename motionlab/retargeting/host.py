@@ -27,8 +27,10 @@ from motionlab.retargeting.checkpoint import Checkpoint
 
 __all__ = ["MAX_WORKERS", "default_workers", "pool", "checkpoint"]
 
-MAX_WORKERS = 16
-"""Most worker processes :func:`default_workers` starts."""
+MAX_WORKERS = 4
+"""Most worker processes :func:`default_workers` starts. The host's share is small beside the
+solve and its results come back through one pipe, so more workers do not load faster; they take
+cores from the thread that launches the GPU's kernels (``docs/performance.md`` measures 2 to 15)."""
 
 _CHECKPOINT: Checkpoint | None = None
 

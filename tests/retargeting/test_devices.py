@@ -320,3 +320,19 @@ def test_a_ray_worker_loads_the_network_as_the_caller_has_it(tiny_checkpoint):
     caller = dataclasses.replace(tiny_checkpoint, model=model32.to(torch.float32))
     worker = cluster._Worker(cluster._checkpoint_bytes(caller), 1, *cluster._placement(caller))
     assert (worker.checkpoint.device, worker.checkpoint.dtype) == (caller.device, torch.float32)
+
+
+@pytest.mark.cuda
+@cuda
+def test_cuda_a_cached_trained_network_retargets_as_on_the_cpu(clip, tmp_path, monkeypatch):
+    """``real.trained`` trains in its pinned CPU child and hands the network to the GPU."""
+    from motionlab.retargeting import real
+
+    monkeypatch.setenv(real.CACHE_ENV, str(tmp_path / "cache"))
+    paths = [bvh.save(tmp_path / f"clip{i}.bvh", m) for i, m in enumerate(synthetic.dataset(2, seed=0, num_frames=150))]
+    config = TrainConfig(steps=2, batch_size=2, device="cpu")
+    nets = {d: real.trained(paths, config, TINY, device=d, progress=False) for d in ("cpu", "cuda")}
+    assert next(nets["cuda"].model.parameters()).device.type == "cuda"
+    target = humanoid.scale_bones(clip.skeleton, legs=1.2)
+    out = {d: retargeting.retarget(clip, target, nets[d], "full", FAST) for d in nets}
+    assert 100 * np.abs(out["cpu"].positions - out["cuda"].positions).max() < CUDA_CM
