@@ -18,6 +18,7 @@ when that file exists already, used as it is (no build: only the commands run).
     python benchmarks/bench_motion_graph_scale.py                   # session:370000 walk:1000000
     python benchmarks/bench_motion_graph_scale.py --cases walk:1000 walk:10000   # quick
     python benchmarks/bench_motion_graph_scale.py --cases session:370000 --keep /tmp/graphs  # then commands only
+    python benchmarks/bench_motion_graph_scale.py --cases session:370000 --backend ray --repeat 1  # Ray's build
 
 Goals (issue 43): a session-sized build (370 k frames) <= 60 s and <= 1.5 GB on the 2-core
 machine, 1 M frames <= 3 GB; ``graph-search`` <= 2 s per command, start-up included, and
@@ -96,8 +97,9 @@ def _gb(kib: int) -> float:
     return kib * 1024 / 1e9  # ru_maxrss is in KiB on Linux; GB = 10^9 bytes, as the stage table
 
 
-def build_case(kind: str, frames: int, out: Path, workers: int) -> dict:
-    """Build one case in this process and save it to ``out``; the figures as a dict."""
+def build_case(kind: str, frames: int, out: Path, workers: int, backend: str = "local") -> dict:
+    """Build one case in this process (``backend``: ``structured.build_structured``'s) and save it
+    to ``out``; the figures as a dict."""
     from motionlab.motion_graphs import distance, io, report, structured
 
     rms = THRESHOLD_M or distance.DEFAULT_THRESHOLD
@@ -105,7 +107,7 @@ def build_case(kind: str, frames: int, out: Path, workers: int) -> dict:
     with clock("load"):
         motions = session(frames, "all" if kind == "session" else kind)
     t0, c0 = time.perf_counter(), resource.getrusage(resource.RUSAGE_SELF)
-    g = structured.build_structured(motions, distance.threshold_from(rms), workers=workers)
+    g = structured.build_structured(motions, distance.threshold_from(rms), workers=workers, backend=backend)
     build_s = time.perf_counter() - t0
     c1 = resource.getrusage(resource.RUSAGE_SELF)
     clock.extend(g.info["stages"])
@@ -115,7 +117,8 @@ def build_case(kind: str, frames: int, out: Path, workers: int) -> dict:
     with clock("save"):
         io.save(out, g, overwrite=True, summary=summary)
     return dict(edges_sha=edges_sha(g),
-        kind=kind, frames=g.num_frames, takes=len(motions), threshold_m=rms, workers=workers, build_s=build_s,
+        kind=kind, frames=g.num_frames, takes=len(motions), threshold_m=rms, workers=workers, backend=backend,
+        build_s=build_s,
         cpu_s=(c1.ru_utime + c1.ru_stime) - (c0.ru_utime + c0.ru_stime), transitions=summary["transitions"],
         peak_gb=_gb(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss), file_mb=out.stat().st_size / 1e6,
         stages=clock.rows, behaviours={b: v["percent"] for b, v in rep["behaviours"].items()},
@@ -195,18 +198,18 @@ except ValueError as e:  # CLIError, GraphError
 start-up imports every system, torch included)."""
 
 
-def build_in_child(case: str, graph: Path, workers: int) -> dict | None:
+def build_in_child(case: str, graph: Path, workers: int, backend: str = "local") -> dict | None:
     """Build ``case`` in a fresh process and save it to ``graph``; print its figures."""
     kind = case.split(":")[0]
     load = os.getloadavg()
-    p = subprocess.run([sys.executable, __file__, "--one", case, "--graph", str(graph), "--workers", str(workers)],
-                       capture_output=True, text=True)  # fmt: skip
+    p = subprocess.run([sys.executable, __file__, "--one", case, "--graph", str(graph), "--workers", str(workers),
+                        "--backend", backend], capture_output=True, text=True)  # fmt: skip
     if p.returncode != 0:
         print(f"{case}: build failed\n{p.stderr[-3000:]}")
         return None
     r = json.loads(p.stdout.strip().splitlines()[-1])
     print(f"\n## {kind} library, {r['frames']} frames, {r['takes']} takes, threshold {r['threshold_m']} m, "
-          f"{r['workers']} threads; load average before {load[0]:.1f}")  # fmt: skip
+          f"{r['workers']} {'threads' if backend == 'local' else 'Ray workers'}; load average before {load[0]:.1f}")  # fmt: skip
     print(f"build {r['build_s']:.1f} s wall ({r['cpu_s']:.1f} s CPU), peak {r['peak_gb']:.2f} GB (whole process: "
           f"library, build, report, save); {r['transitions']} transitions; file {r['file_mb']:.0f} MB")  # fmt: skip
     print(f"edges SHA-256 (alive, src, dst, cost, kind): {r['edges_sha']}")
@@ -219,13 +222,13 @@ def build_in_child(case: str, graph: Path, workers: int) -> dict | None:
     return r
 
 
-def run_case(case: str, workers: int, keep: Path | None = None, repeat: int = 3) -> int:
+def run_case(case: str, workers: int, keep: Path | None = None, repeat: int = 3, backend: str = "local") -> int:
     kind, frames = case.split(":")
     with tempfile.TemporaryDirectory() as d:
         graph = (keep or Path(d)) / (f"{kind}-{frames}.mlgraph" if keep else "g.mlgraph")
         if keep and graph.is_file():
             print(f"\n## {kind} library, {frames} frames: the graph kept in {graph} (not built again)")
-        elif build_in_child(case, graph, workers) is None:
+        elif build_in_child(case, graph, workers, backend) is None:
             return 1
         print(f"load average before the commands {os.getloadavg()[0]:.1f}")
         print("command | wall s (start-up included) | CPU s | peak GB | result")
@@ -243,6 +246,12 @@ def main(argv=None) -> int:
     ap.add_argument("--cases", nargs="+", default=None, help="KIND:FRAMES, KIND session or walk")
     ap.add_argument("--workers", type=int, default=2, help="build threads (default 2, the machine's cores)")
     ap.add_argument("--repeat", type=int, default=3, help="runs of each graph-search request (default 3)")
+    ap.add_argument(
+        "--backend",
+        choices=("local", "ray"),
+        default="local",
+        help="the build's backend (ray: compare its edges SHA-256)",
+    )
     ap.add_argument("--keep", type=Path, help="folder for the graphs: KIND-FRAMES.mlgraph, used again when there")
     ap.add_argument("--one", help=argparse.SUPPRESS)
     ap.add_argument("--graph", help=argparse.SUPPRESS)
@@ -253,13 +262,13 @@ def main(argv=None) -> int:
         return 0
     if args.one:
         kind, frames = args.one.split(":")
-        print(json.dumps(build_case(kind, int(frames), Path(args.graph), args.workers)))
+        print(json.dumps(build_case(kind, int(frames), Path(args.graph), args.workers, args.backend)))
         return 0
     cases = args.cases or (["walk:1000", "walk:10000"] if os.environ.get("MOTIONLAB_QUICK") else list(CASES))
     print(f"machine: {os.cpu_count()} CPUs, load average {os.getloadavg()}")
     if args.keep:
         args.keep.mkdir(parents=True, exist_ok=True)
-    return max(run_case(c, args.workers, args.keep, max(args.repeat, 1)) for c in cases)
+    return max(run_case(c, args.workers, args.keep, max(args.repeat, 1), args.backend) for c in cases)
 
 
 if __name__ == "__main__":
