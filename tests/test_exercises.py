@@ -422,7 +422,7 @@ def test_encoder_start_experiment(running_pair):
     assert angle > default_angle + 0.1, "without the Gauss-Newton start the result ends further from A's angles"
     wrong = {
         "lr=0.1": _full_method_numbers(*running_pair, init="encoder", lr=0.1)[0],
-        "paper's set-up": _full_method_numbers(*running_pair, init="encoder", lambda_contact=0.0, lr=0.1)[0],
+        "paper-like set-up": _full_method_numbers(*running_pair, init="encoder", lambda_contact=0.0, lr=0.1)[0],
         "default run": default_angle,
         "radians": np.radians(angle),
     }

@@ -47,7 +47,7 @@ def my_contact_weight_experiment(source, target_rig, ckpt):
 
 
 def my_foot_weight_experiment(source, target_rig, ckpt):
-    """Exercise 4: the paper's set-up with λ_foot = 5; mean angle to A's rotations, degrees."""
+    """Exercise 4: the paper-like set-up with λ_foot = 5; mean angle to A's rotations, degrees."""
     from motionlab import retargeting
     from motionlab.core import preprocess
     from motionlab.retargeting import plots

@@ -32,7 +32,7 @@ takes at nearly constant speed), ``euler_order`` (the same angles in another cha
 (the heading from the hips alone); 02 ``q_delta_legs`` (how much q_Δ changes on shorter legs),
 ``no_correction`` (decoding without q_Δ); 03 ``encoder_start`` (motionlab without the
 Gauss–Newton start), ``contact_weight`` (a fifth of the contact weight), ``foot_weight`` (λ_foot in
-the paper's set-up), ``theta_directions`` (θ as bone directions); 04 ``shorter_legs`` (whether
+the paper-like set-up), ``theta_directions`` (θ as bone directions); 04 ``shorter_legs`` (whether
 copying's pose error follows the change of leg length); 05 ``style_change``
 (the ``dwell`` at which a style change lasts a gait cycle), ``vanishing_threshold`` (the graph
 threshold at which a style leaves the pruned standard graph), ``transition_clip`` (what joins two

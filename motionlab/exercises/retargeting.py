@@ -249,7 +249,7 @@ contact_loss = Exercise(
 # --------------------------------------------------------------------------- notebook 03, experiments
 _RUNS: dict = {}
 PAPER = {"init": "encoder", "lambda_contact": 0.0, "lr": 0.1}
-"""The paper's set-up in :class:`~motionlab.retargeting.solver.SolverConfig` terms (section 5 of notebook 03)."""
+"""The paper-like set-up in :class:`~motionlab.retargeting.solver.SolverConfig` terms (section 5 of notebook 03)."""
 
 
 def _measure(source, target, checkpoint, what: str, **settings) -> float:
@@ -280,7 +280,7 @@ def _measure(source, target, checkpoint, what: str, **settings) -> float:
 
 
 def _paper_angle(source, target, checkpoint, lambda_foot: float = 5.0, paper: bool = True, degrees: bool = True):
-    """Mean angle (degrees) between A's rotations and the full method's, in the paper's set-up
+    """Mean angle (degrees) between A's rotations and the full method's, in the paper-like set-up
     (encoder start, no contact term, lr 0.1) or motionlab's, for ``lambda_foot``."""
     settings = dict(PAPER, lambda_foot=lambda_foot) if paper else {"lambda_foot": lambda_foot}
     value = _measure(source, target, checkpoint, "angle", **settings)
@@ -300,7 +300,7 @@ encoder_start = Question(
         ),
         Mistake(
             lambda source, target, ckpt: _measure(source, target, ckpt, "angle", **PAPER),
-            "that is the paper's set-up (no contact term, lr=0.1); keep motionlab's other settings.",
+            "that is the paper-like set-up (no contact term, lr=0.1); keep motionlab's other settings.",
         ),
         Mistake(
             lambda source, target, ckpt: _measure(source, target, ckpt, "angle"),
@@ -342,7 +342,7 @@ contact_weight = Question(
 
 
 foot_weight = Question(
-    "03 · exercise 4 (experiment: λ_foot in the paper's set-up)",
+    "03 · exercise 4 (experiment: λ_foot in the paper-like set-up)",
     lambda source, target, ckpt: _paper_angle(source, target, ckpt, 5.0),
     atol=0.006,  # an answer typed with two decimals passes
     rtol=0.005,
