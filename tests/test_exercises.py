@@ -15,6 +15,7 @@ import torch
 
 from motionlab import exercises
 from motionlab.core import fk, humanoid, quat
+from tests.conftest import require_data
 
 ROOT = Path(__file__).resolve().parents[1]
 KEYS = ROOT / "instructor" / "solutions"  # the instructor's key, outside the students' notebooks/
@@ -346,7 +347,7 @@ def test_foot_weight_experiment(retarget_pair):
     from motionlab.retargeting.solver import SolverConfig
 
     source, target, ckpt = retarget_pair
-    src = preprocess.prepare(source, ckpt.fps)
+    src = preprocess.prepare(source, ckpt.fps, stand=True)
 
     def angle(cfg):
         run = retargeting.retarget(source, target, ckpt, "full", cfg)
@@ -389,7 +390,7 @@ def _full_method_numbers(source, target, ckpt, **settings):
     from motionlab.retargeting.solver import SolverConfig
 
     run = retargeting.retarget(source, target, ckpt, "full", SolverConfig(**settings))
-    src = preprocess.prepare(source, ckpt.fps)
+    src = preprocess.prepare(source, ckpt.fps, stand=True)
     feet = [humanoid.JOINTS.index(n) for n in humanoid.FEET]
     angle = float(plots.joint_angle_errors(run.motion.local_rot, src.local_rot).mean())
     slide = 100 * float(metrics.planted_slide(run.positions, feet, pipeline.source_contacts(src), ckpt.fps))
@@ -877,3 +878,26 @@ def test_key_frames_experiment(behaviour_clips):
     result = q.check(round(1 / exact, 3), clips)
     assert not result.passed and "inverse" in result.hint
     assert not q.check(exact + 0.5, clips).passed
+
+
+@pytest.mark.slow
+def test_the_angle_checks_measure_as_notebook_03_does():
+    """03's checks compare with A on its standing rest pose (``src`` of section 1, ``stand=True``):
+    on Aj, whose rest knees bend, the angle measured on the raw rest differs, and a student who
+    measured as section 5 does was told wrong."""
+    from motionlab import data, retargeting
+    from motionlab.core import bvh, preprocess
+    from motionlab.interpolation import demo
+    from motionlab.retargeting import plots
+    from motionlab.retargeting.solver import SolverConfig
+
+    require_data("mixamo", "Aj")
+    source = demo.trim_frozen(bvh.load(data.clip_path("mixamo", "Aj", "Run_Arc_Left")))
+    target = bvh.load(data.clip_path("mixamo", "Mousey_m", "Run_Arc_Left")).skeleton
+    ckpt = retargeting.load_default()
+    run = retargeting.retarget(
+        source, target, ckpt, "full", SolverConfig(init="encoder", lambda_contact=0.0, lr=0.1, lambda_foot=5.0)
+    )
+    src = preprocess.prepare(source, ckpt.fps, stand=True)  # notebook 03, section 1
+    as_section_5 = float(plots.joint_angle_errors(run.motion.local_rot, src.local_rot).mean())
+    assert exercises.foot_weight.check(as_section_5, source, target, ckpt).passed

@@ -39,6 +39,7 @@ def main() -> None:
     ckpt = retargeting.load_real()  # notebook 03's network on the course data
     for name in ("encoder_start", "contact_weight", "foot_weight", "theta_directions"):
         print(f"03 {name:19s} {ex.EXPERIMENTS[name].reference(source, target, ckpt):.2f}")
+    _notebook_03_more(source, demo.trim_frozen(bvh.load(data.clip_path("mixamo", "Mousey_m", "Run_Arc_Left"))), ckpt)
     from motionlab import synthetic
     from motionlab.core import humanoid
 
@@ -78,6 +79,33 @@ def _notebook_02(held_out_path) -> None:
     held_out = demo.trim_frozen(bvh.load(held_out_path))
     print(f"02 ex1 q_delta_legs    {ex.q_delta_legs.reference(loaded, held_out):.3f} deg")
     print(f"02 ex2 no_correction   {ex.no_correction.reference(loaded, held_out):.2f} cm")
+
+
+def _notebook_03_more(source, target_clip, ckpt) -> None:
+    """The other numbers 03's experiments ask to print, measured as section 5 measures them."""
+    from motionlab.core import humanoid, metrics
+    from motionlab.exercises.retargeting import PAPER
+    from motionlab.retargeting import pipeline, plots
+    from motionlab.retargeting.solver import SolverConfig
+
+    feet = [humanoid.JOINTS.index(n) for n in humanoid.FEET]
+    src = preprocess.prepare(source, ckpt.fps, stand=True)
+    gt_pos = preprocess.prepare(target_clip, ckpt.fps).global_positions()
+    height = pipeline.target_skeleton(target_clip.skeleton).height()
+    planted = pipeline.source_contacts(src)
+    for label, cfg in (
+        ("ex2 encoder start", SolverConfig(init="encoder")),
+        ("ex3 contact 0.1", SolverConfig(lambda_contact=0.1)),
+        ("ex4 paper-like, foot 5", SolverConfig(**dict(PAPER, lambda_foot=5.0))),
+        ("ex5 theta directions", SolverConfig(theta="directions")),
+    ):
+        run = retargeting.retarget(source, target_clip.skeleton, ckpt, "full", cfg)
+        pos, n = run.positions, min(len(run.positions), len(gt_pos), len(planted))
+        pose = metrics.mse(pos[:n] - pos[:n, :1], gt_pos[:n] - gt_pos[:n, :1], height=height)
+        print(f"03 {label:23s} angle {plots.joint_angle_errors(run.motion.local_rot, src.local_rot).mean():.2f} deg, "
+              f"slide {100 * metrics.planted_slide(pos[:n], feet, planted[:n], ckpt.fps):.2f} cm/s, "
+              f"below ground {100 * metrics.foot_penetration(pos, feet):.2f} cm, pose MSE/h2 {pose:.2e}, "
+              f"{run.steps} steps ({run.stop_reason})")  # fmt: skip
 
 
 def _notebook_07(ckpt) -> None:

@@ -23,7 +23,7 @@ def _full_method(source, target_rig, ckpt, cfg):
     from motionlab.core import preprocess
 
     run = retargeting.retarget(source, target_rig, ckpt, "full", cfg)
-    return run, preprocess.prepare(source, ckpt.fps)
+    return run, preprocess.prepare(source, ckpt.fps, stand=True)
 
 
 def my_encoder_start_experiment(source, target_rig, ckpt):
@@ -55,7 +55,7 @@ def my_foot_weight_experiment(source, target_rig, ckpt):
 
     cfg = SolverConfig(init="encoder", lambda_contact=0.0, lr=0.1, lambda_foot=5.0)
     run = retargeting.retarget(source, target_rig, ckpt, "full", cfg)
-    src = preprocess.prepare(source, ckpt.fps)
+    src = preprocess.prepare(source, ckpt.fps, stand=True)
     return plots.joint_angle_errors(run.motion.local_rot, src.local_rot).mean()
 
 
@@ -67,5 +67,5 @@ def my_theta_directions_experiment(source, target_rig, ckpt):
     from motionlab.retargeting.solver import SolverConfig
 
     run = retargeting.retarget(source, target_rig, ckpt, "full", SolverConfig(theta="directions"))
-    src = preprocess.prepare(source, ckpt.fps)
+    src = preprocess.prepare(source, ckpt.fps, stand=True)
     return round(float(plots.joint_angle_errors(run.motion.local_rot, src.local_rot).mean()), 2)

@@ -266,7 +266,7 @@ def _measure(source, target, checkpoint, what: str, **settings) -> float:
     key = _key(source, target, checkpoint, settings)
     if key not in _RUNS:
         run = retargeting.retarget(source, target, checkpoint, "full", SolverConfig(**settings))
-        src = preprocess.prepare(source, checkpoint.fps)
+        src = preprocess.prepare(source, checkpoint.fps, stand=True)  # A as section 5 measures it
         feet = [humanoid.JOINTS.index(n) for n in humanoid.FEET]
         n = min(len(run.positions), src.num_frames)
         planted = pipeline.source_contacts(src)[:n]
