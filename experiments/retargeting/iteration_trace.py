@@ -27,6 +27,7 @@ SETTINGS = {
     "300 steps": SolverConfig(max_steps=300, patience=0),
     "lambda_contact 2": SolverConfig(lambda_contact=2.0),
     "lr 0.002": SolverConfig(lr=0.002),
+    "lr 0.0002": SolverConfig(lr=0.0002),
 }
 """Solver settings compared (the default first)."""
 
