@@ -53,8 +53,11 @@ def standing_toe(skeleton) -> float:
 def main(argv=None) -> None:
     argparse.ArgumentParser(description=__doc__.splitlines()[0]).parse_args(argv)
     warnings.simplefilter("ignore", UserWarning)
+    try:
+        folder = data.data_root() / "mixamo"
+    except data.DataNotFound as e:
+        raise SystemExit(f"foot_clearance: {e}") from None
     ckpt = retargeting.load_real("cpu", progress=False)
-    folder = data.data_root() / "mixamo"
     print(f"{'target':<13} {'toe stands':>10} {'lowest toe: truth':>18} {'ours':>6}   "
           f"{'window frames: truth':>20} {'ours':>6}   {'their speed cm/s: truth':>23} {'ours':>6}")  # fmt: skip
     for target in DEFAULT_TARGETS:

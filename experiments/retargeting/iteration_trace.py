@@ -38,8 +38,11 @@ def main(argv=None) -> None:
     ap.add_argument("--target", default="Kaya", help="a Mixamo character of the course data (default Kaya)")
     args = ap.parse_args(argv)
     warnings.simplefilter("ignore", UserWarning)
-    source = bvh.load(args.source)
-    target = bvh.load(data.data_root() / "mixamo" / args.target / "Running.bvh")
+    try:
+        rig = data.data_root() / "mixamo" / args.target / "Running.bvh"
+        source, target = bvh.load(args.source), bvh.load(rig)
+    except (data.DataNotFound, OSError, bvh.BVHError) as e:
+        raise SystemExit(f"iteration_trace: {e}") from None
     ckpt = retargeting.load_real("cpu", progress=False)
     for method in ("copy", "network"):
         run = retargeting.retarget(source, target, ckpt, method)
