@@ -311,6 +311,28 @@ class RetargetNet(nn.Module):
             s = s[:, None]
         return fk_by_level(local_rot, s, humanoid.PARENTS)
 
+    def length_jacobian(self, phi: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """Lengths ``‖r_j‖`` of F_qlinear's 22 raw quaternions ``r = W φ + b`` (before eq. 10's
+        normalisation) and their Jacobian ``d‖r_j‖ = u_jᵀ W_j dφ`` (``u_j = r_j / ‖r_j‖``).
+
+        The rotations do not depend on these lengths, but a short ``r_j`` makes its rotation turn
+        fast under a small change of φ (``d unit(r) = (I − u uᵀ)/‖r‖ dr``).
+
+        Parameters
+        ----------
+        phi : Tensor (M, D)         latents of M frames
+
+        Returns
+        -------
+        lengths : Tensor (M, 22)
+        jacobian : Tensor (M, 22, D)
+        """
+        M, D = phi.shape
+        r = self.f_qlinear(phi).reshape(M, NUM_JOINTS, 4)
+        length = torch.sqrt((r * r).sum(-1))
+        u = r / length[..., None]
+        return length, torch.einsum("mja,jad->mjd", u, self.f_qlinear.weight.reshape(NUM_JOINTS, 4, D))
+
     def rotation_jacobian(
         self, phi: torch.Tensor, embedding: torch.Tensor, tangent: bool = False
     ) -> tuple[torch.Tensor, torch.Tensor]:

@@ -96,7 +96,7 @@ TRAINING_CODE = (
     "retargeting/model.py",
     "retargeting/losses.py",
     "retargeting/features.py",
-    "retargeting/solver.py",
+    "retargeting/grid.py",
     "core/preprocess.py",
     "core/quat_torch.py",
     "core/humanoid.py",

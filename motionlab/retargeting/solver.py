@@ -25,7 +25,7 @@ registry. A new term is one function and one :func:`terms.register`; its weight 
 ``SolverConfig(weights={name: w})`` and its per-sequence inputs passed as ``solve(..., inputs=)``.
 Every tensor follows the network's device and float type (:mod:`motionlab.retargeting.devices`).
 
-Three further additions of motionlab (their ablations are on docs/results_retargeting.md):
+Further additions of motionlab (their ablations are on docs/results_retargeting.md):
 
 **A Gauss–Newton start (``init="project"``; the default ``"auto"`` uses it).** The encoder
 reproduces A's joint rotations only approximately on clips it was not trained on, and Adam on the
@@ -35,7 +35,13 @@ found by least squares, one frame at a time. This is a Gauss–Newton step on th
 (:func:`project_latent`; ``q_Δ`` depends on φ, hence ``project_iters`` rounds, each step smoothed
 over time like the Adam updates below). It starts the iteration from ``L_angle ≈ 0``: the decoder
 then says what the source says, and Adam only has to trade that against the foot terms.
-``init="encoder"`` starts from ``F_enc(X_A)`` as the paper does.
+The same least squares (in its smoothed rounds) keeps each raw quaternion ``W φ + b`` at its
+encoder-start length, at least 1, which the rotations do not see: a raw quaternion shortened almost to zero makes its rotation swing
+under the smallest step of Adam. ``init="encoder"`` starts from ``F_enc(X_A)`` as the paper does.
+
+**Backtracking (``backtrack``).** A step that does not lower ``L_iter`` is undone, and Adam
+starts again from the best iterate with half the step size, so every iterate kept is better
+than the one before and a step size too large for the pair shrinks until it descends.
 
 **Foot contacts (``lambda_contact``).** Where A's foot is planted
 (:mod:`motionlab.retargeting.contacts`), B's foot should stay still in the world;
@@ -64,7 +70,6 @@ Taught in ``notebooks/03_latent_iteration.ipynb``.
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable, Sequence
 from contextlib import contextmanager
@@ -78,6 +83,7 @@ from motionlab.core import quat_torch as tq
 from motionlab.core import threads
 from motionlab.retargeting import losses, terms
 from motionlab.retargeting.contacts import CONTACT_JOINTS
+from motionlab.retargeting.grid import step_grid
 from motionlab.retargeting.model import NUM_JOINTS, Decoded, RetargetNet
 from motionlab.retargeting.terms import TermInputs
 
@@ -139,12 +145,18 @@ class SolverConfig:
     project_damping : float or None   relative damping of the Gauss–Newton rounds
                            (:func:`project_latent`); None: :data:`PROJECT_DAMPING` for the
                            network's float type
+    project_lengths : bool the smoothed Gauss–Newton rounds also keep F_qlinear's raw quaternions
+                           at their start length, at least :data:`MIN_RAW_LENGTH` (ours;
+                           :func:`project_latent`)
     project_exact : int    of the ``project_iters`` rounds, how many last ones are not smoothed
                            (they remove what the smoothed rounds leave of A's fastest details;
                            ``motionlab evaluate --exact-rounds K`` compares values)
     theta : str            ``"rotations"`` (joint rotations, default) or ``"directions"``
                            (unit bone directions from positions)
     smooth_sigma : float   σ (frames) of the Gaussian that smooths latent updates over time; 0: off
+    backtrack : bool       a step that does not lower ``L_iter`` is undone: Adam restarts from the
+                           best iterate with half the step size (ours; False: plain Adam, which
+                           may wander above its start and return it unchanged)
     weights : dict         weight of a registered loss term by name (:mod:`.terms`), overriding
                            the ``lambda_*`` fields and the term's default (:meth:`weight`)
     """
@@ -164,6 +176,8 @@ class SolverConfig:
     smooth_projection: bool = True
     project_exact: int = 4
     project_damping: float | None = None
+    project_lengths: bool = True
+    backtrack: bool = True
     weights: dict = field(default_factory=dict)
 
     def weight(self, name: str) -> float:
@@ -232,19 +246,6 @@ class SolverResult:
     steps: int = 0
     seconds: float = 0.0
     best_step: int = 0
-
-
-def step_grid(size: float) -> float:
-    """The spacing iterates are rounded to: the power of two just below ``size · 2⁻¹²``.
-
-    The latent iteration rounds its start φ₀ to ``step_grid(std(φ₀))`` and the latent offset,
-    after each Adam step, to ``step_grid(lr)`` (``lr`` the group's actual step size). Differences
-    in the last bits of the gradients (another CPU's kernels add in another order) are rounded
-    away instead of growing step by step, so the iterates, and the step at which the stopping rule
-    stops, are the same on every CPU (``docs/reproducibility.md``,
-    ``experiments/retargeting/reproducibility.py``).
-    """
-    return 2.0 ** math.floor(math.log2(size) - 12)
 
 
 def _smoother(sigma: float, channels: int, dtype, device):
@@ -341,6 +342,7 @@ def project_latent(
     smooth=None,
     exact_rounds: int = 0,
     index: torch.Tensor | None = None,
+    keep_lengths: bool = True,
 ) -> torch.Tensor:
     """The latent whose decoded rotations ``q ⊗ q_Δ`` match ``target_rot``: Gauss–Newton per frame.
 
@@ -376,6 +378,12 @@ def project_latent(
         start still reaches the target's fastest details
     index : Tensor (N, T) of int, optional   for rows padded beyond their length: the frame each
         frame stands for (``min(t, length − 1)``), as in :func:`smoother`
+    keep_lengths : bool                in the smoothed rounds, also keep each of F_qlinear's raw
+        quaternions (before eq. 10's normalisation) at its length in ``phi``, or at
+        :data:`MIN_RAW_LENGTH` where that is shorter: 22 more residuals per frame. The rotations do
+        not see these lengths, and smoothed steps can shorten a raw quaternion almost to zero, where
+        the next small change of φ turns its rotation far (a bad start for Adam). The exact rounds
+        then fit the rotations alone
 
     Returns
     -------
@@ -387,17 +395,27 @@ def project_latent(
         emb = emb.expand(N, -1) if emb.shape[0] == 1 else emb
         damping = PROJECT_DAMPING.get(phi.dtype, 1e-3) if damping is None else damping
         out = phi.clone()
+        if keep_lengths:
+            lengths = model.f_qlinear(phi).unflatten(-1, (NUM_JOINTS, 4)).norm(dim=-1).clamp_min(MIN_RAW_LENGTH)
         alive = torch.arange(N, device=phi.device)
         for k in range(iters):
-            step, done = gauss_newton_step(model, out[alive], target_rot[alive], emb[alive], damping)
+            smoothed = smooth is not None and k < iters - exact_rounds
+            keep = lengths[alive] if keep_lengths and smoothed else None  # the exact rounds: rotations alone
+            step, done = gauss_newton_step(model, out[alive], target_rot[alive], emb[alive], damping, keep)
             alive, step = alive[~done], step[~done]  # a row whose residuals are all tiny is finished
             if len(alive) == 0:
                 break
-            if smooth is not None and k < iters - exact_rounds:
+            if smoothed:
                 step = smooth(step, None if index is None else index[alive])
             out[alive] += step
     return out
 
+
+MIN_RAW_LENGTH = 1.0
+"""The shortest length the Gauss–Newton start's smoothed rounds ask of a raw quaternion
+``r_j = W_j φ + b_j`` (F_qlinear before eq. 10's normalisation, ``keep_lengths``). A change ``dφ``
+turns ``unit(r_j)`` by about ``‖W_j dφ‖ / ‖r_j‖`` radians, so at length ≥ 1 no faster than the
+layer's own ``W_j dφ``, the unit the normalised output has. Not tuned: the length with that meaning."""
 
 PROJECT_FRAMES = 32
 """Frames per chunk of :func:`project_latent`'s Jacobians on the CPU. Per-frame results do not
@@ -424,18 +442,21 @@ def _chunk_frames(phi: torch.Tensor) -> int:
     return max(PROJECT_GPU_FRAMES, int(0.25 * free // per_frame))
 
 
-def gauss_newton_step(model, phi, target_rot, emb, damping) -> tuple[torch.Tensor, torch.Tensor]:
+def gauss_newton_step(model, phi, target_rot, emb, damping, lengths=None) -> tuple[torch.Tensor, torch.Tensor]:
     """One damped Gauss–Newton step (N, T, D) of :func:`project_latent` for each row, unsmoothed,
-    and which rows (N,) have every residual below 1e-5 already (bool).
+    and which rows (N,) have every rotation residual below 1e-5 already (bool).
 
     ``phi`` (N, T, D) latents, ``target_rot`` (N, T, 22, 4) the rotations to decode, ``emb`` (N, E)
-    the skeleton embeddings, ``damping`` the relative damping μ; frames are solved in chunks of
-    :data:`PROJECT_FRAMES` on the CPU (sized by free memory on a GPU), with the same result.
+    the skeleton embeddings, ``damping`` the relative damping μ; ``lengths`` (N, T, 22), optional:
+    the lengths F_qlinear's raw quaternions should have (:meth:`RetargetNet.length_jacobian`), 22
+    more residuals per frame. Frames are solved in chunks of :data:`PROJECT_FRAMES` on the CPU
+    (sized by free memory on a GPU), with the same result.
     """
     N, T, D = phi.shape
     flat, target = phi.reshape(N * T, D), target_rot.reshape(N * T, NUM_JOINTS, 4)
+    lengths = None if lengths is None else lengths.reshape(N * T, NUM_JOINTS, 1)
     emb_frames = emb[:, None, :].expand(N, T, emb.shape[-1]).reshape(N * T, -1)
-    eye = torch.eye(3 * NUM_JOINTS, dtype=phi.dtype, device=phi.device)
+    eye = torch.eye((3 if lengths is None else 4) * NUM_JOINTS, dtype=phi.dtype, device=phi.device)
     step, worst = torch.empty_like(flat), torch.empty(N * T, dtype=phi.dtype, device=phi.device)
     chunk = _chunk_frames(phi)
     for c in range(0, N * T, chunk):
@@ -446,9 +467,14 @@ def gauss_newton_step(model, phi, target_rot, emb, damping) -> tuple[torch.Tenso
         worst[part] = resid.abs().amax(dim=(1, 2))
         # Jᵀ r with J in each quaternion's tangent basis: the same step (the rows left out are 0)
         resid = tq.mul(tq.conj(out), resid)[..., 1:].reshape(out.shape[0], -1, 1)
-        # (JᵀJ + μI)⁻¹ Jᵀ r = Jᵀ (J Jᵀ + μI)⁻¹ r: a 66 × 66 system per frame instead of D × D
+        # μ from the rotation rows alone: the mean of JJᵀ's diagonal over the 88 numbers of the rotations
+        mu = damping * (jac.square().sum((1, 2)) / (4 * NUM_JOINTS)).clamp_min(1e-12)
+        if lengths is not None:  # the lengths' rows: residual (wanted − current length), Jacobian uᵀ W
+            length, ljac = model.length_jacobian(flat[part])
+            jac = torch.cat([jac, ljac], 1)
+            resid = torch.cat([resid, lengths[part] - length[..., None]], 1)
+        # (JᵀJ + μI)⁻¹ Jᵀ r = Jᵀ (J Jᵀ + μI)⁻¹ r: a 66 × 66 (88 × 88) system per frame instead of D × D
         jjt = jac @ jac.transpose(1, 2)
-        mu = damping * (jjt.diagonal(dim1=1, dim2=2).sum(-1) / (4 * NUM_JOINTS)).clamp_min(1e-12)  # mean over 88
         chol = torch.linalg.cholesky(jjt + mu[:, None, None] * eye)  # symmetric positive definite
         step[part] = (jac.transpose(1, 2) @ torch.cholesky_solve(resid, chol))[..., 0]
     return step.reshape(N, T, D), worst.reshape(N, T).amax(1) < 1e-5
@@ -784,7 +810,7 @@ def _start(p: _Problem):
         steps_filter = smooth if cfg.smooth_projection else None
         phi0 = project_latent(
             model, phi0, p.src, offsets, cfg.project_iters, cfg.project_damping, smooth=steps_filter,
-            exact_rounds=cfg.project_exact, index=p.index,
+            exact_rounds=cfg.project_exact, index=p.index, keep_lengths=cfg.project_lengths,
         )  # fmt: skip
     return phi0, embedding, smooth
 
@@ -796,7 +822,8 @@ _BETAS, _EPS = (0.9, 0.999), 1e-8
 @dataclass
 class _Steps:
     """The latent offset δ (N, T, D) (φ = φ₀ + smooth(δ)) and Adam's state over it, written out
-    so that every row has its own step size, grid and step count (a group's rows share them)."""
+    so that every row has its own step size, grid and step count (a group's rows share them);
+    with backtracking, the best iterate's δ and its gradient, to go back to."""
 
     delta: torch.Tensor
     lr: np.ndarray
@@ -804,6 +831,8 @@ class _Steps:
     m: torch.Tensor
     v: torch.Tensor
     count: np.ndarray
+    best_delta: torch.Tensor | None = None
+    best_grad: torch.Tensor | None = None
 
 
 def _steps(phi0: torch.Tensor, p: _Problem) -> _Steps:
@@ -822,7 +851,10 @@ def _steps(phi0: torch.Tensor, p: _Problem) -> _Steps:
     like = dict(dtype=phi0.dtype, device=phi0.device)
     grid = torch.as_tensor(grid, **like)[:, None, None]
     zeros = torch.zeros_like(phi0)
-    return _Steps(zeros.clone().requires_grad_(True), lr, grid, zeros.clone(), zeros, np.zeros(N, dtype=np.int64))
+    steps = _Steps(zeros.clone().requires_grad_(True), lr, grid, zeros.clone(), zeros, np.zeros(N, dtype=np.int64))
+    if p.cfg.backtrack:
+        steps.best_delta, steps.best_grad = torch.zeros_like(phi0), torch.zeros_like(phi0)
+    return steps
 
 
 def _rows_of(bounds: np.ndarray, groups: list) -> np.ndarray:
@@ -891,10 +923,10 @@ class _Track:
             torch.empty_like(phi0),
         )
 
-    def record(self, p: _Problem, active: list, values: list, out, phi, callback) -> list[int]:
+    def record(self, p: _Problem, active: list, values: list, out, phi, callback) -> tuple[list[int], list[int]]:
         """Log one evaluation of the active groups, keep their best iterates; the indices into
-        ``active`` of the groups that stop here."""
-        cfg, stopped, row, better = p.cfg, [], 0, []
+        ``active`` of the groups that stop here, and of those whose ``L_iter`` is their lowest yet."""
+        cfg, stopped, row, better, improved = p.cfg, [], 0, [], []
         for k, g in enumerate(active):
             value, n = values[k][0], p.sizes[g]
             for key, v in zip(self.keys, values[k]):
@@ -904,6 +936,7 @@ class _Track:
             if value < self.best_value[g]:  # Adam can overshoot: keep the best iterate seen, not the last
                 self.best_value[g], self.best_step[g] = value, self.steps[g]
                 better.append((row, p.bounds[g], n))
+                improved.append(k)
             if value < self.best[g] * (1.0 - cfg.min_delta):
                 self.best[g], self.since_best[g] = value, 0
             else:
@@ -917,7 +950,7 @@ class _Track:
                 continue
             stopped.append(k)
         self._keep(better, out, phi)
-        return stopped
+        return stopped, improved
 
     def _keep(self, better: list, out, phi) -> None:
         """Copy the improved groups' rows ``(row in out, row in the batch, rows)`` into the best iterate."""
@@ -950,13 +983,19 @@ class _Track:
         ]
 
 
-def _adam_step(p: _Problem, steps: _Steps, group_loss: torch.Tensor, active: list, stopped: list) -> list:
+def _adam_step(
+    p: _Problem, steps: _Steps, group_loss: torch.Tensor, active: list, stopped: list, improved: list
+) -> list:
     """One Adam update (``torch.optim.Adam``'s arithmetic) of the groups still running, their δ put
-    back on the grid; the groups left. A stopped group keeps its latent."""
+    back on the grid; the groups left. A stopped group keeps its latent. With backtracking, a group
+    whose last step did not lower its loss (not in ``improved``) goes back first (:func:`_backtrack`)."""
     keep = torch.ones(len(active), dtype=group_loss.dtype, device=group_loss.device)
     keep[stopped] = 0.0
     steps.delta.grad = None
     (group_loss * keep).sum().backward()
+    if p.cfg.backtrack:
+        _backtrack(p, steps, [g for k, g in enumerate(active) if k in improved and k not in stopped],
+                   [g for k, g in enumerate(active) if k not in improved and k not in stopped])  # fmt: skip
     active = [g for k, g in enumerate(active) if k not in stopped]
     rows = _rows_of(p.bounds, active)
     steps.count[rows] += 1
@@ -977,6 +1016,28 @@ def _adam_step(p: _Problem, steps: _Steps, group_loss: torch.Tensor, active: lis
     return active
 
 
+def _backtrack(p: _Problem, steps: _Steps, better: list, worse: list) -> None:
+    """Groups ``better`` (their loss the lowest yet): remember δ and its gradient. Groups ``worse``:
+    back to the remembered δ and gradient, Adam's moments and step count reset, step size halved
+    (its grid with it)."""
+    device = steps.delta.device
+    with torch.no_grad():
+        if better:
+            rows = torch.as_tensor(_rows_of(p.bounds, better), device=device)
+            steps.best_delta[rows] = steps.delta[rows]
+            steps.best_grad[rows] = steps.delta.grad[rows]
+        if worse:
+            at = _rows_of(p.bounds, worse)
+            rows = torch.as_tensor(at, device=device)
+            steps.delta[rows] = steps.best_delta[rows]
+            steps.delta.grad[rows] = steps.best_grad[rows]
+            steps.m[rows], steps.v[rows] = 0.0, 0.0
+            steps.count[at] = 0
+            steps.lr[at] *= 0.5
+            grid = [step_grid(lr) for lr in steps.lr[at]]
+            steps.grid[rows] = torch.as_tensor(grid, dtype=steps.grid.dtype, device=device)[:, None, None]
+
+
 def _iterate(p: _Problem, callback, progress) -> list[SolverResult]:
     """The latent iteration for consecutive groups of sequences (``p.sizes`` rows each), each group
     an independent problem: group loss = mean of its sequences' losses, own step size and stop."""
@@ -990,10 +1051,10 @@ def _iterate(p: _Problem, callback, progress) -> list[SolverResult]:
         bar = tqdm(total=cfg.max_steps, desc="latent iteration", disable=not progress, leave=False)
         while active:
             out, phi, group_loss, values = _losses(p, phi0, embedding, smooth, steps, active)
-            stopped = track.record(p, active, values, out, phi, callback)
+            stopped, improved = track.record(p, active, values, out, phi, callback)
             if len(stopped) == len(active):
                 break
-            active = _adam_step(p, steps, group_loss, active, stopped)
+            active = _adam_step(p, steps, group_loss, active, stopped, improved)
             for g in active:
                 track.steps[g] += 1
             bar.update(1)

@@ -23,7 +23,7 @@ mirrored left↔right (:func:`mirrored`): twice the poses from the same recordin
 **Weights on a grid (``TrainConfig.grid``, on by default).** Another numeric back end adds in
 another order, so gradients differ in their last bits, and Adam, which divides each gradient by
 its own running size, lets such differences grow over a thousand steps. As in the latent
-iteration (:func:`motionlab.retargeting.solver.step_grid`), the initial weights are rounded to
+iteration (:func:`motionlab.retargeting.grid.step_grid`), the initial weights are rounded to
 ``step_grid(lr)`` and every parameter, after each Adam step, to ``step_grid(lr_t)`` (``lr_t`` the
 step's learning rate: a power of two about 2⁻¹² of it), and the skeleton augmentation's scale
 factors to :data:`DRAW_GRID`. Rare last-bit differences are then rounded away instead of growing;
@@ -53,8 +53,8 @@ from motionlab.core.skeleton import Skeleton
 from motionlab.retargeting import devices, losses
 from motionlab.retargeting.checkpoint import DTYPES, Checkpoint
 from motionlab.retargeting.features import clip_features
+from motionlab.retargeting.grid import step_grid
 from motionlab.retargeting.model import NUM_JOINTS, ModelConfig, RetargetNet
-from motionlab.retargeting.solver import step_grid
 
 __all__ = [
     "TrainingSet",

@@ -131,6 +131,21 @@ def test_rotation_jacobian_matches_autograd():
             model.use_correction = True
 
 
+def test_length_jacobian_matches_autograd():
+    """``‖r_j‖`` of F_qlinear's raw quaternions and ``d‖r_j‖/dφ``, against autograd."""
+    model = retargeting.load_default().model
+    torch.manual_seed(2)
+    phi = torch.randn(3, model.config.latent, dtype=torch.float64)
+
+    def lengths(p):
+        return model.f_qlinear(p).reshape(3, 22, 4).norm(dim=-1)
+
+    full = torch.autograd.functional.jacobian(lengths, phi)  # (3, 22, 3, D)
+    length, jac = model.length_jacobian(phi)
+    torch.testing.assert_close(length, lengths(phi), atol=1e-12, rtol=1e-12)
+    torch.testing.assert_close(jac, torch.stack([full[i, :, i] for i in range(3)]), atol=1e-10, rtol=1e-8)
+
+
 def test_the_tangent_jacobian_keeps_every_direction_the_rotations_move_in():
     """``tangent=True``: 3 rows per joint, the vector part of ``o* ⊗ dJ``; the 4th row (along the
     unit quaternion o) is 0, so JᵀJ, and with it the Gauss–Newton step, is that of the 88 rows."""

@@ -166,9 +166,33 @@ def test_projected_start_reaches_a_cmu_skeleton_source_on_every_frame():
             model, phi0, src.theta, pair.offsets, cfg.project_iters, cfg.project_damping, smooth, cfg.project_exact
         )
         rot = model.decode(phi, pair.offsets).local_rot
+        shortest = model.f_qlinear(phi).unflatten(-1, (22, 4)).norm(dim=-1).min()
     dot = (rot * src.theta).sum(-1).abs().clamp(max=1.0)
     degrees = np.degrees(2 * torch.arccos(dot).numpy())
     assert degrees.max() < 0.1, f"the start is {degrees.max():.2f} deg from A's rotations somewhere"
+    # rotations alone left a raw quaternion 0.018 long, where Adam's first step turned it far
+    assert shortest > 0.1 * solver.MIN_RAW_LENGTH, f"a raw quaternion of the start is {shortest:.3f} long"
+
+
+def test_backtracking_descends_where_plain_adam_returns_its_start():
+    """Xia's walk (CMU's skeleton) onto Aj: plain Adam's first steps raise L_iter and the plateau
+    rule returns the start; backtracking halves the step until it descends (issue 41)."""
+    from experiments.retargeting import rig_matrix
+    from motionlab import data, retargeting
+    from tests.conftest import require_data
+
+    require_data("xia")
+    require_data("mixamo")
+    ckpt = retargeting.load_default("cpu")
+    clips = rig_matrix.family_clips(data.data_root(), seconds=3.0)
+    plain = retargeting.retarget(clips["xia"], clips["mixamo"], ckpt, "full", SolverConfig(backtrack=False))
+    assert plain.best_step == 0 and plain.history["loss"][1] > plain.history["loss"][0]
+    back = retargeting.retarget(clips["xia"], clips["mixamo"], ckpt, "full", SolverConfig())
+    kept = [back.history["loss"][0]]
+    for value in back.history["loss"][1:]:  # every evaluation is either kept (lower) or undone
+        kept.append(min(kept[-1], value))
+    assert back.losses["loss"] == kept[-1] < 0.5 * plain.losses["loss"]
+    assert back.plausibility.slide < plain.plausibility.slide
 
 
 def test_a_float32_network_projects_every_family():
