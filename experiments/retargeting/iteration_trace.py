@@ -1,6 +1,6 @@
 """What the latent iteration does on one pair: the planted-foot slide and each loss term over the steps.
 
-    MOTIONLAB_DATA=/path/to/data python -m experiments.retargeting.iteration_trace SOURCE.bvh [--target Kaya]
+    MOTIONLAB_DATA=/path/to/data python -m experiments.retargeting.iteration_trace SOURCE.bvh [--target Kaya] [--brief]
 
 Retargets SOURCE (any rig motionlab reads) onto a Mixamo character (its ``Running.bvh`` rig)
 with the network trained on Aj's real clips (``retargeting.load_real``) under several solver
@@ -69,6 +69,7 @@ def main(argv=None) -> None:
     ap.add_argument("source", help="a BVH file")
     ap.add_argument("--target", default="Kaya", help="a Mixamo character of the course data (default Kaya)")
     ap.add_argument("--checkpoint", help="a network file to use instead of retargeting.load_real's")
+    ap.add_argument("--brief", action="store_true", help="one line per setting, without the terms")
     args = ap.parse_args(argv)
     warnings.simplefilter("ignore", UserWarning)
     try:
@@ -92,7 +93,7 @@ def main(argv=None) -> None:
             run = retargeting.retarget(source, target, ckpt, "full", cfg)
         print(f"{label:<20} slide {100 * run.plausibility.slide:6.2f} cm/s, {run.steps} steps ({run.stop_reason}), "
               f"returned step {run.best_step}; shortest raw quaternion at the start {min(shortest):.3f}")  # fmt: skip
-        for term, values in run.history.items():
+        for term, values in () if args.brief else run.history.items():
             v = np.asarray(values)
             print(f"    {term:<8} start {v[0]:.4g}, lowest {v.min():.4g} (step {int(v.argmin())}), last {v[-1]:.4g}")
 

@@ -83,6 +83,8 @@ ABLATIONS: tuple[tuple, ...] = (
     ("full, paper's two losses", "full", "stride", {"paper_terms": True}),
     ("full, encoder start", "full", "stride", {"init": "encoder", "lr": 0.1}),
     ("full, without q_delta", "full", "stride", {"correction": False}),
+    ("full, plain Adam", "full", "stride", {"backtrack": False}),
+    ("full, rotations-only start", "full", "stride", {"project_lengths": False}),
 )
 """The full method with one addition switched off: ``(label, method, root_mode, options)``, where
 ``options`` are :class:`SolverConfig` fields, ``correction=False`` (q_Δ replaced by the identity)

@@ -40,8 +40,9 @@ encoder-start length, at least 1, which the rotations do not see: a raw quaterni
 under the smallest step of Adam. ``init="encoder"`` starts from ``F_enc(X_A)`` as the paper does.
 
 **Backtracking (``backtrack``).** A step that does not lower ``L_iter`` is undone, and Adam
-starts again from the best iterate with half the step size, so every iterate kept is better
-than the one before and a step size too large for the pair shrinks until it descends.
+starts again from the best iterate with half the step size; a step that does lowers it lets the
+step grow by a tenth again, up to the configured one. Every iterate kept is better than the one
+before, and the step size settles where the pair descends.
 
 **Foot contacts (``lambda_contact``).** Where A's foot is planted
 (:mod:`motionlab.retargeting.contacts`), B's foot should stay still in the world;
@@ -155,8 +156,9 @@ class SolverConfig:
                            (unit bone directions from positions)
     smooth_sigma : float   σ (frames) of the Gaussian that smooths latent updates over time; 0: off
     backtrack : bool       a step that does not lower ``L_iter`` is undone: Adam restarts from the
-                           best iterate with half the step size (ours; False: plain Adam, which
-                           may wander above its start and return it unchanged)
+                           best iterate with half the step size, which grows by a tenth after
+                           each step that does (ours; False: plain Adam, which may wander above
+                           its start and return it unchanged)
     weights : dict         weight of a registered loss term by name (:mod:`.terms`), overriding
                            the ``lambda_*`` fields and the term's default (:meth:`weight`)
     """
@@ -818,6 +820,11 @@ def _start(p: _Problem):
 _BETAS, _EPS = (0.9, 0.999), 1e-8
 """Adam's defaults (Kingma and Ba 2015), as ``torch.optim.Adam`` has them."""
 
+_GROW, _SHRINK = 1.1, 0.5
+"""Backtracking's step-size factors after a step that lowered ``L_iter`` and after one that did
+not: the "bold driver" rule's classic values (grow a little on success, halve on failure), not
+tuned here; the step never grows past the configured ``lr · std(φ₀)``."""
+
 
 @dataclass
 class _Steps:
@@ -833,6 +840,7 @@ class _Steps:
     count: np.ndarray
     best_delta: torch.Tensor | None = None
     best_grad: torch.Tensor | None = None
+    lr_max: np.ndarray | None = None
 
 
 def _steps(phi0: torch.Tensor, p: _Problem) -> _Steps:
@@ -853,7 +861,7 @@ def _steps(phi0: torch.Tensor, p: _Problem) -> _Steps:
     zeros = torch.zeros_like(phi0)
     steps = _Steps(zeros.clone().requires_grad_(True), lr, grid, zeros.clone(), zeros, np.zeros(N, dtype=np.int64))
     if p.cfg.backtrack:
-        steps.best_delta, steps.best_grad = torch.zeros_like(phi0), torch.zeros_like(phi0)
+        steps.best_delta, steps.best_grad, steps.lr_max = torch.zeros_like(phi0), torch.zeros_like(phi0), lr.copy()
     return steps
 
 
@@ -1017,15 +1025,17 @@ def _adam_step(
 
 
 def _backtrack(p: _Problem, steps: _Steps, better: list, worse: list) -> None:
-    """Groups ``better`` (their loss the lowest yet): remember δ and its gradient. Groups ``worse``:
-    back to the remembered δ and gradient, Adam's moments and step count reset, step size halved
-    (its grid with it)."""
+    """Groups ``better`` (their loss the lowest yet): remember δ and its gradient, step size × 1.1
+    (at most the configured one). Groups ``worse``: back to the remembered δ and gradient, Adam's
+    moments and step count reset, step size halved (:data:`_GROW`, :data:`_SHRINK`)."""
     device = steps.delta.device
     with torch.no_grad():
         if better:
-            rows = torch.as_tensor(_rows_of(p.bounds, better), device=device)
+            at = _rows_of(p.bounds, better)
+            rows = torch.as_tensor(at, device=device)
             steps.best_delta[rows] = steps.delta[rows]
             steps.best_grad[rows] = steps.delta.grad[rows]
+            _set_lr(steps, at, np.minimum(steps.lr[at] * _GROW, steps.lr_max[at]))
         if worse:
             at = _rows_of(p.bounds, worse)
             rows = torch.as_tensor(at, device=device)
@@ -1033,9 +1043,14 @@ def _backtrack(p: _Problem, steps: _Steps, better: list, worse: list) -> None:
             steps.delta.grad[rows] = steps.best_grad[rows]
             steps.m[rows], steps.v[rows] = 0.0, 0.0
             steps.count[at] = 0
-            steps.lr[at] *= 0.5
-            grid = [step_grid(lr) for lr in steps.lr[at]]
-            steps.grid[rows] = torch.as_tensor(grid, dtype=steps.grid.dtype, device=device)[:, None, None]
+            _set_lr(steps, at, steps.lr[at] * _SHRINK)
+
+
+def _set_lr(steps: _Steps, rows: np.ndarray, lr: np.ndarray) -> None:
+    """Rows ``rows`` get Adam step size ``lr`` and its grid (:func:`step_grid`)."""
+    steps.lr[rows] = lr
+    grid = torch.as_tensor([step_grid(x) for x in lr], dtype=steps.grid.dtype, device=steps.grid.device)
+    steps.grid[torch.as_tensor(rows, device=steps.grid.device)] = grid[:, None, None]
 
 
 def _iterate(p: _Problem, callback, progress) -> list[SolverResult]:
