@@ -106,6 +106,7 @@ def _per_process(sources, specs, out: Path, args) -> float:
                 "-o",
                 str(out / name / f"{Path(s).stem}.bvh"),
                 "-q",
+                "--keep-implausible",  # as expand, which writes implausible outputs with a flag
             ]
             if args.device:
                 cmd += ["--device", args.device]

@@ -30,7 +30,8 @@ import numpy as np
 from motionlab import data, retargeting
 from motionlab.core import bvh, humanoid, preprocess
 from motionlab.retargeting import checkpoint as ckpt_io
-from motionlab.retargeting import evaluate, pipeline, plausibility
+from motionlab.retargeting import evaluate, losses, pipeline, plausibility
+from motionlab.retargeting.solver import SolverConfig
 
 
 def _cut(motion, n: int):
@@ -41,13 +42,13 @@ def _cut(motion, n: int):
     )
 
 
-def check_pair(ckpt, source, src: pipeline.PreparedSource, gt_rig) -> tuple:
+def check_pair(ckpt, source, src: pipeline.PreparedSource, gt_rig, solver=None) -> tuple:
     """(ground truth's Plausibility, motionlab's Plausibility, motionlab's deepest joint) of one pair."""
     gt = preprocess.prepare(gt_rig, ckpt.fps, stand=True)
     n = min(gt.num_frames, src.motion.num_frames)
     planted = src.planted[0].cpu().numpy()[:n]
     truth = plausibility.check(gt.global_positions()[:n], gt.skeleton, _cut(src.motion, n), planted)
-    out = retargeting.retarget(source, gt_rig.skeleton, ckpt, "full")
+    out = retargeting.retarget(source, gt_rig.skeleton, ckpt, "full", solver)
     deepest = humanoid.JOINTS[int(np.argmin(out.positions[..., 1].min(axis=0)))]
     return truth, out.plausibility, deepest
 
@@ -78,7 +79,9 @@ def main(argv=None) -> None:
     ap.add_argument("--checkpoint", help="network (default: the shipped one)")
     ap.add_argument("--targets", nargs="+", default=list(evaluate.DEFAULT_TARGETS))
     ap.add_argument("--animations", nargs="+", default=list(evaluate.DEFAULT_ANIMATIONS))
+    ap.add_argument("--foot-weight", type=float, help=f"λ_foot of the full method (default {losses.LAMBDA_FOOT})")
     args = ap.parse_args(argv)
+    solver = None if args.foot_weight is None else SolverConfig(lambda_foot=args.foot_weight)
     start = time.perf_counter()
     ckpt = ckpt_io.load(args.checkpoint) if args.checkpoint else retargeting.load_default()
     folder = data.data_root() / "mixamo"
@@ -89,10 +92,13 @@ def main(argv=None) -> None:
         src = pipeline.prepare_source(source, ckpt, "full")
         for target in args.targets:
             rig = bvh.load(folder / target / f"{anim}.bvh")
-            results[target, anim] = check_pair(ckpt, source, src, rig)
+            results[target, anim] = check_pair(ckpt, source, src, rig, solver)
             shares[target] = rest_angles(humanoid.to_canonical_skeleton(rig.skeleton))
         shares[evaluate.DEFAULT_SOURCE] = rest_angles(humanoid.to_canonical_skeleton(source.skeleton))
-    print(f"network: {args.checkpoint or 'shipped default'}")
+    print(
+        f"network: {args.checkpoint or 'shipped default'}"
+        + ("" if solver is None else f"; lambda_foot {args.foot_weight}")
+    )
     print(f"{'character':<14} {'ground truth fails':<34} {'motionlab fails':<34} own rest: knee bend, foot pitch (deg)")
     for target in args.targets + ["all"]:
         pairs = [v for (t, _), v in results.items() if target in ("all", t)]
