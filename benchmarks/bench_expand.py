@@ -107,6 +107,8 @@ def _per_process(sources, specs, out: Path, args) -> float:
                 str(out / name / f"{Path(s).stem}.bvh"),
                 "-q",
                 "--keep-implausible",  # as expand, which writes implausible outputs with a flag
+                "--network",
+                "synthetic",  # the shipped network, as the batched runs below load it
             ]
             if args.device:
                 cmd += ["--device", args.device]

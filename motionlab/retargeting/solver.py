@@ -35,9 +35,10 @@ found by least squares, one frame at a time. This is a Gauss–Newton step on th
 (:func:`project_latent`; ``q_Δ`` depends on φ, hence ``project_iters`` rounds, each step smoothed
 over time like the Adam updates below). It starts the iteration from ``L_angle ≈ 0``: the decoder
 then says what the source says, and Adam only has to trade that against the foot terms.
-The same least squares (in its smoothed rounds) keeps each raw quaternion ``W φ + b`` at its
-encoder-start length, at least 1, which the rotations do not see: a raw quaternion shortened almost to zero makes its rotation swing
-under the smallest step of Adam. ``init="encoder"`` starts from ``F_enc(X_A)`` as the paper does.
+In its smoothed rounds the same least squares also pulls each raw quaternion ``W φ + b``
+towards its encoder-start length, at least 1, which the rotations do not see: a raw quaternion
+shortened almost to zero makes its rotation swing under the smallest step of Adam (the exact
+rounds fit the rotations alone and may shorten it again, far less). ``init="encoder"`` starts from ``F_enc(X_A)`` as the paper does.
 
 **Backtracking (``backtrack``).** A step that does not lower ``L_iter`` is undone, and Adam
 starts again from the best iterate with half the step size; a step that does lowers it lets the
@@ -146,9 +147,9 @@ class SolverConfig:
     project_damping : float or None   relative damping of the Gauss–Newton rounds
                            (:func:`project_latent`); None: :data:`PROJECT_DAMPING` for the
                            network's float type
-    project_lengths : bool the smoothed Gauss–Newton rounds also keep F_qlinear's raw quaternions
-                           at their start length, at least :data:`MIN_RAW_LENGTH` (ours;
-                           :func:`project_latent`)
+    project_lengths : bool the smoothed Gauss–Newton rounds (``smooth_projection``) also pull
+                           F_qlinear's raw quaternions towards their start length, at least
+                           :data:`MIN_RAW_LENGTH` (ours; :func:`project_latent`)
     project_exact : int    of the ``project_iters`` rounds, how many last ones are not smoothed
                            (they remove what the smoothed rounds leave of A's fastest details;
                            ``motionlab evaluate --exact-rounds K`` compares values)
