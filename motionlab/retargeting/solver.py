@@ -381,12 +381,12 @@ def project_latent(
         start still reaches the target's fastest details
     index : Tensor (N, T) of int, optional   for rows padded beyond their length: the frame each
         frame stands for (``min(t, length − 1)``), as in :func:`smoother`
-    keep_lengths : bool                in the smoothed rounds, also keep each of F_qlinear's raw
-        quaternions (before eq. 10's normalisation) at its length in ``phi``, or at
+    keep_lengths : bool                in the smoothed rounds, also pull each of F_qlinear's raw
+        quaternions (before eq. 10's normalisation) towards its length in ``phi``, or towards
         :data:`MIN_RAW_LENGTH` where that is shorter: 22 more residuals per frame. The rotations do
         not see these lengths, and smoothed steps can shorten a raw quaternion almost to zero, where
         the next small change of φ turns its rotation far (a bad start for Adam). The exact rounds
-        then fit the rotations alone
+        then fit the rotations alone (and may shorten it again, far less)
 
     Returns
     -------
@@ -1002,6 +1002,7 @@ def _adam_step(
     keep[stopped] = 0.0
     steps.delta.grad = None
     (group_loss * keep).sum().backward()
+    stopped, improved = set(stopped), set(improved)  # membership per group: sets, not lists
     if p.cfg.backtrack:
         _backtrack(p, steps, [g for k, g in enumerate(active) if k in improved and k not in stopped],
                    [g for k, g in enumerate(active) if k not in improved and k not in stopped])  # fmt: skip
