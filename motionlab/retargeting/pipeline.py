@@ -58,6 +58,7 @@ from motionlab.retargeting import contacts, plausibility
 from motionlab.retargeting.checkpoint import Checkpoint
 from motionlab.retargeting.features import ClipFeatures, check_motion, clip_features
 from motionlab.retargeting.solver import SolverConfig, solve
+from motionlab.retargeting.terms import TO_SOURCE
 
 __all__ = [
     "METHODS",
@@ -288,6 +289,8 @@ class PreparedPair:
     floor : Tensor (1, T, 22) or None     the lowest height each joint of B may reach (L_floor,
         :mod:`.terms`): A's own joint heights scaled by ``r_y`` where A's joint is under the
         floor, else 0; metres
+    to_source : Tensor (1, T) or None     A's leg length / B's on every frame: the length-valued
+        terms (L_foot, L_contact, L_floor) measure B in A's units (:data:`.terms.TO_SOURCE`)
     """
 
     source: PreparedSource
@@ -298,6 +301,7 @@ class PreparedPair:
     root_height: torch.Tensor | None = None
     root_xz: torch.Tensor | None = None
     floor: torch.Tensor | None = None
+    to_source: torch.Tensor | None = None
 
 
 def prepare_source(
@@ -341,7 +345,8 @@ def prepare_pair(source: PreparedSource, target: Skeleton | Motion, root_mode: s
     root_xz = torch.as_tensor(root_pos[:, [0, 2]], dtype=dtype, device=device)[None]
     floor = np.minimum(0.0, r[1] * src.global_positions()[..., 1])  # A's depth under the floor, scaled
     floor = torch.as_tensor(floor, dtype=dtype, device=device)[None]
-    return PreparedPair(source, tgt, r, root_pos, offsets, height, root_xz, floor)
+    to_source = torch.full_like(height, humanoid.leg_length(src.skeleton) / humanoid.leg_length(tgt))
+    return PreparedPair(source, tgt, r, root_pos, offsets, height, root_xz, floor, to_source)
 
 
 def finish(
@@ -412,7 +417,7 @@ def solve_pair(checkpoint, pair: PreparedPair, solver: SolverConfig | None = Non
         yaw=src.yaw,
         planted=src.planted,
         fps=src.motion.fps,
-        inputs={"floor": pair.floor},
+        inputs={"floor": pair.floor, TO_SOURCE: pair.to_source},
     )
 
 

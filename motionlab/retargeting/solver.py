@@ -232,7 +232,8 @@ class SolverResult:
     history : dict of lists             per evaluated step: ``loss`` (L_iter), then one list per
                                         registered term (:mod:`.terms`): ``angle`` (L_angle),
                                         ``foot`` (L_foot, metres), ``contact`` (L_contact, m/s;
-                                        0 without contact labels), ``floor`` (L_floor, metres)…;
+                                        0 without contact labels), ``floor`` (L_floor, metres)…
+                                        (B's lengths in A's units with ``inputs[terms.TO_SOURCE]``);
                                         entry 0 is the starting point (after the projection, if any)
     stop_reason : str                   ``"threshold"``, ``"plateau"`` or ``"max_steps"``
     best_step : int                     the step whose latent is returned: the lowest ``L_iter``
@@ -628,7 +629,9 @@ def solve(
     fps : float or Tensor (N,), optional  frame rate of the sequences (needed by the contact term)
     inputs : dict of Tensor (N, T, ...), optional   per-sequence inputs of registered terms
         (:attr:`terms.TermInputs.extra`), e.g. ``"floor"`` (N, T, 22): the lowest height each
-        joint of B may reach, metres (without it L_floor keeps every joint above the floor)
+        joint of B may reach, metres (without it L_floor keeps every joint above the floor),
+        and ``terms.TO_SOURCE`` (N, T): A's leg length / B's, the unit of the length-valued
+        terms (without it: metres of B)
 
     Returns
     -------

@@ -46,6 +46,13 @@ L_floor is off by default (:data:`losses.FLOOR_DEFAULT`); switched on, its weigh
 the 4 foot joints, L_floor over the other 18, so a joint under the floor costs exactly what a foot
 under the ground costs in the paper's L_foot (the feet stay L_foot's alone). Where no joint goes under its allowed depth L_floor and its gradient are exactly 0, so
 the iteration's numbers are those without it.
+
+The three length-valued terms measure B in **A's units** when the solver is given
+``inputs[TO_SOURCE]`` (A's leg length / B's; :func:`motionlab.retargeting.pipeline.retarget` and
+``expand`` give it): a depth or a slide of B costs what the same fraction of the leg costs on A,
+so a small character's feet are held as firmly as a large one's, as the plausibility check
+(which measures in B's leg lengths) asks. On a target of A's size the numbers are the paper's.
+This is motionlab's choice; the paper states L_foot (eq. 17) without a unit.
 """
 
 from __future__ import annotations
@@ -65,10 +72,17 @@ __all__ = [
     "get",
     "unpadded",
     "PAPER_TERMS",
+    "TO_SOURCE",
 ]
 
 PAPER_TERMS = ("angle", "foot")
 """The two terms of the paper (eqs. 15–17); the others are motionlab's additions."""
+
+TO_SOURCE = "to_source"
+"""Key of :attr:`TermInputs.extra` holding A's leg length / B's, (1, T) (every frame the same).
+The length-valued built-in terms (L_foot, L_contact, L_floor) multiply their value by it, so they
+measure B in A's units: a target and the same target scaled by s get the same loss, and a target
+of A's size the paper's. Without it they measure in metres of B."""
 
 
 @dataclass(frozen=True)
@@ -200,19 +214,26 @@ def _angle(decoded, inputs: TermInputs):
     return losses.direction_loss(inputs.source, decoded.positions, inputs.frames)
 
 
+def in_source_units(value, inputs: TermInputs):
+    """A length-valued term's ``value`` in A's units: × ``inputs.extra[TO_SOURCE]`` (unchanged without it)."""
+    scale = inputs.extra.get(TO_SOURCE)
+    return value if scale is None else value * scale[0, 0]
+
+
 def _foot(decoded, inputs: TermInputs):
-    return losses.foot_loss(decoded.positions[..., 1] + inputs.root_height[..., None], inputs.frames)
+    value = losses.foot_loss(decoded.positions[..., 1] + inputs.root_height[..., None], inputs.frames)
+    return in_source_units(value, inputs)
 
 
 def _contact(decoded, inputs: TermInputs):
     feet = losses.feet_in_world(decoded.positions, inputs.root_world, inputs.yaw)
     planted = inputs.planted if inputs.frames is None else inputs.planted & inputs.frames[..., None]
-    return losses.contact_loss(feet, planted, inputs.fps)
+    return in_source_units(losses.contact_loss(feet, planted, inputs.fps), inputs)
 
 
 def _floor(decoded, inputs: TermInputs):
     heights = decoded.positions[..., 1] + inputs.root_height[..., None]
-    return losses.floor_loss(heights, inputs.extra.get("floor"), inputs.frames)
+    return in_source_units(losses.floor_loss(heights, inputs.extra.get("floor"), inputs.frames), inputs)
 
 
 register(

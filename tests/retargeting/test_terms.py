@@ -19,7 +19,8 @@ from motionlab import retargeting, synthetic
 from motionlab.cli import build_parser, main
 from motionlab.core import bvh, humanoid
 from motionlab.retargeting import expand as ex
-from motionlab.retargeting import losses, plots, terms
+from motionlab.retargeting import losses, plots, solver, terms
+from motionlab.retargeting.model import Decoded
 from motionlab.retargeting.solver import SolverConfig
 
 FAST = SolverConfig(max_steps=4)
@@ -141,6 +142,47 @@ def test_floor_changes_nothing_where_no_joint_goes_under(ckpt, clip):
         terms.register(floor)
     assert np.array_equal(with_floor.positions, without.positions)
     assert with_floor.history["loss"] == without.history["loss"]
+
+
+def test_the_length_terms_give_a_target_twice_as_large_the_same_values():
+    """The length-valued terms measure B in A's units (``terms.TO_SOURCE``): B's motion at twice
+    the size, with half the scale, costs the same; without the scale it costs twice as much."""
+    g = torch.Generator().manual_seed(0)
+    T = 12
+    rot = torch.nn.functional.normalize(torch.randn(1, T, 22, 4, generator=g, dtype=torch.float64), dim=-1)
+    pos = 0.3 * torch.randn(1, T, 22, 3, generator=g, dtype=torch.float64)
+    height = 0.2 + 0.05 * torch.rand(1, T, generator=g, dtype=torch.float64)
+    world = torch.randn(1, T, 3, generator=g, dtype=torch.float64)
+    yaw = torch.rand(1, T, generator=g, dtype=torch.float64)
+    planted = torch.rand(1, T, 4, generator=g) < 0.5
+    floor = -0.05 * torch.rand(1, T, 22, generator=g, dtype=torch.float64)
+    cfg = SolverConfig(weights={"floor": 1.0})
+
+    def values(k, scale):
+        extra = (
+            {"floor": k * floor}
+            if scale is None
+            else {"floor": k * floor, terms.TO_SOURCE: torch.full((1, T), scale, dtype=torch.float64)}
+        )
+        out = Decoded(rot, k * pos, rot, rot)
+        _, v = solver.sequence_terms(
+            rot, out, k * height, cfg, k * world, yaw, planted, torch.tensor([30.0], dtype=torch.float64), extra
+        )
+        return {name: float(v[name][0]) for name in ("foot", "contact", "floor")}
+
+    one, two = values(1.0, 0.8), values(2.0, 0.4)
+    assert min(one.values()) > 0  # every length term is compared, none is trivially 0
+    assert two == pytest.approx(one, rel=1e-12)
+    assert values(2.0, None) == pytest.approx({k: 2 * v / 0.8 for k, v in one.items()}, rel=1e-12)
+
+
+def test_without_the_scale_a_term_is_in_metres_of_b():
+    """``in_source_units`` multiplies by ``extra[TO_SOURCE]`` and leaves the value alone without it."""
+    value = torch.tensor(0.25, dtype=torch.float64)
+    plain = terms.TermInputs(None, "rotations", None)
+    scaled = terms.TermInputs(None, "rotations", None, extra={terms.TO_SOURCE: torch.full((1, 5), 2.0)})
+    assert float(terms.in_source_units(value, plain)) == 0.25
+    assert float(terms.in_source_units(value, scaled)) == 0.5
 
 
 # ----------------------------------------------------------------------------- the reported loss
