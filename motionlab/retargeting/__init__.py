@@ -5,7 +5,7 @@ proportions by optimising the network's latent code (weights frozen) so that joi
 match the source and the feet stay above the ground.
 
 * :mod:`.model` — F_enc, F_qlinear, F_skel, F_Δ, Hamilton correction and FK;
-* :mod:`.losses` — L_recon, L_angle, L_foot, L_contact, L_floor; :mod:`.terms` — the latent
+* :mod:`.losses` — L_recon, L_angle, L_foot, L_contact, L_floor, L_clear; :mod:`.terms` — the latent
   iteration's loss terms as named objects (the registry a new term joins);
 * :mod:`.devices` — the default torch device and its checks;
 * :mod:`.train` — training on one character; :mod:`.checkpoint` — save / load;

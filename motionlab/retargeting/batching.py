@@ -227,7 +227,11 @@ def solve_jobs(
         yaw=_stacked([j.source.yaw for j in jobs], T),
         planted=_stacked([j.source.planted for j in jobs], T),
         fps=torch.tensor([j.source.motion.fps for j in jobs], dtype=x.dtype, device=x.device),
-        inputs={"floor": _stacked([j.floor for j in jobs], T), TO_SOURCE: _stacked([j.to_source for j in jobs], T)},
+        inputs={
+            "floor": _stacked([j.floor for j in jobs], T),
+            TO_SOURCE: _stacked([j.to_source for j in jobs], T),
+            "clearance": _stacked([j.clearance for j in jobs], T),
+        },
         lengths=lengths,
     )
 

@@ -85,10 +85,12 @@ ABLATIONS: tuple[tuple, ...] = (
     ("full, without q_delta", "full", "stride", {"correction": False}),
     ("full, plain Adam", "full", "stride", {"backtrack": False}),
     ("full, rotations-only start", "full", "stride", {"project_lengths": False}),
+    ("full, without L_clear", "full", "stride", {"without": "clearance"}),
 )
 """The full method with one addition switched off: ``(label, method, root_mode, options)``, where
 ``options`` are :class:`SolverConfig` fields, ``correction=False`` (q_Δ replaced by the identity)
-or ``paper_terms=True`` (every loss term but the paper's two weighted 0: :data:`terms.PAPER_TERMS`)."""
+``paper_terms=True`` (every loss term but the paper's two weighted 0: :data:`terms.PAPER_TERMS`)
+or ``without=NAME`` (that registered term weighted 0)."""
 
 
 def rows_with_root(root_mode: str, ablations: bool = False) -> tuple[tuple, ...]:
@@ -282,8 +284,10 @@ def _run_row(row: tuple, source, target, checkpoint: Checkpoint | None, solver: 
     _, method, root_mode = row[:3]
     options = dict(row[3]) if len(row) > 3 else {}
     correction = options.pop("correction", True)
+    off = {options.pop("without"): 0.0} if "without" in options else {}
     if options.pop("paper_terms", False):
         off = {t.name: 0.0 for t in terms.registered() if t.name not in terms.PAPER_TERMS}
+    if off:
         options["weights"] = {**(solver or SolverConfig()).weights, **off}
     cfg = dataclasses.replace(solver or SolverConfig(), **options)
     model = checkpoint.model if checkpoint is not None else None

@@ -10,9 +10,10 @@ loss                   formula                                                  
 ``rotation_loss``      mean over frames and joints of 1 − ⟨q, q̂⟩²                   unitless
 ``contact_loss``       mean over planted frame pairs of fps·‖x_t+1 − x_t‖₂ (feet)   m/s
 ``floor_loss``         1/(18T) Σ_t Σ_{j ∉ feet} max(f_t,j − y_t,j, 0), f ≤ 0        metres
+``clearance_loss``     1/(4T) Σ_t Σ_{i ∈ feet} max(c_t,i − y_t,i, 0), c ≥ 0         metres
 =====================  ===========================================================  ==========
 
-The iteration's terms (L_angle, L_foot, L_contact, L_floor) are registered, with their weights,
+The iteration's terms (L_angle, L_foot, L_contact, L_floor, L_clear) are registered, with their weights,
 in :mod:`motionlab.retargeting.terms`; the λ constants here are theirs.
 
 **Our choice of θ (the paper leaves it open): the joint angles themselves**, i.e. each joint's
@@ -38,6 +39,10 @@ even when every joint position is right.
 ``floor_loss`` is *our addition* too: L_foot only sees the feet, so a hand, knee or head may go
 under the floor; L_floor keeps every joint at or above it, or no deeper than the source's own
 joint went (scaled to B: :func:`motionlab.retargeting.pipeline.prepare_pair`).
+
+``clearance_loss`` is *our addition* as well: while A's foot swings (not planted), B's foot joint
+should be at least as high as A's, scaled to B (``c``, :func:`motionlab.retargeting.pipeline.prepare_pair`),
+so that B's swinging feet clear the floor as A's do rather than skim it.
 
 Paper: Wang, Li, Xie and Jia 2023, eq. (8) (L_recon) and eqs. (15)–(17) (the iteration's losses, §2.2). Taught in ``notebooks/03_latent_iteration.ipynb``.
 """
@@ -66,6 +71,8 @@ __all__ = [
     "LAMBDA_CONTACT",
     "LAMBDA_FLOOR",
     "FLOOR_DEFAULT",
+    "clearance_loss",
+    "LAMBDA_CLEARANCE",
     "frame_mean",
 ]
 
@@ -87,6 +94,10 @@ FLOOR_DEFAULT = 0.0
 """The floor term's default weight: off. On the paper's Table 1 protocol it raises the full
 method's pose error above copying rotations (docs/results_retargeting.md, "L_floor"), so it is
 an opt-in (:data:`LAMBDA_FLOOR`)."""
+LAMBDA_CLEARANCE = LAMBDA_FOOT
+"""Weight of the clearance term (our addition): λ_foot, since both are a mean depth over the four
+foot joints: a swinging foot 1 cm below A's (scaled) height costs what a foot 1 cm under the
+ground does."""
 FOOT_JOINTS: tuple[int, ...] = tuple(humanoid.JOINTS.index(n) for n in humanoid.FEET)
 """Indices of LeftFoot, RightFoot, LeftToeBase, RightToeBase in the canonical skeleton."""
 
@@ -274,3 +285,27 @@ def floor_loss(
         )
     depth = -heights if allowed is None else allowed - heights
     return frame_mean(torch.relu(depth[..., list(_OTHER_JOINTS)]), frames)
+
+
+def clearance_loss(feet_y: torch.Tensor, allowed: torch.Tensor, frames: torch.Tensor | None = None) -> torch.Tensor:
+    """L_clear: mean over frames and the four foot joints of ``max(allowed − y, 0)``, metres.
+
+    Parameters
+    ----------
+    feet_y : Tensor (..., T, 4)    heights of LeftFoot, RightFoot, LeftToeBase, RightToeBase above
+        the floor, metres
+    allowed : Tensor (..., T, 4)   the lowest height each may reach (>= 0: A's own height, scaled,
+        while A's foot swings; 0 where it is planted)
+    frames : Tensor (..., T) of bool, optional   the frames that count (:func:`frame_mean`)
+
+    Exactly 0, with a zero gradient, where every foot joint is at or above its allowed height.
+
+    Raises
+    ------
+    ValueError unless both are (..., T, 4) of the same shape.
+    """
+    if feet_y.shape[-1] != len(FOOT_JOINTS) or allowed.shape != feet_y.shape:
+        raise ValueError(
+            f"clearance_loss: expected feet_y and allowed (..., T, 4), got {tuple(feet_y.shape)} and {tuple(allowed.shape)}"
+        )
+    return frame_mean(torch.relu(allowed - feet_y), frames)

@@ -57,6 +57,7 @@ from motionlab.core.skeleton import Skeleton
 from motionlab.retargeting import contacts, plausibility
 from motionlab.retargeting.checkpoint import Checkpoint
 from motionlab.retargeting.features import ClipFeatures, check_motion, clip_features
+from motionlab.retargeting.losses import FOOT_JOINTS
 from motionlab.retargeting.solver import SolverConfig, solve
 from motionlab.retargeting.terms import TO_SOURCE
 
@@ -290,7 +291,10 @@ class PreparedPair:
         :mod:`.terms`): A's own joint heights scaled by ``r_y`` where A's joint is under the
         floor, else 0; metres
     to_source : Tensor (1, T) or None     A's leg length / B's on every frame: the length-valued
-        terms (L_foot, L_contact, L_floor) measure B in A's units (:data:`.terms.TO_SOURCE`)
+        terms (L_foot, L_contact, L_floor, L_clear) measure B in A's units (:data:`.terms.TO_SOURCE`)
+    clearance : Tensor (1, T, 4) or None  the lowest height of each foot joint of B (L_clear,
+        :mod:`.terms`): A's own foot heights scaled by ``r_y`` (at least 0) while A's foot is not
+        planted, 0 where it is; metres
     """
 
     source: PreparedSource
@@ -302,6 +306,7 @@ class PreparedPair:
     root_xz: torch.Tensor | None = None
     floor: torch.Tensor | None = None
     to_source: torch.Tensor | None = None
+    clearance: torch.Tensor | None = None
 
 
 def prepare_source(
@@ -343,10 +348,13 @@ def prepare_pair(source: PreparedSource, target: Skeleton | Motion, root_mode: s
     offsets = torch.tensor(tgt.offsets, dtype=dtype, device=device)
     height = torch.as_tensor(root_pos[:, 1], dtype=dtype, device=device)[None]
     root_xz = torch.as_tensor(root_pos[:, [0, 2]], dtype=dtype, device=device)[None]
-    floor = np.minimum(0.0, r[1] * src.global_positions()[..., 1])  # A's depth under the floor, scaled
-    floor = torch.as_tensor(floor, dtype=dtype, device=device)[None]
+    heights = r[1] * src.global_positions()[..., 1]  # A's joint heights, scaled to B
+    floor = torch.as_tensor(np.minimum(0.0, heights), dtype=dtype, device=device)[None]  # A's depth under the floor
+    swing = ~source.planted[0].cpu().numpy()  # (T, 4): A's foot joints off the ground
+    clearance = np.where(swing, np.maximum(heights[:, list(FOOT_JOINTS)], 0.0), 0.0)
+    clearance = torch.as_tensor(clearance, dtype=dtype, device=device)[None]
     to_source = torch.full_like(height, humanoid.leg_length(src.skeleton) / humanoid.leg_length(tgt))
-    return PreparedPair(source, tgt, r, root_pos, offsets, height, root_xz, floor, to_source)
+    return PreparedPair(source, tgt, r, root_pos, offsets, height, root_xz, floor, to_source, clearance)
 
 
 def finish(
@@ -417,7 +425,7 @@ def solve_pair(checkpoint, pair: PreparedPair, solver: SolverConfig | None = Non
         yaw=src.yaw,
         planted=src.planted,
         fps=src.motion.fps,
-        inputs={"floor": pair.floor, TO_SOURCE: pair.to_source},
+        inputs={"floor": pair.floor, TO_SOURCE: pair.to_source, "clearance": pair.clearance},
     )
 
 

@@ -320,6 +320,7 @@ def plot_reconstruction(true_pos, pred_pos, joints: Sequence[str], fps: float | 
 _TITLES = {
     "contact": "contact loss: planted feet's speed (cm/s)",
     "floor": "floor loss: mean depth of the other joints below their limit (cm)",
+    "clearance": "clearance loss: mean depth of the swinging feet below A's (cm)",
 }
 _CENTI = {"m": "cm", "m/s": "cm/s"}
 

@@ -39,6 +39,8 @@ name          value                                                             
 ``contact``   L_contact (motionlab): speed of A's planted feet on B                    m/s     0.5
 ``floor``     L_floor (motionlab): the other 18 joints below the floor, beyond the     m       0 (off)
               source's own depth scaled to B (:func:`losses.floor_loss`)
+``clearance`` L_clear (motionlab): B's feet below A's (scaled) while A's foot swings    m       0.5
+              (:func:`losses.clearance_loss`; input ``extra["clearance"]``)
 ============  =======================================================================  ======  ======
 
 L_floor is off by default (:data:`losses.FLOOR_DEFAULT`); switched on, its weight is
@@ -47,7 +49,12 @@ the 4 foot joints, L_floor over the other 18, so a joint under the floor costs e
 under the ground costs in the paper's L_foot (the feet stay L_foot's alone). Where no joint goes under its allowed depth L_floor and its gradient are exactly 0, so
 the iteration's numbers are those without it.
 
-The three length-valued terms measure B in **A's units** when the solver is given
+L_clear keeps B's swinging feet as far off the floor as A's, scaled to B: without it, a foot that
+copies A's rotations on other proportions skims the floor through its swing (the ``skate``
+column of Table 1 counts such frames). Its weight is λ_foot's, by the same measure: a mean depth
+over the four foot joints. Where A's foot is planted, L_foot and L_contact rule alone.
+
+The four length-valued terms measure B in **A's units** when the solver is given
 ``inputs[TO_SOURCE]`` (A's leg length / B's; :func:`motionlab.retargeting.pipeline.retarget` and
 ``expand`` give it): a depth or a slide of B costs what the same fraction of the leg costs on A,
 so a small character's feet are held as firmly as a large one's, as the plausibility check
@@ -231,6 +238,11 @@ def _contact(decoded, inputs: TermInputs):
     return in_source_units(losses.contact_loss(feet, planted, inputs.fps), inputs)
 
 
+def _clearance(decoded, inputs: TermInputs):
+    feet = decoded.positions[..., list(losses.FOOT_JOINTS), 1] + inputs.root_height[..., None]
+    return in_source_units(losses.clearance_loss(feet, inputs.extra["clearance"], inputs.frames), inputs)
+
+
 def _floor(decoded, inputs: TermInputs):
     heights = decoded.positions[..., 1] + inputs.root_height[..., None]
     return in_source_units(losses.floor_loss(heights, inputs.extra.get("floor"), inputs.frames), inputs)
@@ -259,6 +271,17 @@ register(
         "m",
         (),
         "L_floor: every joint at or above the floor, or no deeper than the source's own (motionlab's addition)",
+        True,
+    )
+)
+register(
+    Term(
+        "clearance",
+        losses.LAMBDA_CLEARANCE,
+        _clearance,
+        "m",
+        ("clearance",),
+        "L_clear: swinging feet as high as the source's, scaled (motionlab's addition)",
         True,
     )
 )

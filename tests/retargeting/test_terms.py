@@ -220,10 +220,14 @@ def test_the_papers_two_losses_row_switches_every_other_term_off(monkeypatch):
     from motionlab.retargeting.cli_options import solver_config
 
     used = {}
-    monkeypatch.setattr(evaluate, "retarget", lambda *args: used.setdefault("cfg", args[4]))
+    monkeypatch.setattr(evaluate, "retarget", lambda *args: used.__setitem__("cfg", args[4]))
     cfg = solver_config(build_parser().parse_args(["evaluate", "--floor-weight", "3", "--angle-weight", "0.4"]))
     assert (cfg.weight("floor"), cfg.weight("angle"), cfg.weight("contact")) == (3.0, 0.4, 0.5)
     paper = next(r for r in evaluate.ABLATIONS if "paper" in r[0])
     evaluate._run_row(paper, None, None, None, cfg)
     weights = {t.name: used["cfg"].weight(t.name) for t in terms.registered()}
-    assert weights == {"angle": 0.4, "foot": 0.5, "contact": 0.0, "floor": 0.0}
+    assert weights == {"angle": 0.4, "foot": 0.5, "contact": 0.0, "floor": 0.0, "clearance": 0.0}
+    without = next(r for r in evaluate.ABLATIONS if "L_clear" in r[0])
+    evaluate._run_row(without, None, None, None, cfg)
+    weights = {t.name: used["cfg"].weight(t.name) for t in terms.registered()}
+    assert weights == {"angle": 0.4, "foot": 0.5, "contact": 0.5, "floor": 3.0, "clearance": 0.0}
