@@ -154,10 +154,21 @@ def _fidelity(ckpt, args):
             )
 
 
+def _window(motion, ckpt, frames: int = 120):
+    """``motion``'s first ``frames`` frames at the network's rate, the last frame repeated to fill them."""
+    from motionlab.core import preprocess
+
+    n = int(round(frames * motion.fps / ckpt.fps))
+    pad = lambda a: None if a is None else preprocess.pad_to(a, n)[:n]  # noqa: E731
+    return motion.copy(local_rot=pad(motion.local_rot), root_pos=pad(motion.root_pos), local_pos=pad(motion.local_pos))
+
+
 def _solve(ckpt, args):
-    from motionlab.core import bvh, preprocess
-    from motionlab.retargeting.pipeline import root_scale, source_contacts
-    from motionlab.retargeting.solver import SolverConfig, solve
+    """The latent iteration as ``motionlab retarget`` runs it (:func:`pipeline.solve_pair`, every
+    term's inputs), timed on 120-frame windows."""
+    from motionlab.core import bvh
+    from motionlab.retargeting.pipeline import prepare_pair, prepare_source, solve_pair
+    from motionlab.retargeting.solver import SolverConfig
 
     if args.synthetic:
         from motionlab import synthetic
@@ -174,36 +185,20 @@ def _solve(ckpt, args):
             humanoid.to_canonical_skeleton(bvh.load(root / t / "Running.bvh").skeleton) for t in DEFAULT_TARGETS[:3]
         ]
     cfg = SolverConfig()
-    times, steps, reasons = [], [], []
+    times, steps, reasons, frames = [], [], [], set()
     for src in sources:
-        c = preprocess.prepare(src, ckpt.fps)
-        f = clip_features(c)
-        x = ckpt.stats.normalize(preprocess.pad_to(f.x, 120)[:120])
-        rot = preprocess.pad_to(f.local_rot, 120)[:120]
-        planted = preprocess.pad_to(source_contacts(c), 120)[:120]
-        yaw = preprocess.pad_to(f.yaw, 120)[:120]
+        prepared = prepare_source(_window(src, ckpt), ckpt, "full", cfg)
+        frames.add(prepared.x.shape[1])
         for tgt in targets:
-            r = root_scale(c.skeleton, tgt)
-            root = preprocess.pad_to(c.root_pos * np.array([r[0], r[1], r[0]]), 120)[:120]
-            res = solve(
-                ckpt.model,
-                torch.tensor(x, dtype=ckpt.dtype)[None],
-                torch.tensor(rot, dtype=ckpt.dtype)[None],
-                torch.tensor(tgt.offsets, dtype=ckpt.dtype),
-                torch.tensor(root[:, 1], dtype=ckpt.dtype)[None],
-                cfg,
-                root_xz=torch.tensor(root[:, [0, 2]], dtype=ckpt.dtype)[None],
-                yaw=torch.tensor(yaw, dtype=ckpt.dtype)[None],
-                planted=torch.tensor(planted)[None],
-                fps=ckpt.fps,
-            )
+            res = solve_pair(ckpt, prepare_pair(prepared, tgt), cfg)
             times.append(res.seconds)
             steps.append(res.steps)
             reasons.append(res.stop_reason)
     med = statistics.median(times)
     print(
-        f"latent solver: {len(times)} windows of 120 frames, median {med:.3f} s (min {min(times):.3f}, max {max(times):.3f}), "
-        f"median {statistics.median(steps):.0f} steps ({1000 * sum(times) / max(sum(steps), 1):.1f} ms/step); "
+        f"latent solver: {len(times)} windows of {'/'.join(map(str, sorted(frames)))} frames, median {med:.3f} s "
+        f"(min {min(times):.3f}, max {max(times):.3f}), median {statistics.median(steps):.0f} steps "
+        f"({1000 * sum(times) / max(sum(steps), 1):.1f} ms/step); "
         f"stops: { {r: reasons.count(r) for r in sorted(set(reasons))} }  goal <= 1 s: {'met' if med <= 1.0 else 'MISSED'}"
     )
 

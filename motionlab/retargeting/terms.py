@@ -87,9 +87,10 @@ PAPER_TERMS = ("angle", "foot")
 
 TO_SOURCE = "to_source"
 """Key of :attr:`TermInputs.extra` holding A's leg length / B's, (1, T) (every frame the same).
-The length-valued built-in terms (L_foot, L_contact, L_floor) multiply their value by it, so they
-measure B in A's units: a target and the same target scaled by s get the same loss, and a target
-of A's size the paper's. Without it they measure in metres of B."""
+The length-valued built-in terms (L_foot, L_contact, L_floor, L_clear) multiply their value by
+it, so they measure B in A's units: a motion of B and the same motion scaled by s (on B scaled by
+s) cost the same, and on a target of A's size the values are the metres of the paper's terms.
+Without it they measure in metres of B."""
 
 
 @dataclass(frozen=True)

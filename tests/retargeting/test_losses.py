@@ -96,3 +96,16 @@ def test_angle_loss_is_two_sines_of_a_quarter_angle():
     b = tq.from_axis_angle(torch.tensor([0.0, 1.0, 0.0]), alpha).expand(1, 22, 4)
     assert float(angle_loss(a, b)) == pytest.approx(float(2 * torch.sin(alpha / 4)), rel=1e-5)
     assert float(angle_loss(a, -b)) == pytest.approx(float(2 * torch.sin(alpha / 4)), rel=1e-5)  # sign-blind
+
+
+def test_clearance_loss_is_the_mean_depth_of_the_feet_below_their_allowed_heights():
+    feet = torch.tensor([[[0.10, 0.00, 0.05, 0.20], [0.30, 0.30, 0.30, 0.30]]], dtype=torch.float64, requires_grad=True)
+    allowed = torch.tensor([[[0.15, 0.00, 0.00, 0.10], [0.0, 0.0, 0.0, 0.5]]], dtype=torch.float64)
+    value = losses.clearance_loss(feet, allowed)
+    assert float(value.detach()) == pytest.approx((0.05 + 0.20) / 8)
+    (grad,) = torch.autograd.grad(value, feet)
+    assert torch.count_nonzero(grad) == 2  # only the two joints below their height pull
+    above = losses.clearance_loss(feet.detach() + 1.0, allowed)
+    assert float(above) == 0.0
+    with pytest.raises(ValueError, match=r"\(\.\.\., T, 4\)"):
+        losses.clearance_loss(feet[..., :3], allowed[..., :3])

@@ -231,3 +231,23 @@ def test_the_papers_two_losses_row_switches_every_other_term_off(monkeypatch):
     evaluate._run_row(without, None, None, None, cfg)
     weights = {t.name: used["cfg"].weight(t.name) for t in terms.registered()}
     assert weights == {"angle": 0.4, "foot": 0.5, "contact": 0.5, "floor": 3.0, "clearance": 0.0}
+
+
+def test_the_clearance_input_is_the_sources_swinging_feet_scaled(ckpt, clip):
+    """``prepare_pair``'s L_clear input: r_y × A's foot heights (at least 0) where A's foot swings,
+    0 where it is planted; with it the iteration holds B's swinging feet up (``clearance`` falls)."""
+    from motionlab.retargeting import pipeline
+
+    src = pipeline.prepare_source(clip, ckpt, "full")
+    pair = pipeline.prepare_pair(src, _target(clip))
+    allowed = pair.clearance[0].numpy()
+    planted = src.planted[0].numpy()
+    heights = pair.root_scale[1] * src.motion.global_positions()[:, list(losses.FOOT_JOINTS), 1]
+    assert planted.any() and (~planted).any()
+    assert np.all(allowed[planted] == 0.0)
+    np.testing.assert_allclose(allowed[~planted], np.maximum(heights[~planted], 0.0))
+    short = retargeting.retarget(
+        clip, humanoid.scale_bones(clip.skeleton, legs=0.7), ckpt, "full", SolverConfig(max_steps=20)
+    )
+    history = short.history["clearance"]
+    assert history[0] > 0 and history[short.best_step] < history[0]
