@@ -53,7 +53,8 @@ def my_foot_weight_experiment(source, target_rig, ckpt):
     from motionlab.retargeting import plots
     from motionlab.retargeting.solver import SolverConfig
 
-    cfg = SolverConfig(init="encoder", lambda_contact=0.0, lr=0.1, lambda_foot=5.0)
+    paper_only = {"contact": 0.0, "clearance": 0.0}  # section 5's paper-like row: L_angle and L_foot alone
+    cfg = SolverConfig(init="encoder", lr=0.1, lambda_foot=5.0, weights=paper_only)
     run = retargeting.retarget(source, target_rig, ckpt, "full", cfg)
     src = preprocess.prepare(source, ckpt.fps, stand=True)
     return plots.joint_angle_errors(run.motion.local_rot, src.local_rot).mean()

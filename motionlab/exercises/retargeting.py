@@ -248,7 +248,7 @@ contact_loss = Exercise(
 
 # --------------------------------------------------------------------------- notebook 03, experiments
 _RUNS: dict = {}
-PAPER = {"init": "encoder", "lambda_contact": 0.0, "lr": 0.1}
+PAPER = {"init": "encoder", "lr": 0.1, "weights": {"contact": 0.0, "clearance": 0.0}}
 """The paper-like set-up in :class:`~motionlab.retargeting.solver.SolverConfig` terms (section 5 of notebook 03)."""
 
 
@@ -281,7 +281,7 @@ def _measure(source, target, checkpoint, what: str, **settings) -> float:
 
 def _paper_angle(source, target, checkpoint, lambda_foot: float = 5.0, paper: bool = True, degrees: bool = True):
     """Mean angle (degrees) between A's rotations and the full method's, in the paper-like set-up
-    (encoder start, no contact term, lr 0.1) or motionlab's, for ``lambda_foot``."""
+    (encoder start, no foot terms of motionlab's, lr 0.1) or motionlab's, for ``lambda_foot``."""
     settings = dict(PAPER, lambda_foot=lambda_foot) if paper else {"lambda_foot": lambda_foot}
     value = _measure(source, target, checkpoint, "angle", **settings)
     return value if degrees else float(np.radians(value))
@@ -295,12 +295,12 @@ encoder_start = Question(
     mistakes=[
         Mistake(
             lambda source, target, ckpt: _measure(source, target, ckpt, "angle", init="encoder", lr=0.1),
-            "that is section 5's row 'encoder start + contact term', which also sets lr=0.1; change "
+            "that is section 5's row 'encoder start + foot terms', which also sets lr=0.1; change "
             "only the start: SolverConfig(init='encoder').",
         ),
         Mistake(
             lambda source, target, ckpt: _measure(source, target, ckpt, "angle", **PAPER),
-            "that is the paper-like set-up (no contact term, lr=0.1); keep motionlab's other settings.",
+            "that is the paper-like set-up (no foot terms, lr=0.1); keep motionlab's other settings.",
         ),
         Mistake(
             lambda source, target, ckpt: _measure(source, target, ckpt, "angle"),
@@ -353,8 +353,8 @@ foot_weight = Question(
         ),
         Mistake(
             lambda source, target, ckpt: _paper_angle(source, target, ckpt, 5.0, paper=False),
-            "that is motionlab's set-up (Gauss–Newton start, contact term); the paper's is "
-            "SolverConfig(init='encoder', lambda_contact=0.0, lr=0.1, lambda_foot=5.0).",
+            "that is motionlab's set-up (Gauss–Newton start, foot terms); the paper's is section 5's "
+            "SolverConfig(init='encoder', lr=0.1, weights=paper_only) with lambda_foot=5.0.",
         ),
         Mistake(
             lambda source, target, ckpt: _paper_angle(source, target, ckpt, 5.0, degrees=False),
