@@ -38,11 +38,12 @@ from motionlab.retargeting.pipeline import (
     PreparedSource,
     RetargetResult,
     finish,
+    length_scale,
     prepare_pair,
     prepare_source,
 )
 from motionlab.retargeting.solver import SolverConfig, SolverResult, solve_many
-from motionlab.retargeting.terms import TO_SOURCE
+from motionlab.retargeting.terms import LENGTH_SCALE
 
 __all__ = [
     "BYTES_PER_FRAME",
@@ -229,7 +230,7 @@ def solve_jobs(
         fps=torch.tensor([j.source.motion.fps for j in jobs], dtype=x.dtype, device=x.device),
         inputs={
             "floor": _stacked([j.floor for j in jobs], T),
-            TO_SOURCE: _stacked([j.to_source for j in jobs], T),
+            LENGTH_SCALE: _stacked([length_scale(checkpoint, j) for j in jobs], T),
             "clearance": _stacked([j.clearance for j in jobs], T),
         },
         lengths=lengths,

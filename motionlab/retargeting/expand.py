@@ -121,7 +121,7 @@ COLUMNS = columns()
 """Manifest columns (with the built-in loss terms; :func:`columns` follows the registry): ``status``
 is ``ok`` or ``error``; ``loss`` the returned (best) iterate's L_iter, then each term's value there
 (``angle`` L_angle, ``foot`` L_foot in metres, ``contact`` L_contact in m/s, ``floor`` L_floor in
-metres, …; lengths of B in A's units, :data:`~motionlab.retargeting.terms.TO_SOURCE`); ``seconds`` the pair's share of its batch's wall time;
+metres, …; lengths of B at the network's character's scale, :data:`~motionlab.retargeting.terms.LENGTH_SCALE`); ``seconds`` the pair's share of its batch's wall time;
 ``flag`` lists the quality thresholds exceeded (``penetration``, ``skating``) and the failed
 plausibility tests (``implausible_foot``, ``_floor``, ``_hips``, ``_bones``), empty if none; ``fps`` the
 output's frame rate; the ``*_sha256`` columns key resumption (module docstring)."""

@@ -59,7 +59,7 @@ from motionlab.retargeting.checkpoint import Checkpoint
 from motionlab.retargeting.features import ClipFeatures, check_motion, clip_features
 from motionlab.retargeting.losses import FOOT_JOINTS
 from motionlab.retargeting.solver import SolverConfig, solve
-from motionlab.retargeting.terms import TO_SOURCE
+from motionlab.retargeting.terms import LENGTH_SCALE
 
 __all__ = [
     "METHODS",
@@ -75,6 +75,7 @@ __all__ = [
     "prepare_pair",
     "finish",
     "solve_pair",
+    "length_scale",
     "source_contacts",
     "contact_stride",
     "at_rate",
@@ -290,8 +291,6 @@ class PreparedPair:
     floor : Tensor (1, T, 22) or None     the lowest height each joint of B may reach (L_floor,
         :mod:`.terms`): A's own joint heights scaled by ``r_y`` where A's joint is under the
         floor, else 0; metres
-    to_source : Tensor (1, T) or None     A's leg length / B's on every frame: the length-valued
-        terms (L_foot, L_contact, L_floor, L_clear) measure B in A's units (:data:`.terms.TO_SOURCE`)
     clearance : Tensor (1, T, 4) or None  the lowest height of each foot joint of B (L_clear,
         :mod:`.terms`): A's own foot heights scaled by ``r_y`` (at least 0) while A's foot is not
         planted, 0 where it is; metres
@@ -305,7 +304,6 @@ class PreparedPair:
     root_height: torch.Tensor | None = None
     root_xz: torch.Tensor | None = None
     floor: torch.Tensor | None = None
-    to_source: torch.Tensor | None = None
     clearance: torch.Tensor | None = None
 
 
@@ -353,8 +351,7 @@ def prepare_pair(source: PreparedSource, target: Skeleton | Motion, root_mode: s
     swing = ~source.planted[0].cpu().numpy()  # (T, 4): A's foot joints off the ground
     clearance = np.where(swing, np.maximum(heights[:, list(FOOT_JOINTS)], 0.0), 0.0)
     clearance = torch.as_tensor(clearance, dtype=dtype, device=device)[None]
-    to_source = torch.full_like(height, humanoid.leg_length(src.skeleton) / humanoid.leg_length(tgt))
-    return PreparedPair(source, tgt, r, root_pos, offsets, height, root_xz, floor, to_source, clearance)
+    return PreparedPair(source, tgt, r, root_pos, offsets, height, root_xz, floor, clearance)
 
 
 def finish(
@@ -405,6 +402,13 @@ def at_rate(result: RetargetResult, fps: float, source_fps: float) -> RetargetRe
     return replace(result, motion=motion, positions=motion.global_positions(), resampled=note)
 
 
+def length_scale(checkpoint: Checkpoint, pair: PreparedPair) -> torch.Tensor:
+    """(1, T): the network's character's leg length / B's on every frame (:data:`.terms.LENGTH_SCALE`)."""
+    return torch.full_like(
+        pair.root_height, humanoid.leg_length(checkpoint.skeleton) / humanoid.leg_length(pair.target)
+    )
+
+
 def solve_pair(checkpoint, pair: PreparedPair, solver: SolverConfig | None = None, callback=None, progress=None):
     """The latent iteration of the full method on one prepared pair: :func:`solver.solve` with the
     pair's source features, target offsets, root height and ground path, A's heading and contacts.
@@ -425,7 +429,7 @@ def solve_pair(checkpoint, pair: PreparedPair, solver: SolverConfig | None = Non
         yaw=src.yaw,
         planted=src.planted,
         fps=src.motion.fps,
-        inputs={"floor": pair.floor, TO_SOURCE: pair.to_source, "clearance": pair.clearance},
+        inputs={"floor": pair.floor, "clearance": pair.clearance, LENGTH_SCALE: length_scale(checkpoint, pair)},
     )
 
 

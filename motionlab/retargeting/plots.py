@@ -333,7 +333,8 @@ def plot_iteration(history: Mapping[str, Sequence[float]], axes=None, title: str
     history : a solver history (:attr:`SolverResult.history`): ``loss`` (L_iter), ``angle``
         (L_angle), ``foot`` (L_foot, metres) and one list per other registered loss term
         (:mod:`motionlab.retargeting.terms`: ``contact`` in m/s, ``floor`` in metres, …; lengths
-        of B in A's units where the solver had :data:`~motionlab.retargeting.terms.TO_SOURCE`)
+        of B at the network's character's scale where the solver had
+        :data:`~motionlab.retargeting.terms.LENGTH_SCALE`)
     axes : two Axes, plus one per other term shown; None: a new figure
     title : suptitle
     config : the :class:`~motionlab.retargeting.solver.SolverConfig` of the run (default: the

@@ -233,7 +233,8 @@ class SolverResult:
                                         registered term (:mod:`.terms`): ``angle`` (L_angle),
                                         ``foot`` (L_foot, metres), ``contact`` (L_contact, m/s;
                                         0 without contact labels), ``floor`` (L_floor, metres)…
-                                        (B's lengths in A's units with ``inputs[terms.TO_SOURCE]``);
+                                        (B's lengths at the network's character's scale with
+                                        ``inputs[terms.LENGTH_SCALE]``);
                                         entry 0 is the starting point (after the projection, if any)
     stop_reason : str                   ``"threshold"``, ``"plateau"`` or ``"max_steps"``
     best_step : int                     the step whose latent is returned: the lowest ``L_iter``
@@ -630,8 +631,8 @@ def solve(
     inputs : dict of Tensor (N, T, ...), optional   per-sequence inputs of registered terms
         (:attr:`terms.TermInputs.extra`), e.g. ``"floor"`` (N, T, 22): the lowest height each
         joint of B may reach, metres (without it L_floor keeps every joint above the floor),
-        and ``terms.TO_SOURCE`` (N, T): A's leg length / B's, the unit of the length-valued
-        terms (without it: metres of B)
+        and ``terms.LENGTH_SCALE`` (N, T): the network's character's leg length / B's, the unit
+        of the length-valued terms (without it: metres of B)
 
     Returns
     -------

@@ -54,12 +54,14 @@ copies A's rotations on other proportions skims the floor through its swing (the
 column of Table 1 counts such frames). Its weight is λ_foot's, by the same measure: a mean depth
 over the four foot joints. Where A's foot is planted, L_foot and L_contact rule alone.
 
-The four length-valued terms measure B in **A's units** when the solver is given
-``inputs[TO_SOURCE]`` (A's leg length / B's; :func:`motionlab.retargeting.pipeline.retarget` and
-``expand`` give it): a depth or a slide of B costs what the same fraction of the leg costs on A,
-so a small character's feet are held as firmly as a large one's, as the plausibility check
-(which measures in B's leg lengths) asks. On a target of A's size the numbers are the paper's.
-This is motionlab's choice; the paper states L_foot (eq. 17) without a unit.
+The four length-valued terms measure B **at the scale of the network's own character** when the
+solver is given ``inputs[LENGTH_SCALE]`` (that character's leg length / B's, from the checkpoint's
+skeleton; :func:`motionlab.retargeting.pipeline.retarget` and ``expand`` give it): a depth or a
+slide of B costs what the same fraction of the leg costs on the character the weights were set
+for, so a small character's feet are held as firmly as a large one's, as the plausibility check
+(which measures in B's leg lengths) asks, whatever the unit of the source's or the target's file.
+On a target of that character's size the numbers are the paper's. This is motionlab's choice;
+the paper states L_foot (eq. 17) without a unit.
 """
 
 from __future__ import annotations
@@ -79,18 +81,19 @@ __all__ = [
     "get",
     "unpadded",
     "PAPER_TERMS",
-    "TO_SOURCE",
+    "LENGTH_SCALE",
+    "at_training_scale",
 ]
 
 PAPER_TERMS = ("angle", "foot")
 """The two terms of the paper (eqs. 15–17); the others are motionlab's additions."""
 
-TO_SOURCE = "to_source"
-"""Key of :attr:`TermInputs.extra` holding A's leg length / B's, (1, T) (every frame the same).
-The length-valued built-in terms (L_foot, L_contact, L_floor, L_clear) multiply their value by
-it, so they measure B in A's units: a motion of B and the same motion scaled by s (on B scaled by
-s) cost the same, and on a target of A's size the values are the metres of the paper's terms.
-Without it they measure in metres of B."""
+LENGTH_SCALE = "length_scale"
+"""Key of :attr:`TermInputs.extra` holding the network's character's leg length / B's, (1, T)
+(every frame the same). The length-valued built-in terms (L_foot, L_contact, L_floor, L_clear)
+multiply their value by it, so they measure B at that character's scale: a motion of B and the
+same motion scaled by s (on B scaled by s) cost the same, and on a target of that character's
+size the values are metres. Without it they measure in metres of B."""
 
 
 @dataclass(frozen=True)
@@ -222,31 +225,32 @@ def _angle(decoded, inputs: TermInputs):
     return losses.direction_loss(inputs.source, decoded.positions, inputs.frames)
 
 
-def in_source_units(value, inputs: TermInputs):
-    """A length-valued term's ``value`` in A's units: × ``inputs.extra[TO_SOURCE]`` (unchanged without it)."""
-    scale = inputs.extra.get(TO_SOURCE)
+def at_training_scale(value, inputs: TermInputs):
+    """A length-valued term's ``value`` at the network's character's scale: × ``inputs.extra[LENGTH_SCALE]``
+    (unchanged without it)."""
+    scale = inputs.extra.get(LENGTH_SCALE)
     return value if scale is None else value * scale[0, 0]
 
 
 def _foot(decoded, inputs: TermInputs):
     value = losses.foot_loss(decoded.positions[..., 1] + inputs.root_height[..., None], inputs.frames)
-    return in_source_units(value, inputs)
+    return at_training_scale(value, inputs)
 
 
 def _contact(decoded, inputs: TermInputs):
     feet = losses.feet_in_world(decoded.positions, inputs.root_world, inputs.yaw)
     planted = inputs.planted if inputs.frames is None else inputs.planted & inputs.frames[..., None]
-    return in_source_units(losses.contact_loss(feet, planted, inputs.fps), inputs)
+    return at_training_scale(losses.contact_loss(feet, planted, inputs.fps), inputs)
 
 
 def _clearance(decoded, inputs: TermInputs):
     feet = decoded.positions[..., list(losses.FOOT_JOINTS), 1] + inputs.root_height[..., None]
-    return in_source_units(losses.clearance_loss(feet, inputs.extra["clearance"], inputs.frames), inputs)
+    return at_training_scale(losses.clearance_loss(feet, inputs.extra["clearance"], inputs.frames), inputs)
 
 
 def _floor(decoded, inputs: TermInputs):
     heights = decoded.positions[..., 1] + inputs.root_height[..., None]
-    return in_source_units(losses.floor_loss(heights, inputs.extra.get("floor"), inputs.frames), inputs)
+    return at_training_scale(losses.floor_loss(heights, inputs.extra.get("floor"), inputs.frames), inputs)
 
 
 register(

@@ -145,8 +145,8 @@ def test_floor_changes_nothing_where_no_joint_goes_under(ckpt, clip):
 
 
 def test_the_length_terms_give_a_target_twice_as_large_the_same_values():
-    """The length-valued terms measure B in A's units (``terms.TO_SOURCE``): B's motion at twice
-    the size, with half the scale, costs the same; without the scale it costs twice as much."""
+    """The length-valued terms measure B at the network's character's scale (``terms.LENGTH_SCALE``):
+    B's motion at twice the size, with half the scale, costs the same; without it, twice as much."""
     g = torch.Generator().manual_seed(0)
     T = 12
     rot = torch.nn.functional.normalize(torch.randn(1, T, 22, 4, generator=g, dtype=torch.float64), dim=-1)
@@ -162,7 +162,7 @@ def test_the_length_terms_give_a_target_twice_as_large_the_same_values():
         extra = (
             {"floor": k * floor}
             if scale is None
-            else {"floor": k * floor, terms.TO_SOURCE: torch.full((1, T), scale, dtype=torch.float64)}
+            else {"floor": k * floor, terms.LENGTH_SCALE: torch.full((1, T), scale, dtype=torch.float64)}
         )
         out = Decoded(rot, k * pos, rot, rot)
         _, v = solver.sequence_terms(
@@ -177,12 +177,12 @@ def test_the_length_terms_give_a_target_twice_as_large_the_same_values():
 
 
 def test_without_the_scale_a_term_is_in_metres_of_b():
-    """``in_source_units`` multiplies by ``extra[TO_SOURCE]`` and leaves the value alone without it."""
+    """``at_training_scale`` multiplies by ``extra[LENGTH_SCALE]`` and leaves the value alone without it."""
     value = torch.tensor(0.25, dtype=torch.float64)
     plain = terms.TermInputs(None, "rotations", None)
-    scaled = terms.TermInputs(None, "rotations", None, extra={terms.TO_SOURCE: torch.full((1, 5), 2.0)})
-    assert float(terms.in_source_units(value, plain)) == 0.25
-    assert float(terms.in_source_units(value, scaled)) == 0.5
+    scaled = terms.TermInputs(None, "rotations", None, extra={terms.LENGTH_SCALE: torch.full((1, 5), 2.0)})
+    assert float(terms.at_training_scale(value, plain)) == 0.25
+    assert float(terms.at_training_scale(value, scaled)) == 0.5
 
 
 # ----------------------------------------------------------------------------- the reported loss
