@@ -354,7 +354,7 @@ def test_foot_weight_experiment(retarget_pair):
         return plots.joint_angle_errors(run.motion.local_rot, src.local_rot).mean()
 
     wrong = {  # value -> a phrase of the hint it must get
-        "0.5": angle(SolverConfig(init="encoder", lambda_contact=0.0, lr=0.1)),
+        "0.5": angle(SolverConfig(init="encoder", lr=0.1, weights={"contact": 0.0, "clearance": 0.0})),
         "motionlab's set-up": angle(SolverConfig(lambda_foot=5.0)),
         "radians": np.radians(answer),
     }
@@ -423,7 +423,7 @@ def test_encoder_start_experiment(running_pair):
     assert angle > default_angle + 0.1, "without the Gauss-Newton start the result ends further from A's angles"
     wrong = {
         "lr=0.1": _full_method_numbers(*running_pair, init="encoder", lr=0.1)[0],
-        "paper-like set-up": _full_method_numbers(*running_pair, init="encoder", lambda_contact=0.0, lr=0.1)[0],
+        "paper-like set-up": _full_method_numbers(*running_pair, **exercises.retargeting.PAPER)[0],
         "default run": default_angle,
         "radians": np.radians(angle),
     }
@@ -896,7 +896,7 @@ def test_the_angle_checks_measure_as_notebook_03_does():
     target = bvh.load(data.clip_path("mixamo", "Mousey_m", "Run_Arc_Left")).skeleton
     ckpt = retargeting.load_default()
     run = retargeting.retarget(
-        source, target, ckpt, "full", SolverConfig(init="encoder", lambda_contact=0.0, lr=0.1, lambda_foot=5.0)
+        source, target, ckpt, "full", SolverConfig(**dict(exercises.retargeting.PAPER, lambda_foot=5.0))
     )
     src = preprocess.prepare(source, ckpt.fps, stand=True)  # notebook 03, section 1
     as_section_5 = float(plots.joint_angle_errors(run.motion.local_rot, src.local_rot).mean())
