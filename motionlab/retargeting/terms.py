@@ -31,17 +31,17 @@ average over those alone (:func:`losses.frame_mean`). A term declares that it do
 
 The built-in terms, in order:
 
-============  =======================================================================  ======  ======
-name          value                                                                    unit    weight
-============  =======================================================================  ======  ======
-``angle``     L_angle (eq. 16): A's joint angles vs B's (:func:`losses.angle_loss`)    —       0.3
-``foot``      L_foot (eq. 17): the feet below the ground (:func:`losses.foot_loss`)     m       0.5
-``contact``   L_contact (motionlab): speed of A's planted feet on B                    m/s     0.5
-``floor``     L_floor (motionlab): the other 18 joints below the floor, beyond the     m       0 (off)
-              source's own depth scaled to B (:func:`losses.floor_loss`)
-``clearance`` L_clear (motionlab): B's feet below A's (scaled) while A's foot swings    m       0.5
-              (:func:`losses.clearance_loss`; input ``extra["clearance"]``)
-============  =======================================================================  ======  ======
+==============  =======================================================================  ======  ======
+name            value                                                                    unit    weight
+==============  =======================================================================  ======  ======
+``angle``       L_angle (eq. 16): A's joint angles vs B's (:func:`losses.angle_loss`)    —       0.3
+``foot``        L_foot (eq. 17): the feet below the ground (:func:`losses.foot_loss`)    m       0.5
+``contact``     L_contact (motionlab): speed of A's planted feet on B                    m/s     0.5
+``floor``       L_floor (motionlab): the other 18 joints below the floor, beyond the     m       0 (off)
+                source's own depth scaled to B (:func:`losses.floor_loss`)
+``clearance``   L_clear (motionlab): B's feet below A's (scaled) while A's foot swings   m       0.5
+                (:func:`losses.clearance_loss`; input ``extra["clearance"]``)
+==============  =======================================================================  ======  ======
 
 L_floor is off by default (:data:`losses.FLOOR_DEFAULT`); switched on, its weight is
 λ_foot × 18 / 4 = 2.25 (:data:`losses.LAMBDA_FLOOR`, ``--floor-weight 2.25``): L_foot is a mean over
