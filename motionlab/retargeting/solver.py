@@ -136,8 +136,9 @@ class SolverConfig:
                            ``min_delta`` of the best loss (0: never)
     min_delta : float
     lambda_angle, lambda_foot : float   loss weights (paper: 0.3 and 0.5)
-    lambda_contact : float weight of the contact term (ours; 0: the paper's two losses); used
-                           when :func:`solve` is given contact labels
+    lambda_contact : float weight of the contact term (ours; 0: off); used when :func:`solve`
+                           is given contact labels. The paper's two losses alone also need
+                           ``weights={"clearance": 0.0}`` (:mod:`.terms`)
     init : str             ``"project"`` (least-squares first step onto A's rotations) or
                            ``"encoder"`` (φ₀ = F_enc(X_A), the paper); ``"auto"`` (default): project
                            for ``theta="rotations"``, the encoder for ``"directions"``
