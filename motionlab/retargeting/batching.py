@@ -38,12 +38,11 @@ from motionlab.retargeting.pipeline import (
     PreparedSource,
     RetargetResult,
     finish,
-    length_scale,
     prepare_pair,
     prepare_source,
+    term_inputs,
 )
 from motionlab.retargeting.solver import SolverConfig, SolverResult, solve_many
-from motionlab.retargeting.terms import LENGTH_SCALE
 
 __all__ = [
     "BYTES_PER_FRAME",
@@ -214,6 +213,7 @@ def solve_jobs(
     Raises ``ValueError`` (from ``solve_many``) when the lengths differ and a registered term does
     not honour padded frames (:func:`motionlab.retargeting.terms.unpadded`).
     """
+    inputs = [term_inputs(checkpoint, j) for j in jobs]
     lengths = [j.source.x.shape[1] for j in jobs]
     T = max(lengths)
     x = _stacked([j.source.x for j in jobs], T)
@@ -228,11 +228,7 @@ def solve_jobs(
         yaw=_stacked([j.source.yaw for j in jobs], T),
         planted=_stacked([j.source.planted for j in jobs], T),
         fps=torch.tensor([j.source.motion.fps for j in jobs], dtype=x.dtype, device=x.device),
-        inputs={
-            "floor": _stacked([j.floor for j in jobs], T),
-            LENGTH_SCALE: _stacked([length_scale(checkpoint, j) for j in jobs], T),
-            "clearance": _stacked([j.clearance for j in jobs], T),
-        },
+        inputs={key: _stacked([i[key] for i in inputs], T) for key in inputs[0]},
         lengths=lengths,
     )
 

@@ -75,7 +75,7 @@ __all__ = [
     "prepare_pair",
     "finish",
     "solve_pair",
-    "length_scale",
+    "term_inputs",
     "source_contacts",
     "contact_stride",
     "at_rate",
@@ -402,11 +402,12 @@ def at_rate(result: RetargetResult, fps: float, source_fps: float) -> RetargetRe
     return replace(result, motion=motion, positions=motion.global_positions(), resampled=note)
 
 
-def length_scale(checkpoint: Checkpoint, pair: PreparedPair) -> torch.Tensor:
-    """(1, T): the network's character's leg length / B's on every frame (:data:`.terms.LENGTH_SCALE`)."""
-    return torch.full_like(
-        pair.root_height, humanoid.leg_length(checkpoint.skeleton) / humanoid.leg_length(pair.target)
-    )
+def term_inputs(checkpoint: Checkpoint, pair: PreparedPair) -> dict[str, torch.Tensor]:
+    """The pair's inputs of the registered terms (:attr:`.terms.TermInputs.extra`), each (1, T, ...):
+    ``floor``, ``clearance`` and :data:`.terms.LENGTH_SCALE` (the network's character's leg
+    length / B's on every frame)."""
+    scale = humanoid.leg_length(checkpoint.skeleton) / humanoid.leg_length(pair.target)
+    return {"floor": pair.floor, "clearance": pair.clearance, LENGTH_SCALE: torch.full_like(pair.root_height, scale)}
 
 
 def solve_pair(checkpoint, pair: PreparedPair, solver: SolverConfig | None = None, callback=None, progress=None):
@@ -429,7 +430,7 @@ def solve_pair(checkpoint, pair: PreparedPair, solver: SolverConfig | None = Non
         yaw=src.yaw,
         planted=src.planted,
         fps=src.motion.fps,
-        inputs={"floor": pair.floor, "clearance": pair.clearance, LENGTH_SCALE: length_scale(checkpoint, pair)},
+        inputs=term_inputs(checkpoint, pair),
     )
 
 
