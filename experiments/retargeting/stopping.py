@@ -79,10 +79,13 @@ def main(argv=None) -> None:
     args = ap.parse_args(argv)
     rules = {k: RULES[k] for k in dict.fromkeys(["all steps", *args.rules])}
     warnings.simplefilter("ignore", UserWarning)
-    root = data.data_root()
-    ckpt = retargeting.load_real("cpu", progress=False)
-    sources = [clip(root / rel, args.seconds) for rel in (BUILD if args.set == "build" else CHECK)]
-    targets = [bvh.load(root / "mixamo" / t / "Running.bvh") for t in TARGETS]
+    try:
+        root = data.data_root()
+        sources = [clip(root / rel, args.seconds) for rel in (BUILD if args.set == "build" else CHECK)]
+        targets = [bvh.load(root / "mixamo" / t / "Running.bvh") for t in TARGETS]
+        ckpt = retargeting.load_real("cpu", progress=False)
+    except (data.DataNotFound, OSError, ValueError) as e:  # bvh.BVHError is a ValueError
+        raise SystemExit(f"stopping: {e}") from None
     rows = {name: [] for name in rules}
     for s in sources:
         for t in targets:

@@ -38,7 +38,7 @@ then says what the source says, and Adam only has to trade that against the foot
 In its smoothed rounds the same least squares also pulls each raw quaternion ``W φ + b``
 towards its encoder-start length, at least 1, which the rotations do not see: a raw quaternion
 shortened almost to zero makes its rotation swing under the smallest step of Adam (the exact
-rounds fit the rotations alone and may shorten it again, far less). ``init="encoder"`` starts from ``F_enc(X_A)`` as the paper does.
+rounds fit the rotations alone and may shorten it again). ``init="encoder"`` starts from ``F_enc(X_A)`` as the paper does.
 
 **Backtracking (``backtrack``).** A step that does not lower ``L_iter`` is undone, and Adam
 starts again from the best iterate with half the step size; a step that does lowers it lets the
@@ -389,7 +389,7 @@ def project_latent(
         :data:`MIN_RAW_LENGTH` where that is shorter: 22 more residuals per frame. The rotations do
         not see these lengths, and smoothed steps can shorten a raw quaternion almost to zero, where
         the next small change of φ turns its rotation far (a bad start for Adam). The exact rounds
-        then fit the rotations alone (and may shorten it again, far less)
+        then fit the rotations alone (and may shorten it again)
 
     Returns
     -------

@@ -49,10 +49,9 @@ the 4 foot joints, L_floor over the other 18, so a joint under the floor costs e
 under the ground costs in the paper's L_foot (the feet stay L_foot's alone). Where no joint goes under its allowed depth L_floor and its gradient are exactly 0, so
 the iteration's numbers are those without it.
 
-L_clear keeps B's swinging feet as far off the floor as A's, scaled to B: without it, a foot that
-copies A's rotations on other proportions skims the floor through its swing (the ``skate``
-column of Table 1 counts such frames). Its weight is λ_foot's, by the same measure: a mean depth
-over the four foot joints. Where A's foot is planted, L_foot and L_contact rule alone.
+L_clear keeps B's swinging feet at least as far off the floor as A's, scaled to B (why:
+``docs/results_retargeting.md``). Its weight is λ_foot's, by the same measure: a mean depth over
+the four foot joints. Where A's foot is planted, L_foot and L_contact rule alone.
 
 The four length-valued terms measure B **at the scale of the network's own character** when the
 solver is given ``inputs[LENGTH_SCALE]`` (that character's leg length / B's, from the checkpoint's
