@@ -5,8 +5,10 @@
 Retargets Table 1's 60 pairs (Aj's 10 animations onto the six characters) with the full method and
 the network trained on real motion (``retargeting.load_real``), and prints per target character:
 
-* ``toe stands``: the height (cm) of B's toe joints when B stands (its canonical standing pose:
-  the sole on the floor, so the joint sits above it);
+* ``sole``: the height (cm) of B's toe joints when B stands, read from its rest root offset
+  (:func:`motionlab.core.rest_pose.sole_height`), and ``planted toe``: the median height of the
+  toe joints over the frames where Mixamo's own clips plant them (the contact detector's labels):
+  the check that the rest offset says where the rig's own takes put the floor;
 * ``lowest toe``: the lowest toe joint over the 10 clips, in Mixamo's own clips (the ground
   truth) and in motionlab's output;
 * the skating column's two factors: frames (foot joints × frame pairs) below its 5 cm window
@@ -24,7 +26,7 @@ import warnings
 import numpy as np
 
 from motionlab import data, retargeting
-from motionlab.core import bvh, humanoid, preprocess
+from motionlab.core import bvh, contacts, humanoid, preprocess, rest_pose
 from motionlab.core.motion import Motion
 from motionlab.retargeting.evaluate import DEFAULT_ANIMATIONS, DEFAULT_TARGETS
 
@@ -43,11 +45,10 @@ def window(pos: np.ndarray, fps: float) -> tuple[int, float]:
     return int(low.sum()), float(speed[low].sum())
 
 
-def standing_toe(skeleton) -> float:
-    """Height (m) of the toe joints of ``skeleton``'s canonical standing pose."""
-    sk = humanoid.to_canonical_skeleton(skeleton)
-    rest = Motion(sk, np.tile([1.0, 0, 0, 0], (1, 22, 1)), sk.offsets[0][None], 60.0)
-    return float(rest.global_positions()[0, TOES, 1].min())
+def planted_toes(motion: Motion) -> np.ndarray:
+    """Heights (m) of the toe joints of a canonical motion over the frames where they are planted."""
+    labels = contacts.of_motion(motion)[:, [list(contacts.CONTACT_JOINTS).index(t) for t in TOES]]
+    return motion.global_positions()[:, TOES, 1][labels]
 
 
 def main(argv=None) -> None:
@@ -58,21 +59,25 @@ def main(argv=None) -> None:
     except data.DataNotFound as e:
         raise SystemExit(f"foot_clearance: {e}") from None
     ckpt = retargeting.load_real("cpu", progress=False)
-    print(f"{'target':<13} {'toe stands':>10} {'lowest toe: truth':>18} {'ours':>6}   "
+    print(f"{'target':<13} {'sole':>5} {'planted toe':>11} {'lowest toe: truth':>18} {'ours':>6}   "
           f"{'window frames: truth':>20} {'ours':>6}   {'their speed cm/s: truth':>23} {'ours':>6}")  # fmt: skip
     for target in DEFAULT_TARGETS:
         low, counts = {"truth": [], "ours": []}, {"truth": np.zeros(2), "ours": np.zeros(2)}
+        planted = []
         for anim in DEFAULT_ANIMATIONS:
             truth_rig = bvh.load(folder / target / f"{anim}.bvh")
-            truth = preprocess.prepare(truth_rig, ckpt.fps).global_positions()
+            truth_motion = preprocess.prepare(truth_rig, ckpt.fps, stand=True)
+            truth = truth_motion.global_positions()
+            planted.append(planted_toes(truth_motion))
             ours = retargeting.retarget(bvh.load(folder / "Aj" / f"{anim}.bvh"), truth_rig.skeleton, ckpt).positions
             n = min(len(truth), len(ours))
             for name, pos in (("truth", truth[:n]), ("ours", ours[:n])):
                 low[name].append(pos[:, TOES, 1].min())
                 counts[name] += window(pos, ckpt.fps)
-        stands = 100 * standing_toe(truth_rig.skeleton)
+        sole = 100 * rest_pose.sole_height(truth_motion.skeleton)
+        planted_cm = 100 * float(np.median(np.concatenate(planted)))
         (tn, ts), (on, os_) = counts["truth"], counts["ours"]
-        print(f"{target:<13} {stands:>10.1f} {100 * min(low['truth']):>18.1f} {100 * min(low['ours']):>6.1f}   "
+        print(f"{target:<13} {sole:>5.1f} {planted_cm:>11.1f} {100 * min(low['truth']):>18.1f} {100 * min(low['ours']):>6.1f}   "
               f"{tn:>20.0f} {on:>6.0f}   {100 * ts / tn:>23.1f} {100 * os_ / on:>6.1f}")  # fmt: skip
 
 

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from motionlab import data, retargeting
 from motionlab import exercises as ex
-from motionlab.core import bvh, preprocess
+from motionlab.core import bvh, humanoid, preprocess
 from motionlab.interpolation import demo
 from motionlab.motion_graphs import clips
 
@@ -116,7 +116,13 @@ def _notebook_07(ckpt) -> None:
     with tempfile.TemporaryDirectory() as folder:
         clip_path = bvh.save(Path(folder) / "Jumping.bvh", jumping)
         lowest = ex.arm_length.reference(str(clip_path), ckpt, SolverConfig(max_steps=20))
-    print(f"07 ex1 arm_length      {lowest:.3f} of the leg")
+        long_arms = humanoid.scale_bones(humanoid.canonical_skeleton(), arms=1.35)  # the `long_arms` preset
+        preset = retargeting.retarget(
+            bvh.load(clip_path), long_arms, ckpt, solver=SolverConfig(max_steps=20)
+        ).plausibility
+    print(
+        f"07 ex1 arm_length      {lowest:.3f} of the leg (long_arms, x 1.35: {preset.lowest:.3f}, failed {preset.failed})"
+    )
 
 
 if __name__ == "__main__":

@@ -33,6 +33,11 @@ rest (or an A-stance's sideways spread) is a rigging choice, not the performer's
 of the motion is lost by removing it, because the motion is re-expressed on the new rest with
 its world positions unchanged.
 
+**The sole.** A rig's lowest joint (a toe) sits inside the foot, above the floor by the foot's
+own sole: :func:`sole_height`, read from the rest root offset where that places the rig on the
+floor. The canonical standing pose keeps that height, so a standing skeleton's lowest joint is at
+its sole height, and at 0 when the rest offsets do not say where the floor is.
+
 The motion is re-expressed on the new rest offsets with world positions unchanged: with
 ``A_j`` the rotation that carries joint ``j``'s child offsets from the old rest to the new one,
 ``offset'_c = A_p offset_c`` and ``local_rot'_j = A_p local_rot_j A_j⁻¹`` (``p``: parent).
@@ -61,6 +66,7 @@ __all__ = [
     "on_reference",
     "standing",
     "standing_skeleton",
+    "sole_height",
 ]
 
 TOLERANCE_DEG = 40.0
@@ -191,13 +197,33 @@ def _straighten(offsets: np.ndarray, every: bool = False) -> tuple[np.ndarray, t
     return turn, tuple(names)
 
 
-def _apply(motion: Motion, turn: np.ndarray) -> Motion:
-    """``motion`` on rest offsets turned by ``turn`` (22, 4) per joint, world positions unchanged."""
+def sole_height(skeleton: Skeleton) -> float | None:
+    """Height (metres) of a canonical 22-joint skeleton's lowest rest joint above the floor, or None.
+
+    The rest pose is placed by the root's rest offset, as a BVH file places it: a rig exported
+    standing on the floor (Mixamo's) puts its lowest joint, a toe inside the foot, a sole's
+    height above it. The height counts only when it could be a sole: at least 0 (to a micrometre,
+    a file's rounding) and below the ankles (the foot joints) above the lowest joint; otherwise (CMU's root offset at the origin,
+    Bandai Namco's flat rest) the rest offsets do not say where the floor is: None.
+
+    Raises ValueError when the skeleton is not canonical.
+    """
+    if not humanoid.is_canonical(skeleton):
+        raise ValueError("sole_height() needs a 22-joint canonical skeleton (humanoid.to_canonical_skeleton)")
+    y = skeleton.rest_positions()[:, 1]
+    lowest = float(y.min())
+    ankles = float(y[[_J.index("LeftFoot"), _J.index("RightFoot")]].min()) - lowest
+    return max(lowest, 0.0) if -1e-6 <= lowest < ankles else None
+
+
+def _apply(motion: Motion, turn: np.ndarray, sole: float = 0.0) -> Motion:
+    """``motion`` on rest offsets turned by ``turn`` (22, 4) per joint, world positions unchanged;
+    the new rest's lowest joint ``sole`` metres above the floor."""
     sk, parents = motion.skeleton, humanoid.PARENTS
     offsets = sk.offsets.copy()
     offsets[1:] = quat.rotate(turn[parents[1:]], sk.offsets[1:])
     offsets[0] = sk.offsets[0] * np.array([1.0, 0.0, 1.0])
-    offsets[0, 1] = -Skeleton(sk.names, parents, offsets).rest_positions()[:, 1].min()  # lowest joint on y = 0
+    offsets[0, 1] = sole - Skeleton(sk.names, parents, offsets).rest_positions()[:, 1].min()
     ends = {j: quat.rotate(turn[j], e) for j, e in sk.end_sites.items()}
     inv = quat.conj(turn)
     local = quat.mul(motion.local_rot, inv[None])
@@ -303,7 +329,8 @@ def standing(
         turn, pose = _pose_turn(motion, what, family)
     if pose.source == "rest" and not pose.straightened:
         return motion, pose
-    return _apply(motion, turn), pose
+    sole = sole_height(motion.skeleton) if pose.source == "rest" else None
+    return _apply(motion, turn, sole or 0.0), pose
 
 
 def standing_skeleton(

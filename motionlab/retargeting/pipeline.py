@@ -27,7 +27,13 @@ about the world origin, with one ratio for the ground plane and one for the heig
   angles, a longer leg takes a longer stride, and the hip offset and the foot count too;
 * vertically by ``r_y`` = B's / A's **hip height** (height of the Hips above the lowest joint in
   the canonical standing rest pose, :func:`hip_height`, :mod:`motionlab.core.rest_pose`), so a
-  standing pose keeps its feet on the ground whatever rest pose each studio rigged;
+  standing pose keeps its feet on the ground whatever rest pose each studio rigged; and raised by
+  ``d = s_B − r_y s_A``, ``s`` being each rig's *sole*, the height of its toe joints above the
+  floor when they stand on it: a sole does not grow with the leg, so B's planted toe stands on
+  B's own sole, not on A's scaled. B's sole is read from its rest root offset
+  (:func:`motionlab.core.rest_pose.sole_height`; 0 when the rest offsets do not place the rig on
+  the floor); A's the same way, or, when its rest does not say, from the clip itself
+  (:func:`source_sole`: where its toes stand while planted);
 * the heading (facing direction) of every frame is A's: the network's root rotation, expressed
   in A's heading frame, is turned back by A's heading.
 
@@ -214,6 +220,27 @@ def source_contacts(source: Motion) -> np.ndarray:
     return contacts.of_motion(source)
 
 
+def source_sole(source: Motion, canonical: Motion) -> float:
+    """A's sole (metres): the height of its toe joints above the floor when they stand on it.
+
+    From the rig's rest root offset when that places the rig on the floor
+    (:func:`motionlab.core.rest_pose.sole_height`); otherwise the median height of the toe joints
+    over the frames where the clip plants them (:func:`source_contacts`); 0 when it plants none.
+
+    Parameters
+    ----------
+    source : the source Motion on its own rig (its rest offsets as the file has them)
+    canonical : the same motion on the canonical 22 joints (:func:`preprocess.prepare`)
+    """
+    sole = rest_pose.sole_height(humanoid.to_canonical_skeleton(source.skeleton))
+    if sole is not None:
+        return sole
+    toes = [i for i, j in enumerate(contacts.CONTACT_JOINTS) if "Toe" in humanoid.JOINTS[j]]
+    planted = source_contacts(canonical)[:, toes]
+    heights = canonical.global_positions()[:, [contacts.CONTACT_JOINTS[i] for i in toes], 1][planted]
+    return float(np.median(heights)) if heights.size else 0.0
+
+
 def target_skeleton(target: Skeleton | Motion, what: str = "target") -> Skeleton:
     """B's canonical 22-joint skeleton in its standing rest pose (:func:`rest_pose.standing_skeleton`).
 
@@ -263,6 +290,7 @@ class PreparedSource:
     theta : Tensor (1, T, 22, 4) or (1, T, 22, 3) or None   θ(A) for the solver's ``theta``
     yaw : Tensor (1, T) or None        A's heading, radians (the contact term's world frame)
     planted : Tensor (1, T, 4) of bool or None   A's foot contacts (:func:`source_contacts`)
+    sole : float                 A's sole, metres (:func:`source_sole`)
     """
 
     name: str
@@ -272,6 +300,7 @@ class PreparedSource:
     theta: torch.Tensor | None = None
     yaw: torch.Tensor | None = None
     planted: torch.Tensor | None = None
+    sole: float = 0.0
 
 
 @dataclass
@@ -289,11 +318,11 @@ class PreparedPair:
     root_height : Tensor (1, T) or None   B's root height, metres
     root_xz : Tensor (1, T, 2) or None    B's root on the ground plane, metres (contact term)
     floor : Tensor (1, T, 22) or None     the lowest height each joint of B may reach (L_floor,
-        :mod:`.terms`): A's own joint heights scaled by ``r_y`` where A's joint is under the
-        floor, else 0; metres
+        :mod:`.terms`): A's own joint heights scaled as the root (``r_y``, then raised by ``d``,
+        module docstring) where that is under the floor, else 0; metres
     clearance : Tensor (1, T, 4) or None  the lowest height of each foot joint of B (L_clear,
-        :mod:`.terms`): A's own foot heights scaled by ``r_y`` (at least 0) while A's foot is not
-        planted, 0 where it is; metres
+        :mod:`.terms`): A's own foot heights scaled as the root (at least 0) while A's foot is
+        not planted, 0 where it is; metres
     """
 
     source: PreparedSource
@@ -322,13 +351,14 @@ def prepare_source(
     fps = checkpoint.fps if checkpoint is not None else source.fps
     src = preprocess.prepare(source, fps, stand=True)
     check_motion(src, "source motion")
+    sole = source_sole(source, src)
     if method == "copy":
-        return PreparedSource(source.name, src)
+        return PreparedSource(source.name, src, sole=sole)
     feats = clip_features(src)
     x, theta = _network_inputs(checkpoint, feats, (solver or SolverConfig()).theta)
     yaw = torch.as_tensor(feats.yaw, dtype=x.dtype, device=x.device)[None]
     planted = torch.as_tensor(source_contacts(src), device=x.device)[None]
-    return PreparedSource(source.name, src, feats, x, theta, yaw, planted)
+    return PreparedSource(source.name, src, feats, x, theta, yaw, planted, sole)
 
 
 def prepare_pair(source: PreparedSource, target: Skeleton | Motion, root_mode: str = "stride") -> PreparedPair:
@@ -339,14 +369,15 @@ def prepare_pair(source: PreparedSource, target: Skeleton | Motion, root_mode: s
     if root_mode == "contacts":
         stride = contact_stride(src, tgt)
         r = (stride, r[1]) if stride is not None else r
-    root_pos = src.root_pos * np.array([r[0], r[1], r[0]])
+    lift = (rest_pose.sole_height(tgt) or 0.0) - r[1] * source.sole  # d (module docstring)
+    root_pos = src.root_pos * np.array([r[0], r[1], r[0]]) + np.array([0.0, lift, 0.0])
     if source.x is None:
         return PreparedPair(source, tgt, r, root_pos)
     device, dtype = source.x.device, source.x.dtype
     offsets = torch.tensor(tgt.offsets, dtype=dtype, device=device)
     height = torch.as_tensor(root_pos[:, 1], dtype=dtype, device=device)[None]
     root_xz = torch.as_tensor(root_pos[:, [0, 2]], dtype=dtype, device=device)[None]
-    heights = r[1] * src.global_positions()[..., 1]  # A's joint heights, scaled to B
+    heights = r[1] * src.global_positions()[..., 1] + lift  # A's joint heights, scaled to B (as the root)
     floor = torch.as_tensor(np.minimum(0.0, heights), dtype=dtype, device=device)[None]  # A's depth under the floor
     swing = ~source.planted[0].cpu().numpy()  # (T, 4): A's foot joints off the ground
     clearance = np.where(swing, np.maximum(heights[:, list(FOOT_JOINTS)], 0.0), 0.0)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from motionlab import synthetic
-from motionlab.core import bvh, humanoid, preprocess, quat, rest_pose
+from motionlab.core import bvh, contacts, humanoid, preprocess, quat, rest_pose
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
 from motionlab.retargeting import pipeline
@@ -210,3 +210,54 @@ def test_expand_takes_the_standing_pose_from_rest_from(tmp_path):
     assert bad.skeleton is None and "--rest-from" in bad.error
     (good,) = expand.characters(str(tmp_path / "crawl.bvh"), rest_from=walk)
     np.testing.assert_allclose(good.skeleton.offsets, rest_pose.standing(walk)[0].skeleton.offsets, atol=1e-6)
+
+
+def _raised(skeleton: Skeleton, dy: float) -> Skeleton:
+    offsets = skeleton.offsets.copy()
+    offsets[0, 1] += dy
+    return Skeleton(skeleton.names, skeleton.parents, offsets)
+
+
+def test_sole_height_is_the_lowest_rest_joint_above_the_floor_when_it_can_be_a_sole():
+    """Read from the rest root offset: the synthetic character's toe 1 cm up; a rig placed lower
+    than the floor (CMU's root at the origin) or with its toes above its ankles' height says nothing."""
+    sk = humanoid.canonical_skeleton()
+    assert rest_pose.sole_height(sk) == pytest.approx(0.01)
+    assert rest_pose.sole_height(_raised(sk, 0.02)) == pytest.approx(0.03)
+    assert rest_pose.sole_height(_raised(sk, -0.02)) is None
+    assert rest_pose.sole_height(_raised(sk, -sk.offsets[0, 1])) is None  # the root at the origin
+    assert rest_pose.sole_height(_raised(sk, 0.5)) is None  # higher than a foot
+    with pytest.raises(ValueError, match="canonical"):
+        rest_pose.sole_height(bvh.load(require_data("cmu", "131", "131_01.bvh")).skeleton)
+
+
+def test_the_standing_pose_keeps_the_rigs_sole():
+    """Turning the rest onto the standing pose puts the lowest joint at the rig's sole, not at 0."""
+    walk = _walk()
+    turn = np.tile([1.0, 0, 0, 0], (22, 1))
+    for side in ("Left", "Right"):  # arms down: the rest is turned, the legs are not
+        turn[humanoid.JOINTS.index(f"{side}Arm")] = quat.from_axis_angle([0.0, 0.0, 1.0], np.radians(-70))
+    for dy, sole in ((0.0, 0.01), (0.015, 0.025), (-0.03, 0.0)):
+        moved = _repose(walk, turn)
+        moved = Motion(_raised(moved.skeleton, dy), moved.local_rot, moved.root_pos, moved.fps)
+        out, pose = rest_pose.standing(moved)
+        assert pose.source == "rest" and pose.straightened
+        assert out.skeleton.rest_positions()[:, 1].min() == pytest.approx(sole)
+        assert (rest_pose.sole_height(out.skeleton) or 0.0) == pytest.approx(sole)
+
+
+def test_a_mixamo_rigs_sole_is_where_its_own_clips_plant_the_toe():
+    """Known answer from the studio's data: each Mixamo character's sole (its rest root offset)
+    is the median height of its toe joints while planted in its own clips, within 3 mm."""
+    folder = require_data("mixamo")
+    for character in sorted(p for p in folder.iterdir() if p.is_dir()):
+        clips = sorted(character.glob("*.bvh"))[:3]
+        sole = rest_pose.sole_height(pipeline.target_skeleton(bvh.load(clips[0]).skeleton))
+        raw = rest_pose.sole_height(humanoid.to_canonical_skeleton(bvh.load(clips[0]).skeleton))
+        assert sole == pytest.approx(raw, abs=1e-9)  # the standing pose keeps it
+        planted = []
+        for path in clips:
+            motion = preprocess.prepare(bvh.load(path), 60, stand=True)
+            labels = contacts.of_motion(motion)[:, 2:]  # the toe joints
+            planted.append(motion.global_positions()[:, list(contacts.CONTACT_JOINTS[2:]), 1][labels])
+        assert abs(np.median(np.concatenate(planted)) - sole) < 0.003, character.name

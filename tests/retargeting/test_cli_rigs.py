@@ -29,7 +29,7 @@ def test_output_at_the_source_rate_and_the_resample_is_printed_under_quiet(walk3
 
 def test_implausible_output_is_refused_unless_kept(walk30, tmp_path, capsys):
     out = tmp_path / "sunk.bvh"
-    argv = ["retarget", str(walk30), "--scale-legs", "0.4", "--root", "legs", "-o", str(out), "-q", "--steps", "3"]
+    argv = ["retarget", str(walk30), "--scale-legs", "0.3", "--root", "legs", "-o", str(out), "-q", "--steps", "3"]
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert "IMPLAUSIBLE (foot" in err and "nothing written" in err and "--keep-implausible" in err

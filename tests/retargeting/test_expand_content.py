@@ -98,13 +98,13 @@ def test_missing_file_and_old_manifest_are_redone(lib, ckpt):
 def test_mixed_run_flags_only_the_implausible_pairs(lib, ckpt, capsys):
     """Root scaled by thigh + shin sinks a very short-legged character's feet into the floor."""
     shutil.rmtree(lib / "out", ignore_errors=True)
-    chars = ex.characters(str(lib / "rigs" / "hero.bvh"), presets=["stubby:legs=0.4"])
+    chars = ex.characters(str(lib / "rigs" / "hero.bvh"), presets=["stubby:legs=0.3"])
     job = ex.expand([str(lib / "clips" / "walk.bvh")], chars, lib / "out", ckpt, FAST, root_mode="legs")
     flags = {r["character"]: r["flag"] for r in job.rows}
     assert "implausible_foot" in flags["stubby"] and "implausible" not in flags["hero"]
     assert job.implausible == 1 and "1 implausible" in job.summary()
     argv = ["expand", str(lib / "clips" / "walk.bvh"), "--characters", str(lib / "rigs" / "hero.bvh")]
-    argv += ["--preset", "stubby:legs=0.4", "--root", "legs", "--steps", "4", "-q", "--force"]
+    argv += ["--preset", "stubby:legs=0.3", "--root", "legs", "--steps", "4", "-q", "--force"]
     assert main(argv + ["-o", str(lib / "cli")]) == 1
     assert "failed the plausibility check" in capsys.readouterr().err
     assert main(argv + ["-o", str(lib / "cli"), "--keep-implausible"]) == 0

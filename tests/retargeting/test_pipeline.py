@@ -5,8 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from motionlab import retargeting
-from motionlab.core import humanoid
+from motionlab import retargeting, synthetic
+from motionlab.core import contacts, humanoid, quat, rest_pose
+from motionlab.core.motion import Motion
+from motionlab.core.skeleton import Skeleton
+from motionlab.retargeting import pipeline
 from motionlab.retargeting.pipeline import hip_height, leg_chain, retarget, root_scale
 from motionlab.retargeting.solver import SolverConfig
 
@@ -36,7 +39,7 @@ def test_copy_keeps_rotations_and_scales_the_root(clips, target):
     out = retarget(src, target, None, "copy", root_mode="hips")
     r = hip_height(target) / hip_height(src.skeleton)
     assert out.root_scale == pytest.approx((r, r))
-    np.testing.assert_allclose(out.motion.root_pos, src.root_pos * r)
+    np.testing.assert_allclose(out.motion.root_pos, src.root_pos * r + [0.0, _lift(src.skeleton, target, r), 0.0])
     np.testing.assert_allclose(out.motion.local_rot, src.local_rot)
     legs = retarget(src, target, None, "copy", root_mode="legs")
     r_legs = humanoid.leg_length(target) / humanoid.leg_length(src.skeleton)
@@ -52,7 +55,46 @@ def test_default_root_scales_ground_by_leg_chain_and_height_by_hips(clips, targe
     assert r_xz != pytest.approx(r_y, rel=1e-3)  # the test target has other leg proportions
     assert out.root_scale == pytest.approx((r_xz, r_y))
     np.testing.assert_allclose(out.motion.root_pos[:, [0, 2]], src.root_pos[:, [0, 2]] * r_xz)
-    np.testing.assert_allclose(out.motion.root_pos[:, 1], src.root_pos[:, 1] * r_y)
+    np.testing.assert_allclose(out.motion.root_pos[:, 1], src.root_pos[:, 1] * r_y + _lift(src.skeleton, target, r_y))
+
+
+def _lift(a, b, r_y: float) -> float:
+    """The root's raise d = s_B − r_y s_A (each rig's sole from its rest, pipeline's module docstring)."""
+    return rest_pose.sole_height(b) - r_y * rest_pose.sole_height(a)
+
+
+def test_a_source_whose_rest_says_nothing_has_the_sole_its_clip_plants_its_toes_on():
+    """A rig whose rest root offset does not place it on the floor (CMU's: at the origin) takes
+    its sole from the clip: the median height of its toe joints while planted."""
+    walk = synthetic.generate("walk", humanoid.canonical_skeleton(), num_frames=120, fps=60, seed=0)
+    assert pipeline.source_sole(walk, walk) == pytest.approx(0.01)  # from the rest offsets
+    offsets = walk.skeleton.offsets.copy()
+    offsets[0] = 0.0
+    lost = walk.copy(skeleton=Skeleton(walk.skeleton.names, walk.skeleton.parents, offsets))
+    assert rest_pose.sole_height(lost.skeleton) is None
+    planted = contacts.of_motion(walk)[:, 2:]
+    toes = walk.global_positions()[:, list(contacts.CONTACT_JOINTS[2:]), 1][planted]
+    assert pipeline.source_sole(lost, lost) == pytest.approx(np.median(toes))
+    raised = lost.copy(root_pos=lost.root_pos + [0.0, 0.03, 0.0])  # the take recorded 3 cm higher
+    assert pipeline.source_sole(raised, raised) == pytest.approx(np.median(toes) + 0.03)
+
+
+def test_a_target_stands_on_its_own_sole():
+    """B's root is raised by B's sole less A's scaled one: a standing frame puts B's lowest joint
+    at B's sole height, whatever A's, and a target with A's sole on longer legs is raised by
+    the difference."""
+    a = humanoid.canonical_skeleton()
+    s_a = rest_pose.sole_height(a)
+    assert s_a > 0  # the synthetic character's toe sits 1 cm above the floor
+    stand = Motion(a, np.tile(quat.IDENTITY, (4, 22, 1)), np.tile(a.offsets[0], (4, 1)), 60.0)
+    for legs in (0.5, 1.0, 1.6):
+        b = humanoid.scale_bones(a, legs=legs)  # keeps the lowest joint's height: the same sole
+        out = retarget(stand, b, None, "copy")
+        assert rest_pose.sole_height(b) == pytest.approx(s_a)
+        assert out.positions[..., 1].min() == pytest.approx(s_a, abs=1e-12)
+        assert out.motion.root_pos[0, 1] == pytest.approx(
+            out.root_scale[1] * a.offsets[0, 1] + (1 - out.root_scale[1]) * s_a
+        )
 
 
 def test_leg_chain_is_the_summed_leg_bones():

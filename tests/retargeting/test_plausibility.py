@@ -47,7 +47,7 @@ def test_root_rule_that_sinks_short_legs_is_flagged():
     """Scaling the root by thigh + shin on a very short-legged character puts its feet in the floor."""
     ckpt = retargeting.load_default("cpu")
     clip = synthetic.dataset(1, seed=1, num_frames=40)[0]
-    stubby = humanoid.scale_bones(humanoid.canonical_skeleton(), legs=0.4)
+    stubby = humanoid.scale_bones(humanoid.canonical_skeleton(), legs=0.3)
     assert retarget(clip, stubby, ckpt, solver=FAST).plausibility.ok
     bad = retarget(clip, stubby, ckpt, solver=FAST, root_mode="legs").plausibility
     assert "foot" in bad.failed and "IMPLAUSIBLE" in bad.describe()

@@ -17,7 +17,7 @@ import torch
 
 from motionlab import retargeting, synthetic
 from motionlab.cli import build_parser, main
-from motionlab.core import bvh, humanoid
+from motionlab.core import bvh, humanoid, rest_pose
 from motionlab.retargeting import expand as ex
 from motionlab.retargeting import losses, plots, solver, terms
 from motionlab.retargeting.model import Decoded
@@ -234,15 +234,18 @@ def test_the_papers_two_losses_row_switches_every_other_term_off(monkeypatch):
 
 
 def test_the_clearance_input_is_the_sources_swinging_feet_scaled(ckpt, clip):
-    """``prepare_pair``'s L_clear input: r_y × A's foot heights (at least 0) where A's foot swings,
-    0 where it is planted; with it the iteration holds B's swinging feet up (``clearance`` falls)."""
+    """``prepare_pair``'s L_clear input: A's foot heights scaled as the root (r_y, then the soles'
+    difference d, at least 0) where A's foot swings, 0 where it is planted; with it the iteration
+    holds B's swinging feet up (``clearance`` falls)."""
     from motionlab.retargeting import pipeline
 
     src = pipeline.prepare_source(clip, ckpt, "full")
     pair = pipeline.prepare_pair(src, _target(clip))
     allowed = pair.clearance[0].numpy()
     planted = src.planted[0].numpy()
-    heights = pair.root_scale[1] * src.motion.global_positions()[:, list(losses.FOOT_JOINTS), 1]
+    lift = pair.root_pos[0, 1] - pair.root_scale[1] * src.motion.root_pos[0, 1]
+    assert lift == pytest.approx(rest_pose.sole_height(pair.target) - pair.root_scale[1] * src.sole)
+    heights = pair.root_scale[1] * src.motion.global_positions()[:, list(losses.FOOT_JOINTS), 1] + lift
     assert planted.any() and (~planted).any()
     assert np.all(allowed[planted] == 0.0)
     np.testing.assert_allclose(allowed[~planted], np.maximum(heights[~planted], 0.0))
