@@ -220,12 +220,19 @@ def source_contacts(source: Motion) -> np.ndarray:
     return contacts.of_motion(source)
 
 
+SOLE_FPS = 60.0
+"""Rate (frames/s) at which :func:`source_sole` detects the planted toes: the networks' own
+(:attr:`Checkpoint.fps`'s default), whatever the method, so every method of a pair gets the same
+root; at 30 fps a run's stances are too short for the detector (``docs/rigs.md``)."""
+
+
 def source_sole(source: Motion, canonical: Motion) -> float:
     """A's sole (metres): the height of its toe joints above the floor when they stand on it.
 
     From the rig's rest root offset when that places the rig on the floor
     (:func:`motionlab.core.rest_pose.sole_height`); otherwise the median height of the toe joints
-    over the frames where the clip plants them (:func:`source_contacts`); 0 when it plants none.
+    over the frames where the clip, at :data:`SOLE_FPS`, plants them (:func:`source_contacts`);
+    0 when it plants none.
 
     Parameters
     ----------
@@ -235,9 +242,10 @@ def source_sole(source: Motion, canonical: Motion) -> float:
     sole = rest_pose.sole_height(humanoid.to_canonical_skeleton(source.skeleton))
     if sole is not None:
         return sole
+    clip = canonical if canonical.fps == SOLE_FPS else canonical.resample(SOLE_FPS)
     toes = [i for i, j in enumerate(contacts.CONTACT_JOINTS) if "Toe" in humanoid.JOINTS[j]]
-    planted = source_contacts(canonical)[:, toes]
-    heights = canonical.global_positions()[:, [contacts.CONTACT_JOINTS[i] for i in toes], 1][planted]
+    planted = source_contacts(clip)[:, toes]
+    heights = clip.global_positions()[:, [contacts.CONTACT_JOINTS[i] for i in toes], 1][planted]
     return float(np.median(heights)) if heights.size else 0.0
 
 

@@ -79,6 +79,20 @@ def test_a_source_whose_rest_says_nothing_has_the_sole_its_clip_plants_its_toes_
     assert pipeline.source_sole(raised, raised) == pytest.approx(np.median(toes) + 0.03)
 
 
+def test_every_method_gets_the_same_sole_at_any_source_rate(tiny_checkpoint):
+    """The clip's sole is found at the networks' rate: copying (which keeps a 30 fps source's rate)
+    and the full method (which runs at the checkpoint's) put B's root at the same height."""
+    walk = synthetic.generate("walk", humanoid.canonical_skeleton(), num_frames=60, fps=30, seed=0)
+    offsets = walk.skeleton.offsets.copy()
+    offsets[0] = 0.0  # the rest says nothing: the sole comes from the clip
+    lifted = walk.root_pos + [0.0, 0.03, 0.0]  # a take recorded with its floor 3 cm low
+    walk = walk.copy(skeleton=Skeleton(walk.skeleton.names, walk.skeleton.parents, offsets), root_pos=lifted)
+    copy = pipeline.prepare_source(walk, None, "copy")
+    full = pipeline.prepare_source(walk, tiny_checkpoint, "full")
+    assert copy.motion.fps == 30 and full.motion.fps == tiny_checkpoint.fps == 60
+    assert copy.sole == full.sole == pytest.approx(0.03, abs=0.002)
+
+
 def test_a_target_stands_on_its_own_sole():
     """B's root is raised by B's sole less A's scaled one: a standing frame puts B's lowest joint
     at B's sole height, whatever A's, and a target with A's sole on longer legs is raised by
