@@ -27,7 +27,6 @@ import numpy as np
 
 from motionlab import data, retargeting
 from motionlab.core import bvh, contacts, humanoid, preprocess, rest_pose
-from motionlab.core.motion import Motion
 from motionlab.retargeting.evaluate import DEFAULT_ANIMATIONS, DEFAULT_TARGETS
 
 WINDOW_M = 0.05
@@ -43,12 +42,6 @@ def window(pos: np.ndarray, fps: float) -> tuple[int, float]:
     speed = np.linalg.norm(np.diff(p[..., [0, 2]], axis=0), axis=-1) * fps
     low = (p[1:, :, 1] < WINDOW_M) & (p[:-1, :, 1] < WINDOW_M)
     return int(low.sum()), float(speed[low].sum())
-
-
-def planted_toes(motion: Motion) -> np.ndarray:
-    """Heights (m) of the toe joints of a canonical motion over the frames where they are planted."""
-    labels = contacts.of_motion(motion)[:, [list(contacts.CONTACT_JOINTS).index(t) for t in TOES]]
-    return motion.global_positions()[:, TOES, 1][labels]
 
 
 def main(argv=None) -> None:
@@ -68,7 +61,7 @@ def main(argv=None) -> None:
             truth_rig = bvh.load(folder / target / f"{anim}.bvh")
             truth_motion = preprocess.prepare(truth_rig, ckpt.fps, stand=True)
             truth = truth_motion.global_positions()
-            planted.append(planted_toes(truth_motion))
+            planted.append(contacts.planted_toe_heights(truth_motion))
             ours = retargeting.retarget(bvh.load(folder / "Aj" / f"{anim}.bvh"), truth_rig.skeleton, ckpt).positions
             n = min(len(truth), len(ours))
             for name, pos in (("truth", truth[:n]), ("ours", ours[:n])):

@@ -35,7 +35,7 @@ import numpy as np
 import torch
 
 from motionlab import data, retargeting
-from motionlab.core import bvh, humanoid, metrics, preprocess, rest_pose
+from motionlab.core import bvh, humanoid, metrics, preprocess
 from motionlab.retargeting.evaluate import DEFAULT_ANIMATIONS, DEFAULT_SOURCE, DEFAULT_TARGETS
 from motionlab.retargeting.pipeline import (
     PreparedPair,
@@ -44,6 +44,7 @@ from motionlab.retargeting.pipeline import (
     leg_chain,
     prepare_pair,
     prepare_source,
+    sole_lift,
     solve_pair,
     target_skeleton,
 )
@@ -64,7 +65,7 @@ def with_root(pair: PreparedPair, rule: str) -> PreparedPair:
     """``pair`` with A's root trajectory scaled by ``rule``'s ratios instead."""
     sk_a, sk_b = pair.source.motion.skeleton, pair.target
     r = tuple(m(sk_b) / m(sk_a) for m in RULES[rule])
-    lift = rest_pose.sole_height(sk_b) - r[1] * rest_pose.sole_height(sk_a)  # each rig on its sole, as the pipeline
+    lift = sole_lift(pair.source, sk_b, r[1])  # each rig on its own sole, as the pipeline
     root_pos = pair.source.motion.root_pos * np.array([r[0], r[1], r[0]]) + np.array([0.0, lift, 0.0])
     dtype, device = pair.offsets.dtype, pair.offsets.device
     return dataclasses.replace(

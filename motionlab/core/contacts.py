@@ -62,6 +62,7 @@ __all__ = [
     "detect_contacts",
     "rest_heights",
     "of_motion",
+    "planted_toe_heights",
 ]
 
 CONTACT_JOINTS: tuple[int, ...] = tuple(humanoid.JOINTS.index(n) for n in humanoid.FEET)
@@ -170,3 +171,11 @@ def of_motion(motion) -> np.ndarray:
     with the skeleton's own rest heights and height)."""
     sk = motion.skeleton
     return detect_contacts(motion.global_positions(), rest_heights(sk), sk.height(), motion.fps)
+
+
+def planted_toe_heights(motion) -> np.ndarray:
+    """Heights (metres, 1-D) of a canonical motion's toe joints over the frames where
+    :func:`of_motion` plants them: where the take's toes stand (its sole, :mod:`.rest_pose`)."""
+    toes = [i for i, j in enumerate(CONTACT_JOINTS) if "Toe" in humanoid.JOINTS[j]]
+    labels = of_motion(motion)[:, toes]
+    return motion.global_positions()[:, [CONTACT_JOINTS[i] for i in toes], 1][labels]

@@ -202,9 +202,10 @@ def sole_height(skeleton: Skeleton) -> float | None:
 
     The rest pose is placed by the root's rest offset, as a BVH file places it: a rig exported
     standing on the floor (Mixamo's) puts its lowest joint, a toe inside the foot, a sole's
-    height above it. The height counts only when it could be a sole: at least 0 (to a micrometre,
-    a file's rounding) and below the ankles (the foot joints) above the lowest joint; otherwise (CMU's root offset at the origin,
-    Bandai Namco's flat rest) the rest offsets do not say where the floor is: None.
+    height above it. The height counts only when it could be a sole: at least 0 (to a
+    micrometre, a file's rounding) and below the ankles (the foot joints) above the lowest joint.
+    Otherwise (CMU's root offset at the origin, Bandai Namco's flat rest) the rest offsets do not
+    say where the floor is: None.
 
     Raises ValueError when the skeleton is not canonical.
     """

@@ -83,6 +83,8 @@ __all__ = [
     "solve_pair",
     "term_inputs",
     "source_contacts",
+    "source_sole",
+    "sole_lift",
     "contact_stride",
     "at_rate",
     "retarget",
@@ -243,10 +245,14 @@ def source_sole(source: Motion, canonical: Motion) -> float:
     if sole is not None:
         return sole
     clip = canonical if canonical.fps == SOLE_FPS else canonical.resample(SOLE_FPS)
-    toes = [i for i, j in enumerate(contacts.CONTACT_JOINTS) if "Toe" in humanoid.JOINTS[j]]
-    planted = source_contacts(clip)[:, toes]
-    heights = clip.global_positions()[:, [contacts.CONTACT_JOINTS[i] for i in toes], 1][planted]
+    heights = contacts.planted_toe_heights(clip)
     return float(np.median(heights)) if heights.size else 0.0
+
+
+def sole_lift(source: PreparedSource, target: Skeleton, r_y: float) -> float:
+    """``d = s_B − r_y s_A`` (metres): how far B's root is raised above A's scaled root so that B
+    stands on its own sole (module docstring); ``target`` is B's canonical standing skeleton."""
+    return (rest_pose.sole_height(target) or 0.0) - r_y * source.sole
 
 
 def target_skeleton(target: Skeleton | Motion, what: str = "target") -> Skeleton:
@@ -377,7 +383,7 @@ def prepare_pair(source: PreparedSource, target: Skeleton | Motion, root_mode: s
     if root_mode == "contacts":
         stride = contact_stride(src, tgt)
         r = (stride, r[1]) if stride is not None else r
-    lift = (rest_pose.sole_height(tgt) or 0.0) - r[1] * source.sole  # d (module docstring)
+    lift = sole_lift(source, tgt, r[1])
     root_pos = src.root_pos * np.array([r[0], r[1], r[0]]) + np.array([0.0, lift, 0.0])
     if source.x is None:
         return PreparedPair(source, tgt, r, root_pos)

@@ -255,9 +255,5 @@ def test_a_mixamo_rigs_sole_is_where_its_own_clips_plant_the_toe():
         sole = rest_pose.sole_height(pipeline.target_skeleton(bvh.load(clips[0]).skeleton))
         raw = rest_pose.sole_height(humanoid.to_canonical_skeleton(bvh.load(clips[0]).skeleton))
         assert sole == pytest.approx(raw, abs=1e-9)  # the standing pose keeps it
-        planted = []
-        for path in clips:
-            motion = preprocess.prepare(bvh.load(path), 60, stand=True)
-            labels = contacts.of_motion(motion)[:, 2:]  # the toe joints
-            planted.append(motion.global_positions()[:, list(contacts.CONTACT_JOINTS[2:]), 1][labels])
+        planted = [contacts.planted_toe_heights(preprocess.prepare(bvh.load(p), 60, stand=True)) for p in clips]
         assert abs(np.median(np.concatenate(planted)) - sole) < 0.003, character.name

@@ -72,8 +72,11 @@ def test_a_source_whose_rest_says_nothing_has_the_sole_its_clip_plants_its_toes_
     offsets[0] = 0.0
     lost = walk.copy(skeleton=Skeleton(walk.skeleton.names, walk.skeleton.parents, offsets))
     assert rest_pose.sole_height(lost.skeleton) is None
-    planted = contacts.of_motion(walk)[:, 2:]
-    toes = walk.global_positions()[:, list(contacts.CONTACT_JOINTS[2:]), 1][planted]
+    toes = contacts.planted_toe_heights(walk)
+    planted = contacts.of_motion(walk)[:, 2:]  # the toe joints (CONTACT_JOINTS' last two)
+    assert len(toes) == planted.sum() and np.allclose(
+        toes, walk.global_positions()[:, list(contacts.CONTACT_JOINTS[2:]), 1][planted]
+    )
     assert pipeline.source_sole(lost, lost) == pytest.approx(np.median(toes))
     raised = lost.copy(root_pos=lost.root_pos + [0.0, 0.03, 0.0])  # the take recorded 3 cm higher
     assert pipeline.source_sole(raised, raised) == pytest.approx(np.median(toes) + 0.03)
