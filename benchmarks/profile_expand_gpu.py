@@ -1,13 +1,13 @@
-"""Where a GPU expansion spends its solve time, and what two candidate changes would save (issue 40).
+"""Where a GPU expansion spends its solve time, and what replaying each step as a CUDA graph saves (issue 40).
 
 Prepares all of Aj's clips × the six Table 1 characters as ``expand`` does (host workers), plans
 the padded batches, solves the smallest once to warm the device up (not timed), then times the
-latent iteration of every batch (``batching.solve_jobs``, device synchronised) with the
-Gauss–Newton start in chunks as large as free memory allows (as shipped), in chunks of
-``solver.PROJECT_GPU_FRAMES`` frames (the least a GPU chunk holds), and as shipped again. Then it
+latent iteration of every batch (``batching.solve_jobs``, device synchronised) with its step
+replayed as a CUDA graph (as shipped, :mod:`motionlab.retargeting.graphs`), launched eagerly
+(``MOTIONLAB_CUDA_GRAPHS=0``), and as shipped again. Then it
 profiles the batch with the most rows: Python (cProfile, top functions by own time) and the device (``torch.profiler``: top
 operators by device time, kernel launches per step). Results of the variants are compared with
-the shipped ones (largest joint difference, cm). On a GPU it first splits ``expand``'s load time:
+the first run's (largest joint difference, cm). On a GPU it first splits ``expand``'s load time:
 preparing the clips in one process, and in pools of workers (start, prepare, shut down).
 
 Usage::
@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import cProfile
 import io
+import os
 import pstats
 import time
 
@@ -103,16 +104,11 @@ def main(argv=None) -> None:
     frames = sum(p.frames for p in pairs)
     print(f"{len(pairs)} pairs, {frames} frames prepared in {time.perf_counter() - clock:.1f} s; batches (rows x frames): "
           + ", ".join(f"{len(b)}x{b[0].frames}" for b in batches))  # fmt: skip
-    shipped = solver.PROJECT_BYTES_PER_FRAME
     _run(ckpt, batches[-1:])  # warm-up (kernel loading, cuDNN's choice of algorithms): not timed
-    variants = [
-        ("chunks by free memory", shipped),
-        (f"chunks of {solver.PROJECT_GPU_FRAMES}", 10**15),
-        ("chunks by free memory, again", shipped),
-    ]  # A, B, A: a drift between runs shows as a difference between the two A runs
-    reference = None
-    for name, per_frame in variants:
-        solver.PROJECT_BYTES_PER_FRAME = per_frame
+    variants = [("step as a CUDA graph", "1"), ("step launched eagerly", "0"), ("step as a CUDA graph, again", "1")]
+    reference = None  # A, B, A: a drift between runs shows as a difference between the two A runs
+    for name, graphs_on in variants:
+        os.environ["MOTIONLAB_CUDA_GRAPHS"] = graphs_on
         out, seconds = _run(ckpt, batches)
         pos = np.concatenate([r.positions[0].reshape(-1) for r in out])
         diff = "" if reference is None else f"; vs the first {100 * np.abs(pos - reference).max():.2g} cm"
@@ -120,7 +116,7 @@ def main(argv=None) -> None:
         steps = max(r.steps for r in out)
         print(f"{name:<29} solve {sum(seconds):6.2f} s = {frames / sum(seconds):7.0f} frames/s; per batch "
               + " ".join(f"{s:.2f}" for s in seconds) + f"; most steps {steps}{diff}")  # fmt: skip
-    solver.PROJECT_BYTES_PER_FRAME = shipped
+    os.environ.pop("MOTIONLAB_CUDA_GRAPHS")
     widest = max(batches, key=len)
     prof = cProfile.Profile()
     prof.enable()
@@ -134,13 +130,20 @@ def main(argv=None) -> None:
     if ckpt.device.type == "cuda":
         from torch.profiler import ProfilerActivity, profile
 
-        with profile(activities=[ProfilerActivity.CPU, ProfilerActivity.CUDA]) as tp:
-            res = batching.solve_jobs(ckpt, [p.job for p in widest])
-            _sync(ckpt.device)
-        table = tp.key_averages().table(sort_by="self_cuda_time_total", row_limit=15, max_name_column_width=40)
-        launches = sum(e.count for e in tp.key_averages() if e.key.startswith("cudaLaunchKernel"))
-        print(f"--- device profile: {launches} kernel launches for {max(r.steps for r in res)} steps")
-        print(table)
+        for graphs_on in ("1", "0"):
+            os.environ["MOTIONLAB_CUDA_GRAPHS"] = graphs_on
+            with profile(activities=[ProfilerActivity.CPU, ProfilerActivity.CUDA]) as tp:
+                res = batching.solve_jobs(ckpt, [p.job for p in widest])
+                _sync(ckpt.device)
+            table = tp.key_averages().table(sort_by="self_cuda_time_total", row_limit=12, max_name_column_width=40)
+            count = {
+                k: sum(e.count for e in tp.key_averages() if e.key.startswith(k))
+                for k in ("cudaLaunchKernel", "cudaGraphLaunch")
+            }
+            print(f"--- device profile, MOTIONLAB_CUDA_GRAPHS={graphs_on}: {count['cudaLaunchKernel']} kernel launches "
+                  f"and {count['cudaGraphLaunch']} graph launches for {max(r.steps for r in res)} steps")  # fmt: skip
+            print(table)
+        os.environ.pop("MOTIONLAB_CUDA_GRAPHS")
 
 
 if __name__ == "__main__":

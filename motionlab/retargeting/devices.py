@@ -15,7 +15,9 @@ from __future__ import annotations
 
 import torch
 
-__all__ = ["pick", "available"]
+__all__ = ["pick", "available", "index"]
+
+_INDEX: dict = {}
 
 
 def available() -> list[str]:
@@ -59,3 +61,13 @@ def pick(device: str | torch.device | None = None) -> torch.device:
     elif dev.type != "cpu":
         raise ValueError(f"device {device!r}: motionlab runs on {available()}, not on {dev.type}")
     return dev
+
+
+def index(values, device: torch.device) -> torch.Tensor:
+    """``values`` (a sequence of ints) as an int64 tensor on ``device``, made once per values and
+    device. The latent iteration indexes joints and tree levels at every step: a Python list as an
+    index is copied to the device each time, and on a GPU that copy waits for the queued work."""
+    key = (tuple(int(v) for v in values), torch.device(device))
+    if key not in _INDEX:
+        _INDEX[key] = torch.tensor(key[0], dtype=torch.int64, device=key[1])
+    return _INDEX[key]

@@ -54,6 +54,7 @@ import json
 import os
 import time
 from collections.abc import Callable, Iterable, Sequence
+from concurrent.futures import Future
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -759,6 +760,8 @@ def _local_outputs(batches, checkpoint, solver, pool, context, timings):
         if pool is None:
             yield [_finished_output(*a) for a in args]
             continue
+        for a in args:  # host data only to the workers: no CUDA tensor, no CUDA call in their pipe's thread
+            a[2].phi = a[2].phi.cpu()
         futures = [pool.submit(_finished_output, *a) for a in args]
         if pending is not None:
             yield _collect(pending, timings)
@@ -812,6 +815,22 @@ def prepare_clip(path, rest_from, targets, root_mode, solver, checkpoint=None):
     return motion, prepared, skating, jobs
 
 
+def _prepare_here(tasks: dict, args: dict, checkpoint: Checkpoint) -> None:
+    """Prepare in this process, from the last clip back, each clip no worker has taken yet (its
+    future cancelled and replaced by a finished one): the workers take seconds to start.
+    ``args``: :func:`prepare_clip`'s by clip; ``checkpoint``: a CPU copy, as the workers hold
+    (:func:`host.cpu_copy`)."""
+    for clip in reversed(list(tasks)):
+        if not tasks[clip].cancel():
+            return
+        done: Future = Future()
+        try:
+            done.set_result(prepare_clip(*args[clip], checkpoint))
+        except Exception as err:  # raised again by result(), as a worker's would be
+            done.set_exception(err)
+        tasks[clip] = done
+
+
 def _load_pairs(todo, checkpoint, solver, rows, result, suffix, rest_from=None, root_mode="stride", pool=None):
     """Read and prepare each source once (in the host workers when there is a ``pool``), with its
     pairs; a clip or character that fails becomes ``error`` rows."""
@@ -820,11 +839,13 @@ def _load_pairs(todo, checkpoint, solver, rows, result, suffix, rest_from=None, 
     by_clip: dict[str, list] = {}
     for clip, path, c, digest in todo:
         by_clip.setdefault(clip, [path, [], digest])[1].append(c)
-    tasks = {}
+    tasks, args = {}, {}
     for clip, (path, chars, _) in by_clip.items():
         usable = [(c.name, c.skeleton) for c in chars if c.skeleton is not None]
-        args = (path, rest_from, usable, root_mode, solver)
-        tasks[clip] = pool.submit(prepare_clip, *args) if pool else args
+        args[clip] = (path, rest_from, usable, root_mode, solver)
+        tasks[clip] = pool.submit(prepare_clip, *args[clip]) if pool else args[clip]
+    if pool:
+        _prepare_here(tasks, args, host.cpu_copy(checkpoint))
     for clip, (path, chars, digest) in by_clip.items():
         try:
             task = tasks[clip]

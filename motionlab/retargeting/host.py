@@ -5,7 +5,8 @@ kinematics, the plausibility checks) is CPU work done pair by pair, while a GPU 
 batch at once (``docs/performance.md`` gives the split of the time). :func:`pool` starts worker
 processes for that work; :func:`motionlab.retargeting.expand.expand` reads and prepares the
 clips there and finishes and encodes each batch's outputs there while the GPU solves the next
-batch. Each worker holds a CPU copy of the checkpoint (:func:`checkpoint`): preparing a clip
+batch; while the workers start, this process prepares the clips they have not taken yet
+(from the last one back). Each worker holds a CPU copy of the checkpoint (:func:`checkpoint`): preparing a clip
 needs its feature statistics, frame rate and float type. The workers are forked from a fresh
 server process that has imported motionlab once (``forkserver``), never from this one, which is
 safe beside CUDA. Results are the same as in one process (a test checks it).
@@ -25,7 +26,7 @@ import torch
 
 from motionlab.retargeting.checkpoint import Checkpoint
 
-__all__ = ["MAX_WORKERS", "default_workers", "pool", "checkpoint"]
+__all__ = ["MAX_WORKERS", "default_workers", "pool", "checkpoint", "cpu_copy"]
 
 MAX_WORKERS = 4
 """Most worker processes :func:`default_workers` starts. The host's share is small beside the
@@ -54,6 +55,11 @@ def checkpoint() -> Checkpoint | None:
     return _CHECKPOINT
 
 
+def cpu_copy(checkpoint: Checkpoint) -> Checkpoint:
+    """``checkpoint`` with a copy of its network on the CPU (what a worker holds)."""
+    return dataclasses.replace(checkpoint, model=copy.deepcopy(checkpoint.model).cpu())
+
+
 @contextmanager
 def pool(checkpoint: Checkpoint, workers: int) -> Iterator[Executor | None]:
     """``workers`` processes holding a CPU copy of ``checkpoint``; None when ``workers`` < 1
@@ -61,7 +67,7 @@ def pool(checkpoint: Checkpoint, workers: int) -> Iterator[Executor | None]:
     if workers < 1:
         yield None
         return
-    cpu = dataclasses.replace(checkpoint, model=copy.deepcopy(checkpoint.model).cpu())
+    cpu = cpu_copy(checkpoint)
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload(["motionlab.retargeting.expand"])
     with ProcessPoolExecutor(workers, mp_context=context, initializer=_start, initargs=(cpu,)) as executor:

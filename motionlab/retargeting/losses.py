@@ -52,6 +52,7 @@ from __future__ import annotations
 import torch
 
 from motionlab.core import fk_torch, humanoid
+from motionlab.retargeting import devices
 from motionlab.retargeting.contacts import CONTACT_JOINTS
 
 __all__ = [
@@ -197,7 +198,7 @@ def foot_loss(world_y: torch.Tensor, frames: torch.Tensor | None = None) -> torc
     ValueError when the heights are neither (..., T, 22) nor (..., T, 4).
     """
     if world_y.shape[-1] == len(humanoid.JOINTS):
-        world_y = world_y[..., list(FOOT_JOINTS)]
+        world_y = world_y.index_select(-1, devices.index(FOOT_JOINTS, world_y.device))
     elif world_y.shape[-1] != len(FOOT_JOINTS):
         raise ValueError(f"expected heights (..., T, 22) or (..., T, 4), got {tuple(world_y.shape)}")
     return frame_mean(torch.relu(-world_y), frames)
@@ -251,7 +252,7 @@ def feet_in_world(positions: torch.Tensor, root_pos: torch.Tensor, yaw: torch.Te
     ``root_pos`` (..., T, 3) the world root path and ``yaw`` (..., T) the heading, radians: a point
     ``p`` of the heading frame is ``R_y(yaw) p + root`` in the world.
     """
-    feet = positions[..., list(CONTACT_JOINTS), :]
+    feet = positions.index_select(-2, devices.index(CONTACT_JOINTS, positions.device))
     c, s = torch.cos(yaw)[..., None], torch.sin(yaw)[..., None]
     x, y, z = feet.unbind(-1)
     return torch.stack([c * x + s * z, y, -s * x + c * z], dim=-1) + root_pos[..., None, :]
@@ -284,7 +285,7 @@ def floor_loss(
             f"floor_loss: expected allowed {tuple(heights.shape)} like heights, got {tuple(allowed.shape)}"
         )
     depth = -heights if allowed is None else allowed - heights
-    return frame_mean(torch.relu(depth[..., list(_OTHER_JOINTS)]), frames)
+    return frame_mean(torch.relu(depth.index_select(-1, devices.index(_OTHER_JOINTS, depth.device))), frames)
 
 
 def clearance_loss(feet_y: torch.Tensor, allowed: torch.Tensor, frames: torch.Tensor | None = None) -> torch.Tensor:

@@ -40,6 +40,7 @@ from torch import nn
 
 from motionlab.core import humanoid
 from motionlab.core import quat_torch as tq
+from motionlab.retargeting import devices
 
 __all__ = ["ModelConfig", "RetargetNet", "Decoded", "skeleton_tensor", "unit", "fk_by_level"]
 
@@ -146,6 +147,19 @@ def _levels(parents) -> tuple[list[list[int]], list[list[int]], list[int]]:
     return levels, parent_pos, order
 
 
+def _level_index(parents, device: torch.device) -> tuple[list[int], torch.Tensor, list[torch.Tensor], torch.Tensor]:
+    """:func:`_levels` as index tensors on ``device`` (:func:`devices.index`): level sizes, the joints
+    in level order, each level's parent positions, the permutation back."""
+    levels, parent_pos, order = _levels(parents)
+    flat = [j for lvl in levels for j in lvl]
+    return (
+        [len(lvl) for lvl in levels],
+        devices.index(flat, device),
+        [devices.index(pp, device) for pp in parent_pos],
+        devices.index(order, device),
+    )
+
+
 def _matrices(q: torch.Tensor) -> torch.Tensor:
     """Rotation matrices (..., 3, 3) of unit quaternions (..., 4), in few tensor operations."""
     w, x, y, z = q.unbind(-1)
@@ -173,28 +187,25 @@ def fk_by_level(local_rot: torch.Tensor, local_pos: torch.Tensor, parents) -> to
     local_pos : Tensor (..., J, 3)   offsets from the parent (root: its position), broadcast with local_rot
     parents   : sequence of int      parent indices, -1 for the root, parents[j] < j
     """
-    levels, parent_pos, order = _levels(parents)
+    sizes, flat, parent_pos, order = _level_index(parents, local_rot.device)
     batch = torch.broadcast_shapes(local_rot.shape[:-2], local_pos.shape[:-2])
     local_pos = local_pos.to(local_rot.dtype)
-    dev = local_rot.device
     mats = _matrices(local_rot)
-    flat = torch.tensor([j for lvl in levels for j in lvl], device=dev)
     mats = mats.index_select(-3, flat)
     offs = local_pos.index_select(-2, flat)[..., None]
-    first = len(levels[0])
+    first = sizes[0]
     rot = mats[..., :first, :, :]
     pos = offs[..., :first, :, :].expand(batch + (first, 3, 1))
     all_pos = [pos]
     begin = first
-    for lvl, pp in zip(levels[1:], parent_pos[1:]):
-        stop = begin + len(lvl)
-        pidx = torch.tensor(pp, device=dev)
+    for size, pidx in zip(sizes[1:], parent_pos[1:]):
+        stop = begin + size
         prot = rot.index_select(-3, pidx)
         pos = pos.index_select(-3, pidx) + prot @ offs[..., begin:stop, :, :]
         rot = prot @ mats[..., begin:stop, :, :]
         all_pos.append(pos)
         begin = stop
-    return torch.cat(all_pos, dim=-3)[..., 0].index_select(-2, torch.tensor(order, device=dev))
+    return torch.cat(all_pos, dim=-3)[..., 0].index_select(-2, order)
 
 
 class _Encoder(nn.Module):

@@ -61,6 +61,12 @@ smooth. ``smooth_sigma=0`` optimises φ directly, as the paper states.
 to a grid a four-thousandth of a step fine, so that last-bit differences between CPUs' kernels
 cannot grow into other results or another stopping step. The network computes in float64.
 
+**On a GPU the step is one CUDA graph** (:mod:`motionlab.retargeting.graphs`): the decoding, the
+terms and the gradient of every row are recorded once and replayed at each step, rows whose
+problem has stopped included (their gradient is not used), so that the GPU does not wait for
+Python to launch hundreds of small kernels. Each problem's arithmetic is the same as without the
+graph (a test runs the all-rows step on the CPU).
+
 θ, what "joint angles" means, is our choice: the local joint rotations (see
 :mod:`motionlab.retargeting.losses` for why, and ``theta="directions"`` for the
 position-based alternative). The foot loss needs world heights: ``y = root_height(t) + FK_y``,
@@ -83,7 +89,7 @@ from tqdm.auto import tqdm
 
 from motionlab.core import quat_torch as tq
 from motionlab.core import threads
-from motionlab.retargeting import losses, terms
+from motionlab.retargeting import graphs, losses, terms
 from motionlab.retargeting.contacts import CONTACT_JOINTS
 from motionlab.retargeting.grid import step_grid
 from motionlab.retargeting.model import NUM_JOINTS, Decoded, RetargetNet
@@ -669,7 +675,8 @@ def solve_many(
     Each sequence has its own loss, its own Adam step size (``lr · std(φ₀)`` of its own latent),
     its own stopping rule and its own best iterate, so result ``i`` is what :func:`solve` gives for
     sequence ``i`` alone (up to float rounding: batched matrix products may round differently).
-    A sequence that has stopped leaves the batch, so later steps only compute the others.
+    A sequence that has stopped leaves the batch, so later steps only compute the others (on a
+    GPU every row is computed to the end: the step is a recorded CUDA graph, :mod:`.graphs`).
     Typical use: many (clip, character) pairs (:mod:`motionlab.retargeting.expand`).
 
     Parameters are those of :func:`solve` (``offsets`` usually (N, 22, 3): one skeleton per
@@ -871,6 +878,15 @@ def _steps(phi0: torch.Tensor, p: _Problem) -> _Steps:
     return steps
 
 
+def _host(values, device, dtype=None) -> torch.Tensor:
+    """Host numbers (a list or array) as a tensor on ``device``. To a GPU the copy does not wait
+    for the work already queued there: the iteration makes a few such tensors every step, and a
+    waiting copy would stall the host until the device is idle."""
+    if torch.device(device).type == "cpu":
+        return torch.as_tensor(values, dtype=dtype, device=device)
+    return torch.as_tensor(values, dtype=dtype, device="cpu").to(device, non_blocking=True)
+
+
 def _rows_of(bounds: np.ndarray, groups: list) -> np.ndarray:
     """The batch rows (int64) of ``groups``, in order: ``bounds[g]:bounds[g + 1]`` for each."""
     groups = np.asarray(groups, dtype=np.int64)
@@ -880,12 +896,12 @@ def _rows_of(bounds: np.ndarray, groups: list) -> np.ndarray:
     return np.concatenate([np.arange(a, a + n) for a, n in zip(starts, sizes)]).astype(np.int64)
 
 
-def _losses(p: _Problem, phi0, embedding, smooth, steps: _Steps, active: list):
-    """Decode the active groups' latents; ``(out, phi, group_loss (active,), values)`` where
-    ``values[k]`` is ``[L_iter, each registered term's value]`` of active group k (means over its rows)."""
+def _evaluate(p: _Problem, phi0, embedding, smooth, steps: _Steps, active: list):
+    """Decode the active groups' latents; ``(out, phi, group_loss (active,), parts (active, 1 + terms))``
+    where ``parts[k]`` is ``[L_iter, each registered term's value]`` of active group k (means over its rows)."""
     groups, bounds, device, dtype = len(p.sizes), p.bounds, phi0.device, phi0.dtype
     everyone = len(active) == groups
-    rows = None if everyone else torch.as_tensor(_rows_of(bounds, active), device=device)
+    rows = None if everyone else _host(_rows_of(bounds, active), device)
     pick = (lambda t: t) if everyone else (lambda t: None if t is None else t[rows])
     phi = pick(phi0) + smooth(pick(steps.delta), pick(p.index))
     offsets = p.offsets[rows] if p.per_row_offsets and not everyone else p.offsets
@@ -893,13 +909,32 @@ def _losses(p: _Problem, phi0, embedding, smooth, steps: _Steps, active: list):
     given = p.rows(rows)
     loss, by_term = sequence_terms(pick(p.src), out, pick(p.root_height), p.cfg, **given)  # (rows,): each alone
     owner = pick(p.group_of_row)
-    which = owner if everyone else torch.searchsorted(torch.as_tensor(active, device=device), owner)
+    which = owner if everyone else torch.searchsorted(_host(active, device), owner)
     count = torch.zeros(len(active), dtype=dtype, device=device).index_add_(0, which, torch.ones_like(loss))
     parts = [
         torch.zeros(len(active), dtype=dtype, device=device).index_add_(0, which, v) / count
         for v in (loss, *by_term.values())
     ]
-    return out, phi, parts[0], torch.stack([q.detach() for q in parts], 1).tolist()
+    return out, phi, parts[0], torch.stack([q.detach() for q in parts], 1)
+
+
+def _losses(p: _Problem, phi0, embedding, smooth, steps: _Steps, active: list):
+    """:func:`_evaluate` with ``values``, its parts as Python lists, in place of the parts."""
+    out, phi, group_loss, parts = _evaluate(p, phi0, embedding, smooth, steps, active)
+    return out, phi, group_loss, parts.tolist()
+
+
+def _all_rows_step(p: _Problem, phi0, embedding, smooth, steps: _Steps) -> Callable[[], tuple]:
+    """The step that :class:`graphs.StepGraph` records: every group's losses ``(out, phi, parts)``
+    and the gradient of their sum in ``steps.delta.grad`` (each row's is its own group's)."""
+    everyone = list(range(len(p.sizes)))
+
+    def step() -> tuple:
+        out, phi, group_loss, parts = _evaluate(p, phi0, embedding, smooth, steps, everyone)
+        group_loss.sum().backward()
+        return out, phi, parts
+
+    return step
 
 
 @dataclass
@@ -941,8 +976,10 @@ class _Track:
         """Log one evaluation of the active groups, keep their best iterates; the indices into
         ``active`` of the groups that stop here, and of those whose ``L_iter`` is their lowest yet."""
         cfg, stopped, row, better, improved = p.cfg, [], 0, [], []
+        full = out.local_rot.shape[0] == p.bounds[-1]  # out holds every row, not only the active ones
         for k, g in enumerate(active):
             value, n = values[k][0], p.sizes[g]
+            row = p.bounds[g] if full else row
             for key, v in zip(self.keys, values[k]):
                 self.histories[g][key].append(v)
             if callback is not None:
@@ -970,9 +1007,8 @@ class _Track:
         """Copy the improved groups' rows ``(row in out, row in the batch, rows)`` into the best iterate."""
         if not better:
             return
-        src = np.concatenate([np.arange(r, r + n) for r, _, n in better])
-        dst = torch.as_tensor(np.concatenate([np.arange(b, b + n) for _, b, n in better]), device=phi.device)
-        src = torch.as_tensor(src, device=phi.device)
+        src = _host(np.concatenate([np.arange(r, r + n) for r, _, n in better]), phi.device)
+        dst = _host(np.concatenate([np.arange(b, b + n) for _, b, n in better]), phi.device)
         self.best_rot[dst] = out.local_rot.detach()[src]
         self.best_pos[dst] = out.positions.detach()[src]
         self.best_phi[dst] = phi.detach()[src]
@@ -1002,11 +1038,14 @@ def _adam_step(
 ) -> list:
     """One Adam update (``torch.optim.Adam``'s arithmetic) of the groups still running, their δ put
     back on the grid; the groups left. A stopped group keeps its latent. With backtracking, a group
-    whose last step did not lower its loss (not in ``improved``) goes back first (:func:`_backtrack`)."""
-    keep = torch.ones(len(active), dtype=group_loss.dtype, device=group_loss.device)
-    keep[stopped] = 0.0
-    steps.delta.grad = None
-    (group_loss * keep).sum().backward()
+    whose last step did not lower its loss (not in ``improved``) goes back first (:func:`_backtrack`).
+    ``group_loss`` None: ``steps.delta.grad`` already holds the gradient (:func:`_all_rows_step`)."""
+    if group_loss is not None:
+        keep = torch.ones(len(active), dtype=group_loss.dtype, device=group_loss.device)
+        if stopped:
+            keep[_host(stopped, keep.device)] = 0.0
+        steps.delta.grad = None
+        (group_loss * keep).sum().backward()
     stopped, improved = set(stopped), set(improved)  # membership per group: sets, not lists
     if p.cfg.backtrack:
         _backtrack(p, steps, [g for k, g in enumerate(active) if k in improved and k not in stopped],
@@ -1016,10 +1055,10 @@ def _adam_step(
     steps.count[rows] += 1
     like = dict(dtype=steps.m.dtype, device=steps.m.device)
     (b1, b2), t = _BETAS, steps.count[rows]
-    step_size = torch.as_tensor([lr / (1 - b1 ** float(c)) for lr, c in zip(steps.lr[rows], t)], **like)
-    root2 = torch.as_tensor([(1 - b2 ** float(c)) ** 0.5 for c in t], **like)  # Python floats, as Adam's
+    step_size = _host([lr / (1 - b1 ** float(c)) for lr, c in zip(steps.lr[rows], t)], **like)
+    root2 = _host([(1 - b2 ** float(c)) ** 0.5 for c in t], **like)  # Python floats, as Adam's
     step_size, root2 = step_size[:, None, None], root2[:, None, None]
-    index = torch.as_tensor(rows, device=steps.m.device)
+    index = _host(rows, steps.m.device)
     with torch.no_grad():
         g = steps.delta.grad[index]
         m = steps.m[index].lerp_(g, 1 - b1)
@@ -1039,13 +1078,13 @@ def _backtrack(p: _Problem, steps: _Steps, better: list, worse: list) -> None:
     with torch.no_grad():
         if better:
             at = _rows_of(p.bounds, better)
-            rows = torch.as_tensor(at, device=device)
+            rows = _host(at, device)
             steps.best_delta[rows] = steps.delta[rows]
             steps.best_grad[rows] = steps.delta.grad[rows]
             _set_lr(steps, at, np.minimum(steps.lr[at] * _GROW, steps.lr_max[at]))
         if worse:
             at = _rows_of(p.bounds, worse)
-            rows = torch.as_tensor(at, device=device)
+            rows = _host(at, device)
             steps.delta[rows] = steps.best_delta[rows]
             steps.delta.grad[rows] = steps.best_grad[rows]
             steps.m[rows], steps.v[rows] = 0.0, 0.0
@@ -1056,8 +1095,8 @@ def _backtrack(p: _Problem, steps: _Steps, better: list, worse: list) -> None:
 def _set_lr(steps: _Steps, rows: np.ndarray, lr: np.ndarray) -> None:
     """Rows ``rows`` get Adam step size ``lr`` and its grid (:func:`step_grid`)."""
     steps.lr[rows] = lr
-    grid = torch.as_tensor([step_grid(x) for x in lr], dtype=steps.grid.dtype, device=steps.grid.device)
-    steps.grid[torch.as_tensor(rows, device=steps.grid.device)] = grid[:, None, None]
+    grid = _host([step_grid(x) for x in lr], steps.grid.device, steps.grid.dtype)
+    steps.grid[_host(rows, steps.grid.device)] = grid[:, None, None]
 
 
 def _iterate(p: _Problem, callback, progress) -> list[SolverResult]:
@@ -1070,9 +1109,19 @@ def _iterate(p: _Problem, callback, progress) -> list[SolverResult]:
         steps = _steps(phi0, p)
         track = _Track.new(phi0, len(p.sizes))
         active = list(range(len(p.sizes)))
+        graph = (
+            graphs.StepGraph(_all_rows_step(p, phi0, embedding, smooth, steps), steps.delta)
+            if graphs.enabled(phi0.device)
+            else None
+        )
         bar = tqdm(total=cfg.max_steps, desc="latent iteration", disable=not progress, leave=False)
         while active:
-            out, phi, group_loss, values = _losses(p, phi0, embedding, smooth, steps, active)
+            if graph is None:
+                out, phi, group_loss, values = _losses(p, phi0, embedding, smooth, steps, active)
+            else:  # every row, replayed; the active groups' values read off
+                out, phi, parts = graph.run()
+                every, group_loss = parts.tolist(), None
+                values = [every[g] for g in active]
             stopped, improved = track.record(p, active, values, out, phi, callback)
             if len(stopped) == len(active):
                 break

@@ -69,7 +69,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from motionlab.retargeting import losses
+from motionlab.retargeting import devices, losses
 
 __all__ = [
     "Term",
@@ -243,7 +243,10 @@ def _contact(decoded, inputs: TermInputs):
 
 
 def _clearance(decoded, inputs: TermInputs):
-    feet = decoded.positions[..., list(losses.FOOT_JOINTS), 1] + inputs.root_height[..., None]
+    feet = (
+        decoded.positions[..., 1].index_select(-1, devices.index(losses.FOOT_JOINTS, decoded.positions.device))
+        + inputs.root_height[..., None]
+    )
     return at_training_scale(losses.clearance_loss(feet, inputs.extra["clearance"], inputs.frames), inputs)
 
 

@@ -18,6 +18,7 @@ from __future__ import annotations
 import contextlib
 import os
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -336,3 +337,46 @@ def test_cuda_a_cached_trained_network_retargets_as_on_the_cpu(clip, tmp_path, m
     target = humanoid.scale_bones(clip.skeleton, legs=1.2)
     out = {d: retargeting.retarget(clip, target, nets[d], "full", FAST) for d in nets}
     assert 100 * np.abs(out["cpu"].positions - out["cuda"].positions).max() < CUDA_CM
+
+
+def _quadratic_step(leaf):
+    """A step as the solver's: a loss of ``leaf`` and its gradient in ``leaf.grad``."""
+
+    def step():
+        loss = ((2 * leaf + 1) ** 2).sum()
+        loss.backward()
+        return (loss.detach(),)
+
+    return step
+
+
+@pytest.mark.parametrize("device", ["cpu", pytest.param("cuda", marks=[pytest.mark.cuda, cuda])])
+def test_a_step_graph_runs_its_step_on_the_current_values(device):
+    """Known answers: L = Σ (2x + 1)², dL/dx = 4 (2x + 1), after ``leaf`` is changed in place
+    between runs (as the solver's Adam update does). On CUDA the step is recorded and replayed."""
+    from motionlab.retargeting import graphs
+
+    leaf = torch.zeros(3, dtype=torch.float64, device=device, requires_grad=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)  # a step that cannot be recorded warns
+        graph = graphs.StepGraph(_quadratic_step(leaf), leaf)
+    assert graph.recorded == (device == "cuda")
+    for x in (0.0, 1.0, -2.0):
+        with torch.no_grad():
+            leaf.fill_(x)
+        (loss,) = graph.run()
+        assert float(loss) == 3 * (2 * x + 1) ** 2
+        assert leaf.grad.tolist() == [4 * (2 * x + 1)] * 3
+
+
+@pytest.mark.cuda
+@cuda
+def test_cuda_the_iteration_replayed_as_a_graph_equals_it_run_eagerly(clip, monkeypatch):
+    target = humanoid.scale_bones(clip.skeleton, legs=1.2)
+    ck = retargeting.load_default("cuda")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)  # the iteration's step could not be recorded
+        graphed = retargeting.retarget(clip, target, ck, "full", FAST)
+    monkeypatch.setenv("MOTIONLAB_CUDA_GRAPHS", "0")
+    eager = retargeting.retarget(clip, target, ck, "full", FAST)
+    assert 100 * np.abs(graphed.positions - eager.positions).max() < CUDA_CM

@@ -121,6 +121,43 @@ def test_sequences_of_other_lengths_padded_into_one_batch_are_solved_as_alone(ck
             np.testing.assert_allclose(m.history[key], values, rtol=1e-9, atol=1e-12)
 
 
+@pytest.mark.parametrize("cfg", [SolverConfig(max_steps=30, patience=3, min_delta=0.02), SolverConfig(max_steps=20)])
+def test_the_all_rows_step_a_cuda_graph_replays_gives_the_solvers_results(ckpt, cfg, monkeypatch):
+    """On a GPU every step computes every row (:mod:`graphs`), also rows whose problem stopped; run
+    eagerly on the CPU that step gives each problem its usual result, steps and stop, whether the
+    problems stop together or apart (the first config stops them at different steps)."""
+    from motionlab.retargeting import graphs
+    from motionlab.retargeting.pipeline import prepare_pair, prepare_source
+
+    clips = [synthetic.dataset(1, seed=s, num_frames=n)[0] for s, n in ((3, 30), (4, 44), (5, 37), (6, 40))]
+    jobs = [prepare_pair(prepare_source(c, ckpt), k) for c, k in zip(clips, synthetic.character_set(4, seed=0))]
+    T = max(j.source.x.shape[1] for j in jobs)
+
+    def padded(t):
+        return torch.cat([t, t[:, -1:].expand((1, T - t.shape[1]) + t.shape[2:])], 1) if t.shape[1] < T else t
+
+    def batch(*keys, of=lambda j, k: getattr(j, k)):
+        return [torch.cat([padded(of(j, k)) for j in jobs]) for k in keys]
+
+    x, theta, yaw = batch("x", "theta", "yaw", of=lambda j, k: getattr(j.source, k))
+    heights, root_xz, floor = batch("root_height", "root_xz", "floor")
+    planted = torch.cat([padded(j.source.planted.double()).bool() for j in jobs])
+    fps = torch.tensor([60.0] * len(jobs), dtype=torch.float64)
+    offsets, lengths = torch.stack([j.offsets for j in jobs]), [j.source.x.shape[1] for j in jobs]
+    results = {}
+    for on in (False, True):
+        monkeypatch.setattr(graphs, "enabled", lambda device, on=on: on)
+        results[on] = solve_many(
+            ckpt.model, x, theta, offsets, heights, cfg, root_xz=root_xz, yaw=yaw, planted=planted, fps=fps,
+            inputs={"floor": floor}, lengths=lengths,
+        )  # fmt: skip
+    stops = [(r.steps, r.stop_reason, r.best_step) for r in results[False]]
+    assert stops == [(r.steps, r.stop_reason, r.best_step) for r in results[True]]
+    for usual, every in zip(results[False], results[True]):
+        np.testing.assert_allclose(every.positions, usual.positions, atol=1e-12)
+        assert every.history == usual.history
+
+
 def test_padding_is_refused_while_a_term_ignores_padded_frames(ckpt):
     from motionlab.retargeting import terms
 
@@ -173,6 +210,30 @@ def test_host_workers_and_padded_batches_write_what_one_process_writes(ckpt, lib
         assert float(a["loss"]) == pytest.approx(float(b["loss"]), rel=1e-6)
         first, second = (bvh.load(tmp_path / d / a["output"]).global_positions() for d in ("plain", "gpu"))
         np.testing.assert_allclose(first, second, atol=2e-6)  # the files hold 6 decimals
+
+
+def test_this_process_prepares_from_the_back_the_clips_no_worker_has_taken(ckpt, library, tmp_path):
+    """While the workers start, expand prepares the clips still queued itself, from the last one
+    back, until it meets one a worker holds; a clip that fails keeps its error for result()."""
+    from concurrent.futures import Future
+
+    bad = tmp_path / "bad.bvh"
+    bad.write_text("HIERARCHY\nROOT Hips\n{\n")
+    paths = [library / "clips" / f"{n}.bvh" for n in ("walk", "turn", "short")] + [bad]
+    targets = [(c.name, c.skeleton) for c in _targets(library)[:1]]
+    args = {p.stem: (p, None, targets, "stride", FAST) for p in paths}
+    tasks = {clip: Future() for clip in args}
+    tasks["walk"].set_running_or_notify_cancel()  # a worker has it
+    queued = tasks["turn"]
+    tasks["turn"].set_running_or_notify_cancel()
+    ex._prepare_here(tasks, args, ckpt)
+    assert tasks["walk"].running() and tasks["turn"] is queued  # stopped at the first taken clip
+    with pytest.raises(bvh.BVHError, match="bad.bvh"):
+        tasks["bad"].result()
+    motion, prepared, skating, jobs = tasks["short"].result()
+    alone = ex.prepare_clip(*args["short"], ckpt)
+    assert skating == alone[2] and np.array_equal(prepared.x, alone[1].x)
+    assert np.array_equal(jobs["rig0"].root_height, alone[3]["rig0"].root_height)
 
 
 def test_resume_after_interruption_redoes_only_missing(ckpt, library, tmp_path):

@@ -1,0 +1,81 @@
+"""One step of the latent iteration as a CUDA graph: its hundreds of kernels launched as one.
+
+On a GPU the batched latent iteration (:mod:`motionlab.retargeting.solver`) is bound by kernel
+launches, not by arithmetic: one step (decode, every loss term, the gradient) is about 700 small
+kernels, and launching them from Python takes longer than the GPU takes to run them
+(``docs/performance.md``). A CUDA graph records those kernels once and replays them with one
+launch. The step then has to be the same every time: the same tensors (updated in place), the
+same shapes (every row of the batch, also rows whose problem has stopped: their gradient is
+computed and not used) and nothing that waits for the device.
+
+:class:`StepGraph` records a step on CUDA and replays it; elsewhere it runs the same step eagerly,
+so the CPU exercises the same all-rows arithmetic (a test compares it with the solver's usual
+path). ``MOTIONLAB_CUDA_GRAPHS=0`` switches graphs off (:func:`enabled`).
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+from collections.abc import Callable
+
+import torch
+
+__all__ = ["enabled", "StepGraph"]
+
+WARMUP = 3
+"""Eager runs of the step on a side stream before it is recorded (as torch's CUDA graph notes ask)."""
+
+
+def enabled(device: str | torch.device) -> bool:
+    """Whether the iteration on ``device`` replays its step as a CUDA graph: on CUDA devices,
+    unless the environment sets ``MOTIONLAB_CUDA_GRAPHS=0``."""
+    return torch.device(device).type == "cuda" and os.environ.get("MOTIONLAB_CUDA_GRAPHS", "1") != "0"
+
+
+class StepGraph:
+    """``step()`` (the losses and ``leaf``'s gradient, nothing that waits for the device) recorded
+    once on CUDA, replayed by :meth:`run`.
+
+    :meth:`run` returns the recorded outputs: the same tensors each time, overwritten by the next
+    run (read or copy them first). ``leaf.grad`` is likewise one tensor that every run overwrites;
+    it may be changed in place between runs, never replaced. Off CUDA, or when recording fails
+    (with a warning), :meth:`run` calls ``step`` eagerly after clearing ``leaf.grad``.
+    """
+
+    def __init__(self, step: Callable[[], tuple], leaf: torch.Tensor) -> None:
+        self._step, self._leaf, self._graph, self._out = step, leaf, None, None
+        if leaf.device.type == "cuda":
+            try:
+                self._record()
+            except RuntimeError as err:  # an operation that cannot be recorded: run eagerly
+                self._graph = None
+                warnings.warn(f"the latent iteration runs without a CUDA graph: {err}", RuntimeWarning, stacklevel=3)
+
+    def _record(self) -> None:
+        device = self._leaf.device
+        side = torch.cuda.Stream(device=device)
+        side.wait_stream(torch.cuda.current_stream(device))
+        with torch.cuda.stream(side):
+            for _ in range(WARMUP):
+                self._leaf.grad = None
+                self._step()
+        torch.cuda.current_stream(device).wait_stream(side)
+        self._leaf.grad = None
+        graph = torch.cuda.CUDAGraph()
+        with torch.cuda.graph(graph):
+            out = self._step()
+        self._graph, self._out = graph, out
+
+    @property
+    def recorded(self) -> bool:
+        """True when :meth:`run` replays a CUDA graph."""
+        return self._graph is not None
+
+    def run(self) -> tuple:
+        """One step: the outputs of ``step()``, with ``leaf.grad`` holding the gradient."""
+        if self._graph is None:
+            self._leaf.grad = None
+            return self._step()
+        self._graph.replay()
+        return self._out
