@@ -3,8 +3,8 @@
 Prepares all of Aj's clips × the six Table 1 characters as ``expand`` does (host workers), plans
 the padded batches, solves the smallest once to warm the device up (not timed), then times the
 latent iteration of every batch (``batching.solve_jobs``, device synchronised) with its step
-replayed as a CUDA graph (as shipped, :mod:`motionlab.retargeting.graphs`), launched eagerly
-(``MOTIONLAB_CUDA_GRAPHS=0``), and as shipped again. Then it
+replayed as a CUDA graph (``MOTIONLAB_CUDA_GRAPHS=1``, :mod:`motionlab.retargeting.graphs`),
+launched eagerly (the default), and as a graph again. Then it
 profiles the batch with the most rows: Python (cProfile, top functions by own time) and the device (``torch.profiler``: top
 operators by device time, kernel launches per step). Results of the variants are compared with
 the first run's (largest joint difference, cm). On a GPU it first splits ``expand``'s load time:

@@ -10,7 +10,11 @@ computed and not used) and nothing that waits for the device.
 
 :class:`StepGraph` records a step on CUDA and replays it; elsewhere it runs the same step eagerly,
 so the CPU exercises the same all-rows arithmetic (a test compares it with the solver's usual
-path). ``MOTIONLAB_CUDA_GRAPHS=0`` switches graphs off (:func:`enabled`).
+path, another checks that the step reads nothing back from the device and copies nothing from the
+host, which a graph could not record).
+
+**Off by default** until it has been measured on a GPU: ``MOTIONLAB_CUDA_GRAPHS=1`` switches it on
+(:func:`enabled`); ``benchmarks/gpu_check.sh`` (stage ``graphs``) measures it against the eager step.
 """
 
 from __future__ import annotations
@@ -28,9 +32,9 @@ WARMUP = 3
 
 
 def enabled(device: str | torch.device) -> bool:
-    """Whether the iteration on ``device`` replays its step as a CUDA graph: on CUDA devices,
-    unless the environment sets ``MOTIONLAB_CUDA_GRAPHS=0``."""
-    return torch.device(device).type == "cuda" and os.environ.get("MOTIONLAB_CUDA_GRAPHS", "1") != "0"
+    """Whether the iteration on ``device`` replays its step as a CUDA graph: on CUDA devices when
+    the environment sets ``MOTIONLAB_CUDA_GRAPHS=1``."""
+    return torch.device(device).type == "cuda" and os.environ.get("MOTIONLAB_CUDA_GRAPHS") == "1"
 
 
 class StepGraph:

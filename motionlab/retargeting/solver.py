@@ -61,11 +61,12 @@ smooth. ``smooth_sigma=0`` optimises φ directly, as the paper states.
 to a grid a four-thousandth of a step fine, so that last-bit differences between CPUs' kernels
 cannot grow into other results or another stopping step. The network computes in float64.
 
-**On a GPU the step is one CUDA graph** (:mod:`motionlab.retargeting.graphs`): the decoding, the
-terms and the gradient of every row are recorded once and replayed at each step, rows whose
-problem has stopped included (their gradient is not used), so that the GPU does not wait for
-Python to launch hundreds of small kernels. Each problem's arithmetic is the same as without the
-graph (a test runs the all-rows step on the CPU).
+**On a GPU the step can be one CUDA graph** (:mod:`motionlab.retargeting.graphs`, switched on by
+``MOTIONLAB_CUDA_GRAPHS=1`` until measured on a GPU): the decoding, the terms and the gradient of
+every row are recorded once and replayed at each step, rows whose problem has stopped included
+(their gradient is not used), so that the GPU does not wait for Python to launch hundreds of small
+kernels. Each problem's arithmetic is the same as without the graph (a test runs the all-rows step
+on the CPU). Either way a step reads one thing back from the device, its losses (a test counts).
 
 θ, what "joint angles" means, is our choice: the local joint rotations (see
 :mod:`motionlab.retargeting.losses` for why, and ``theta="directions"`` for the
@@ -675,8 +676,8 @@ def solve_many(
     Each sequence has its own loss, its own Adam step size (``lr · std(φ₀)`` of its own latent),
     its own stopping rule and its own best iterate, so result ``i`` is what :func:`solve` gives for
     sequence ``i`` alone (up to float rounding: batched matrix products may round differently).
-    A sequence that has stopped leaves the batch, so later steps only compute the others (on a
-    GPU every row is computed to the end: the step is a recorded CUDA graph, :mod:`.graphs`).
+    A sequence that has stopped leaves the batch, so later steps only compute the others (with
+    the step as a CUDA graph, :mod:`.graphs`, every row is computed to the end).
     Typical use: many (clip, character) pairs (:mod:`motionlab.retargeting.expand`).
 
     Parameters are those of :func:`solve` (``offsets`` usually (N, 22, 3): one skeleton per

@@ -15,6 +15,7 @@ without one: ``pytest -m cuda`` on a GPU machine).
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import os
 import sys
@@ -30,6 +31,7 @@ import motionlab
 from motionlab import retargeting, synthetic
 from motionlab.core import bvh, humanoid
 from motionlab.retargeting import batching, devices
+from motionlab.retargeting.pipeline import prepare_pair, prepare_source
 from motionlab.retargeting.solver import SolverConfig
 from motionlab.retargeting.train import TrainConfig, train
 from tests.retargeting.conftest import TINY
@@ -101,6 +103,33 @@ def explicit_devices():
     finally:
         torch.from_numpy = from_numpy
     assert not found, "tensors made without naming their device/dtype:\n" + "\n".join(dict.fromkeys(found))
+
+
+_WAITS = {torch.Tensor.item, torch.Tensor.tolist, torch.Tensor.__bool__, torch.Tensor.__float__, torch.Tensor.__int__}
+_WAITS |= {torch.Tensor.numpy, torch.Tensor.cpu}
+
+
+class _HostTraffic(TorchFunctionMode):
+    """Counts, by ``(kind, function, caller)``, what would make a GPU wait or the host copy: ``wait``
+    (a value read back: item, tolist, bool…), ``copy`` (a tensor made from host data) and ``index``
+    (a tensor indexed by a host list or array, which is copied to the device first)."""
+
+    def __init__(self):
+        super().__init__()
+        self.count: collections.Counter = collections.Counter()
+
+    def __torch_function__(self, func, types, args=(), kwargs=None):
+        kwargs = kwargs or {}
+        caller = sys._getframe(1).f_code.co_name
+        if func in _WAITS:
+            self.count[("wait", func.__name__, caller)] += 1
+        elif func in _FROM_DATA and not isinstance(args[0] if args else kwargs.get("data"), torch.Tensor):
+            self.count[("copy", func.__name__, caller)] += 1
+        elif func in (torch.Tensor.__getitem__, torch.Tensor.__setitem__):
+            index = args[1] if isinstance(args[1], tuple) else (args[1],)
+            if any(isinstance(i, (list, np.ndarray)) for i in index):
+                self.count[("index", func.__name__, caller)] += 1
+        return func(*args, **kwargs)
 
 
 # ----------------------------------------------------------------------------- the checker itself
@@ -374,9 +403,58 @@ def test_a_step_graph_runs_its_step_on_the_current_values(device):
 def test_cuda_the_iteration_replayed_as_a_graph_equals_it_run_eagerly(clip, monkeypatch):
     target = humanoid.scale_bones(clip.skeleton, legs=1.2)
     ck = retargeting.load_default("cuda")
+    monkeypatch.setenv("MOTIONLAB_CUDA_GRAPHS", "1")
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)  # the iteration's step could not be recorded
         graphed = retargeting.retarget(clip, target, ck, "full", FAST)
     monkeypatch.setenv("MOTIONLAB_CUDA_GRAPHS", "0")
     eager = retargeting.retarget(clip, target, ck, "full", FAST)
     assert 100 * np.abs(graphed.positions - eager.positions).max() < CUDA_CM
+
+
+def _jobs(checkpoint, n=2):
+    clips = [synthetic.dataset(1, seed=s, num_frames=f)[0] for s, f in ((3, 30), (4, 44), (5, 37))[:n]]
+    return [prepare_pair(prepare_source(c, checkpoint), k) for c, k in zip(clips, synthetic.character_set(n, seed=0))]
+
+
+def test_a_step_of_the_iteration_waits_for_the_device_once(tiny_checkpoint):
+    """Per step of the latent iteration (steps 4 to 8, no problem stopping): one read-back (the
+    losses, which the stopping rule needs), no index or host copy that would wait (the code of
+    stop 50 made about 20), only the few non-blocking copies of ``solver._host``. Index tensors made once per
+    device (``devices.index``) do not count."""
+    jobs = _jobs(tiny_checkpoint)
+    counts = {}
+    for steps in (4, 8):
+        with _HostTraffic() as traffic:
+            batching.solve_jobs(tiny_checkpoint, jobs, SolverConfig(max_steps=steps, threshold=0.0, patience=0))
+        counts[steps] = traffic.count
+    per_step = {k: (counts[8][k] - counts[4][k]) / 4 for k in set(counts[8]) | set(counts[4]) if k[2] != "index"}
+    waits = {k: v for k, v in per_step.items() if v and k[2] != "_host"}  # _host: copies, and only copies
+    assert waits == {("wait", "tolist", "_losses"): 1.0}
+    assert all(kind == "copy" for kind, _, caller in per_step if caller == "_host")
+
+
+def test_the_step_a_cuda_graph_records_neither_waits_nor_copies(tiny_checkpoint):
+    """A CUDA graph cannot record a read-back or a copy from the host: the all-rows step
+    (``solver._all_rows_step``) has none, padded rows and the contact and floor terms included."""
+    from motionlab.retargeting import graphs
+
+    recorded = []
+    real = graphs.StepGraph
+
+    class Watched(real):
+        def __init__(self, step, leaf):
+            def watched():
+                with _HostTraffic() as traffic:
+                    out = step()
+                recorded.append(traffic.count)
+                return out
+
+            super().__init__(watched, leaf)
+
+    jobs = _jobs(tiny_checkpoint, 3)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(graphs, "enabled", lambda device: True)
+        mp.setattr(graphs, "StepGraph", Watched)
+        batching.solve_jobs(tiny_checkpoint, jobs, SolverConfig(max_steps=3))
+    assert len(recorded) >= 3 and all(not c for c in recorded), recorded[0]
