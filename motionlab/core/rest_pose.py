@@ -136,10 +136,10 @@ def _angle(v: np.ndarray, ref: np.ndarray) -> np.ndarray:
     return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
 
 
-def _uprightness(pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Worst angle (degrees) to vertical of thighs, shins (down) and Hips→Neck (up), and which
-    (index into :data:`_UPRIGHT`); pos (..., 22, 3)."""
-    down = np.array([0.0, -1.0, 0.0])
+def _uprightness(pos: np.ndarray, up=(0.0, 1.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
+    """Worst angle (degrees) to vertical (``up``, +Y) of thighs, shins (down) and Hips→Neck (up),
+    and which (index into :data:`_UPRIGHT`); pos (..., 22, 3)."""
+    down = -np.asarray(up, dtype=np.float64)
     angles = [_angle(pos[..., _J.index("Neck"), :] - pos[..., 0, :], -down)]
     for name in _UPRIGHT[1:]:
         j = _J.index(name)
@@ -254,11 +254,34 @@ def _standing_turn(motion: Motion, what: str, check: bool = True) -> tuple[np.nd
         raise RestPoseError(
             f"{what}: no standing pose: the rest offsets do not stand and in no frame are thighs and shins within "
             f"{TOLERANCE_DEG:g} deg of straight down and Hips->Neck of straight up (most upright: frame {t}, where "
-            f"{_WHAT[which[t]]} is {score[t]:.0f} deg off); {REST_FROM_HINT}"
+            f"{_WHAT[which[t]]} is {score[t]:.0f} deg off); {_other_up(g_pos) or REST_FROM_HINT}"
         )
 
     yaw = humanoid.heading(g_pos[t])
     return quat.mul(quat.from_yaw(-yaw)[None], g_rot[t]), t, float(score[t])
+
+
+_AXES = {
+    "+Z": (0.0, 0.0, 1.0),
+    "-Z": (0.0, 0.0, -1.0),
+    "+X": (1.0, 0.0, 0.0),
+    "-X": (-1.0, 0.0, 0.0),
+    "-Y": (0.0, -1.0, 0.0),
+}
+
+
+def _other_up(g_pos: np.ndarray) -> str:
+    """What to do when some frame of ``g_pos`` (T, 22, 3) stands upright about another world axis
+    than +Y (a file exported with another up axis), else ``""``."""
+    for name, axis in _AXES.items():
+        score = _uprightness(g_pos, axis)[0]
+        t = int(np.argmin(score))
+        if score[t] <= TOLERANCE_DEG:
+            return (
+                f"but it stands with {name} up (frame {t}, within {score[t]:.0f} deg): a file exported with {name} up? "
+                "motionlab reads BVH with +Y up, the format's convention: export it with Y up"
+            )
+    return ""
 
 
 def _turned_offsets(offsets: np.ndarray, turn: np.ndarray) -> np.ndarray:

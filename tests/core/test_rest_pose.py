@@ -123,6 +123,31 @@ def test_no_standing_pose_is_a_named_error():
         rest_pose.standing_skeleton(lying.skeleton, "rig.bvh")
 
 
+def test_a_file_exported_with_z_up_is_named_so():
+    """A walk turned as a whole onto +Z up (offsets, root path and rotations; as a Z-up exporter
+    writes it) cannot stand about +Y: the refusal says which axis it stands about and how to fix it;
+    a take that stands about no axis keeps the --rest-from hint."""
+    walk, up = _walk(20), quat.from_axis_angle(np.array([1.0, 0.0, 0.0]), np.pi / 2)  # +Y onto +Z
+    sk = walk.skeleton
+    zup = Motion(
+        Skeleton(sk.names, sk.parents, quat.rotate(up, sk.offsets)),
+        quat.mul(quat.mul(up, walk.local_rot), quat.conj(up)),
+        quat.rotate(up, walk.root_pos),
+        walk.fps,
+    )
+    np.testing.assert_allclose(zup.global_positions(), quat.rotate(up, walk.global_positions()), atol=1e-9)
+    with pytest.raises(
+        rest_pose.RestPoseError, match=r"zup.bvh: no standing pose.*stands with \+Z up.*export it with Y up"
+    ) as err:
+        rest_pose.standing(zup, "zup.bvh")
+    assert "--rest-from" not in str(err.value)
+    lying = _lying(_walk(10))
+    crawl = lying.copy(local_rot=np.tile(quat.normalize(lying.local_rot[:1] * 0 + [1.0, 0, 0, 0]), (10, 1, 1)))
+    with pytest.raises(rest_pose.RestPoseError, match="--rest-from FILE.bvh") as err:
+        rest_pose.standing(crawl, "crawl.bvh")
+    assert "stands with" not in str(err.value)
+
+
 def test_bandai_namco_stands_like_a_mixamo_character():
     """The issue's bug: Bandai's rest hip height was 0.065 m; its standing pose gives a human one."""
     root = require_data("bandai_namco")
