@@ -880,10 +880,11 @@ def _steps(phi0: torch.Tensor, p: _Problem) -> _Steps:
 
 
 def _host(values, device, dtype=None) -> torch.Tensor:
-    """Host numbers (a list or array) as a tensor on ``device``. To a GPU the copy does not wait
-    for the work already queued there: the iteration makes a few such tensors every step, and a
-    waiting copy would stall the host until the device is idle."""
-    if torch.device(device).type == "cpu":
+    """Host numbers (a list or array) as a tensor on ``device``. To a CUDA GPU the copy does not
+    wait for the work already queued there: the iteration makes a few such tensors every step, and
+    a waiting copy would stall the host until the device is idle."""
+    device = torch.device(device)
+    if device.type != "cuda":
         return torch.as_tensor(values, dtype=dtype, device=device)
     return torch.as_tensor(values, dtype=dtype, device="cpu").to(device, non_blocking=True)
 
