@@ -1,9 +1,9 @@
 """One step of the latent iteration as a CUDA graph: its hundreds of kernels launched as one.
 
 On a GPU the batched latent iteration (:mod:`motionlab.retargeting.solver`) is bound by kernel
-launches, not by arithmetic: one step (decode, every loss term, the gradient) is about 700 small
+launches, not by arithmetic: one step (decode, every loss term, the gradient) is hundreds of small
 kernels, and launching them from Python takes longer than the GPU takes to run them
-(``docs/performance.md``). A CUDA graph records those kernels once and replays them with one
+(``docs/performance.md`` has the profile). A CUDA graph records those kernels once and replays them with one
 launch. The step then has to be the same every time: the same tensors (updated in place), the
 same shapes (every row of the batch, also rows whose problem has stopped: their gradient is
 computed and not used) and nothing that waits for the device.
