@@ -254,7 +254,7 @@ def _standing_turn(motion: Motion, what: str, check: bool = True) -> tuple[np.nd
         raise RestPoseError(
             f"{what}: no standing pose: the rest offsets do not stand and in no frame are thighs and shins within "
             f"{TOLERANCE_DEG:g} deg of straight down and Hips->Neck of straight up (most upright: frame {t}, where "
-            f"{_WHAT[which[t]]} is {score[t]:.0f} deg off); {_other_up(g_pos) or REST_FROM_HINT}"
+            f"{_WHAT[which[t]]} is {score[t]:.0f} deg off); {_other_up(g_pos)}{REST_FROM_HINT}"
         )
 
     yaw = humanoid.heading(g_pos[t])
@@ -272,14 +272,16 @@ _AXES = {
 
 def _other_up(g_pos: np.ndarray) -> str:
     """What to do when some frame of ``g_pos`` (T, 22, 3) stands upright about another world axis
-    than +Y (a file exported with another up axis), else ``""``."""
+    than +Y: a file exported with another up axis, or a take lying along that axis (then
+    :data:`REST_FROM_HINT`, which follows, applies); else ``""``."""
     for name, axis in _AXES.items():
         score = _uprightness(g_pos, axis)[0]
         t = int(np.argmin(score))
         if score[t] <= TOLERANCE_DEG:
             return (
                 f"but it stands with {name} up (frame {t}, within {score[t]:.0f} deg): a file exported with {name} up? "
-                "motionlab reads BVH with +Y up, the format's convention: export it with Y up"
+                "motionlab reads BVH with +Y up, the format's convention: export it with Y up. If the take only "
+                "lies or crawls, "
             )
     return ""
 
@@ -379,7 +381,8 @@ def standing_skeleton(
         if not worst <= TOLERANCE_DEG and rule != "tpose" and reference is None:
             raise RestPoseError(
                 f"{what}: the rest offsets are not a standing pose ({_WHAT[int(which)]} is {float(worst):.0f} deg "
-                f"off, at most {TOLERANCE_DEG:g} expected) and no motion was given to find one; {REST_FROM_HINT}"
+                f"off, at most {TOLERANCE_DEG:g} expected) and no motion was given to find one; "
+                f"{_other_up(sk.rest_positions()[None])}{REST_FROM_HINT}"
             )
     out, pose = standing(motion, what, family, reference)
     return out.skeleton, pose

@@ -126,7 +126,8 @@ def test_no_standing_pose_is_a_named_error():
 def test_a_file_exported_with_z_up_is_named_so():
     """A walk turned as a whole onto +Z up (offsets, root path and rotations; as a Z-up exporter
     writes it) cannot stand about +Y: the refusal says which axis it stands about and how to fix it;
-    a take that stands about no axis keeps the --rest-from hint."""
+    a take lying along that axis (the same numbers) needs --rest-from, which the message gives too;
+    a take that stands about no axis gets the --rest-from hint alone."""
     walk, up = _walk(20), quat.from_axis_angle(np.array([1.0, 0.0, 0.0]), np.pi / 2)  # +Y onto +Z
     sk = walk.skeleton
     zup = Motion(
@@ -140,7 +141,9 @@ def test_a_file_exported_with_z_up_is_named_so():
         rest_pose.RestPoseError, match=r"zup.bvh: no standing pose.*stands with \+Z up.*export it with Y up"
     ) as err:
         rest_pose.standing(zup, "zup.bvh")
-    assert "--rest-from" not in str(err.value)
+    assert "If the take only lies or crawls, take the standing pose from another take" in str(err.value)
+    with pytest.raises(rest_pose.RestPoseError, match=r"rig.bvh: the rest offsets are not a standing pose.*\+Z up"):
+        rest_pose.standing_skeleton(zup.skeleton, "rig.bvh")  # a Z-up rig given without motion
     lying = _lying(_walk(10))
     crawl = lying.copy(local_rot=np.tile(quat.normalize(lying.local_rot[:1] * 0 + [1.0, 0, 0, 0]), (10, 1, 1)))
     with pytest.raises(rest_pose.RestPoseError, match="--rest-from FILE.bvh") as err:
