@@ -33,8 +33,16 @@ WARMUP = 3
 
 def enabled(device: str | torch.device) -> bool:
     """Whether the iteration on ``device`` replays its step as a CUDA graph: on CUDA devices when
-    the environment sets ``MOTIONLAB_CUDA_GRAPHS=1``."""
-    return torch.device(device).type == "cuda" and os.environ.get("MOTIONLAB_CUDA_GRAPHS") == "1"
+    the environment sets ``MOTIONLAB_CUDA_GRAPHS=1``.
+
+    Raises
+    ------
+    ValueError when ``MOTIONLAB_CUDA_GRAPHS`` is set to anything but ``0`` or ``1``.
+    """
+    value = os.environ.get("MOTIONLAB_CUDA_GRAPHS") or "0"
+    if value not in ("0", "1"):
+        raise ValueError(f"MOTIONLAB_CUDA_GRAPHS must be 0 (off, the default) or 1 (on), got {value!r}")
+    return value == "1" and torch.device(device).type == "cuda"
 
 
 class StepGraph:

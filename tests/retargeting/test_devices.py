@@ -419,8 +419,8 @@ def _jobs(checkpoint, n=2):
 
 def test_a_step_of_the_iteration_waits_for_the_device_once(tiny_checkpoint):
     """Per step of the latent iteration (steps 4 to 8, no problem stopping): one read-back (the
-    losses, which the stopping rule needs), no index or host copy that would wait (the code of
-    stop 50 made about 20), only the few non-blocking copies of ``solver._host``. Index tensors made once per
+    losses, which the stopping rule needs), no index or host copy that would wait, only the few
+    non-blocking copies of ``solver._host``. Index tensors made once per
     device (``devices.index``) do not count."""
     jobs = _jobs(tiny_checkpoint)
     counts = {}
@@ -458,3 +458,14 @@ def test_the_step_a_cuda_graph_records_neither_waits_nor_copies(tiny_checkpoint)
         mp.setattr(graphs, "StepGraph", Watched)
         batching.solve_jobs(tiny_checkpoint, jobs, SolverConfig(max_steps=3))
     assert len(recorded) >= 3 and all(not c for c in recorded), recorded[0]
+
+
+def test_the_graph_switch_takes_0_or_1(monkeypatch):
+    from motionlab.retargeting import graphs
+
+    for value, cuda in (("", False), ("0", False), ("1", True)):
+        monkeypatch.setenv("MOTIONLAB_CUDA_GRAPHS", value)
+        assert graphs.enabled("cpu") is False and graphs.enabled(torch.device("cuda")) is cuda
+    monkeypatch.setenv("MOTIONLAB_CUDA_GRAPHS", "true")
+    with pytest.raises(ValueError, match="MOTIONLAB_CUDA_GRAPHS must be 0 .* or 1 .*, got 'true'"):
+        graphs.enabled("cpu")
