@@ -3,8 +3,9 @@
 #   pytest    the CUDA tests (pytest -m cuda);
 #   expand64  expanding all of Aj's clips onto the six Table 1 characters on cuda in float64, outputs
 #             compared with a CPU run of the same pairs (REF) (KEEP=1: kept as OUT/gpu_out.tgz.*);
-#   graphs    expand64 with each solver step replayed as a CUDA graph (MOTIONLAB_CUDA_GRAPHS=1,
-#             motionlab.retargeting.graphs; off by default until measured);
+#   eager     expand64 with each solver step launched eagerly (MOTIONLAB_CUDA_GRAPHS=0) instead of
+#             replayed as a CUDA graph (motionlab.retargeting.graphs, the default on CUDA);
+#   fk        benchmarks/bench_fk_product.py (FK's 3x3 products as batched GEMMs or broadcast sums);
 #   workers   the same with FEW host worker processes instead of every core but one (FEW: a list,
 #             default 4);
 #   expand32  the same in float32 (the dtype rule's speed);
@@ -40,14 +41,15 @@ for s in ${STAGES:-pytest expand64 expand32 table1}; do
     expand64)
         expand --keep "$work/gpu_out"
         [ -n "${KEEP:-}" ] && (cd "$work" && tar czf - gpu_out | split -b 15M - "$OUT/gpu_out.tgz.") ;;
-    graphs) MOTIONLAB_CUDA_GRAPHS=1 expand ;;
+    eager) MOTIONLAB_CUDA_GRAPHS=0 expand ;;
+    fk) timeout 60 $PY benchmarks/bench_fk_product.py --device "$DEV" ;;
     workers) for w in ${FEW:-4}; do expand --host-workers "$w"; done ;;
     expand32) expand --dtype float32 ;;
     table1)
         timeout 300 $PY -m motionlab evaluate --device "$DEV" --checkpoint "$OUT/motionlab_Aj.pt" --no-ablations -q \
             --csv "$OUT/table1_$DEV.csv" 2>&1 | tee "$OUT/table1_$DEV.txt" ;;
     profile) timeout 240 $PY benchmarks/profile_expand_gpu.py --device "$DEV" $( [ "$CLIPS" = all ] || echo --clips "$CLIPS" ) ;;
-    *) echo "unknown stage $s (pytest expand64 graphs workers expand32 table1 profile)"; exit 2 ;;
+    *) echo "unknown stage $s (pytest expand64 eager fk workers expand32 table1 profile)"; exit 2 ;;
     esac
 done
 stage done

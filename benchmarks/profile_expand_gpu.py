@@ -4,7 +4,7 @@ Prepares all of Aj's clips × the six Table 1 characters as ``expand`` does (hos
 the padded batches, solves the smallest once to warm the device up (not timed), then times the
 latent iteration of every batch (``batching.solve_jobs``, device synchronised) with its step
 replayed as a CUDA graph (``MOTIONLAB_CUDA_GRAPHS=1``, :mod:`motionlab.retargeting.graphs`),
-launched eagerly (the default), and as a graph again. Then it
+launched eagerly (``MOTIONLAB_CUDA_GRAPHS=0``), and as a graph again (the default on CUDA). Then it
 profiles the batch with the most rows: Python (cProfile, top functions by own time) and the device (``torch.profiler``: top
 operators by device time, kernel launches per step). Results of the variants are compared with
 the first run's (largest joint difference, cm). On a GPU it first splits ``expand``'s load time:

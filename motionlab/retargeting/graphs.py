@@ -13,8 +13,8 @@ so the CPU exercises the same all-rows arithmetic (a test compares it with the s
 path, another checks that the step reads nothing back from the device and copies nothing from the
 host, which a graph could not record).
 
-**Off by default** until it has been measured on a GPU: ``MOTIONLAB_CUDA_GRAPHS=1`` switches it on
-(:func:`enabled`); ``benchmarks/gpu_check.sh`` (stage ``graphs``) measures it against the eager step.
+**On by default on CUDA**; ``MOTIONLAB_CUDA_GRAPHS=0`` switches it off (:func:`enabled`), and
+``benchmarks/gpu_check.sh`` (stage ``eager``) measures the graph against the eager step.
 """
 
 from __future__ import annotations
@@ -32,16 +32,16 @@ WARMUP = 3
 
 
 def enabled(device: str | torch.device) -> bool:
-    """Whether the iteration on ``device`` replays its step as a CUDA graph: on CUDA devices when
-    the environment sets ``MOTIONLAB_CUDA_GRAPHS=1``.
+    """Whether the iteration on ``device`` replays its step as a CUDA graph: on CUDA devices unless
+    the environment sets ``MOTIONLAB_CUDA_GRAPHS=0``.
 
     Raises
     ------
     ValueError when ``MOTIONLAB_CUDA_GRAPHS`` is set to anything but ``0`` or ``1``.
     """
-    value = os.environ.get("MOTIONLAB_CUDA_GRAPHS") or "0"
+    value = os.environ.get("MOTIONLAB_CUDA_GRAPHS") or "1"
     if value not in ("0", "1"):
-        raise ValueError(f"MOTIONLAB_CUDA_GRAPHS must be 0 (off, the default) or 1 (on), got {value!r}")
+        raise ValueError(f"MOTIONLAB_CUDA_GRAPHS must be 0 (off) or 1 (on, the default), got {value!r}")
     return value == "1" and torch.device(device).type == "cuda"
 
 

@@ -173,6 +173,19 @@ def _matrices(q: torch.Tensor) -> torch.Tensor:
     return m.reshape(q.shape[:-1] + (3, 3))
 
 
+def _product(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
+    """``a @ b`` for small matrices (..., n, k) @ (..., k, m): on CUDA :func:`_summed_product`
+    (batched GEMM kernels are made for large matrices and run tens of thousands of 3×3 products
+    slowly), elsewhere ``a @ b`` itself, whose CPU kernels are fast on them."""
+    return _summed_product(a, b) if a.device.type == "cuda" else a @ b
+
+
+def _summed_product(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
+    """``a @ b`` (..., n, m) as a broadcast product (..., n, k, m) summed over ``k``: two elementwise
+    kernels, however many matrices the batch holds."""
+    return (a.unsqueeze(-1) * b.unsqueeze(-3)).sum(-2)
+
+
 def fk_by_level(local_rot: torch.Tensor, local_pos: torch.Tensor, parents) -> torch.Tensor:
     """World joint positions (..., J, 3) by forward kinematics, one tree level at a time.
 
@@ -201,8 +214,8 @@ def fk_by_level(local_rot: torch.Tensor, local_pos: torch.Tensor, parents) -> to
     for size, pidx in zip(sizes[1:], parent_pos[1:]):
         stop = begin + size
         prot = rot.index_select(-3, pidx)
-        pos = pos.index_select(-3, pidx) + prot @ offs[..., begin:stop, :, :]
-        rot = prot @ mats[..., begin:stop, :, :]
+        pos = pos.index_select(-3, pidx) + _product(prot, offs[..., begin:stop, :, :])
+        rot = _product(prot, mats[..., begin:stop, :, :])
         all_pos.append(pos)
         begin = stop
     return torch.cat(all_pos, dim=-3)[..., 0].index_select(-2, order)

@@ -61,8 +61,8 @@ smooth. ``smooth_sigma=0`` optimises φ directly, as the paper states.
 to a grid a four-thousandth of a step fine, so that last-bit differences between CPUs' kernels
 cannot grow into other results or another stopping step. The network computes in float64.
 
-**On a GPU the step can be one CUDA graph** (:mod:`motionlab.retargeting.graphs`, switched on by
-``MOTIONLAB_CUDA_GRAPHS=1`` until measured on a GPU): the decoding, the terms and the gradient of
+**On a GPU the step is one CUDA graph** (:mod:`motionlab.retargeting.graphs`; switched off by
+``MOTIONLAB_CUDA_GRAPHS=0``): the decoding, the terms and the gradient of
 every row are recorded once and replayed at each step, rows whose problem has stopped included
 (their gradient is not used), so that the GPU does not wait for Python to launch hundreds of small
 kernels. Each problem's arithmetic is the same as without the graph (a test runs the all-rows step

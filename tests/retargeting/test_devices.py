@@ -460,10 +460,10 @@ def test_the_step_a_cuda_graph_records_neither_waits_nor_copies(tiny_checkpoint)
     assert len(recorded) >= 3 and all(not c for c in recorded), recorded[0]
 
 
-def test_the_graph_switch_takes_0_or_1(monkeypatch):
+def test_the_graph_switch_takes_0_or_1_and_is_on_by_default_on_cuda(monkeypatch):
     from motionlab.retargeting import graphs
 
-    for value, cuda in (("", False), ("0", False), ("1", True)):
+    for value, cuda in (("", True), ("0", False), ("1", True)):
         monkeypatch.setenv("MOTIONLAB_CUDA_GRAPHS", value)
         assert graphs.enabled("cpu") is False and graphs.enabled(torch.device("cuda")) is cuda
     monkeypatch.setenv("MOTIONLAB_CUDA_GRAPHS", "true")
