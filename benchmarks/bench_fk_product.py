@@ -2,7 +2,7 @@
 
 The latent iteration runs :func:`motionlab.retargeting.model.fk_by_level` forward and backward at
 every step on every row of a batch. On CUDA its small matrix products are broadcast sums
-(``model._summed_product``) instead of batched GEMMs (``a @ b``). This times FK forward and
+(``model.summed_product``) instead of batched GEMMs (``a @ b``). This times FK forward and
 backward on a batch as wide as the widest of ``expand``'s GPU batches (246 pairs × 111 frames by
 default), both ways, device synchronised, and prints the largest difference in positions (cm,
 skeleton in metres) and in gradients.
@@ -27,19 +27,15 @@ from motionlab.retargeting.devices import pick
 
 def _run(product, q0: torch.Tensor, offsets: torch.Tensor, repeats: int) -> tuple[float, torch.Tensor, torch.Tensor]:
     """Median seconds of one FK forward and backward with ``product``; its positions and gradient."""
-    real, model._product = model._product, product
-    try:
-        times = []
-        for _ in range(repeats + 2):  # the first two warm the device up
-            q = q0.clone().requires_grad_()
-            _sync(q.device)
-            start = time.perf_counter()
-            pos = model.fk_by_level(q, offsets, humanoid.PARENTS)
-            pos.square().sum().backward()
-            _sync(q.device)
-            times.append(time.perf_counter() - start)
-    finally:
-        model._product = real
+    times = []
+    for _ in range(repeats + 2):  # the first two warm the device up
+        q = q0.clone().requires_grad_()
+        _sync(q.device)
+        start = time.perf_counter()
+        pos = model.fk_by_level(q, offsets, humanoid.PARENTS, product=product)
+        pos.square().sum().backward()
+        _sync(q.device)
+        times.append(time.perf_counter() - start)
     return sorted(times[2:])[len(times[2:]) // 2], pos.detach(), q.grad
 
 
@@ -60,8 +56,8 @@ def main() -> None:
     q0 = tq.normalize(torch.randn(args.rows, args.frames, len(humanoid.PARENTS), 4, dtype=torch.float64, generator=gen))
     offsets = torch.tensor(humanoid.canonical_skeleton().offsets, dtype=torch.float64)
     q0, offsets = q0.to(device), offsets.to(device)
-    t_mm, pos_mm, grad_mm = _run(lambda a, b: a @ b, q0, offsets, args.repeats)
-    t_sum, pos_sum, grad_sum = _run(model._summed_product, q0, offsets, args.repeats)
+    t_mm, pos_mm, grad_mm = _run(torch.matmul, q0, offsets, args.repeats)
+    t_sum, pos_sum, grad_sum = _run(model.summed_product, q0, offsets, args.repeats)
     print(
         f"FK forward + backward on {device}, float64, {args.rows} x {args.frames} frames x {len(humanoid.PARENTS)} joints"
     )

@@ -42,7 +42,7 @@ from motionlab.core import humanoid
 from motionlab.core import quat_torch as tq
 from motionlab.retargeting import devices
 
-__all__ = ["ModelConfig", "RetargetNet", "Decoded", "skeleton_tensor", "unit", "fk_by_level"]
+__all__ = ["ModelConfig", "RetargetNet", "Decoded", "skeleton_tensor", "unit", "fk_by_level", "summed_product"]
 
 NUM_JOINTS = len(humanoid.JOINTS)
 FEATURE_DIM = 3 * NUM_JOINTS + 4
@@ -173,20 +173,14 @@ def _matrices(q: torch.Tensor) -> torch.Tensor:
     return m.reshape(q.shape[:-1] + (3, 3))
 
 
-def _product(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
-    """``a @ b`` for small matrices (..., n, k) @ (..., k, m): on CUDA :func:`_summed_product`
-    (batched GEMM kernels are made for large matrices and run tens of thousands of 3×3 products
-    slowly), elsewhere ``a @ b`` itself, whose CPU kernels are fast on them."""
-    return _summed_product(a, b) if a.device.type == "cuda" else a @ b
-
-
-def _summed_product(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
-    """``a @ b`` (..., n, m) as a broadcast product (..., n, k, m) summed over ``k``: two elementwise
-    kernels, however many matrices the batch holds."""
+def summed_product(a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
+    """``a @ b`` for small matrices (..., n, k) @ (..., k, m) as a broadcast product (..., n, k, m)
+    summed over ``k``: two elementwise kernels, however many matrices the batch holds. CUDA runs
+    ``a @ b`` on tens of thousands of 3×3 matrices as GEMM kernels made for large ones, slowly."""
     return (a.unsqueeze(-1) * b.unsqueeze(-3)).sum(-2)
 
 
-def fk_by_level(local_rot: torch.Tensor, local_pos: torch.Tensor, parents) -> torch.Tensor:
+def fk_by_level(local_rot: torch.Tensor, local_pos: torch.Tensor, parents, product=None) -> torch.Tensor:
     """World joint positions (..., J, 3) by forward kinematics, one tree level at a time.
 
     The local rotations become 3×3 matrices once; then every level (all joints of one depth)
@@ -199,7 +193,12 @@ def fk_by_level(local_rot: torch.Tensor, local_pos: torch.Tensor, parents) -> to
     local_rot : Tensor (..., J, 4)   unit quaternions relative to the parent
     local_pos : Tensor (..., J, 3)   offsets from the parent (root: its position), broadcast with local_rot
     parents   : sequence of int      parent indices, -1 for the root, parents[j] < j
+    product   : callable or None     the matrix product ``(a, b) -> a @ b`` of each level; default
+                                     :func:`summed_product` on CUDA, ``torch.matmul`` elsewhere
+                                     (faster on a CPU)
     """
+    if product is None:
+        product = summed_product if local_rot.device.type == "cuda" else torch.matmul
     sizes, flat, parent_pos, order = _level_index(parents, local_rot.device)
     batch = torch.broadcast_shapes(local_rot.shape[:-2], local_pos.shape[:-2])
     local_pos = local_pos.to(local_rot.dtype)
@@ -214,8 +213,8 @@ def fk_by_level(local_rot: torch.Tensor, local_pos: torch.Tensor, parents) -> to
     for size, pidx in zip(sizes[1:], parent_pos[1:]):
         stop = begin + size
         prot = rot.index_select(-3, pidx)
-        pos = pos.index_select(-3, pidx) + _product(prot, offs[..., begin:stop, :, :])
-        rot = _product(prot, mats[..., begin:stop, :, :])
+        pos = pos.index_select(-3, pidx) + product(prot, offs[..., begin:stop, :, :])
+        rot = product(prot, mats[..., begin:stop, :, :])
         all_pos.append(pos)
         begin = stop
     return torch.cat(all_pos, dim=-3)[..., 0].index_select(-2, order)

@@ -108,27 +108,27 @@ def test_fk_by_level_on_a_random_tree_float64():
     np.testing.assert_allclose(fk_by_level(q, off, parents), fk_torch.fk_positions(q, off, parents), atol=1e-12)
 
 
-def test_fk_by_level_with_the_gpus_summed_products_equals_it_with_matmul(monkeypatch):
-    """On CUDA FK composes its 3×3 products as broadcast sums (``model._summed_product``); run here
+def test_fk_by_level_with_the_gpus_summed_products_equals_it_with_matmul():
+    """On CUDA FK composes its 3×3 products as broadcast sums (``model.summed_product``); run here
     on the CPU, they give the same positions and gradients, offsets broadcast over the batch."""
-    from motionlab.retargeting import model
+    from motionlab.retargeting.model import summed_product
 
     parents = humanoid.PARENTS
-    q0 = tq.normalize(
-        torch.randn(3, 5, len(parents), 4, dtype=torch.float64, generator=torch.Generator().manual_seed(1))
-    )
-    off = torch.randn(len(parents), 3, dtype=torch.float64, generator=torch.Generator().manual_seed(2))
+    gen = torch.Generator().manual_seed(1)
+    q0 = tq.normalize(torch.randn(3, 5, len(parents), 4, dtype=torch.float64, generator=gen))
+    off = torch.randn(len(parents), 3, dtype=torch.float64, generator=gen)
     results = []
-    for product in (model._product, model._summed_product):
-        monkeypatch.setattr(model, "_product", product)
+    for product in (None, summed_product):  # None: the CPU's default, torch.matmul
         q = q0.clone().requires_grad_()
-        pos = fk_by_level(q, off, parents)
+        pos = fk_by_level(q, off, parents, product=product)
         pos.square().sum().backward()
         results.append((pos.detach(), q.grad))
     (pos_mm, grad_mm), (pos_sum, grad_sum) = results
     assert pos_sum.shape == (3, 5, len(parents), 3)
     np.testing.assert_allclose(pos_sum, pos_mm, rtol=0, atol=1e-12)
     np.testing.assert_allclose(grad_sum, grad_mm, rtol=0, atol=1e-11)
+    a, b = torch.randn(7, 3, 3, dtype=torch.float64), torch.randn(7, 3, 1, dtype=torch.float64)
+    np.testing.assert_allclose(summed_product(a, b), a @ b, rtol=0, atol=1e-14)
 
 
 def test_gradients_are_finite(net, x):
