@@ -86,7 +86,7 @@ PINNED_BACK_END = {
 }
 """The numeric back end the cached network is trained under (a child process): torch's AVX2
 kernels, MKL's compatible path, OpenBLAS's Haswell kernels, numpy without AVX-512, one thread —
-the settings of CI's second test pass. The same kernels on every x86 CPU with AVX2 give the same
+the settings of CI's pinned test pass. The same kernels on every x86 CPU with AVX2 give the same
 weights; the grid of ``TrainConfig.grid`` alone does not survive a change of kernels over a
 training's 10⁸ parameter updates (``docs/reproducibility.md``)."""
 NETWORKS = ("auto", "real", "synthetic")
