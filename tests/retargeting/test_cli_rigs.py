@@ -39,6 +39,7 @@ def test_implausible_output_is_refused_unless_kept(walk30, tmp_path, capsys):
 
 
 @pytest.mark.slow
+@pytest.mark.real_network
 def test_bandai_onto_mixamo_and_back(tmp_path, capsys):
     """The issue's pair: feet on the floor, hips at a standing height, 30 fps kept."""
     bandai = require_data("bandai_namco", "dataset-1", "walk", "dataset-1_walk_normal_001.bvh")

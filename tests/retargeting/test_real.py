@@ -186,6 +186,7 @@ def test_evaluate_and_load_real_train_one_network(monkeypatch):
 
 
 @pytest.mark.slow
+@pytest.mark.real_network
 def test_the_real_network_reconstructs_held_out_real_clips_better_than_the_shipped_one():
     """Trained once per cache (minutes the first time): on Aj's 10 clips it never saw, the
     reconstruction error is below the shipped synthetic-motion network's."""
