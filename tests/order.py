@@ -1,6 +1,6 @@
 """The tests that need the network trained on real motion run after all the others.
 
-``retargeting.load_real`` trains that network once (about 15 minutes on one core) and caches it; a
+``retargeting.load_real`` trains that network once and caches it; a
 test that needs it while another process trains it waits on the cache's lock. CI trains it in the
 background while the tests run (``.ci/run``), so the tests that need it come last: those marked
 ``real_network`` and the notebooks in :data:`NOTEBOOKS`. Both parts keep their order, so a
