@@ -148,18 +148,19 @@ def _compare(out: Path, reference: Path) -> None:
     """Largest joint-position difference (cm) between OUT's outputs and REF's files of the same name."""
     from motionlab.core import bvh
 
-    found = {}
+    found, same = {}, 0
     for ref in sorted(reference.rglob("*.bvh")):
         mine = out / ref.relative_to(reference)
         if mine.is_file():
             d = 100 * float(np.abs(bvh.load(mine).global_positions() - bvh.load(ref).global_positions()).max())
             found[str(ref.relative_to(reference))] = d
+            same += mine.read_bytes() == ref.read_bytes()
     if not found:
         print(f"outputs vs the reference {reference}: no file of the same name")
         return
     d = np.array(list(found.values()))
     worst = sorted(found, key=found.get, reverse=True)[:3]
-    print(f"outputs vs the reference {reference}: {len(d)} files compared; {int((d == 0).sum())} equal to the "
+    print(f"outputs vs the reference {reference}: {len(d)} files compared; {same} byte for byte, {int((d == 0).sum())} equal to the "
           f"files' 6 decimals, {int((d <= 0.01).sum())} within 0.01 cm; largest joint differences "
           + ", ".join(f"{found[w]:.2g} cm ({w})" for w in worst))  # fmt: skip
 

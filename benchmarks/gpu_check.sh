@@ -11,11 +11,11 @@
 #   expand32  the same in float32 (the dtype rule's speed);
 #   table1    Table 1 (motionlab evaluate --no-ablations) on cuda, training the network there; the
 #             checkpoint is kept (OUT/motionlab_Aj.pt) so the CPU can evaluate the same network;
-#   profile   benchmarks/profile_expand_gpu.py (where the solve's time goes).
+#   profile   benchmarks/profile_expand_gpu.py (where the solve's time goes; PROFILE_ARGS: its options).
 # Usage: DATA=mixamo.tar.xz REF=ref_cpu.tar.xz OUT=folder bash benchmarks/gpu_check.sh
 # (DATA: a tar of MOTIONLAB_DATA's mixamo/ folder; REF: a tar of a folder ref_cpu/ written on the CPU by
 # `python benchmarks/bench_expand.py --clips all --table1-characters --device cpu --skip-per-process
-# --skip-ray --keep ref_cpu`). STAGES names the stages, run in that order (default: pytest expand64
+# --skip-ray --keep ref_cpu`; only the expand stages need it). STAGES names the stages, run in that order (default: pytest expand64
 # expand32 table1). DEV=cpu CLIPS=1 tries the script without a GPU.
 set -u
 export PYTHONPATH=$PWD PYTHONUNBUFFERED=1
@@ -32,7 +32,8 @@ stage setup
 nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv 2>/dev/null
 $PY -c "import torch, numpy; print('torch', torch.__version__, 'numpy', numpy.__version__, 'cuda', torch.cuda.is_available())"
 mkdir -p "$work/data" "$work/ref" "$OUT"
-tar xJf "$DATA" -C "$work/data" && tar xJf "$REF" -C "$work/ref" || exit 1
+tar xJf "$DATA" -C "$work/data" || exit 1
+[ -z "${REF:-}" ] || tar xJf "$REF" -C "$work/ref" || exit 1
 export MOTIONLAB_DATA=$work/data
 for s in ${STAGES:-pytest expand64 expand32 table1}; do
     stage "$s"
@@ -48,7 +49,7 @@ for s in ${STAGES:-pytest expand64 expand32 table1}; do
     table1)
         timeout 300 $PY -m motionlab evaluate --device "$DEV" --checkpoint "$OUT/motionlab_Aj.pt" --no-ablations -q \
             --csv "$OUT/table1_$DEV.csv" 2>&1 | tee "$OUT/table1_$DEV.txt" ;;
-    profile) timeout 240 $PY benchmarks/profile_expand_gpu.py --device "$DEV" $( [ "$CLIPS" = all ] || echo --clips "$CLIPS" ) ;;
+    profile) timeout 240 $PY benchmarks/profile_expand_gpu.py --device "$DEV" ${PROFILE_ARGS:-} $( [ "$CLIPS" = all ] || echo --clips "$CLIPS" ) ;;
     *) echo "unknown stage $s (pytest expand64 eager fk workers expand32 table1 profile)"; exit 2 ;;
     esac
 done

@@ -89,11 +89,44 @@ def _run(ckpt, batches):
     return out, seconds
 
 
+def _replay_share(ckpt, batch) -> None:
+    """The widest batch's solve split into the device time of the graph's replays (CUDA events)
+    and everything else (the host's bookkeeping, Adam's kernels, the wait for the losses)."""
+    from motionlab.retargeting import graphs
+
+    run, spans = graphs.StepGraph.run, []
+
+    def timed(self):
+        begin, end = torch.cuda.Event(enable_timing=True), torch.cuda.Event(enable_timing=True)
+        begin.record()
+        out = run(self)
+        end.record()
+        spans.append((begin, end))
+        return out
+
+    graphs.StepGraph.run = timed
+    try:
+        _sync(ckpt.device)
+        clock = time.perf_counter()
+        res = batching.solve_jobs(ckpt, [p.job for p in batch])
+        _sync(ckpt.device)
+        wall = time.perf_counter() - clock
+    finally:
+        graphs.StepGraph.run = run
+    replay = sum(b.elapsed_time(e) for b, e in spans) / 1000
+    steps = max(r.steps for r in res)
+    print(f"widest batch ({len(batch)} rows x {batch[0].frames} frames): solve {wall:.2f} s, {len(spans)} replays "
+          f"{replay:.2f} s on the device ({1000 * replay / len(spans):.1f} ms each), the rest {wall - replay:.2f} s "
+          f"({1000 * (wall - replay) / max(steps, 1):.1f} ms per step)")  # fmt: skip
+
+
 def main(argv=None) -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--clips", type=int, default=1000, help="first N of Aj's clips (default: all)")
     p.add_argument("--device", default="cuda")
     p.add_argument("--dtype", default="float64", choices=("float64", "float32"))
+    p.add_argument("--rows", type=int, default=12, help="operators shown in each device profile (default 12)")
+    p.add_argument("--widest-only", action="store_true", help="skip timing every batch three ways")
     args = p.parse_args(argv)
     ckpt = retargeting.load_default(args.device, args.dtype)
     if ckpt.device.type != "cpu":
@@ -106,6 +139,7 @@ def main(argv=None) -> None:
           + ", ".join(f"{len(b)}x{b[0].frames}" for b in batches))  # fmt: skip
     _run(ckpt, batches[-1:])  # warm-up (kernel loading, cuDNN's choice of algorithms): not timed
     variants = [("step as a CUDA graph", "1"), ("step launched eagerly", "0"), ("step as a CUDA graph, again", "1")]
+    variants = variants[:0] if args.widest_only else variants
     reference = None  # A, B, A: a drift between runs shows as a difference between the two A runs
     for name, graphs_on in variants:
         os.environ["MOTIONLAB_CUDA_GRAPHS"] = graphs_on
@@ -116,8 +150,10 @@ def main(argv=None) -> None:
         steps = max(r.steps for r in out)
         print(f"{name:<29} solve {sum(seconds):6.2f} s = {frames / sum(seconds):7.0f} frames/s; per batch "
               + " ".join(f"{s:.2f}" for s in seconds) + f"; most steps {steps}{diff}")  # fmt: skip
-    os.environ.pop("MOTIONLAB_CUDA_GRAPHS")
+    os.environ.pop("MOTIONLAB_CUDA_GRAPHS", None)
     widest = max(batches, key=len)
+    if ckpt.device.type == "cuda":
+        _replay_share(ckpt, widest)
     prof = cProfile.Profile()
     prof.enable()
     batching.solve_jobs(ckpt, [p.job for p in widest])
@@ -135,7 +171,9 @@ def main(argv=None) -> None:
             with profile(activities=[ProfilerActivity.CPU, ProfilerActivity.CUDA]) as tp:
                 res = batching.solve_jobs(ckpt, [p.job for p in widest])
                 _sync(ckpt.device)
-            table = tp.key_averages().table(sort_by="self_cuda_time_total", row_limit=12, max_name_column_width=40)
+            table = tp.key_averages().table(
+                sort_by="self_cuda_time_total", row_limit=args.rows, max_name_column_width=40
+            )
             count = {
                 k: sum(e.count for e in tp.key_averages() if e.key.startswith(k))
                 for k in ("cudaLaunchKernel", "cudaGraphLaunch")

@@ -42,6 +42,7 @@ __all__ = [
     "BVHError",
     "CHANNEL_NAMES",
     "DEFAULT_SCALE",
+    "header",
     "load",
     "loads",
     "save",
@@ -622,9 +623,19 @@ def _decode(data: bytes, source: str, first_line: int = 1) -> str:
         raise BVHError(source, line, f"expected UTF-8 text, found the byte {data[exc.start]:#04x}") from None
 
 
-def _read(f, size: int, scale: float, source: str, name: str) -> Motion:
-    """Parse a binary stream of ``size`` bytes (header token by token, motion block in chunks)."""
-    scale = _check_scale(scale)
+def header(path: str | os.PathLike) -> tuple[int, float]:
+    """``(frames, fps)`` of a BVH file from its header alone (``Frames:`` and ``1 / Frame Time:``),
+    without reading the motion block: what :func:`load` gives as ``num_frames`` and ``fps`` when
+    the file is well formed. Raises :class:`BVHError` (naming the file and line) for a malformed
+    header, ``OSError`` when the file cannot be read."""
+    with open(path, "rb") as f:
+        parsed = _read_header(f, os.fstat(f.fileno()).st_size, str(path))[0]
+    return parsed[5], 1.0 / parsed[7]
+
+
+def _read_header(f, size: int, source: str):
+    """The parsed header of a binary stream of ``size`` bytes, the tokens and bytes read so far,
+    the byte-order mark's length and whether lines end in CR alone."""
     head = f.read(min(size, _HEADER_START))
     bom = 3 if head.startswith(b"\xef\xbb\xbf") else 0
     head, size = head[bom:], size - bom
@@ -642,6 +653,13 @@ def _read(f, size: int, scale: float, source: str, name: str) -> Motion:
         except _NeedMore:
             more = f.read(max(len(head), _HEADER_START))
             head += more
+    return header, tok, head, bom, cr_only
+
+
+def _read(f, size: int, scale: float, source: str, name: str) -> Motion:
+    """Parse a binary stream of ``size`` bytes (header token by token, motion block in chunks)."""
+    scale = _check_scale(scale)
+    header, tok, head, bom, cr_only = _read_header(f, size, source)
     names, parents, offsets, channels, end_sites, n_frames, frames_line, ft = header
     if tok.pos <= len(tok.text):
         first_line = tok.line + 1

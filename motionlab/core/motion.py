@@ -18,7 +18,7 @@ from motionlab.core import fk as _fk
 from motionlab.core import quat
 from motionlab.core.skeleton import Skeleton
 
-__all__ = ["Motion", "check_one_rig"]
+__all__ = ["Motion", "check_one_rig", "resampled_frames"]
 
 
 def _check_fps(fps) -> float:
@@ -35,6 +35,15 @@ def _nominal(fps: float) -> float:
     """``fps`` snapped to the nearest whole number when within 1e-4 relative of it."""
     r = round(fps)
     return float(r) if r > 0 and abs(fps - r) < 1e-4 * fps else float(fps)
+
+
+def resampled_frames(frames: int, fps: float, new_fps: float) -> int:
+    """How many frames :meth:`Motion.resample` gives a motion of ``frames`` frames at ``fps`` when
+    resampled to ``new_fps``. Raises ``ValueError`` for a rate that is not a positive number."""
+    src, new = _nominal(_check_fps(fps)), _nominal(_check_fps(new_fps))
+    if abs(new - src) < 1e-9 * src or frames < 2:
+        return frames
+    return int(np.floor((frames - 1) * new / src + 1e-6)) + 1
 
 
 @dataclass(eq=False)
@@ -167,7 +176,7 @@ class Motion:
         src = _nominal(self.fps)
         if abs(_nominal(fps) - src) < 1e-9 * src or self.num_frames < 2:
             return self.copy(fps=float(fps))
-        n_new = int(np.floor((self.num_frames - 1) * _nominal(fps) / src + 1e-6)) + 1
+        n_new = resampled_frames(self.num_frames, self.fps, fps)
         t = np.arange(n_new) * (src / _nominal(fps))  # in source frames
         i0 = np.clip(np.floor(t).astype(np.int64), 0, self.num_frames - 1)
         i1 = np.clip(i0 + 1, 0, self.num_frames - 1)

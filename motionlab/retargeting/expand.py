@@ -53,7 +53,7 @@ import io
 import json
 import os
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import Future
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -61,6 +61,7 @@ from pathlib import Path
 import numpy as np
 
 from motionlab.core import bvh, files, humanoid, metrics, motion_files, rest_pose
+from motionlab.core.motion import resampled_frames
 from motionlab.core.skeleton import Skeleton
 from motionlab.core.threads import batch_threads, torch_threads
 from motionlab.retargeting import host, terms
@@ -416,8 +417,9 @@ class ExpandResult:
                             ``character changed``, ``options changed``, ``file missing``)
     resampled : list of str   one line per source whose frame rate changed on the way
     implausible : int       outputs of this run that failed a plausibility test
-    timings : dict          wall time, seconds: ``load`` (plan, read and prepare the sources and
-                            pairs), ``solve`` (the latent iteration of the batches, and the outputs
+    timings : dict          wall time, seconds: ``load`` (plan the batches, and read and prepare
+                            the sources and pairs where a batch waits for them: a GPU solves
+                            the first batches while host workers prepare the rest), ``solve`` (the latent iteration of the batches, and the outputs
                             finished, checked and encoded where no host workers do it),
                             ``finish`` (waiting for the host workers' outputs, with workers),
                             ``write`` (files and manifest)
@@ -636,7 +638,7 @@ def _plan(clips, targets, out, known, force, suffix, options, result, rows):
         try:
             digests[path] = digests.get(path) or _sha256(path)
         except OSError:
-            digests[path] = ""  # unreadable: _load_pairs records the error
+            digests[path] = ""  # unreadable: preparing the clip records the error
         for c in targets:
             key, output = (c.name, clip), f"{c.name}/{clip}{suffix}"
             file = out / output
@@ -686,17 +688,9 @@ def _expand(
     gpu = checkpoint.device.type != "cpu"
     workers_here = host.default_workers(checkpoint.device) if host_workers is None else host_workers
     with host.pool(checkpoint, workers_here if todo else 0) as pool:
-        pairs, sources_by_clip = _load_pairs(todo, checkpoint, solver, rows, result, suffix, rest_from, root_mode, pool)
-        result.timings["load"] = time.perf_counter() - start
-        for src in sources_by_clip.values():
-            rates = (src.fps, checkpoint.fps, fps or src.fps)
-            if max(rates) - min(rates) > 1e-4 * max(rates):
-                result.resampled.append(
-                    f"{src.path}: resampled: source {rates[0]:g} fps -> network {rates[1]:g} fps -> output {rates[2]:g} fps"
-                )
-        _write_manifest(out, list(rows.values()))
+        loader = _Sources(todo, checkpoint, solver, rows, result, suffix, rest_from, root_mode, pool, fps)
         context = (
-            sources_by_clip,
+            loader.sources,
             {c.name: c for c in targets},
             (max_penetration_cm, skate_ratio),
             suffix,
@@ -704,16 +698,21 @@ def _expand(
             fps,
         )
         padding = (gpu and not terms.unpadded()) if pad is None else pad
-        batches = plan_batches(pairs, max_frames or batch_frames(checkpoint.device), pad=padding)
+        max_frames = max_frames or batch_frames(checkpoint.device)
+        plan = loader.plan(max_frames, padding)
+        planned = time.perf_counter() - start
+        batches = loader.batches(plan, max_frames, padding)
         if backend == "ray":
             from motionlab.retargeting.cluster import solve_batches_ray
 
-            stream = solve_batches_ray(checkpoint, batches, solver, root_mode, address=address, workers=workers)
+            stream = solve_batches_ray(checkpoint, list(batches), solver, root_mode, address=address, workers=workers)
             outputs = ([_output(pr, *context) for pr in solved] for solved in stream)
         else:
             outputs = _local_outputs(batches, checkpoint, solver, pool, context, result.timings)
-        _write_all(outputs, len(batches), out, rows, result, progress, on_batch)
-    result.timings["solve"] -= result.timings.get("finish", 0.0)  # waited for the workers, not the solve
+        _write_all(outputs, len(plan), out, rows, result, progress, on_batch)
+        _write_manifest(out, list(rows.values()))  # the error rows of clips no batch held
+    result.timings["load"] = planned + loader.seconds
+    result.timings["solve"] -= result.timings.get("finish", 0.0) + loader.seconds  # waits, not the solve
     result.rows = sorted(rows.values(), key=lambda r: (r["character"], r["clip"]))
     result.seconds = time.perf_counter() - start
     return result
@@ -815,52 +814,106 @@ def prepare_clip(path, rest_from, targets, root_mode, solver, checkpoint=None):
     return motion, prepared, skating, jobs
 
 
-def _prepare_here(tasks: dict, args: dict, checkpoint: Checkpoint) -> None:
-    """Prepare in this process, from the last clip back, each clip no worker has taken yet (its
-    future cancelled and replaced by a finished one): the workers take seconds to start.
-    ``args``: :func:`prepare_clip`'s by clip; ``checkpoint``: a CPU copy, as the workers hold
-    (:func:`host.cpu_copy`)."""
-    for clip in reversed(list(tasks)):
-        if not tasks[clip].cancel():
-            return
-        done: Future = Future()
-        try:
-            done.set_result(prepare_clip(*args[clip], checkpoint))
-        except Exception as err:  # raised again by result(), as a worker's would be
-            done.set_exception(err)
-        tasks[clip] = done
+def _header_frames(path, checkpoint: Checkpoint) -> int:
+    """The frames a clip has once prepared (at the checkpoint's rate), from its BVH header alone;
+    at least 1. A header that cannot be read counts as 1 frame (preparing the clip says why)."""
+    try:
+        frames, fps = bvh.header(path)
+        return max(1, resampled_frames(frames, fps, checkpoint.fps))
+    except _ERRORS:
+        return 1
 
 
-def _load_pairs(todo, checkpoint, solver, rows, result, suffix, rest_from=None, root_mode="stride", pool=None):
-    """Read and prepare each source once (in the host workers when there is a ``pool``), with its
-    pairs; a clip or character that fails becomes ``error`` rows."""
-    pairs: list[Pair] = []
-    sources_by_clip: dict[str, _Source] = {}
-    by_clip: dict[str, list] = {}
-    for clip, path, c, digest in todo:
-        by_clip.setdefault(clip, [path, [], digest])[1].append(c)
-    tasks, args = {}, {}
-    for clip, (path, chars, _) in by_clip.items():
-        usable = [(c.name, c.skeleton) for c in chars if c.skeleton is not None]
-        args[clip] = (path, rest_from, usable, root_mode, solver)
-        tasks[clip] = pool.submit(prepare_clip, *args[clip]) if pool else args[clip]
-    if pool:
-        _prepare_here(tasks, args, host.cpu_copy(checkpoint))
-    for clip, (path, chars, digest) in by_clip.items():
+class _Sources:
+    """The sources of an expansion, read and prepared in the order the batches need them, so that
+    the first batch solves while the workers prepare the rest.
+
+    The batches are planned from the BVH headers' frame counts (:meth:`plan`); :meth:`batches`
+    prepares each planned batch's clips (in the host workers when there is a ``pool``; a clip no
+    worker has started yet is prepared in this process rather than waited for) and yields its
+    pairs, planned again from their prepared lengths (the same batch when the header was right).
+    A clip or character that fails becomes ``error`` rows. ``seconds``: time spent preparing or
+    waiting for clips.
+    """
+
+    def __init__(self, todo, checkpoint, solver, rows, result, suffix, rest_from, root_mode, pool, fps) -> None:
+        self.checkpoint, self.rows, self.result, self.suffix, self.fps = checkpoint, rows, result, suffix, fps
+        self.pool, self.cpu = pool, host.cpu_copy(checkpoint) if pool else checkpoint
+        self.by_clip: dict[str, list] = {}
+        for clip, path, c, digest in todo:
+            self.by_clip.setdefault(clip, [path, [], digest])[1].append(c)
+        self.args = {
+            clip: (path, rest_from, [(c.name, c.skeleton) for c in chars if c.skeleton is not None], root_mode, solver)
+            for clip, (path, chars, _) in self.by_clip.items()
+        }
+        self.tasks: dict[str, Future | None] = {}  # None: prepared here when taken (no pool)
+        self.taken: set[str] = set()
+        self.pairs: dict[tuple[str, str], Pair] = {}
+        self.sources: dict[str, _Source] = {}
+        self.seconds = 0.0
+
+    def plan(self, max_frames: int, pad: bool) -> list[list[Pair]]:
+        """The batches of every usable pair, their frames read from the headers; each clip's
+        preparation is queued in the order the batches need it."""
+        planned = [
+            Pair(clip, name, None, skeleton, _header_frames(self.args[clip][0], self.checkpoint))
+            for clip in self.by_clip
+            for name, skeleton in self.args[clip][2]
+        ]
+        plan = plan_batches(planned, max_frames, pad)
+        order = dict.fromkeys([p.clip for b in plan for p in b] + list(self.by_clip))
+        for clip in order:
+            self.tasks[clip] = self.pool.submit(prepare_clip, *self.args[clip]) if self.pool else None
+        return plan
+
+    def batches(self, plan: list[list[Pair]], max_frames: int, pad: bool) -> Iterator[list[Pair]]:
+        """Each planned batch's prepared pairs, as batches; then the clips no batch holds."""
+        for planned in plan:
+            self._take(list(dict.fromkeys(p.clip for p in planned)))
+            ready = [self.pairs[p.clip, p.character] for p in planned if (p.clip, p.character) in self.pairs]
+            yield from plan_batches(ready, max_frames, pad) if ready else []
+        self._take(list(self.tasks))
+
+    def _take(self, clips: list[str]) -> None:
+        clock = time.perf_counter()
+        clips = [c for c in clips if c not in self.taken]
+        for clip in clips:  # first those no worker has started: prepared here rather than waited for
+            task = self.tasks[clip]
+            if task is None or task.cancel():
+                self.tasks[clip] = task = Future()
+                try:
+                    task.set_result(prepare_clip(*self.args[clip], self.cpu))
+                except _ERRORS as err:  # raised again by result(), as a worker's would be
+                    task.set_exception(err)
+        for clip in clips:
+            self._record(clip, self.tasks[clip])
+            self.taken.add(clip)
+        self.seconds += time.perf_counter() - clock
+
+    def _record(self, clip: str, task: Future) -> None:
+        """The clip's pairs, or its error rows (``task``: :func:`prepare_clip`'s answer or error)."""
+        path, chars, digest = self.by_clip[clip]
         try:
-            task = tasks[clip]
-            motion, prepared, skating, jobs = task.result() if pool else prepare_clip(*task, checkpoint)
+            motion, prepared, skating, jobs = task.result()
         except _ERRORS as err:
             for c in chars:
-                rows[(c.name, clip)] = _error_row(clip, c.name, str(path), c.origin, _why(err, "source", path), suffix)
-                result.failed += 1
-            continue
-        sources_by_clip[clip] = _Source(str(path), skating, motion.fps, digest)
+                self._error(clip, c, _why(err, "source", path))
+            return
+        self.sources[clip] = _Source(str(path), skating, motion.fps, digest)
+        rates = (motion.fps, self.checkpoint.fps, self.fps or motion.fps)
+        if max(rates) - min(rates) > 1e-4 * max(rates):
+            self.result.resampled.append(
+                f"{path}: resampled: source {rates[0]:g} fps -> network {rates[1]:g} fps -> output {rates[2]:g} fps"
+            )
         for c in chars:
             job = jobs.get(c.name, c.error)
             if isinstance(job, str):
-                rows[(c.name, clip)] = _error_row(clip, c.name, str(path), c.origin, job, suffix)
-                result.failed += 1
-                continue
-            pairs.append(Pair(clip, c.name, motion, c.skeleton, prepared.motion.num_frames, prepared, job))
-    return pairs, sources_by_clip
+                self._error(clip, c, job)
+            else:
+                self.pairs[clip, c.name] = Pair(
+                    clip, c.name, motion, c.skeleton, prepared.motion.num_frames, prepared, job
+                )
+
+    def _error(self, clip: str, c: Character, message: str) -> None:
+        self.rows[(c.name, clip)] = _error_row(clip, c.name, str(self.by_clip[clip][0]), c.origin, message, self.suffix)
+        self.result.failed += 1

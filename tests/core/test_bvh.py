@@ -796,3 +796,32 @@ def test_a_file_ending_on_the_frame_time_line_names_that_line():
     text = SMALL[: SMALL.index("Frame Time: 0.0333333") + len("Frame Time: 0.0333333")]
     with pytest.raises(BVHError, match="line 18: expected 3 frame lines"):
         bvh.loads(text)
+
+
+@pytest.mark.skipif(not REAL_FILES, reason=NO_DATA)
+def test_header_gives_loads_frames_and_rate_on_every_real_file():
+    """``bvh.header`` reads the frame count and rate that ``load`` gives, on every real file (every
+    studio's header layout), without reading the motion block."""
+    for path in REAL_FILES:
+        motion = bvh.load(path)
+        assert bvh.header(path) == (motion.num_frames, motion.fps), path
+
+
+def test_header_reads_no_motion_block_and_names_the_file_and_line_of_a_bad_header(tmp_path):
+    good = bvh.dumps(
+        Motion(
+            Skeleton(("Hips",), np.array([-1]), np.zeros((1, 3))),
+            np.tile(quat.IDENTITY, (3, 1, 1)),
+            np.zeros((3, 3)),
+            30.0,
+        )
+    )
+    broken_block = tmp_path / "block.bvh"
+    broken_block.write_text(good.replace(good.splitlines()[-1], "1 2 x"))
+    assert bvh.header(broken_block) == (3, pytest.approx(30.0))
+    with pytest.raises(BVHError, match="block.bvh"):
+        bvh.load(broken_block)
+    bad = tmp_path / "bad.bvh"
+    bad.write_text(good.replace("Frame Time:", "Frame Tme:"))
+    with pytest.raises(BVHError, match=r"bad\.bvh.*line \d+.*Frame Time"):
+        bvh.header(bad)

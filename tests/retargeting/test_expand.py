@@ -212,28 +212,63 @@ def test_host_workers_and_padded_batches_write_what_one_process_writes(ckpt, lib
         np.testing.assert_allclose(first, second, atol=2e-6)  # the files hold 6 decimals
 
 
-def test_this_process_prepares_from_the_back_the_clips_no_worker_has_taken(ckpt, library, tmp_path):
-    """While the workers start, expand prepares the clips still queued itself, from the last one
-    back, until it meets one a worker holds; a clip that fails keeps its error for result()."""
+def test_clips_are_prepared_in_the_order_the_batches_need_them(ckpt, library, tmp_path):
+    """The batches are planned from the BVH headers before any clip is read; each clip is queued in
+    the order the batches need it, a clip no worker has started is prepared in this process, one a
+    worker holds is waited for, and a clip that fails becomes error rows naming it."""
     from concurrent.futures import Future
+
+    class Pool:  # a host pool whose workers the test plays
+        def __init__(self):
+            self.queued = {}
+
+        def submit(self, fn, *args):
+            self.queued[args[0].stem] = Future()
+            return self.queued[args[0].stem]
 
     bad = tmp_path / "bad.bvh"
     bad.write_text("HIERARCHY\nROOT Hips\n{\n")
-    paths = [library / "clips" / f"{n}.bvh" for n in ("walk", "turn", "short")] + [bad]
-    targets = [(c.name, c.skeleton) for c in _targets(library)[:1]]
-    args = {p.stem: (p, None, targets, "stride", FAST) for p in paths}
-    tasks = {clip: Future() for clip in args}
-    tasks["walk"].set_running_or_notify_cancel()  # a worker has it
-    queued = tasks["turn"]
-    tasks["turn"].set_running_or_notify_cancel()
-    ex._prepare_here(tasks, args, ckpt)
-    assert tasks["walk"].running() and tasks["turn"] is queued  # stopped at the first taken clip
-    with pytest.raises(bvh.BVHError, match="bad.bvh"):
-        tasks["bad"].result()
-    motion, prepared, skating, jobs = tasks["short"].result()
-    alone = ex.prepare_clip(*args["short"], ckpt)
-    assert skating == alone[2] and np.array_equal(prepared.x, alone[1].x)
-    assert np.array_equal(jobs["rig0"].root_height, alone[3]["rig0"].root_height)
+    chars = _targets(library)[:2]
+    todo = [
+        (p.stem, p, c, "")
+        for p in [library / "clips" / f"{n}.bvh" for n in ("short", "walk", "turn")] + [bad]
+        for c in chars
+    ]
+    rows, result, pool = {}, ex.ExpandResult(tmp_path), Pool()
+    loader = ex._Sources(todo, ckpt, FAST, rows, result, ".bvh", None, "stride", pool, None)
+    plan = loader.plan(10_000, pad=False)
+    assert list(pool.queued) == ["walk", "turn", "short", "bad"]  # longest first; no frames known for bad
+    assert [[(p.clip, p.character) for p in b] for b in plan][:2] == [
+        [(c, n) for c in ("walk", "turn") for n in ("rig0", "rig1")],
+        [("short", "rig0"), ("short", "rig1")],
+    ]
+    held = pool.queued["walk"]
+    held.set_running_or_notify_cancel()  # a worker has it
+    held.set_result(ex.prepare_clip(*loader.args["walk"], ckpt))
+    batches = list(loader.batches(plan, 10_000, pad=False))
+    assert [[(p.clip, p.character) for p in b] for b in batches] == [
+        [(p.clip, p.character) for p in b] for b in plan[:2]
+    ]
+    assert loader.tasks["walk"] is held and pool.queued["turn"].cancelled() and pool.queued["short"].cancelled()
+    assert [p.frames for p in batches[0]] == [p.frames for p in plan[0]]  # the headers gave the prepared lengths
+    assert {k: r["status"] for k, r in rows.items()} == {("rig0", "bad"): "error", ("rig1", "bad"): "error"}
+    assert "bad.bvh" in rows[("rig0", "bad")]["error"] and result.failed == 2
+    alone = ex.prepare_clip(*loader.args["short"], ckpt)
+    assert np.array_equal(batches[1][0].prepared.x, alone[1].x)
+
+
+def test_the_header_gives_the_frames_that_loading_and_resampling_give(tmp_path):
+    """``bvh.header``: a file's frame count and rate without its motion block; ``resampled_frames``:
+    the length a resample gives. Together they plan an expansion's batches before any clip is read."""
+    from motionlab.core.motion import resampled_frames
+
+    base = synthetic.dataset(1, seed=4, num_frames=97)[0]
+    for k, (n, fps) in enumerate(((97, 30.0), (1, 24.0), (40, 120.0), (61, 59.9988))):
+        path = bvh.save(tmp_path / f"c{k}.bvh", Motion(base.skeleton, base.local_rot[:n], base.root_pos[:n], fps))
+        loaded = bvh.load(path)
+        assert bvh.header(path) == (loaded.num_frames, loaded.fps)
+        for new in (24.0, 25.0, 30.0, 59.9988, 60.0):
+            assert resampled_frames(loaded.num_frames, loaded.fps, new) == loaded.resample(new).num_frames
 
 
 def test_resume_after_interruption_redoes_only_missing(ckpt, library, tmp_path):
