@@ -320,6 +320,27 @@ def test_bad_sources_recorded_and_job_goes_on(ckpt, library, tmp_path):
     assert code == 1  # failures are reported by the exit status
 
 
+def test_a_clip_whose_block_breaks_its_headers_promise_fails_alone(ckpt, library, tmp_path):
+    """A clip planned from its header (40 frames) whose block ends a frame early fails with the
+    file's line; the clips planned into its batch are solved as without it, byte for byte."""
+    src = tmp_path / "in"
+    src.mkdir()
+    for name in ("walk", "turn"):
+        (src / f"{name}.bvh").write_bytes((library / "clips" / f"{name}.bvh").read_bytes())
+    lines = (library / "clips" / "walk.bvh").read_text().rstrip("\n").split("\n")
+    (src / "liar.bvh").write_text("\n".join(lines[:-1]) + "\n")
+    targets = _targets(library)[:1]
+    job = ex.expand([str(src)], targets, tmp_path / "with", ckpt, FAST)
+    alone = ex.expand([str(src / "walk.bvh"), str(src / "turn.bvh")], targets, tmp_path / "without", ckpt, FAST)
+    assert (job.done, job.failed, alone.done) == (2, 1, 2)
+    error = next(r["error"] for r in job.rows if r["status"] == "error")
+    assert "liar.bvh" in error and "line" in error and "40" in error
+    for name in ("walk", "turn"):
+        assert (tmp_path / "with" / "rig0" / f"{name}.bvh").read_bytes() == (
+            tmp_path / "without" / "rig0" / f"{name}.bvh"
+        ).read_bytes()
+
+
 def test_existing_files_need_force(ckpt, library, tmp_path):
     mine = tmp_path / "rig0" / "short.bvh"
     mine.parent.mkdir()
