@@ -15,8 +15,8 @@
 # Usage: DATA=mixamo.tar.xz REF=ref_cpu.tar.xz OUT=folder bash benchmarks/gpu_check.sh
 # (DATA: a tar of MOTIONLAB_DATA's mixamo/ folder; REF: a tar of a folder ref_cpu/ written on the CPU by
 # `python benchmarks/bench_expand.py --clips all --table1-characters --device cpu --skip-per-process
-# --skip-ray --keep ref_cpu`, about 24 minutes on 2 cores; with --clips 10, Table 1's 10 clips, about 1.5
-# minutes, the GPU's outputs of those 60 pairs are compared; only the expand stages need it). STAGES names
+# --skip-ray --keep ref_cpu`; with --clips 10, Table 1's 10 clips, the GPU's outputs of those 60 pairs are
+# compared, and the reference takes minutes instead of most of an hour; only the expand stages need it). STAGES names
 # the stages, run in that order (default: pytest expand64 expand32 table1). DEV=cpu CLIPS=1 tries the
 # script without a GPU.
 set -u

@@ -6,7 +6,9 @@ latent iteration of every batch (``batching.solve_jobs``, device synchronised) w
 replayed as a CUDA graph (``MOTIONLAB_CUDA_GRAPHS=1``, :mod:`motionlab.retargeting.graphs`),
 launched eagerly (``MOTIONLAB_CUDA_GRAPHS=0``), and as a graph again (the default on CUDA). Then it
 profiles the batch with the most rows: Python (cProfile, top functions by own time) and the device (``torch.profiler``: top
-operators by device time, kernel launches per step). Results of the variants are compared with
+operators by device time, kernel launches per step) and, on CUDA, the split of its solve into the graph
+replays' device time (CUDA events) and the rest (``--widest-only`` skips the three timings of every
+batch). Results of the variants are compared with
 the first run's (largest joint difference, cm). On a GPU it first splits ``expand``'s load time:
 preparing the clips in one process, and in pools of workers (start, prepare, shut down).
 

@@ -419,7 +419,8 @@ class ExpandResult:
     implausible : int       outputs of this run that failed a plausibility test
     timings : dict          wall time, seconds: ``load`` (plan the batches, and read and prepare
                             the sources and pairs where a batch waits for them: a GPU solves
-                            the first batches while host workers prepare the rest), ``solve`` (the latent iteration of the batches, and the outputs
+                            the first batches while host workers prepare the rest), ``solve``
+                            (the latent iteration of the batches, and the outputs
                             finished, checked and encoded where no host workers do it),
                             ``finish`` (waiting for the host workers' outputs, with workers),
                             ``write`` (files and manifest)
@@ -742,6 +743,7 @@ def _write_all(outputs, count: int, out: Path, rows: dict, result: ExpandResult,
         if on_batch is not None:
             on_batch(index, [b[0] for b in batch])
         clock = time.perf_counter()
+    bar.total = bar.n  # fewer than planned when a planned batch's clips all failed
     bar.close()
 
 
@@ -853,8 +855,9 @@ class _Sources:
         self.seconds = 0.0
 
     def plan(self, max_frames: int, pad: bool) -> list[list[Pair]]:
-        """The batches of every usable pair, their frames read from the headers; each clip's
-        preparation is queued in the order the batches need it."""
+        """The batches of every usable pair, their frames read from the headers (the planned pairs
+        carry no source yet: ``source`` None); each clip's preparation is queued in the order the
+        batches need it."""
         planned = [
             Pair(clip, name, None, skeleton, _header_frames(self.args[clip][0], self.checkpoint))
             for clip in self.by_clip
@@ -871,7 +874,7 @@ class _Sources:
         for planned in plan:
             self._take(list(dict.fromkeys(p.clip for p in planned)))
             ready = [self.pairs[p.clip, p.character] for p in planned if (p.clip, p.character) in self.pairs]
-            yield from plan_batches(ready, max_frames, pad) if ready else []
+            yield from plan_batches(ready, max_frames, pad)
         self._take(list(self.tasks))
 
     def _take(self, clips: list[str]) -> None:

@@ -7,8 +7,9 @@ processes for that work; :func:`motionlab.retargeting.expand.expand` plans its b
 BVH headers, has the workers read and prepare the clips in the order the batches need them, and
 solves each batch as soon as its clips are ready, while the workers prepare the next ones and
 finish and encode the outputs of the last. A clip that no worker has started when its batch
-needs it (the workers take seconds to start) is prepared in this process instead. Each worker holds a CPU copy of the checkpoint (:func:`checkpoint`): preparing a clip
-needs its feature statistics, frame rate and float type. The workers are forked from a fresh
+needs it (the workers take seconds to start) is prepared in this process instead. Each worker
+holds a CPU copy of the checkpoint (:func:`checkpoint`): preparing a clip needs its feature
+statistics, frame rate and float type. The workers are forked from a fresh
 server process that has imported motionlab once (``forkserver``), never from this one, which is
 safe beside CUDA. Results are the same as in one process (a test checks it).
 """
