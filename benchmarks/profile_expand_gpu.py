@@ -92,8 +92,9 @@ def _run(ckpt, batches):
 
 
 def _replay_share(ckpt, batch) -> None:
-    """The widest batch's solve split into the device time of the graph's replays (CUDA events)
-    and everything else (the host's bookkeeping, Adam's kernels, the wait for the losses)."""
+    """The widest batch's solve split into the device time of the graph's replays (CUDA events; a
+    replay holds the whole step, its rules and Adam's update included, :mod:`.device_loop`) and
+    everything else (the start, recording the graph, the host's loop and its waits)."""
     from motionlab.retargeting import graphs
 
     run, spans = graphs.StepGraph.run, []

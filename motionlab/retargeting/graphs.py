@@ -1,27 +1,28 @@
 """One step of the latent iteration as a CUDA graph: its hundreds of kernels launched as one.
 
 On a GPU the batched latent iteration (:mod:`motionlab.retargeting.solver`) is bound by kernel
-launches, not by arithmetic: one step (decode, every loss term, the gradient) is hundreds of small
-kernels, and launching them from Python takes longer than the GPU takes to run them
-(``docs/performance.md`` has the profile). A CUDA graph records those kernels once and replays them with one
-launch. The step then has to be the same every time: the same tensors (updated in place), the
-same shapes (every row of the batch, also rows whose problem has stopped: their gradient is
-computed and not used) and nothing that waits for the device.
+launches, not by arithmetic: one step (decode, every loss term, the gradient, the stopping rule
+and Adam's update) is hundreds of small kernels, and launching them from Python takes longer than
+the GPU takes to run them (``docs/performance.md`` has the profile). A CUDA graph records those
+kernels once and replays them with one launch. The step then has to be the same every time: the
+same tensors (updated in place), the same shapes (every row of the batch, also rows whose problem
+has stopped: they are masked, :mod:`.device_loop`) and nothing that waits for the device.
 
 :class:`StepGraph` records a step on CUDA and replays it; elsewhere it runs the same step eagerly,
-so the CPU exercises the same all-rows arithmetic (a test compares it with the solver's usual
-path, another checks that the step reads nothing back from the device and copies nothing from the
+so the CPU exercises the same all-rows arithmetic (a test compares it with the solver's host
+loop, another checks that the step reads nothing back from the device and copies nothing from the
 host, which a graph could not record).
 
-**On by default on CUDA**; ``MOTIONLAB_CUDA_GRAPHS=0`` switches it off (:func:`enabled`), and
-``benchmarks/gpu_check.sh`` (stage ``eager``) measures the graph against the eager step.
+**On by default on CUDA**; ``MOTIONLAB_CUDA_GRAPHS=0`` switches it off (:func:`enabled`): the
+iteration then runs the host loop, as on the CPU, and ``benchmarks/gpu_check.sh`` (stage
+``eager``) measures the one against the other.
 """
 
 from __future__ import annotations
 
 import os
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import torch
 
@@ -53,10 +54,13 @@ class StepGraph:
     run (read or copy them first). ``leaf.grad`` is likewise one tensor that every run overwrites;
     it may be changed in place between runs, never replaced. Off CUDA, or when recording fails
     (with a warning), :meth:`run` calls ``step`` eagerly after clearing ``leaf.grad``.
+
+    ``keep``: tensors that ``step`` changes in place (a state it carries from step to step); the
+    warm-up runs before recording leave them as they were.
     """
 
-    def __init__(self, step: Callable[[], tuple], leaf: torch.Tensor) -> None:
-        self._step, self._leaf, self._graph, self._out = step, leaf, None, None
+    def __init__(self, step: Callable[[], tuple], leaf: torch.Tensor, keep: Sequence[torch.Tensor] = ()) -> None:
+        self._step, self._leaf, self._graph, self._out, self._keep = step, leaf, None, None, list(keep)
         if leaf.device.type == "cuda":
             try:
                 self._record()
@@ -68,11 +72,18 @@ class StepGraph:
         device = self._leaf.device
         side = torch.cuda.Stream(device=device)
         side.wait_stream(torch.cuda.current_stream(device))
-        with torch.cuda.stream(side):
-            for _ in range(WARMUP):
-                self._leaf.grad = None
-                self._step()
-        torch.cuda.current_stream(device).wait_stream(side)
+        with torch.no_grad():
+            saved = [t.clone() for t in self._keep]
+        try:
+            with torch.cuda.stream(side):
+                for _ in range(WARMUP):
+                    self._leaf.grad = None
+                    self._step()
+        finally:  # the state as it was, also when a warm-up run fails
+            torch.cuda.current_stream(device).wait_stream(side)
+            with torch.no_grad():
+                for t, before in zip(self._keep, saved):
+                    t.copy_(before)
         self._leaf.grad = None
         graph = torch.cuda.CUDAGraph()
         with torch.cuda.graph(graph):

@@ -62,11 +62,13 @@ to a grid a four-thousandth of a step fine, so that last-bit differences between
 cannot grow into other results or another stopping step. The network computes in float64.
 
 **On a GPU the step is one CUDA graph** (:mod:`motionlab.retargeting.graphs`; switched off by
-``MOTIONLAB_CUDA_GRAPHS=0``): the decoding, the terms and the gradient of
-every row are recorded once and replayed at each step, rows whose problem has stopped included
-(their gradient is not used), so that the GPU does not wait for Python to launch hundreds of small
-kernels. Each problem's arithmetic is the same as without the graph (a test runs the all-rows step
-on the CPU). Either way a step reads one thing back from the device, its losses (a test counts).
+``MOTIONLAB_CUDA_GRAPHS=0``): the decoding, the terms and the gradient of every row, then the
+stopping rule, backtracking and Adam's update as tensor operations
+(:mod:`motionlab.retargeting.device_loop`), are recorded once and replayed at each step, rows
+whose problem has stopped masked, so that the GPU does not wait for Python to launch hundreds of
+small kernels, and the host reads one flag every few steps. Each problem's numbers are those of
+the host loop below (a test runs both on the CPU). On the CPU a step decodes only the problems
+still running and reads their losses back for the stopping rule.
 
 θ, what "joint angles" means, is our choice: the local joint rotations (see
 :mod:`motionlab.retargeting.losses` for why, and ``theta="directions"`` for the
@@ -1040,14 +1042,12 @@ def _adam_step(
 ) -> list:
     """One Adam update (``torch.optim.Adam``'s arithmetic) of the groups still running, their δ put
     back on the grid; the groups left. A stopped group keeps its latent. With backtracking, a group
-    whose last step did not lower its loss (not in ``improved``) goes back first (:func:`_backtrack`).
-    ``group_loss`` None: ``steps.delta.grad`` already holds the gradient (:func:`_all_rows_step`)."""
-    if group_loss is not None:
-        keep = torch.ones(len(active), dtype=group_loss.dtype, device=group_loss.device)
-        if stopped:
-            keep[_host(stopped, keep.device)] = 0.0
-        steps.delta.grad = None
-        (group_loss * keep).sum().backward()
+    whose last step did not lower its loss (not in ``improved``) goes back first (:func:`_backtrack`)."""
+    keep = torch.ones(len(active), dtype=group_loss.dtype, device=group_loss.device)
+    if stopped:
+        keep[_host(stopped, keep.device)] = 0.0
+    steps.delta.grad = None
+    (group_loss * keep).sum().backward()
     stopped, improved = set(stopped), set(improved)  # membership per group: sets, not lists
     if p.cfg.backtrack:
         _backtrack(p, steps, [g for k, g in enumerate(active) if k in improved and k not in stopped],
@@ -1103,34 +1103,35 @@ def _set_lr(steps: _Steps, rows: np.ndarray, lr: np.ndarray) -> None:
 
 def _iterate(p: _Problem, callback, progress) -> list[SolverResult]:
     """The latent iteration for consecutive groups of sequences (``p.sizes`` rows each), each group
-    an independent problem: group loss = mean of its sequences' losses, own step size and stop."""
-    cfg, model = p.cfg, p.model
+    an independent problem: group loss = mean of its sequences' losses, own step size and stop.
+    On a GPU the whole step, rules included, is one CUDA graph (:mod:`.device_loop`)."""
+    from motionlab.retargeting import device_loop  # it builds on this module's step and rules
+
     start = time.perf_counter()
-    with _frozen(model):
+    with _frozen(p.model):
         phi0, embedding, smooth = _start(p)
         steps = _steps(phi0, p)
         track = _Track.new(phi0, len(p.sizes))
-        active = list(range(len(p.sizes)))
-        graph = (
-            graphs.StepGraph(_all_rows_step(p, phi0, embedding, smooth, steps), steps.delta)
-            if graphs.enabled(phi0.device)
-            else None
-        )
-        bar = tqdm(total=cfg.max_steps, desc="latent iteration", disable=not progress, leave=False)
-        while active:
-            if graph is None:
-                out, phi, group_loss, values = _losses(p, phi0, embedding, smooth, steps, active)
-            else:  # every row, replayed; the active groups' values read off
-                out, phi, parts = graph.run()
-                every, group_loss = parts.tolist(), None
-                values = [every[g] for g in active]
-            stopped, improved = track.record(p, active, values, out, phi, callback)
-            if len(stopped) == len(active):
-                break
-            active = _adam_step(p, steps, group_loss, active, stopped, improved)
-            for g in active:
-                track.steps[g] += 1
-            bar.update(1)
-            bar.set_postfix(loss=f"{np.mean([v[0] for v in values]):.4g}")  # values: already on the host
-        bar.close()
+        if graphs.enabled(phi0.device):
+            device_loop.iterate(p, phi0, embedding, smooth, steps, track, callback, progress)
+        else:
+            _iterate_here(p, phi0, embedding, smooth, steps, track, callback, progress)
     return track.results(p, time.perf_counter() - start)
+
+
+def _iterate_here(p: _Problem, phi0, embedding, smooth, steps: _Steps, track: _Track, callback, progress) -> None:
+    """The iteration with its rules on the host: each step decodes the running groups only, and
+    the host reads their losses back for the stopping rule."""
+    active = list(range(len(p.sizes)))
+    bar = tqdm(total=p.cfg.max_steps, desc="latent iteration", disable=not progress, leave=False)
+    while active:
+        out, phi, group_loss, values = _losses(p, phi0, embedding, smooth, steps, active)
+        stopped, improved = track.record(p, active, values, out, phi, callback)
+        if len(stopped) == len(active):
+            break
+        active = _adam_step(p, steps, group_loss, active, stopped, improved)
+        for g in active:
+            track.steps[g] += 1
+        bar.update(1)
+        bar.set_postfix(loss=f"{np.mean([v[0] for v in values]):.4g}")  # values: already on the host
+    bar.close()

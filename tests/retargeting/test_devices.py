@@ -168,7 +168,12 @@ def test_retarget_full_and_network(tiny_checkpoint, clip):
     assert np.isfinite(full.positions).all()
 
 
-def test_solve_many_as_expand_runs_it(tiny_checkpoint, clip):
+@pytest.mark.parametrize("on_device", [False, True], ids=["host-rules", "device-rules"])
+def test_solve_many_as_expand_runs_it(tiny_checkpoint, clip, on_device, monkeypatch):
+    """Both loops: the host's, and the one a GPU runs (:mod:`device_loop`, here eagerly)."""
+    from motionlab.retargeting import graphs
+
+    monkeypatch.setattr(graphs, "enabled", lambda device: on_device)
     pairs = [
         batching.Pair("c", "legs", clip, humanoid.scale_bones(clip.skeleton, legs=1.2), clip.num_frames),
         batching.Pair("c", "arms", clip, humanoid.scale_bones(clip.skeleton, arms=1.3), clip.num_frames),
@@ -398,6 +403,27 @@ def test_a_step_graph_runs_its_step_on_the_current_values(device):
         assert leaf.grad.tolist() == [4 * (2 * x + 1)] * 3
 
 
+@pytest.mark.parametrize("device", ["cpu", pytest.param("cuda", marks=[pytest.mark.cuda, cuda])])
+def test_a_step_graph_leaves_the_state_it_keeps_as_the_warm_up_found_it(device):
+    """A step that carries a state (a counter, as the solver's step carries Adam's): the warm-up
+    runs before recording on CUDA do not count; each run then adds one, in place."""
+    from motionlab.retargeting import graphs
+
+    leaf = torch.zeros(3, dtype=torch.float64, device=device, requires_grad=True)
+    counter = torch.zeros((), dtype=torch.int64, device=device)
+    loss = _quadratic_step(leaf)
+
+    def step():
+        counter.add_(1)
+        return loss()
+
+    graph = graphs.StepGraph(step, leaf, keep=[counter])
+    assert int(counter) == 0
+    for n in (1, 2, 3):
+        graph.run()
+        assert int(counter) == n
+
+
 @pytest.mark.cuda
 @cuda
 def test_cuda_the_iteration_replayed_as_a_graph_equals_it_run_eagerly(clip, monkeypatch):
@@ -434,23 +460,41 @@ def test_a_step_of_the_iteration_waits_for_the_device_once(tiny_checkpoint):
     assert all(kind == "copy" for kind, _, caller in per_step if caller == "_host")
 
 
+def test_with_the_rules_on_the_device_the_host_waits_once_every_few_steps(tiny_checkpoint, monkeypatch):
+    """The loop a GPU runs (:mod:`device_loop`, here eagerly on the CPU): per ``CHECK_EVERY`` steps
+    one read-back, of whether any problem still runs, and nothing else: no loss read for the
+    stopping rule, no host copy, no host index."""
+    from motionlab.retargeting import device_loop, graphs
+
+    monkeypatch.setattr(graphs, "enabled", lambda device: True)
+    jobs, n = _jobs(tiny_checkpoint), device_loop.CHECK_EVERY
+    counts = {}
+    for steps in (2 * n, 4 * n):  # 2n + 1 and 4n + 1 evaluations: 3 and 5 checks
+        with _HostTraffic() as traffic:
+            batching.solve_jobs(tiny_checkpoint, jobs, SolverConfig(max_steps=steps, threshold=0.0, patience=0))
+        counts[steps] = traffic.count
+    more = {k: counts[4 * n][k] - counts[2 * n][k] for k in set(counts[4 * n]) | set(counts[2 * n])}
+    assert {k: v for k, v in more.items() if v} == {("wait", "__bool__", "iterate"): 2}
+
+
 def test_the_step_a_cuda_graph_records_neither_waits_nor_copies(tiny_checkpoint):
-    """A CUDA graph cannot record a read-back or a copy from the host: the all-rows step
-    (``solver._all_rows_step``) has none, padded rows and the contact and floor terms included."""
+    """A CUDA graph cannot record a read-back or a copy from the host: the whole step
+    (``device_loop``: the losses and gradient of every row, the stopping rule, backtracking and
+    Adam's update) has none, padded rows and the contact and floor terms included."""
     from motionlab.retargeting import graphs
 
     recorded = []
     real = graphs.StepGraph
 
     class Watched(real):
-        def __init__(self, step, leaf):
+        def __init__(self, step, leaf, **kwargs):
             def watched():
                 with _HostTraffic() as traffic:
                     out = step()
                 recorded.append(traffic.count)
                 return out
 
-            super().__init__(watched, leaf)
+            super().__init__(watched, leaf, **kwargs)
 
     jobs = _jobs(tiny_checkpoint, 3)
     with pytest.MonkeyPatch.context() as mp:

@@ -121,11 +121,21 @@ def test_sequences_of_other_lengths_padded_into_one_batch_are_solved_as_alone(ck
             np.testing.assert_allclose(m.history[key], values, rtol=1e-9, atol=1e-12)
 
 
-@pytest.mark.parametrize("cfg", [SolverConfig(max_steps=30, patience=3, min_delta=0.02), SolverConfig(max_steps=20)])
-def test_the_all_rows_step_a_cuda_graph_replays_gives_the_solvers_results(ckpt, cfg, monkeypatch):
-    """On a GPU every step computes every row (:mod:`graphs`), also rows whose problem stopped; run
-    eagerly on the CPU that step gives each problem its usual result, steps and stop, whether the
-    problems stop together or apart (the first config stops them at different steps)."""
+@pytest.mark.parametrize(
+    "cfg",
+    [
+        SolverConfig(max_steps=30, patience=3, min_delta=0.02),
+        SolverConfig(max_steps=20),
+        SolverConfig(max_steps=25, patience=0, backtrack=False),
+        SolverConfig(max_steps=40, threshold=2e-3),
+    ],
+)
+def test_the_whole_step_a_cuda_graph_replays_gives_the_solvers_results(ckpt, cfg, monkeypatch):
+    """On a GPU every step computes every row and runs the stopping rule, backtracking and Adam on
+    the device (:mod:`device_loop`), rows whose problem stopped masked; run eagerly on the CPU it
+    gives each problem the host loop's results byte for byte: steps, stop, best step, history and
+    outputs, whether the problems stop together or apart (plateau, max_steps, threshold), with and
+    without backtracking; the callback sees the same calls."""
     from motionlab.retargeting import graphs
     from motionlab.retargeting.pipeline import prepare_pair, prepare_source
 
@@ -144,18 +154,42 @@ def test_the_all_rows_step_a_cuda_graph_replays_gives_the_solvers_results(ckpt, 
     planted = torch.cat([padded(j.source.planted.double()).bool() for j in jobs])
     fps = torch.tensor([60.0] * len(jobs), dtype=torch.float64)
     offsets, lengths = torch.stack([j.offsets for j in jobs]), [j.source.x.shape[1] for j in jobs]
-    results = {}
+    results, calls, alone = {}, {}, {}
     for on in (False, True):
         monkeypatch.setattr(graphs, "enabled", lambda device, on=on: on)
         results[on] = solve_many(
             ckpt.model, x, theta, offsets, heights, cfg, root_xz=root_xz, yaw=yaw, planted=planted, fps=fps,
             inputs={"floor": floor}, lengths=lengths,
         )  # fmt: skip
+        j, calls[on] = jobs[0], []
+        alone[on] = solve(
+            ckpt.model, j.source.x, j.source.theta, j.offsets, j.root_height, cfg, root_xz=j.root_xz,
+            yaw=j.source.yaw, planted=j.source.planted, fps=60.0, inputs={"floor": j.floor},
+            callback=lambda step, values, on=on: calls[on].append((step, values)),
+        )  # fmt: skip
     stops = [(r.steps, r.stop_reason, r.best_step) for r in results[False]]
     assert stops == [(r.steps, r.stop_reason, r.best_step) for r in results[True]]
+    assert len({r.steps for r in results[False]}) > 1 or cfg.patience == 0  # the groups stop apart
     for usual, every in zip(results[False], results[True]):
-        np.testing.assert_allclose(every.positions, usual.positions, atol=1e-12)
+        assert np.array_equal(every.positions, usual.positions) and np.array_equal(every.local_rot, usual.local_rot)
+        assert torch.equal(every.phi, usual.phi)
         assert every.history == usual.history
+    assert calls[True] == calls[False] and len(calls[True]) == alone[True].steps + 1
+    assert np.array_equal(alone[True].positions, alone[False].positions)
+
+
+def test_a_step_grid_on_the_device_is_the_hosts(ckpt):
+    """``device_loop.step_grids`` gives :func:`grid.step_grid` exactly: step sizes over fifteen
+    decades, each power of two and its two neighbours (where a rounded log2 decides)."""
+    import math
+
+    from motionlab.retargeting.device_loop import step_grids
+    from motionlab.retargeting.grid import step_grid
+
+    edges = [x for k in range(-60, 10) for x in (math.nextafter(2.0**k, 0), 2.0**k, math.nextafter(2.0**k, 1))]
+    sizes = edges + list(10 ** np.random.default_rng(0).uniform(-12, 3, 5000))
+    for part in (sizes, sizes[:3], sizes[:17]):  # the vectorised kernel and its scalar tail
+        assert step_grids(torch.tensor(part, dtype=torch.float64)).tolist() == [step_grid(x) for x in part]
 
 
 def test_padding_is_refused_while_a_term_ignores_padded_frames(ckpt):
