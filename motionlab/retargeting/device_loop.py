@@ -2,7 +2,7 @@
 
 :mod:`.solver` runs each step of the iteration (decode, the terms, the gradient) and then, on the
 host, the rules around it: the stopping rule and the best iterate (``solver._Track``),
-backtracking and Adam's update (``solver._adam_step``). On a GPU those rules are what the step
+backtracking and Adam's update (``solver._adam_step``, :mod:`.adam`). On a GPU those rules are what the step
 waits on: over a hundred small kernels launched one by one from Python, and a read-back of the
 losses at every step (``docs/performance.md``). Here the same rules are tensor operations over
 every row of the batch, a group that has stopped masked rather than dropped, so that the step and
@@ -13,8 +13,8 @@ group has stopped change nothing.
 Each group's numbers are those of the host's rules: the same float64 operations in the same
 order (a test runs both on the CPU and compares steps, stops, histories and outputs). Two
 quantities the host computes from Python floats come from tables or the same formula here:
-Adam's bias corrections (``1 − β₁ᶜ`` and ``√(1 − β₂ᶜ)``, made once on the host for every step
-count ``c``) and the step grid (:func:`step_grids`, :func:`.grid.step_grid`'s formula).
+Adam's bias corrections (:func:`.adam.bias_corrections`, made once on the host for every step
+count) and the step grid (:func:`step_grids`, :func:`.grid.step_grid`'s formula).
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ import numpy as np
 import torch
 from tqdm.auto import tqdm
 
-from motionlab.retargeting import graphs, solver
+from motionlab.retargeting import adam, graphs
 
 __all__ = ["CHECK_EVERY", "iterate", "step_grids"]
 
@@ -78,7 +78,7 @@ class _State:
 def _state(p, steps, terms: int) -> _State:
     """The rules' starting state for ``p`` (``solver._Problem``) and ``steps`` (``solver._Steps``)."""
     groups, device, dtype = len(p.sizes), steps.delta.device, steps.delta.dtype
-    (b1, b2), counts = solver._BETAS, range(p.cfg.max_steps + 2)
+    bias1, root2 = zip(*map(adam.bias_corrections, range(p.cfg.max_steps + 2)))  # count 0: rows not stepped
 
     def per_group(fill, kind=dtype):
         return torch.full((groups,), fill, dtype=kind, device=device)
@@ -100,8 +100,8 @@ def _state(p, steps, terms: int) -> _State:
         lr=host(steps.lr),
         lr_max=host(steps.lr if steps.lr_max is None else steps.lr_max),
         count=torch.zeros(len(steps.lr), dtype=torch.int64, device=device),
-        bias1=host([1 - b1 ** float(c) for c in counts]),  # Python floats, as the host's rule
-        root2=host([(1 - b2 ** float(c)) ** 0.5 for c in counts]),
+        bias1=host(bias1),
+        root2=host(root2),
     )
 
 
@@ -134,8 +134,8 @@ def _backtrack(s: _State, steps, better: torch.Tensor, worse: torch.Tensor) -> N
     grad, b, w = steps.delta.grad, better[:, None, None], worse[:, None, None]
     steps.best_delta.copy_(torch.where(b, steps.delta, steps.best_delta))
     steps.best_grad.copy_(torch.where(b, grad, steps.best_grad))
-    lr = torch.where(better, torch.minimum(s.lr * solver._GROW, s.lr_max), s.lr)
-    s.lr.copy_(torch.where(worse, s.lr * solver._SHRINK, lr))
+    lr = torch.where(better, torch.minimum(s.lr * adam.GROW, s.lr_max), s.lr)
+    s.lr.copy_(torch.where(worse, s.lr * adam.SHRINK, lr))
     steps.delta.copy_(torch.where(w, steps.best_delta, steps.delta))
     grad.copy_(torch.where(w, steps.best_grad, grad))
     steps.m.masked_fill_(w, 0.0)
@@ -151,23 +151,20 @@ def _update(s: _State, p, steps, improved: torch.Tensor) -> None:
     with torch.no_grad():
         if p.cfg.backtrack:
             _backtrack(s, steps, improved[p.group_of_row] & going, ~improved[p.group_of_row] & going)
-        grad, (b1, b2), g = steps.delta.grad, solver._BETAS, going[:, None, None]
         s.count.add_(going.to(torch.int64))
         step_size, root2 = (s.lr / s.bias1[s.count])[:, None, None], s.root2[s.count][:, None, None]
-        m = steps.m.lerp(grad, 1 - b1)
-        v = steps.v.mul(b2).addcmul_(grad, grad, value=1 - b2)
-        d = steps.delta + (-step_size * m) / (v.sqrt() / root2).add_(solver._EPS)
+        m, v, delta = adam.update(steps.delta, steps.delta.grad, steps.m, steps.v, step_size, root2, steps.grid)
+        g = going[:, None, None]
         steps.m.copy_(torch.where(g, m, steps.m))
         steps.v.copy_(torch.where(g, v, steps.v))
-        steps.delta.copy_(torch.where(g, torch.round(d / steps.grid) * steps.grid, steps.delta))
+        steps.delta.copy_(torch.where(g, delta, steps.delta))
         s.steps.add_(s.running.to(torch.int64))
         s.it.add_(1)
 
 
-def _whole_step(p, phi0, embedding, smooth, steps, track, s: _State) -> Callable[[], tuple]:
-    """The step :class:`graphs.StepGraph` records: every row's losses and gradient
-    (``solver._all_rows_step``), then the rules and the update."""
-    losses = solver._all_rows_step(p, phi0, embedding, smooth, steps)
+def _whole_step(p, losses: Callable[[], tuple], steps, track, s: _State) -> Callable[[], tuple]:
+    """The step :class:`graphs.StepGraph` records: ``losses()`` (every row's ``(out, phi, parts)``
+    and gradient, ``solver._all_rows_step``), then the rules and the update."""
 
     def step() -> tuple:
         out, phi, parts = losses()
@@ -177,14 +174,15 @@ def _whole_step(p, phi0, embedding, smooth, steps, track, s: _State) -> Callable
     return step
 
 
-def iterate(p, phi0, embedding, smooth, steps, track, callback=None, progress=False) -> None:
+def iterate(p, losses: Callable[[], tuple], steps, track, callback=None, progress=False) -> None:
     """Run the latent iteration of ``p`` (``solver._Problem``) from ``steps`` (``solver._Steps``)
-    to the last group's stop, replaying the whole step; fill ``track`` (``solver._Track``) as the
-    host's loop does. With a ``callback`` the host reads each step's values (one wait per step)."""
+    to the last group's stop, each step ``losses()`` (every row's losses and gradient) and then the
+    rules; fill ``track`` (``solver._Track``) as the host's loop does. With a ``callback`` the host
+    reads each step's values (one wait per step)."""
     s = _state(p, steps, len(track.keys))
     kept = s.tensors() + [steps.delta, steps.m, steps.v, steps.grid, track.best_rot, track.best_pos, track.best_phi]
     kept += [t for t in (steps.best_delta, steps.best_grad) if t is not None]
-    graph = graphs.StepGraph(_whole_step(p, phi0, embedding, smooth, steps, track, s), steps.delta, keep=kept)
+    graph = graphs.StepGraph(_whole_step(p, losses, steps, track, s), steps.delta, keep=kept)
     every = 1 if callback is not None else CHECK_EVERY
     bar = tqdm(total=p.cfg.max_steps, desc="latent iteration", disable=not progress, leave=False)
     while True:

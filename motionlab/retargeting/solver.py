@@ -92,7 +92,7 @@ from tqdm.auto import tqdm
 
 from motionlab.core import quat_torch as tq
 from motionlab.core import threads
-from motionlab.retargeting import graphs, losses, terms
+from motionlab.retargeting import adam, device_loop, graphs, losses, terms
 from motionlab.retargeting.contacts import CONTACT_JOINTS
 from motionlab.retargeting.grid import step_grid
 from motionlab.retargeting.model import NUM_JOINTS, Decoded, RetargetNet
@@ -833,15 +833,6 @@ def _start(p: _Problem):
     return phi0, embedding, smooth
 
 
-_BETAS, _EPS = (0.9, 0.999), 1e-8
-"""Adam's defaults (Kingma and Ba 2015), as ``torch.optim.Adam`` has them."""
-
-_GROW, _SHRINK = 1.1, 0.5
-"""Backtracking's step-size factors after a step that lowered ``L_iter`` and after one that did
-not: the "bold driver" rule's classic values (grow a little on success, halve on failure), not
-tuned here; the step never grows past the configured ``lr · std(φ₀)``."""
-
-
 @dataclass
 class _Steps:
     """The latent offset δ (N, T, D) (φ = φ₀ + smooth(δ)) and Adam's state over it, written out
@@ -929,8 +920,9 @@ def _losses(p: _Problem, phi0, embedding, smooth, steps: _Steps, active: list):
 
 
 def _all_rows_step(p: _Problem, phi0, embedding, smooth, steps: _Steps) -> Callable[[], tuple]:
-    """The step that :class:`graphs.StepGraph` records: every group's losses ``(out, phi, parts)``
-    and the gradient of their sum in ``steps.delta.grad`` (each row's is its own group's)."""
+    """The first half of the step that :mod:`.device_loop` records: every group's losses
+    ``(out, phi, parts)`` and the gradient of their sum in ``steps.delta.grad`` (each row's is its
+    own group's)."""
     everyone = list(range(len(p.sizes)))
 
     def step() -> tuple:
@@ -1056,26 +1048,22 @@ def _adam_step(
     rows = _rows_of(p.bounds, active)
     steps.count[rows] += 1
     like = dict(dtype=steps.m.dtype, device=steps.m.device)
-    (b1, b2), t = _BETAS, steps.count[rows]
-    step_size = _host([lr / (1 - b1 ** float(c)) for lr, c in zip(steps.lr[rows], t)], **like)
-    root2 = _host([(1 - b2 ** float(c)) ** 0.5 for c in t], **like)  # Python floats, as Adam's
-    step_size, root2 = step_size[:, None, None], root2[:, None, None]
+    bias1, root2 = zip(*map(adam.bias_corrections, steps.count[rows]))
+    step_size = _host([lr / b for lr, b in zip(steps.lr[rows], bias1)], **like)[:, None, None]
+    root2 = _host(root2, **like)[:, None, None]
     index = _host(rows, steps.m.device)
     with torch.no_grad():
-        g = steps.delta.grad[index]
-        m = steps.m[index].lerp_(g, 1 - b1)
-        v = steps.v[index].mul_(b2).addcmul_(g, g, value=1 - b2)
-        d = steps.delta[index] + (-step_size * m) / (v.sqrt() / root2).add_(_EPS)
-        grid = steps.grid[index]
-        steps.m[index], steps.v[index] = m, v
-        steps.delta[index] = torch.round(d / grid) * grid  # on the grid: the same iterates on every CPU
+        m, v, delta = adam.update(
+            steps.delta[index], steps.delta.grad[index], steps.m[index], steps.v[index], step_size, root2, steps.grid[index]
+        )  # fmt: skip
+        steps.m[index], steps.v[index], steps.delta[index] = m, v, delta
     return active
 
 
 def _backtrack(p: _Problem, steps: _Steps, better: list, worse: list) -> None:
     """Groups ``better`` (their loss the lowest yet): remember δ and its gradient, step size × 1.1
     (at most the configured one). Groups ``worse``: back to the remembered δ and gradient, Adam's
-    moments and step count reset, step size halved (:data:`_GROW`, :data:`_SHRINK`)."""
+    moments and step count reset, step size halved (:data:`.adam.GROW`, :data:`.adam.SHRINK`)."""
     device = steps.delta.device
     with torch.no_grad():
         if better:
@@ -1083,7 +1071,7 @@ def _backtrack(p: _Problem, steps: _Steps, better: list, worse: list) -> None:
             rows = _host(at, device)
             steps.best_delta[rows] = steps.delta[rows]
             steps.best_grad[rows] = steps.delta.grad[rows]
-            _set_lr(steps, at, np.minimum(steps.lr[at] * _GROW, steps.lr_max[at]))
+            _set_lr(steps, at, np.minimum(steps.lr[at] * adam.GROW, steps.lr_max[at]))
         if worse:
             at = _rows_of(p.bounds, worse)
             rows = _host(at, device)
@@ -1091,7 +1079,7 @@ def _backtrack(p: _Problem, steps: _Steps, better: list, worse: list) -> None:
             steps.delta.grad[rows] = steps.best_grad[rows]
             steps.m[rows], steps.v[rows] = 0.0, 0.0
             steps.count[at] = 0
-            _set_lr(steps, at, steps.lr[at] * _SHRINK)
+            _set_lr(steps, at, steps.lr[at] * adam.SHRINK)
 
 
 def _set_lr(steps: _Steps, rows: np.ndarray, lr: np.ndarray) -> None:
@@ -1105,15 +1093,14 @@ def _iterate(p: _Problem, callback, progress) -> list[SolverResult]:
     """The latent iteration for consecutive groups of sequences (``p.sizes`` rows each), each group
     an independent problem: group loss = mean of its sequences' losses, own step size and stop.
     On a GPU the whole step, rules included, is one CUDA graph (:mod:`.device_loop`)."""
-    from motionlab.retargeting import device_loop  # it builds on this module's step and rules
-
     start = time.perf_counter()
     with _frozen(p.model):
         phi0, embedding, smooth = _start(p)
         steps = _steps(phi0, p)
         track = _Track.new(phi0, len(p.sizes))
         if graphs.enabled(phi0.device):
-            device_loop.iterate(p, phi0, embedding, smooth, steps, track, callback, progress)
+            step = _all_rows_step(p, phi0, embedding, smooth, steps)
+            device_loop.iterate(p, step, steps, track, callback, progress)
         else:
             _iterate_here(p, phi0, embedding, smooth, steps, track, callback, progress)
     return track.results(p, time.perf_counter() - start)
