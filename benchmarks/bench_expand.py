@@ -28,6 +28,15 @@ compared with a CPU run of the same pairs (``motionlab expand ... --device cpu -
 
     python benchmarks/bench_expand.py --clips all --table1-characters --device cuda \
         --skip-per-process --skip-ray --reference REF
+
+``--device-loop`` runs the iteration as a GPU does, its rules on the device
+(:mod:`motionlab.retargeting.device_loop`), on any device: on the CPU (eagerly, no graph) its
+outputs can be compared with a CPU run's byte for byte::
+
+    python benchmarks/bench_expand.py --clips 8 --table1-characters --device cpu --pad \
+        --skip-per-process --skip-ray --keep REF
+    python benchmarks/bench_expand.py --clips 8 --table1-characters --device cpu --pad \
+        --skip-per-process --skip-ray --device-loop --reference REF
 """
 
 from __future__ import annotations
@@ -252,7 +261,16 @@ def main() -> None:
     p.add_argument("--skip-per-process", action="store_true", help="leave out the one-process-per-pair run")
     p.add_argument("--skip-ray", action="store_true", help="leave out the Ray run")
     p.add_argument("--verify", metavar="OUT", help="only check OUT's outputs against the single-pair path")
+    p.add_argument(
+        "--device-loop",
+        action="store_true",
+        help="run the iteration's rules as on a GPU (motionlab.retargeting.device_loop), eagerly on any device",
+    )
     args = p.parse_args()
+    if args.device_loop:  # the switch a GPU takes (graphs.enabled), taken on every device
+        from motionlab.retargeting import graphs
+
+        graphs.enabled = lambda device: True
     if args.memory:
         return _memory(args)
     if args.verify:

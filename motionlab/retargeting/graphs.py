@@ -70,10 +70,10 @@ class StepGraph:
 
     def _record(self) -> None:
         device = self._leaf.device
+        with torch.no_grad():
+            saved = [t.clone() for t in self._keep]  # on the current stream, before the side one waits for it
         side = torch.cuda.Stream(device=device)
         side.wait_stream(torch.cuda.current_stream(device))
-        with torch.no_grad():
-            saved = [t.clone() for t in self._keep]
         try:
             with torch.cuda.stream(side):
                 for _ in range(WARMUP):
