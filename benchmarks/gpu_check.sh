@@ -3,8 +3,9 @@
 #   pytest    the CUDA tests (pytest -m cuda);
 #   expand64  expanding all of Aj's clips onto the six Table 1 characters on cuda in float64, outputs
 #             compared with a CPU run of the same pairs (REF) (KEEP=1: kept as OUT/gpu_out.tgz.*);
-#   eager     expand64 with each solver step launched eagerly (MOTIONLAB_CUDA_GRAPHS=0) instead of
-#             replayed as a CUDA graph (motionlab.retargeting.graphs, the default on CUDA);
+#   eager     expand64 with the host loop, each solver step launched eagerly (MOTIONLAB_CUDA_GRAPHS=0),
+#             instead of the whole step with its rules replayed as one CUDA graph (the default on CUDA:
+#             motionlab.retargeting.graphs, motionlab.retargeting.device_loop);
 #   fk        benchmarks/bench_fk_product.py (FK's 3x3 products as batched GEMMs or broadcast sums);
 #   workers   the same with FEW host worker processes instead of every core but one (FEW: a list,
 #             default 4);
