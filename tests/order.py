@@ -6,11 +6,17 @@ background while the tests run (``.ci/run``), so the tests that need it come las
 ``real_network`` and the notebooks in :data:`NOTEBOOKS`. Both parts keep their order, so a
 notebook's cells stay together and in order.
 
+The notebooks' cells get the ``real_network`` marker too, so that ``-m real_network`` selects
+every test that needs the network and ``-m "not real_network"`` every other (CI runs the others
+while the network trains).
+
 To find them: run the suite with ``MOTIONLAB_CACHE`` naming a file instead of a folder (and
 ``MOTIONLAB_DATA`` set). The tests that need the network then fail; no other does.
 """
 
 from __future__ import annotations
+
+import pytest
 
 NOTEBOOKS = ("03_latent_iteration.ipynb", "07_expanding_a_database.ipynb")
 """The notebooks that retarget real clips with the real-motion network."""
@@ -21,6 +27,10 @@ def needs_network(item) -> bool:
     return item.get_closest_marker("real_network") is not None or item.path.name in NOTEBOOKS
 
 
+@pytest.hookimpl(tryfirst=True)  # before ``-m`` deselects by marker
 def pytest_collection_modifyitems(items) -> None:
+    for item in items:
+        if item.path.name in NOTEBOOKS:
+            item.add_marker(pytest.mark.real_network)
     first = [i for i in items if not needs_network(i)]
     items[:] = first + [i for i in items if needs_network(i)]

@@ -2,17 +2,21 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 from types import SimpleNamespace
 
 from tests import order
 
+ROOT = Path(__file__).resolve().parents[1]
+
 
 def _item(name: str, path: str, marked: bool = False):
-    marker = object() if marked else None
-    return SimpleNamespace(
-        name=name, path=Path(path), get_closest_marker=lambda m: marker if m == "real_network" else None
-    )
+    item = SimpleNamespace(name=name, path=Path(path), markers=["real_network"] if marked else [])
+    item.get_closest_marker = lambda m: object() if m in item.markers else None
+    item.add_marker = lambda mark: item.markers.append(mark.name)
+    return item
 
 
 def test_the_real_network_tests_and_notebooks_go_last_in_their_order():
@@ -27,6 +31,20 @@ def test_the_real_network_tests_and_notebooks_go_last_in_their_order():
     ]
     order.pytest_collection_modifyitems(items)
     assert [i.name for i in items] == ["a", "c", "d", "b", "cell 0", "cell 1", "e"]
+    assert [i.name for i in items if "real_network" in i.markers] == ["b", "cell 0", "cell 1", "e"]
+
+
+def test_not_real_network_leaves_out_every_cell_of_the_notebooks_named_there():
+    """``-m "not real_network"`` (what CI runs while the network trains) leaves out the cells of
+    the notebooks that need the network and keeps the others' (the hook marks them first)."""
+    run = subprocess.run(
+        [sys.executable, "-m", "pytest", "--collect-only", "-q", "-p", "no:cacheprovider", "-m", "not real_network",
+         "--nbval", f"notebooks/{order.NOTEBOOKS[0]}", "notebooks/01_preprocessing.ipynb"],
+        cwd=ROOT, capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert run.returncode == 0, run.stdout + run.stderr
+    kept = [line for line in run.stdout.splitlines() if "::" in line]
+    assert kept and all(t.startswith("notebooks/01_preprocessing.ipynb::") for t in kept), kept
 
 
 def test_every_notebook_named_there_exists():
