@@ -3,8 +3,8 @@
 :mod:`.solver` runs each step of the iteration (decode, the terms, the gradient) and then, on the
 host, the rules around it: the stopping rule and the best iterate (``solver._Track``),
 backtracking and Adam's update (``solver._adam_step``, :mod:`.adam`). On a GPU those rules are what the step
-waits on: over a hundred small kernels launched one by one from Python, and a read-back of the
-losses at every step (``docs/performance.md``). Here the same rules are tensor operations over
+waits on: small kernels launched one by one from Python, and a read-back of the losses at every
+step (``docs/performance.md``). Here the same rules are tensor operations over
 every row of the batch, a group that has stopped masked rather than dropped, so that the step and
 its rules are recorded together as one CUDA graph (:mod:`.graphs`). The host then reads one
 flag, whether any group still runs, every :data:`CHECK_EVERY` steps; steps replayed after every
@@ -32,7 +32,8 @@ __all__ = ["CHECK_EVERY", "iterate", "step_grids"]
 
 CHECK_EVERY = 8
 """Steps replayed between two reads of "does any group still run?" (one wait for the device
-each). At most ``CHECK_EVERY − 1`` steps are replayed after the last group stops."""
+each). At most ``CHECK_EVERY − 1`` steps are replayed after the last group stops. Not tuned: a
+round number between waiting at every step and wasting many steps after the last stop."""
 
 REASONS = ("max_steps", "threshold", "plateau")
 """``SolverResult.stop_reason`` by the code the device keeps (0, 1, 2)."""
