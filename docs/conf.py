@@ -95,15 +95,28 @@ html_theme_options = {
     "show_toc_level": 2,
     "use_download_button": True,
     "home_page_in_toc": True,
+    # the sidebar lists the pages and the API's packages; a package's page lists its modules (every
+    # page's sidebar holding all 110 API pages made the build and the site's link check slow)
+    "max_navbar_depth": 2,
+    "collapse_navbar": True,
 }
 # three.js for the web players in notebook outputs (motionlab.viz.web): scripts/build_docs.sh vendors
 # it from npm (scripts/vendor_three.sh) into build/web/three.min.js, one classic script that defines
-# window.THREE, copied into _static/ and loaded on every page, so players work from file:// offline.
+# window.THREE, copied into _static/ and loaded on the notebooks' pages (where the players are), so
+# players work from file:// offline; the other pages do not load its 0.5 MB.
 _THREE = ROOT / "build" / "web" / "three.min.js"
 if not _THREE.is_file():
     raise FileNotFoundError(f"{_THREE} is missing: build the site with scripts/build_docs.sh (it runs vendor_three.sh)")
 html_static_path: list[str] = [str(_THREE.parent)]
-html_js_files = ["three.min.js"]
+
+
+def _three_js_on_notebook_pages(app, pagename, templatename, context, doctree) -> None:
+    if pagename.startswith("notebooks/"):
+        app.add_js_file(_THREE.name)
+
+
+def setup(app) -> None:
+    app.connect("html-page-context", _three_js_on_notebook_pages)
 
 # numpydoc parameter types here describe shapes and components ("ndarray, shape (T, J, 4),
 # (w, x, y, z)"), not Python objects; Sphinx looks up words such as `x` or `start` in them and
