@@ -118,6 +118,7 @@ def _three_js_on_notebook_pages(app, pagename, templatename, context, doctree) -
 def setup(app) -> None:
     app.connect("html-page-context", _three_js_on_notebook_pages)
 
+
 # numpydoc parameter types here describe shapes and components ("ndarray, shape (T, J, 4),
 # (w, x, y, z)"), not Python objects; Sphinx looks up words such as `x` or `start` in them and
 # warns when several attributes share the name. Those lookups are not links anyone wrote.
