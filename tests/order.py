@@ -7,8 +7,8 @@ background while the tests run (``.ci/run``), so the tests that need it come las
 notebook's cells stay together and in order.
 
 The notebooks' cells get the ``real_network`` marker too, so that ``-m real_network`` selects
-every test that needs the network and ``-m "not real_network"`` every other (for example to run
-the others on a machine without the network's cache).
+every test that needs the network and ``-m "not real_network"`` every other (CI runs the others
+while the network trains).
 
 To find them: run the suite with ``MOTIONLAB_CACHE`` naming a file instead of a folder (and
 ``MOTIONLAB_DATA`` set). The tests that need the network then fail; no other does.

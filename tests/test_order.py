@@ -35,7 +35,7 @@ def test_the_real_network_tests_and_notebooks_go_last_in_their_order():
 
 
 def test_not_real_network_leaves_out_every_cell_of_the_notebooks_named_there():
-    """``-m "not real_network"`` (every test but those that need the network) leaves out the cells of
+    """``-m "not real_network"`` (what CI runs while the network trains) leaves out the cells of
     the notebooks that need the network and keeps the others' (the hook marks them first)."""
     run = subprocess.run(
         [sys.executable, "-m", "pytest", "--collect-only", "-q", "-p", "no:cacheprovider", "-m", "not real_network",
