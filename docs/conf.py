@@ -95,8 +95,8 @@ html_theme_options = {
     "show_toc_level": 2,
     "use_download_button": True,
     "home_page_in_toc": True,
-    # the sidebar lists the pages and the API's packages; a package's page lists its modules (every
-    # page's sidebar holding all 110 API pages made the build and the site's link check slow)
+    # the sidebar lists the pages and the API's packages, the current section open; a package's
+    # page lists its modules
     "max_navbar_depth": 2,
     "collapse_navbar": True,
 }
