@@ -3,6 +3,9 @@
 # torch is installed first at a pinned version: on machines that keep its CPU wheel locally
 # this avoids downloading the multi-GB CUDA build. Elsewhere, set MOTIONLAB_TORCH_INDEX to
 # https://download.pytorch.org/whl/cpu to fetch the CPU build from PyTorch's own index.
+# `bash scripts/setup.sh --core` stops after torch, numpy and tqdm: what training the retargeting
+# network needs (with PYTHONPATH at the clone; .ci/run starts the training there, then runs this
+# script again for the rest).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV=${MOTIONLAB_VENV:-.venv}
@@ -15,6 +18,10 @@ if ! "$PY" -c "import torch" >/dev/null 2>&1; then
   else
     "$PY" -m pip install -q torch==2.13.0
   fi
+fi
+if [ "${1:-}" = --core ]; then
+  "$PY" -m pip install -q numpy tqdm
+  exit 0
 fi
 "$PY" -m pip install -q -e ".[dev,notebooks,bench,docs,cluster]"
 "$PY" -m ipykernel install --sys-prefix --name python3 >/dev/null 2>&1 || true

@@ -5,7 +5,11 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+import pytest
+
 import motionlab
+
+pytestmark = pytest.mark.backend_free  # no numeric back end changes what it checks (CI runs it once)
 
 PACKAGE = Path(motionlab.__file__).parent
 ABOVE_CORE = ("synthetic", "retargeting", "motion_graphs", "interpolation", "viz", "demo", "cli", "commands", "data")

@@ -7,7 +7,11 @@ import sys
 from pathlib import Path
 from types import SimpleNamespace
 
+import pytest
+
 from tests import order
+
+pytestmark = pytest.mark.backend_free  # no numeric back end changes what it checks (CI runs it once)
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -25,6 +25,8 @@ from hypothesis import strategies as st
 from motionlab import cli, synthetic
 from motionlab.core import bvh, humanoid
 
+pytestmark = pytest.mark.backend_free  # no numeric back end changes what it checks (CI runs it once)
+
 
 class WorkBegan(Exception):
     """Raised by the stand-ins: the command accepted its arguments and started its work."""

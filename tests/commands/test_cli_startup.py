@@ -5,6 +5,8 @@ import sys
 
 import pytest
 
+pytestmark = pytest.mark.backend_free  # no numeric back end changes what it checks (CI runs it once)
+
 
 def _modules_after(argv: list[str]) -> set[str]:
     code = (

@@ -13,6 +13,8 @@ import pytest
 from motionlab import cli, synthetic
 from motionlab.core import bvh, humanoid
 
+pytestmark = pytest.mark.backend_free  # no numeric back end changes what it checks (CI runs it once)
+
 
 def _run(capsys, *argv):
     """``(exit status, stdout, stderr)``; argparse's refusals (SystemExit) count as their status."""

@@ -707,6 +707,7 @@ def _real_file_params() -> list:
     return out or [pytest.param(None, id="no-data")]
 
 
+@pytest.mark.backend_free  # the reader and writer on every real file; FK within 1e-6 of the size
 @pytest.mark.parametrize("path", _real_file_params())
 def test_real_file_loads_and_round_trips(path, tmp_path):
     """file -> load -> save -> load: same skeleton, frame time and global positions; the header

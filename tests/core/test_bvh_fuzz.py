@@ -35,6 +35,8 @@ import motionlab.core.bvh as bvh_module
 from motionlab.core import bvh, quat
 from motionlab.core.bvh import BVHError
 
+pytestmark = pytest.mark.backend_free  # no numeric back end changes what it checks (CI runs it once)
+
 _LEVEL = os.environ.get("MOTIONLAB_FUZZ", "ci").strip().lower()
 EXAMPLES = 5000 if _LEVEL == "thorough" else int(_LEVEL) if _LEVEL.isdigit() else 300
 FUZZ = settings(

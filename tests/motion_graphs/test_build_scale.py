@@ -129,6 +129,7 @@ def test_unknown_backend_is_refused(library):
 
 
 @pytest.mark.slow
+@pytest.mark.backend_free  # Ray's result against the local one, both under this process's back end
 def test_ray_backend_gives_the_local_graph(library):
     """The comparisons inside each style as Ray tasks on a local Ray instance: the same graph."""
     if importlib.util.find_spec("ray") is None:

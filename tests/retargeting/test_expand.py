@@ -446,6 +446,7 @@ def _start_ray(workers: int) -> None:
 
 
 @pytest.mark.slow  # starts a local Ray instance: over 10 s
+@pytest.mark.backend_free  # Ray's result against the local one, both under this process's back end
 def test_ray_backend_equals_local(ckpt, library, tmp_path):
     if importlib.util.find_spec("ray") is None:
         pytest.skip('Ray is not installed: pip install "motionlab[cluster]" (CI installs it)')
