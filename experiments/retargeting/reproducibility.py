@@ -13,8 +13,8 @@ without it (spacing 2⁻⁶⁰ of a step: no rounding in practice).
 
 ``--training`` trains the same network under each back end instead (a small synthetic set with
 ``TrainConfig.grid`` on and off; with ``--real`` also the network of ``retargeting.load_real``,
-Aj's clips with evaluate's settings, grid on: the cached network, trained under
-``real.PINNED_BACK_END``, against a second training in a child process under back end B), and prints how many parameter tensors differ
+Aj's clips with evaluate's settings, grid on: the cached network against trainings in child
+processes under back end B and under ``real.PINNED_BACK_END``, P, side by side), and prints how many parameter tensors differ
 between the back ends, the largest difference, the final loss and the mean joint error of the
 trained network on clips it never saw. Back end C (torch and numpy without SIMD kernels) is a
 harsher check for a machine whose own kernels are back end B's.
@@ -31,6 +31,8 @@ import json
 import os
 import subprocess
 import sys
+
+from motionlab.retargeting.real import PINNED_BACK_END
 
 OTHER_BACK_END = {
     "ATEN_CPU_CAPABILITY": "avx2",
@@ -59,6 +61,8 @@ NO_SIMD = {
     "NPY_DISABLE_CPU_FEATURES": "X86_V3 X86_V4 AVX512_ICL AVX512_SPR",
 }
 """Back end C: torch's and numpy's scalar kernels, one thread."""
+REAL_BACK_ENDS = {"B": OTHER_BACK_END, "P": PINNED_BACK_END}
+"""The back ends the real network is trained again under: B, and P, the one ``load_real`` trains under."""
 SMALL = {"clips": 8, "steps": 200, "batch_size": 16}
 """The small training run: synthetic clips (seed 0), Adam steps, windows per step."""
 
@@ -172,8 +176,9 @@ def _compare_weights(path_a: str, path_b: str) -> tuple[int, int, float]:
     return len(differ), len(a), largest
 
 
-def training(real: bool, small: bool = True) -> None:
-    """Prints, per training run and grid setting, whether back ends B and C give back end A's weights."""
+def training(real: bool, small: bool = True, real_back_ends: str = "BP") -> None:
+    """Prints, per training run and grid setting, whether back ends B and C give back end A's weights
+    (the real run: each of ``real_back_ends``, keys of :data:`REAL_BACK_ENDS`)."""
     import tempfile
 
     print("back end A: this machine's; B:", ", ".join(f"{k}={v}" for k, v in OTHER_BACK_END.items()))
@@ -185,23 +190,23 @@ def training(real: bool, small: bool = True) -> None:
         f"small: {SMALL['clips']} synthetic clips, {SMALL['steps']} steps of {SMALL['batch_size']} windows; held out: 4 other synthetic clips"
     )
     print("real: retargeting.load_real's network (Aj's clips but Table 1's 10, evaluate's settings, grid on):")
-    print(
-        "      A = the cached one (trained under real.PINNED_BACK_END), B = trained again in a child; held out: those 10"
-    )
+    print("      A = the cached one, B and P = trained again in children; held out: those 10")
+    print("back end P (real.PINNED_BACK_END):", ", ".join(f"{k}={v}" for k, v in REAL_BACK_ENDS["P"].items()))
     head = f"{'run':6s} {'grid':>4s} {'back end':>8s} {'differing tensors':>18s} {'max |diff|':>11s} {'final loss':>11s} {'held-out cm':>11s} {'train s':>8s}"
     print(head)
     print("-" * len(head))
     with tempfile.TemporaryDirectory() as tmp:
-        real_paths = {k: os.path.join(tmp, f"real_{k}.pt") for k in "AB"}
-        if real:  # minutes per run: back end B trains beside the rest; A is the cached network
-            other = _start_child(OTHER_BACK_END, ("real", True, real_paths["B"]))
+        real_paths = {k: os.path.join(tmp, f"real_{k}.pt") for k in "ABP"}
+        if real:  # minutes per run: back ends B and P train beside the rest; A is the cached network
+            others = {k: _start_child(REAL_BACK_ENDS[k], ("real", True, real_paths[k])) for k in real_back_ends}
         for grid in (True, False) if small else ():
             paths = {k: os.path.join(tmp, f"small_{grid}_{k}.pt") for k in "ABC"}
             for k, env in {"A": {}, "B": OTHER_BACK_END, "C": NO_SIMD}.items():
                 _row("small", grid, k, _child(env, False, ("small", grid, paths[k])), paths)
         if real:
             _row("real", True, "A", _real_cached(real_paths["A"]), real_paths)
-            _row("real", True, "B", _finish_child(other), real_paths)
+            for k, child in others.items():
+                _row("real", True, k, _finish_child(child), real_paths)
 
 
 def _real_cached(path: str) -> dict:
@@ -237,9 +242,12 @@ def main(argv=None) -> int:
     parser.add_argument("--training", action="store_true", help="compare trained weights instead of iterations")
     parser.add_argument("--real", action="store_true", help="with --training: also the real network (minutes)")
     parser.add_argument("--no-small", action="store_true", help="with --training --real: the real network only")
+    parser.add_argument(
+        "--real-back-ends", default="BP", choices=["BP", "B", "P"], help="with --real: train under these"
+    )
     args = parser.parse_args(argv)
     if args.training:
-        training(args.real, small=not args.no_small)
+        training(args.real, small=not args.no_small, real_back_ends=args.real_back_ends)
         return 0
     print("back end A: this machine's; back end B:", ", ".join(f"{k}={v}" for k, v in OTHER_BACK_END.items()))
     print("* held out: run only after the grids were chosen")
