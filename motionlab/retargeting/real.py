@@ -85,11 +85,9 @@ PINNED_BACK_END = {
     "NPY_DISABLE_CPU_FEATURES": "X86_V4 AVX512_ICL AVX512_SPR",
 }
 """The numeric back end the cached network is trained under (a child process): torch's AVX2
-kernels, MKL's AVX2 branch, OpenBLAS's Haswell kernels, numpy without AVX-512, one thread — CI's
-pinned test pass but for MKL's branch (that pass takes MKL's compatible path, which runs
-matrix products several times slower). The grid of ``TrainConfig.grid`` rounds away what differs
-between MKL's code paths, not what differs between torch's SIMD and scalar kernels
-(``docs/reproducibility.md``)."""
+kernels, MKL's AVX2 branch, OpenBLAS's Haswell kernels, numpy without AVX-512, one thread. It
+differs from CI's pinned test pass only in MKL's branch (that pass takes the compatible path);
+``docs/reproducibility.md`` compares the weights each gives."""
 NETWORKS = ("auto", "real", "synthetic")
 """The choices of :func:`choose` (and the CLI's ``--network``)."""
 TRAINING_CODE = (
