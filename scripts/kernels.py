@@ -23,8 +23,8 @@ MKL_BRANCHES = {
     12: "AVX512",
     14: "AVX512_E1",
 }
-"""MKL's code-path codes (``mkl_cbwr.h``). MKL_CBWR asks for one, and MKL may take another: on the
-2-core AMD machine, MKL_CBWR=AVX2 gives AUTO (``docs/reproducibility.md``)."""
+"""MKL's code-path codes (``mkl_cbwr.h``). MKL_CBWR asks for one, and MKL may take another
+(``docs/reproducibility.md``)."""
 
 
 def mkl_branch() -> str:

@@ -7,6 +7,10 @@
 # network needs (with PYTHONPATH at the clone; .ci/run starts the training there, then runs this
 # script again for the rest).
 set -euo pipefail
+case "${1:-}" in
+  "" | --core) ;;
+  *) echo "setup.sh: unknown option '$1' (expected none, or --core)" >&2; exit 2 ;;
+esac
 cd "$(dirname "$0")/.."
 VENV=${MOTIONLAB_VENV:-.venv}
 [ -x "$VENV/bin/python" ] || python3 -m venv "$VENV"

@@ -3,7 +3,7 @@
 The latent iteration (paper A, eqs. 9–17) runs on several (clip, character) pairs twice, in two
 subprocesses: once with this machine's kernels, once with another numeric back end (torch's AVX2
 kernels, MKL's compatible path, numpy without AVX-512, one thread: the settings of `.ci/run`'s
-second test pass). For each pair it prints the Adam steps and stop of both runs and the largest
+pinned test pass). For each pair it prints the Adam steps and stop of both runs and the largest
 relative difference of their loss histories, with the step grid of ``solver.step_grid`` and
 without it (spacing 2⁻⁶⁰ of a step: no rounding in practice).
 
