@@ -24,6 +24,7 @@ import contextlib
 import inspect
 import math
 import os
+import re
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -368,8 +369,10 @@ def renamed(parser, old: str, new: argparse.Action) -> argparse.Action:
 
 def _help_texts(run) -> tuple[str, str]:
     """``(summary, description)`` of a command from ``run``'s docstring: its first paragraph, then the
-    others (each paragraph's lines joined by spaces, paragraphs by a blank line)."""
-    paragraphs = [" ".join(p.split("\n")) for p in (inspect.getdoc(run) or "").split("\n\n")]
+    others up to the first numpydoc section (``Raises`` over a line of dashes), each paragraph's lines
+    joined by spaces, paragraphs by a blank line."""
+    text = re.split(r"\n\S[^\n]*\n-{3,}\n", inspect.getdoc(run) or "")[0].strip()
+    paragraphs = [" ".join(p.split("\n")) for p in text.split("\n\n")]
     return paragraphs[0], "\n\n".join(paragraphs[1:])
 
 

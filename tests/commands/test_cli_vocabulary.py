@@ -122,6 +122,13 @@ def test_every_command_has_a_description_and_every_option_help_with_its_default(
     assert not missing, "\n".join(missing)
 
 
+def test_no_description_shows_a_docstring_section():
+    """``run``'s docstring is the help text; its numpydoc sections (Raises, Returns) are the
+    developers' and stay out of ``--help``."""
+    leaked = [n for n, p in COMMANDS.items() if "---" in (p.description or "") or "Raises" in (p.description or "")]
+    assert not leaked, leaked
+
+
 def test_every_command_has_quiet():
     for name in COMMANDS:
         strings = {s for a in _options(name) for s in a.option_strings}
