@@ -11,7 +11,7 @@ import argparse
 import importlib
 import sys
 
-from motionlab.cli_args import CLIError, HelpFormatter, RawDescriptionHelpFormatter, rig_error
+from motionlab.cli_args import CLIError, HelpFormatter, rig_error
 
 __all__ = ["main", "build_parser", "CLIError", "rig_error"]
 
@@ -52,8 +52,7 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     if command is not None and command not in sub.choices:
         return build_parser()  # an unknown command: the full parser, in its order, says which exist
     for each in sub.choices.values():  # every option's default in its --help
-        raw = issubclass(each.formatter_class, argparse.RawDescriptionHelpFormatter)
-        each.formatter_class = RawDescriptionHelpFormatter if raw else HelpFormatter
+        each.formatter_class = HelpFormatter
     return parser
 
 

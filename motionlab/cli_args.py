@@ -48,7 +48,6 @@ __all__ = [
     "check_outputs",
     "check_output_folder",
     "HelpFormatter",
-    "RawDescriptionHelpFormatter",
     "DeprecatedAlias",
     "command",
     "add_output",
@@ -331,10 +330,6 @@ class HelpFormatter(argparse.HelpFormatter):
         if action.option_strings and "default" not in text and _shown(action.default):
             text += " (default: %(default)s)"
         return text
-
-
-class RawDescriptionHelpFormatter(argparse.RawDescriptionHelpFormatter, HelpFormatter):
-    """:class:`HelpFormatter` for a command whose description is laid out by hand."""
 
 
 class DeprecatedAlias(argparse.Action):

@@ -9,7 +9,6 @@ Examples::
 
 from __future__ import annotations
 
-import argparse
 import sys
 
 from motionlab import cli_args
@@ -99,7 +98,6 @@ def register(subparsers) -> None:
         subparsers,
         "expand",
         _cmd_expand,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
         epilog="presets: long_legs, short_legs, long_arms, stocky, tall, child, or NAME:legs=1.2,arms=0.9,...",
         quiet=False,
     ) as p:

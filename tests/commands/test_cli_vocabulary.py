@@ -129,6 +129,15 @@ def test_no_description_shows_a_docstring_section():
     assert not leaked, leaked
 
 
+def test_every_help_fits_the_terminal(monkeypatch):
+    """``--help`` wraps every line, the description and epilog included, to the terminal's width."""
+    monkeypatch.setenv("COLUMNS", "80")
+    wide = [
+        f"{n}: {line[:60]}..." for n, p in COMMANDS.items() for line in p.format_help().splitlines() if len(line) > 80
+    ]
+    assert not wide, wide
+
+
 def test_every_command_has_quiet():
     for name in COMMANDS:
         strings = {s for a in _options(name) for s in a.option_strings}
