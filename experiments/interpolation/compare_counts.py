@@ -18,6 +18,11 @@ count and the local count (the stride count where it has none) are exact, and ho
 that ``fill-gaps`` states without ``--times`` (:func:`motionlab.interpolation.detect.estimate_counts`,
 for one gap without ``--takes`` that of ``count_choice``) holds the true count, and how wide it is; *wrong and unflagged* is a count that is not exact and
 whose range does not hold the truth either.
+
+``--in-place N``: the same for actions done in place (``IN_PLACE``: raising and waving hands,
+bowing, kicking, punching, idles), with the share of the gaps where the body does not travel, and
+there how often the in-place count (``CountChoice.stride``) and the step ratio it replaced
+(``CountChoice.ratio``) are within 10% or one frame.
 """
 
 from __future__ import annotations
@@ -87,6 +92,33 @@ FAMILIES = {
 """Rig family -> held-out takes (globs under the data folder) for ``--families``."""
 
 
+IN_PLACE = {
+    "Bandai Namco dataset-2 in place (raise-up-both-hands, wave-both-hands; 30 fps)": [
+        "bandai_namco/sessions/raise-up-both-hands/*.bvh",
+        "bandai_namco/sessions/wave-both-hands/*.bvh",
+    ],
+    "Bandai Namco dataset-1 in place (bow, kick, punch; 30 fps)": [
+        "bandai_namco/dataset-1/bow/*.bvh",
+        "bandai_namco/dataset-1/kick/*.bvh",
+        "bandai_namco/dataset-1/punch/*.bvh",
+    ],
+    "Xia in place (punch, jump; 120 fps)": ["xia/punch/*.bvh", "xia/jump/*.bvh"],
+    "Mixamo Aj in place (idles, standing actions; 60 fps)": [
+        "mixamo/Aj/*Idle*.bvh",
+        "mixamo/Aj/*Standing*.bvh",
+        "mixamo/Aj/Fist_Pump.bvh",
+        "mixamo/Aj/Sitting*.bvh",
+    ],
+    "Mixamo other characters in place (punches, dances, standing; 60 fps)": [
+        "mixamo/[!A]*/Body_Jab_Cross.bvh",
+        "mixamo/[!A]*/Jazz_Dancing.bvh",
+        "mixamo/[!A]*/Standing_*.bvh",
+        "mixamo_ganimator/*/Gangnam-Style.bvh",
+    ],
+}
+"""Actions done in place -> takes (globs under the data folder) for ``--in-place``."""
+
+
 def family_cuts(root, patterns: list[str], cuts: int, rng):
     """``cuts`` seeded ``(motion, first removed frame, frames removed)``: 1 to 30 frames at a
     random place (20 frames kept on each side) of a random take matching ``patterns``."""
@@ -124,11 +156,26 @@ def _family_line(cuts) -> str:
     )
 
 
-def families(root, cuts: int) -> None:
-    """``--families``: one line per rig family of ``FAMILIES`` (seed 39, one generator)."""
-    rng = np.random.default_rng(39)
-    for label, patterns in FAMILIES.items():
-        print(f"{label}: {_family_line(family_cuts(root, patterns, cuts, rng))}", flush=True)
+def _in_place_line(cuts) -> str:
+    """Of ``cuts``' gaps found where the body does not travel: the in-place count against the step ratio."""
+    rows = []
+    for m, s, n in cuts:
+        g = gap_eval.cut(m, s, n)
+        if s - 1 in detect.consecutive_gaps(g) and (c := detect.count_choice(g, s - 1)).ratio is not None:
+            rows.append((n, max(1, round(c.stride)), max(1, round(c.ratio))))
+    n, fitted, ratio = np.array(rows, dtype=np.float64).reshape(-1, 3).T
+    near = lambda a: f"{np.mean(np.abs(a - n) <= np.maximum(1, 0.1 * n)):.1%}" if len(a) else "-"  # noqa: E731
+    return f"{len(n)} in place; within 10% or 1 frame: in-place count {near(fitted)}, step ratio {near(ratio)}"
+
+
+def families(root, cuts: int, table: dict | None = None, seed: int = 39) -> None:
+    """``--families``: one line per rig family of ``table`` (default ``FAMILIES``; one generator)."""
+    rng = np.random.default_rng(seed)
+    for label, patterns in (table or FAMILIES).items():
+        chosen = family_cuts(root, patterns, cuts, rng)
+        print(f"{label}: {_family_line(chosen)}", flush=True)
+        if table is IN_PLACE:
+            print(f"    {_in_place_line(chosen)}", flush=True)
 
 
 def main(argv=None) -> int:
@@ -138,12 +185,17 @@ def main(argv=None) -> int:
     ap.add_argument("--parts", default="2,5,6,7", help="which parts, comma-separated (default: all four)")
     ap.add_argument("--families", type=int, default=0, metavar="N",
                     help="instead: N cuts of 1-30 frames per rig family, counts and their ranges")  # fmt: skip
+    ap.add_argument("--in-place", type=int, default=0, metavar="N",
+                    help="instead: N cuts of 1-30 frames per action done in place (IN_PLACE)")  # fmt: skip
     args = ap.parse_args(argv)
     wanted = set(args.parts.split(","))
     root = check_gaps.data_root()
     t0 = time.perf_counter()
-    if args.families:
-        families(root, args.families)
+    if args.families or args.in_place:
+        if args.families:
+            families(root, args.families)
+        if args.in_place:
+            families(root, args.in_place, IN_PLACE, seed=41)
         wanted = set()
     for name, cuts in part2(root, args.quick).items() if "2" in wanted else ():
         print(f"part 2 {name}: {_score(cuts)}", flush=True)

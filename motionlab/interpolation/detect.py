@@ -689,8 +689,10 @@ def estimate_missing(motion: Motion, steps_at, seconds: float = 1.0, takes=None)
       the stride count only where, on gaps of the same length cut out of the known frames beside
       the real one (up to :data:`REHEARSAL_SECONDS`), it gets significantly more of them within
       10% (or one frame): a one-sided sign test at :data:`SIGNIFICANCE` (:func:`count_choice`);
-    * a body that does not travel (speed below :data:`STEP_FLOOR`): ``n + 1`` is the joint step
-      across the gap over the median joint step around it;
+    * a body that does not travel (speed below :data:`STEP_FLOOR`): the ``n`` for which one cubic
+      in time fits every joint's positions over the nearest :data:`LOCAL_SECONDS` on both sides
+      best (:func:`_in_place_count`), or where it has no answer, ``n + 1`` is the joint step across
+      the gap over the median joint step around it (the step ratio, which also widens the range);
     * with ``takes`` (other recordings of the action, never this one): the mean of the count above
       and how long the recordings need from the pose before the gap to the pose after it,
       time-scaled to the stream (:func:`~.recorded.recorded_missing`).
@@ -735,9 +737,11 @@ def estimate_counts(motion: Motion, steps_at, seconds: float = 1.0, takes=None) 
     """:func:`estimate_missing`'s count at each step ``t → t+1`` in ``steps_at``, with its range.
 
     The range holds every count within :data:`COUNT_TOLERANCE` of the estimate (or one frame), both
-    the stride and the local count (where they disagree, neither can be trusted alone), and where
+    the stride and the local count (where they disagree, neither can be trusted alone; where the
+    body does not travel, the in-place count and the step ratio), and where
     the count was rehearsed on cuts of the same length beside the gap (:func:`count_choice`), every
-    count its errors there point to (the gap's count less each error). With ``takes`` it is
+    count its errors there point to (the gap's count less each error; on cuts where the body does
+    not travel, the step ratio's errors too). With ``takes`` it is
     that of the stream's own count widened to the tolerance about the mean with the recordings.
     Parameters and raises: those of :func:`estimate_missing`.
 
@@ -781,7 +785,8 @@ class CountChoice:
     (:func:`count_choice`; counts in frames missing, ``n``, not rounded)."""
 
     stride: float
-    """The stride count: ground distance over the step cycle, mean speed or step phase."""
+    """The stride count: ground distance over the step cycle, mean speed or step phase; where the body
+    does not travel, the in-place count (:func:`_in_place_count`, else the step ratio)."""
     local: float | None
     """The local count (a quadratic through the edge speeds); ``None`` where it has no answer or
     the body does not travel."""
@@ -795,11 +800,15 @@ class CountChoice:
     """The count used: the local one where ``p < SIGNIFICANCE`` and it has an answer, else the stride one."""
     low: int = 1
     """The fewest frames likely missing, at least 1: the least of ``count`` less its tolerance
-    (:data:`COUNT_TOLERANCE`), the stride and local counts (rounded) and ``count`` less its
-    largest error on the rehearsal cuts (rounded)."""
+    (:data:`COUNT_TOLERANCE`), the stride and local counts (the step ratio in place of the local
+    count where the body does not travel; rounded) and ``count`` less its largest error on the
+    rehearsal cuts (rounded)."""
     high: int = 1
-    """The most frames likely missing: the most of ``count`` plus its tolerance, the two counts
-    and ``count`` less its smallest error on the rehearsal cuts."""
+    """The most frames likely missing: the most of ``count`` plus its tolerance, the counts ``low``
+    takes and ``count`` less its smallest error on the rehearsal cuts."""
+    ratio: float | None = None
+    """Where the body does not travel, the step ratio (the joint step across the gap over the
+    median joint step around it, less one; :func:`_step_ratio`); ``None`` otherwise."""
 
 
 def count_choice(motion: Motion, t: int, start: int = 0, stop: int | None = None, seconds: float = 1.0) -> CountChoice:
@@ -826,7 +835,7 @@ def _choose(a: _Arrays, t: int, start: int, stop: int, seconds: float) -> CountC
     n, arc = _stride_count(a, t, start, stop, seconds)
     local = None if arc is None else _local_count(a.gstep, t, start, stop, arc, n, a.fps)
     m = max(1, int(round(n)))
-    stride, local_at, travels = _rehearse(a, t, start, stop, m, seconds)
+    stride, local_at, travels, ratio_at = _rehearse(a, t, start, stop, m, seconds)
     stride_only, local_only, p = 0, 0, 1.0
     if local is not None:  # the rehearsal chooses between the two counts
         tol = max(1.0, COUNT_TOLERANCE * m)
@@ -837,13 +846,15 @@ def _choose(a: _Arrays, t: int, start: int, stop: int, seconds: float) -> CountC
     use_local = local is not None and p < SIGNIFICANCE
     count = local if use_local else n
     low, high = _tolerance(max(1, int(round(count))))
-    for other in (n, local) if local is not None else (n,):  # where the two counts disagree, both
+    ratio = _in_place_ratio(a, t, start, stop, seconds) if arc is None else None
+    for other in (x for x in (n, local, ratio) if x is not None):  # where the counts disagree, all
         low, high = min(low, max(1, int(round(other)))), max(high, int(round(other)))
     if stride.size:  # the count's errors on the rehearsal cuts widen its range
         errors = (np.where(np.isfinite(local_at), local_at, stride) if use_local else stride) - m
+        errors = np.concatenate([errors, ratio_at[np.isfinite(ratio_at)] - m])  # in place: both counts' errors
         low = min(low, max(1, int(math.floor(count - errors.max() + 0.5))))
         high = max(high, int(math.floor(count - errors.min() + 0.5)))
-    return CountChoice(n, local, stride_only, local_only, p, count, low, high)
+    return CountChoice(n, local, stride_only, local_only, p, count, low, high, ratio)
 
 
 def _moving_bounds(a: _Arrays, t: int, start: int, stop: int) -> tuple[int, int]:
@@ -899,15 +910,15 @@ def _stride_count(a: _Arrays, t: int, start: int, stop: int, seconds: float) -> 
     gstep, fps = a.gstep, a.fps
     half = max(3, int(round(seconds * fps)))
     far = max(half, int(round(2.0 * fps)))
-    before = np.arange(max(start, t - half), t)
-    after = np.arange(t + 1, min(stop, t + 1 + half))
+    before, after = _sides(t, start, stop, half)
     if before.size + after.size == 0:
         return 0.0, None
     speeds = [float(np.mean(gstep[w])) for w in (before, after) if w.size]
     v = float(np.mean(speeds))
     if v <= a.floor:
-        win = np.concatenate([before, after])
-        return a.jsteps[t] / max(float(np.median(a.jsteps[win])), 1e-9) - 1.0, None
+        ratio = _step_ratio(a, t, before, after)
+        fitted = _in_place_count(a, t, start, stop, max(ratio, 1.0))
+        return (ratio if fitted is None else fitted), None
     psi = min(_turn(a.ground, before, after), 0.9 * np.pi)
     arc = gstep[t] * ((0.5 * psi) / np.sin(0.5 * psi) if psi > 1e-6 else 1.0)
     long_before = np.arange(max(start, t - far), t)
@@ -923,6 +934,48 @@ def _stride_count(a: _Arrays, t: int, start: int, stop: int, seconds: float) -> 
         else:
             n = phased
     return n, float(arc)
+
+
+def _in_place_ratio(a: _Arrays, t: int, start: int, stop: int, seconds: float) -> float:
+    """The step ratio (:func:`_step_ratio`) of an in-place gap, over ``seconds`` on each side."""
+    before, after = _sides(t, start, stop, max(3, int(round(seconds * a.fps))))
+    return _step_ratio(a, t, before, after) if before.size + after.size else 0.0
+
+
+def _sides(t: int, start: int, stop: int, half: int) -> tuple[np.ndarray, np.ndarray]:
+    """The known steps up to ``half`` before step ``t`` and after it (within ``start … stop``)."""
+    return np.arange(max(start, t - half), t), np.arange(t + 1, min(stop, t + 1 + half))
+
+
+def _step_ratio(a: _Arrays, t: int, before: np.ndarray, after: np.ndarray) -> float:
+    """``n`` from the joint step across the gap at step ``t → t+1`` over the median joint step of
+    the steps ``before`` and ``after`` it (the step ratio; both index arrays, not both empty)."""
+    win = np.concatenate([before, after])
+    return float(a.jsteps[t] / max(float(np.median(a.jsteps[win])), 1e-9) - 1.0)
+
+
+def _in_place_count(a: _Arrays, t: int, start: int, stop: int, guess: float) -> float | None:
+    """The in-place count at step ``t → t+1`` (known steps ``start … stop``): the ``n`` for which one
+    cubic in time fits every joint coordinate of the nearest :data:`LOCAL_SECONDS` of frames on
+    both sides (at least three frames each) best, by least squares, over ``n = 0, 1, …`` up to
+    3 × ``guess`` or two seconds of frames, whichever is more. Frame ``t`` is at time 0, frame
+    ``t+1`` at ``n + 1``. ``None`` where a side has too few frames for the cubic, or the best ``n``
+    is the last one tried (the fit has no minimum: it only improves as the gap grows).
+    """
+    w = max(3, int(round(LOCAL_SECONDS * a.fps)))
+    kb = np.arange(max(start, t - w + 1), t + 1)  # frames before the gap, its first frame t
+    ka = np.arange(t + 1, min(stop, t + w) + 1)
+    if kb.size < 2 or ka.size < 2 or kb.size + ka.size < 5:
+        return None
+    y = a.positions[np.concatenate([kb, ka])].reshape(kb.size + ka.size, -1)
+    y = y - y.mean(0)
+    grid = np.arange(int(max(3.0 * guess, 2.0 * a.fps)) + 1, dtype=np.float64)  # n
+    x = np.concatenate([np.broadcast_to(kb - t, (len(grid), kb.size)), (ka - t - 1)[None, :] + grid[:, None] + 1.0], 1)
+    x = (x - x.mean(1, keepdims=True)) / (x[:, -1:] - x[:, :1])  # well-conditioned times, one span
+    q, _ = np.linalg.qr(np.stack([x**d for d in range(4)], axis=-1))  # (G, W, 4): each n's cubic
+    residual = np.square(y[None] - q @ (q.transpose(0, 2, 1) @ y[None])).sum((1, 2))
+    best = int(np.argmin(residual))
+    return None if best == len(grid) - 1 else float(grid[best])
 
 
 def _local_count(gstep: np.ndarray, t: int, start: int, stop: int, arc: float, guess: float, fps: float):
@@ -971,10 +1024,11 @@ def _rehearse(a: _Arrays, t: int, start: int, stop: int, m: int, seconds: float 
 
     Returns
     -------
-    stride : ndarray (C,), the stride count of each cut (the joint-step ratio where the body does
+    stride : ndarray (C,), the stride count of each cut (the in-place count where the body does
         not travel)
     local : ndarray (C,), the local count of each cut, NaN where it has none
     travels : ndarray (C,) bool, whether the body travels at the cut
+    ratio : ndarray (C,), the step ratio of each cut where the body does not travel, NaN elsewhere
     """
     far = int(round(REHEARSAL_SECONDS * a.fps))
     edge = max(3, int(round(LOCAL_SECONDS * a.fps)))  # what the local count fits on
@@ -986,9 +1040,10 @@ def _rehearse(a: _Arrays, t: int, start: int, stop: int, m: int, seconds: float 
             tp = p - lo
             n, arc = _stride_count(sub, tp, 0, len(sub.gstep), seconds)
             local = None if arc is None else _local_count(sub.gstep, tp, 0, len(sub.gstep), arc, n, a.fps)
-            counts.append((n, np.nan if local is None else local, arc is not None))
-    x = np.asarray(counts, dtype=np.float64).reshape(-1, 3)
-    return x[:, 0], x[:, 1], x[:, 2] > 0
+            ratio = _in_place_ratio(sub, tp, 0, len(sub.gstep), seconds) if arc is None else np.nan
+            counts.append((n, np.nan if local is None else local, arc is not None, ratio))
+    x = np.asarray(counts, dtype=np.float64).reshape(-1, 4)
+    return x[:, 0], x[:, 1], x[:, 2] > 0, x[:, 3]
 
 
 def _sign_test(wins: int, losses: int) -> float:

@@ -379,3 +379,32 @@ def test_a_count_comes_with_the_range_it_is_likely_in():
 def test_the_least_range_of_a_count_is_its_tolerance(count, low, high):
     """Known answers: within 10% of the count or one frame, whichever is more, never below 1."""
     assert detect._tolerance(count) == (low, high)
+
+
+def test_in_place_count_of_joints_moving_as_a_cubic_is_exact():
+    """Joints that move as one cubic in time (a body in place raising its arms faster and faster):
+    the in-place count recovers the cut exactly, where the joint step over the median step (the
+    step ratio) reads the gap's speed from slower frames and undercounts."""
+    fps, n, s = 30.0, 9, 12
+    k = np.arange(80.0)[:, None, None] / fps
+    positions = np.random.default_rng(0).normal(scale=0.3, size=(6, 3)) * k**3  # metres: from rest at frame 0
+    keep = np.r_[0:s, s + n : 80]  # frames s … s+n-1 dropped: the gap is step s-1 → s
+    pose = positions.reshape(80, -1)
+    a = detect._Arrays._from(positions[:, 0] * [1.0, 0.0, 1.0], positions, pose, fps, 0.0, 0.0).without(keep)
+    assert detect._in_place_count(a, s - 1, 0, len(a.gstep), guess=3.0) == n
+    before, after = detect._sides(s - 1, 0, len(a.gstep), 30)
+    assert detect._step_ratio(a, s - 1, before, after) < n - 2
+
+
+@pytest.mark.realdata
+def test_real_in_place_gap_is_counted_from_the_joints_around_it():
+    """A held-out take raising both hands (not among those the in-place rule was compared on): 7
+    frames dropped where the arms start to rise. The step ratio read 76 there; the in-place count
+    is within a frame, and the range holds the truth."""
+    root = require_data("bandai_namco", "sessions", "raise-up-both-hands")
+    m = bvh.load(root / "dataset-2_raise-up-both-hands_feminine_038.bvh")
+    cut = m[np.r_[0:15, 22 : m.num_frames]]
+    assert detect.consecutive_gaps(cut) == [14]
+    c = detect.count_choice(cut, 14)
+    assert c.ratio is not None and abs(c.ratio - 7) > 20
+    assert abs(c.stride - 7) <= 1 and c.low <= 7 <= c.high
