@@ -20,10 +20,9 @@ for one gap without ``--takes`` that of ``count_choice``) holds the true count, 
 whose range does not hold the truth either.
 
 ``--in-place N``: the same for actions done in place (``IN_PLACE``: raising and waving hands,
-bowing, kicking, punching, idles), with the gaps where the body does not travel, and there how
-often the in-place count (``CountChoice.stride``) and the step ratio it replaced
-(``CountChoice.ratio``) are within 10% or one frame, and the gaps where the body travels, and on
-how many of them the rehearsal chose the in-place count (``CountChoice.posed``).
+bowing, kicking, punching, idles), with the share of the gaps where the body does not travel, and
+there how often the in-place count (``CountChoice.stride``) and the step ratio it replaced
+(``CountChoice.ratio``) are within 10% or one frame.
 """
 
 from __future__ import annotations
@@ -159,22 +158,14 @@ def _family_line(cuts) -> str:
 
 def _in_place_line(cuts) -> str:
     """Of ``cuts``' gaps found where the body does not travel: the in-place count against the step ratio."""
-    rows, chosen, travelling = [], 0, 0
+    rows = []
     for m, s, n in cuts:
         g = gap_eval.cut(m, s, n)
-        if s - 1 not in detect.consecutive_gaps(g):
-            continue
-        if (c := detect.count_choice(g, s - 1)).ratio is not None:
+        if s - 1 in detect.consecutive_gaps(g) and (c := detect.count_choice(g, s - 1)).ratio is not None:
             rows.append((n, max(1, round(c.stride)), max(1, round(c.ratio))))
-        else:
-            travelling += 1
-            chosen += c.posed is not None and c.count == c.posed
     n, fitted, ratio = np.array(rows, dtype=np.float64).reshape(-1, 3).T
     near = lambda a: f"{np.mean(np.abs(a - n) <= np.maximum(1, 0.1 * n)):.1%}" if len(a) else "-"  # noqa: E731
-    return (
-        f"{len(n)} in place; within 10% or 1 frame: in-place count {near(fitted)}, step ratio {near(ratio)}; "
-        f"{travelling} travelling, the in-place count chosen on {chosen}"
-    )
+    return f"{len(n)} in place; within 10% or 1 frame: in-place count {near(fitted)}, step ratio {near(ratio)}"
 
 
 def families(root, cuts: int, table: dict | None = None, seed: int = 39) -> None:

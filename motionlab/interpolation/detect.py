@@ -689,13 +689,10 @@ def estimate_missing(motion: Motion, steps_at, seconds: float = 1.0, takes=None)
       the stride count only where, on gaps of the same length cut out of the known frames beside
       the real one (up to :data:`REHEARSAL_SECONDS`), it gets significantly more of them within
       10% (or one frame): a one-sided sign test at :data:`SIGNIFICANCE` (:func:`count_choice`);
-    * **in-place count** (:func:`_in_place_count`): the ``n`` for which one cubic in time fits
-      every joint's positions over the nearest :data:`LOCAL_SECONDS` on both sides best. Where the
-      body travels it replaces the count chosen above only where it beats that count in turn, by
-      the same rehearsal and test (a punch or a dance whose hips drift: the ground says little of
-      its timing); where the body does not travel (speed below :data:`STEP_FLOOR`) it is the
-      count, or where it has no answer, ``n + 1`` is the joint step across the gap over the median
-      joint step around it (the step ratio, which also widens the range);
+    * a body that does not travel (speed below :data:`STEP_FLOOR`): the ``n`` for which one cubic
+      in time fits every joint's positions over the nearest :data:`LOCAL_SECONDS` on both sides
+      best (:func:`_in_place_count`), or where it has no answer, ``n + 1`` is the joint step across
+      the gap over the median joint step around it (the step ratio, which also widens the range);
     * with ``takes`` (other recordings of the action, never this one): the mean of the count above
       and how long the recordings need from the pose before the gap to the pose after it,
       time-scaled to the stream (:func:`~.recorded.recorded_missing`).
@@ -784,7 +781,7 @@ def _tolerance(count: int) -> tuple[int, int]:
 
 @dataclass
 class CountChoice:
-    """The stream's counts for one gap and the rehearsal that chose among them
+    """The stream's two counts for one gap and the rehearsal that chose between them
     (:func:`count_choice`; counts in frames missing, ``n``, not rounded)."""
 
     stride: float
@@ -800,34 +797,23 @@ class CountChoice:
     p: float
     """One-sided sign test of ``local_only`` against ``stride_only``."""
     count: float
-    """The count used: the local one where ``p < SIGNIFICANCE`` and it has an answer, else the stride
-    one; then the in-place one instead where ``posed_p < SIGNIFICANCE`` (it beats that count)."""
+    """The count used: the local one where ``p < SIGNIFICANCE`` and it has an answer, else the stride one."""
     low: int = 1
     """The fewest frames likely missing, at least 1: the least of ``count`` less its tolerance
     (:data:`COUNT_TOLERANCE`), the stride and local counts (the step ratio in place of the local
-    count where the body does not travel), the in-place count where it is ``count`` (all rounded)
-    and ``count`` less its largest error on the rehearsal cuts (also the step ratio's, on cuts
-    where the body does not travel; rounded)."""
+    count where the body does not travel; rounded) and ``count`` less its largest error on the
+    rehearsal cuts (rounded)."""
     high: int = 1
     """The most frames likely missing: the most of ``count`` plus its tolerance, the counts ``low``
     takes and ``count`` less its smallest error on the rehearsal cuts."""
     ratio: float | None = None
     """Where the body does not travel, the step ratio (the joint step across the gap over the
     median joint step around it, less one; :func:`_step_ratio`); ``None`` otherwise."""
-    posed: float | None = None
-    """Where the body travels, the in-place count (:func:`_in_place_count`): one cubic in time through
-    the joints' positions on both sides, for actions done in place whose body still drifts; ``None``
-    where it has no answer or the body does not travel (then it is ``stride``)."""
-    posed_only: int = 0
-    """Rehearsal cuts that only the in-place count got within :data:`COUNT_TOLERANCE` (or one frame),
-    against the count the stride and local counts chose."""
-    posed_p: float = 1.0
-    """One-sided sign test of ``posed_only`` against the cuts only that chosen count got."""
 
 
 def count_choice(motion: Motion, t: int, start: int = 0, stop: int | None = None, seconds: float = 1.0) -> CountChoice:
-    """The stream's counts of the gap at step ``t → t+1`` of ``motion`` (known steps ``start …
-    stop``, default the whole stream) and the rehearsal among them (:func:`estimate_missing`).
+    """Both stream counts of the gap at step ``t → t+1`` of ``motion`` (known steps ``start …
+    stop``, default the whole stream) and the rehearsal between them (:func:`estimate_missing`).
 
     Raises
     ------
@@ -846,54 +832,29 @@ def count_choice(motion: Motion, t: int, start: int = 0, stop: int | None = None
 
 def _choose(a: _Arrays, t: int, start: int, stop: int, seconds: float) -> CountChoice:
     start, stop = _moving_bounds(a, t, start, stop)
-    n, _, local, posed, ratio = _counts(a, t, start, stop, seconds)
-    m = max(1, int(round(n)))
-    stride, travels, local_at, posed_at, ratio_at = _rehearse(a, t, start, stop, m, seconds)
-    local_only, stride_only, p = _duel(local_at, stride, travels, m) if local is not None else (0, 0, 1.0)
-    count, used = (local, np.where(np.isfinite(local_at), local_at, stride)) if p < SIGNIFICANCE else (n, stride)
-    # the in-place count replaces the count so chosen only where it beats that count in turn
-    posed_only, _, posed_p = _duel(posed_at, used, travels, m) if posed is not None else (0, 0, 1.0)
-    if posed_p < SIGNIFICANCE:
-        count, used = posed, np.where(np.isfinite(posed_at), posed_at, used)
-    others = (n, local, ratio, posed if posed_p < SIGNIFICANCE else None)  # where the counts disagree, all
-    errors = np.concatenate([used - m, ratio_at - m])  # in place: the step ratio's errors too
-    low, high = _count_range(count, others, errors)
-    return CountChoice(n, local, stride_only, local_only, p, count, low, high, ratio, posed, posed_only, posed_p)
-
-
-def _counts(a: _Arrays, t: int, start: int, stop: int, seconds: float):
-    """Every count of the gap at step ``t → t+1`` (known steps ``start … stop``): the stride count,
-    whether the body travels, the local and the in-place count (``None``: no answer, or the body
-    does not travel and the stride count is the in-place one), and the step ratio (``None`` where
-    the body travels)."""
     n, arc = _stride_count(a, t, start, stop, seconds)
-    if arc is None:
-        return n, False, None, None, _in_place_ratio(a, t, start, stop, seconds)
-    local = _local_count(a.gstep, t, start, stop, arc, n, a.fps)
-    return n, True, local, _in_place_count(a, t, start, stop, max(n, 1.0)), None
-
-
-def _duel(at: np.ndarray, other: np.ndarray, travels: np.ndarray, m: int) -> tuple[int, int, float]:
-    """Rehearsal cuts of ``m`` frames where the body travels that only the count ``at`` (C,) got
-    within :data:`COUNT_TOLERANCE` (or one frame; NaN: no hit), those that only the count ``other``
-    got, and the one-sided sign test of the first against the second."""
-    tol = max(1.0, COUNT_TOLERANCE * m)
-    hit, hit_other = (travels & (np.abs(np.round(x) - m) <= tol) for x in (at, other))
-    wins, losses = int(np.sum(hit & ~hit_other)), int(np.sum(hit_other & ~hit))
-    return wins, losses, _sign_test(wins, losses)
-
-
-def _count_range(count: float, others, errors: np.ndarray) -> tuple[int, int]:
-    """``(low, high)``: ``count``'s tolerance, every count of ``others`` that is not ``None``, and
-    ``count`` less each finite rehearsal error of ``errors``."""
+    local = None if arc is None else _local_count(a.gstep, t, start, stop, arc, n, a.fps)
+    m = max(1, int(round(n)))
+    stride, local_at, travels, ratio_at = _rehearse(a, t, start, stop, m, seconds)
+    stride_only, local_only, p = 0, 0, 1.0
+    if local is not None:  # the rehearsal chooses between the two counts
+        tol = max(1.0, COUNT_TOLERANCE * m)
+        hit_stride = travels & (np.abs(np.round(stride) - m) <= tol)
+        hit_local = travels & (np.abs(np.round(local_at) - m) <= tol)  # NaN: no hit
+        stride_only, local_only = int(np.sum(hit_stride & ~hit_local)), int(np.sum(hit_local & ~hit_stride))
+        p = _sign_test(local_only, stride_only)
+    use_local = local is not None and p < SIGNIFICANCE
+    count = local if use_local else n
     low, high = _tolerance(max(1, int(round(count))))
-    for other in (x for x in others if x is not None):
+    ratio = _in_place_ratio(a, t, start, stop, seconds) if arc is None else None
+    for other in (x for x in (n, local, ratio) if x is not None):  # where the counts disagree, all
         low, high = min(low, max(1, int(round(other)))), max(high, int(round(other)))
-    errors = errors[np.isfinite(errors)]
-    if errors.size:
+    if stride.size:  # the count's errors on the rehearsal cuts widen its range
+        errors = (np.where(np.isfinite(local_at), local_at, stride) if use_local else stride) - m
+        errors = np.concatenate([errors, ratio_at[np.isfinite(ratio_at)] - m])  # in place: both counts' errors
         low = min(low, max(1, int(math.floor(count - errors.max() + 0.5))))
         high = max(high, int(math.floor(count - errors.min() + 0.5)))
-    return low, high
+    return CountChoice(n, local, stride_only, local_only, p, count, low, high, ratio)
 
 
 def _moving_bounds(a: _Arrays, t: int, start: int, stop: int) -> tuple[int, int]:
@@ -1052,12 +1013,12 @@ def _local_count(gstep: np.ndarray, t: int, start: int, stop: int, arc: float, g
 
 
 def _rehearse(a: _Arrays, t: int, start: int, stop: int, m: int, seconds: float = 1.0):
-    """Every count of gaps of ``m`` frames rehearsed on the known frames beside the real gap at step
+    """Both counts of gaps of ``m`` frames rehearsed on the known frames beside the real gap at step
     ``t → t+1`` (known steps ``start … stop``).
 
     On each side (up to ``REHEARSAL_SECONDS``; never across the gap) ``m`` frames are cut out at
     every place that leaves ``LOCAL_SECONDS`` (at least three frames) of known frames on both sides
-    of the cut, and every count is made for each cut as for a real gap (a loop over cuts, each
+    of the cut, and both counts are made for each cut as for a real gap (a loop over cuts, each
     count vectorised over its frames). The cuts overlap, so they are not independent trials: the
     sign test of :func:`estimate_missing` on them overstates the evidence, and its 5% is nominal.
 
@@ -1065,10 +1026,8 @@ def _rehearse(a: _Arrays, t: int, start: int, stop: int, m: int, seconds: float 
     -------
     stride : ndarray (C,), the stride count of each cut (the in-place count where the body does
         not travel)
-    travels : ndarray (C,) bool, whether the body travels at the cut
     local : ndarray (C,), the local count of each cut, NaN where it has none
-    posed : ndarray (C,), the in-place count of each cut where the body travels, NaN elsewhere or
-        where it has none
+    travels : ndarray (C,) bool, whether the body travels at the cut
     ratio : ndarray (C,), the step ratio of each cut where the body does not travel, NaN elsewhere
     """
     far = int(round(REHEARSAL_SECONDS * a.fps))
@@ -1078,10 +1037,13 @@ def _rehearse(a: _Arrays, t: int, start: int, stop: int, m: int, seconds: float 
         for p in range(lo + edge - 1, hi - m - edge):  # frames p+1 … p+m cut out
             keep = np.r_[lo : p + 1, p + 1 + m : hi]
             sub = a.without(keep)
-            n, travels, *others = _counts(sub, p - lo, 0, len(sub.gstep), seconds)
-            counts.append((n, travels, *(np.nan if x is None else x for x in others)))
-    x = np.asarray(counts, dtype=np.float64).reshape(-1, 5)
-    return x[:, 0], x[:, 1] > 0, x[:, 2], x[:, 3], x[:, 4]
+            tp = p - lo
+            n, arc = _stride_count(sub, tp, 0, len(sub.gstep), seconds)
+            local = None if arc is None else _local_count(sub.gstep, tp, 0, len(sub.gstep), arc, n, a.fps)
+            ratio = _in_place_ratio(sub, tp, 0, len(sub.gstep), seconds) if arc is None else np.nan
+            counts.append((n, np.nan if local is None else local, arc is not None, ratio))
+    x = np.asarray(counts, dtype=np.float64).reshape(-1, 4)
+    return x[:, 0], x[:, 1], x[:, 2] > 0, x[:, 3]
 
 
 def _sign_test(wins: int, losses: int) -> float:

@@ -3,7 +3,6 @@
 import numpy as np
 import pytest
 
-from experiments.interpolation import gap_eval
 from motionlab.core import bvh
 from motionlab.core.motion import Motion
 from motionlab.interpolation import demo, detect, gaps
@@ -409,16 +408,3 @@ def test_real_in_place_gap_is_counted_from_the_joints_around_it():
     c = detect.count_choice(cut, 14)
     assert c.ratio is not None and abs(c.ratio - 7) > 20
     assert abs(c.stride - 7) <= 1 and c.low <= 7 <= c.high
-
-
-@pytest.mark.realdata
-def test_a_punch_whose_hips_drift_is_counted_from_its_joints():
-    """A Xia punch: the hips drift faster than the floor speed, so the body counts as travelling,
-    but the ground says little of the timing (the stride count reads 18.1 and the local count 17.6
-    for 12 frames cut). On the rehearsal cuts beside the gap the in-place count beats the count the
-    stride and local counts chose, so it is the count, within a frame."""
-    m = bvh.load(require_data("xia", "punch") / "depressed_18_000.bvh")
-    c = detect.count_choice(gap_eval.cut(m, 53, 12), 52)
-    assert c.ratio is None and c.posed is not None and c.posed_p < detect.SIGNIFICANCE
-    assert c.count == c.posed and abs(c.count - 12) <= 1 and c.low <= 12 <= c.high
-    assert abs(c.stride - 12) > 5 and abs(c.local - 12) > 5
