@@ -957,10 +957,11 @@ def _step_ratio(a: _Arrays, t: int, before: np.ndarray, after: np.ndarray) -> fl
 def _in_place_count(a: _Arrays, t: int, start: int, stop: int, guess: float) -> float | None:
     """The in-place count at step ``t → t+1`` (known steps ``start … stop``): the ``n`` for which one
     cubic in time fits every joint coordinate of the nearest :data:`LOCAL_SECONDS` of frames on
-    both sides (at least three frames each) best, by least squares, over ``n = 0, 1, …`` up to
-    3 × ``guess`` or two seconds of frames, whichever is more. Frame ``t`` is at time 0, frame
-    ``t+1`` at ``n + 1``. ``None`` where a side has too few frames for the cubic, or the best ``n``
-    is the last one tried (the fit has no minimum: it only improves as the gap grows).
+    both sides (at least three frames a side where the known steps allow) best, by least squares,
+    over ``n = 0, 1, …`` up to 3 × ``guess`` or two seconds of frames, whichever is more. Frame
+    ``t`` is at time 0, frame ``t+1`` at ``n + 1``. ``None`` where a side has fewer than two frames
+    or both fewer than five (a cubic and one more), or the best ``n`` is the last one tried (the fit
+    has no minimum: it only improves as the gap grows).
     """
     w = max(3, int(round(LOCAL_SECONDS * a.fps)))
     kb = np.arange(max(start, t - w + 1), t + 1)  # frames before the gap, its first frame t
