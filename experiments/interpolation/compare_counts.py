@@ -20,9 +20,9 @@ for one gap without ``--takes`` that of ``count_choice``) holds the true count, 
 whose range does not hold the truth either.
 
 ``--in-place N``: the same for actions done in place (``IN_PLACE``: raising and waving hands,
-bowing, kicking, punching, idles), with the share of the gaps where the body does not travel, and
-there how often the in-place count (``CountChoice.stride``) and the step ratio it replaced
-(``CountChoice.ratio``) are within 10% or one frame.
+bowing, kicking, punching, idles), and under each family's line how many of its gaps found are
+where the body does not travel, and how often there the in-place count (``CountChoice.stride``)
+and the step ratio it replaced (``CountChoice.ratio``) are within 10% or one frame.
 """
 
 from __future__ import annotations
