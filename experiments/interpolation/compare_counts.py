@@ -23,6 +23,9 @@ whose range does not hold the truth either.
 bowing, kicking, punching, idles), and under each family's line how many of its gaps found are
 where the body does not travel, and how often there the in-place count (``CountChoice.stride``)
 and the step ratio it replaced (``CountChoice.ratio``) are within 10% or one frame.
+
+``--held-out N``: the same for takes in neither of those sets (``HELD_OUT``: backward, sideways and
+normal walks, left turns, Mixamo actions, runs and jumps), on which no count rule was chosen.
 """
 
 from __future__ import annotations
@@ -119,6 +122,35 @@ IN_PLACE = {
 """Actions done in place -> takes (globs under the data folder) for ``--in-place``."""
 
 
+HELD_OUT = {
+    "Bandai Namco dataset-1 backward and sideways walks (30 fps)": [
+        "bandai_namco/dataset-1/walk-back/*.bvh",
+        "bandai_namco/dataset-1/walk-left/*.bvh",
+        "bandai_namco/dataset-1/walk-right/*.bvh",
+    ],
+    "Bandai Namco dataset-2 normal walks and left turns (30 fps)": [
+        "bandai_namco/sessions/walk/dataset-2_walk_normal_*.bvh",
+        "bandai_namco/dataset-2/walk-turn-left/*.bvh",
+    ],
+    "Mixamo Aj actions (pitching, hits, golf, punches, gestures; 60 fps)": [
+        "mixamo/Aj/Baseball_Pitching.bvh",
+        "mixamo/Aj/Hit_Reaction*.bvh",
+        "mixamo/Aj/Golf_*.bvh",
+        "mixamo/Aj/Combo_Punch.bvh",
+        "mixamo/Aj/Taunt_Gesture.bvh",
+        "mixamo/Aj/Pointing.bvh",
+        "mixamo/Aj/Military_Signaling.bvh",
+    ],
+    "Mixamo other characters (runs, jumps, a start; 60 fps)": [
+        "mixamo/[!A]*/Running.bvh",
+        "mixamo/[!A]*/Jumping.bvh",
+        "mixamo/[!A]*/Run_Arc_Left.bvh",
+        "mixamo/[!A]*/Catwalk_Idle_To_Walk_Forward.bvh",
+    ],
+}
+"""Takes in neither ``FAMILIES`` nor ``IN_PLACE`` -> globs for ``--held-out``: no rule was chosen on them."""
+
+
 def family_cuts(root, patterns: list[str], cuts: int, rng):
     """``cuts`` seeded ``(motion, first removed frame, frames removed)``: 1 to 30 frames at a
     random place (20 frames kept on each side) of a random take matching ``patterns``."""
@@ -187,15 +219,19 @@ def main(argv=None) -> int:
                     help="instead: N cuts of 1-30 frames per rig family, counts and their ranges")  # fmt: skip
     ap.add_argument("--in-place", type=int, default=0, metavar="N",
                     help="instead: N cuts of 1-30 frames per action done in place (IN_PLACE)")  # fmt: skip
+    ap.add_argument("--held-out", type=int, default=0, metavar="N",
+                    help="instead: N cuts of 1-30 frames per set of takes no rule was chosen on (HELD_OUT)")  # fmt: skip
     args = ap.parse_args(argv)
     wanted = set(args.parts.split(","))
     root = check_gaps.data_root()
     t0 = time.perf_counter()
-    if args.families or args.in_place:
+    if args.families or args.in_place or args.held_out:
         if args.families:
             families(root, args.families)
         if args.in_place:
             families(root, args.in_place, IN_PLACE, seed=41)
+        if args.held_out:
+            families(root, args.held_out, HELD_OUT, seed=43)
         wanted = set()
     for name, cuts in part2(root, args.quick).items() if "2" in wanted else ():
         print(f"part 2 {name}: {_score(cuts)}", flush=True)

@@ -73,6 +73,9 @@ __all__ = [
     "REHEARSAL_SECONDS",
     "SIGNIFICANCE",
     "COUNT_TOLERANCE",
+    "SIZES_SECONDS",
+    "SIZES",
+    "SIZE_PLACES",
     "CountChoice",
     "count_choice",
     "MissingCount",
@@ -112,6 +115,16 @@ COUNT_TOLERANCE = 0.1
 """A count is right within this fraction of the true count, or one frame, whichever is more: what
 the rehearsal scores (:func:`count_choice`), and the least a count's range spans on each side
 (:class:`MissingCount`)."""
+
+SIZES_SECONDS = 1.0
+"""The longest gap, in seconds, that a count's range tries as the true size (or three times the
+count, if longer; :func:`_plausible_sizes`): as far as the counts read the motion on each side."""
+
+SIZES = 10
+"""How many gap sizes, spaced geometrically from one frame, a count's range tries (:func:`_plausible_sizes`)."""
+
+SIZE_PLACES = 8
+"""Places on each side of a gap at which each tried size is cut out (:func:`_plausible_sizes`)."""
 
 TRANSIENT = 0.2
 """Relative difference of the mean ground speeds on the two sides of a gap above which the body is
@@ -741,7 +754,9 @@ def estimate_counts(motion: Motion, steps_at, seconds: float = 1.0, takes=None) 
     body does not travel, the in-place count and the step ratio), and where
     the count was rehearsed on cuts of the same length beside the gap (:func:`count_choice`), every
     count its errors there point to (the gap's count less each error; on cuts where the body does
-    not travel, the step ratio's errors too). With ``takes`` it is
+    not travel, the step ratio's errors too), and every gap size up to a second (or three times the
+    count) whose cuts beside the gap can be counted as this one was (:func:`_plausible_sizes`: a
+    repeating or slowing motion can hide a longer gap). With ``takes`` it is
     that of the stream's own count widened to the tolerance about the mean with the recordings.
     Parameters and raises: those of :func:`estimate_missing`.
 
@@ -801,11 +816,11 @@ class CountChoice:
     low: int = 1
     """The fewest frames likely missing, at least 1: the least of ``count`` less its tolerance
     (:data:`COUNT_TOLERANCE`), the stride and local counts (the step ratio in place of the local
-    count where the body does not travel; rounded) and ``count`` less its largest error on the
-    rehearsal cuts (rounded)."""
+    count where the body does not travel; rounded), ``count`` less its largest error on the
+    rehearsal cuts (rounded) and the gap sizes that could have given ``count`` (:func:`_plausible_sizes`)."""
     high: int = 1
     """The most frames likely missing: the most of ``count`` plus its tolerance, the counts ``low``
-    takes and ``count`` less its smallest error on the rehearsal cuts."""
+    takes, ``count`` less its smallest error on the rehearsal cuts and those gap sizes."""
     ratio: float | None = None
     """Where the body does not travel, the step ratio (the joint step across the gap over the
     median joint step around it, less one; :func:`_step_ratio`); ``None`` otherwise."""
@@ -846,6 +861,8 @@ def _choose(a: _Arrays, t: int, start: int, stop: int, seconds: float) -> CountC
     use_local = local is not None and p < SIGNIFICANCE
     count = local if use_local else n
     low, high = _tolerance(max(1, int(round(count))))
+    for size in _plausible_sizes(a, t, start, stop, count, use_local, seconds):
+        low, high = min(low, size), max(high, size)
     ratio = _in_place_ratio(a, t, start, stop, seconds) if arc is None else None
     for other in (x for x in (n, local, ratio) if x is not None):  # where the counts disagree, all
         low, high = min(low, max(1, int(round(other)))), max(high, int(round(other)))
@@ -1013,15 +1030,42 @@ def _local_count(gstep: np.ndarray, t: int, start: int, stop: int, arc: float, g
     return float(found[np.argmin(np.abs(found - guess))])
 
 
-def _rehearse(a: _Arrays, t: int, start: int, stop: int, m: int, seconds: float = 1.0):
+def _plausible_sizes(
+    a: _Arrays, t: int, start: int, stop: int, count: float, use_local: bool, seconds: float
+) -> list[int]:
+    """The gap sizes that could have given ``count`` at step ``t → t+1`` (known steps ``start …
+    stop``): the range by test inversion, so that it holds gaps the count undercounts.
+
+    :data:`SIZES` sizes ``k``, geometric from one frame to the larger of three times ``count`` and
+    :data:`SIZES_SECONDS` of frames, are each cut out at up to :data:`SIZE_PLACES` evenly spaced
+    places on each side (:func:`_rehearse`) and counted by the rule the real gap used (the local
+    count where ``use_local`` and it has an answer, else the stride count). ``k`` is kept where at
+    least three cuts fit and ``count`` (rounded) lies between the least and the most of their
+    counts (rounded), widened by its tolerance (:data:`COUNT_TOLERANCE`, or one frame). A loop over
+    sizes, each over its cuts.
+    """
+    m = max(1, int(round(count)))
+    tol = max(1.0, COUNT_TOLERANCE * m)
+    top = max(3 * m, int(round(SIZES_SECONDS * a.fps)), 2)
+    kept = []
+    for k in np.unique(np.round(np.geomspace(1, top, SIZES)).astype(int)):
+        stride, local, _, _ = _rehearse(a, t, start, stop, int(k), seconds, SIZE_PLACES)
+        got = np.round(np.where(np.isfinite(local), local, stride) if use_local else stride)
+        if got.size >= 3 and got.min() - tol <= m <= got.max() + tol:
+            kept.append(int(k))
+    return kept
+
+
+def _rehearse(a: _Arrays, t: int, start: int, stop: int, m: int, seconds: float = 1.0, places: int | None = None):
     """Both counts of gaps of ``m`` frames rehearsed on the known frames beside the real gap at step
     ``t → t+1`` (known steps ``start … stop``).
 
     On each side (up to ``REHEARSAL_SECONDS``; never across the gap) ``m`` frames are cut out at
     every place that leaves ``LOCAL_SECONDS`` (at least three frames) of known frames on both sides
-    of the cut, and both counts are made for each cut as for a real gap (a loop over cuts, each
-    count vectorised over its frames). The cuts overlap, so they are not independent trials: the
-    sign test of :func:`estimate_missing` on them overstates the evidence, and its 5% is nominal.
+    of the cut (at most ``places`` of them, evenly spaced, where given), and both counts are made
+    for each cut as for a real gap (a loop over cuts, each count vectorised over its frames). The
+    cuts overlap, so they are not independent trials: the sign test of :func:`estimate_missing` on
+    them overstates the evidence, and its 5% is nominal.
 
     Returns
     -------
@@ -1035,7 +1079,10 @@ def _rehearse(a: _Arrays, t: int, start: int, stop: int, m: int, seconds: float 
     edge = max(3, int(round(LOCAL_SECONDS * a.fps)))  # what the local count fits on
     counts = []
     for lo, hi in ((max(start, t - far), t + 1), (t + 1, min(stop + 1, t + 1 + far))):
-        for p in range(lo + edge - 1, hi - m - edge):  # frames p+1 … p+m cut out
+        at = np.arange(lo + edge - 1, hi - m - edge)
+        if places is not None and at.size > places:
+            at = at[np.round(np.linspace(0, at.size - 1, places)).astype(int)]
+        for p in at.tolist():  # frames p+1 … p+m cut out
             keep = np.r_[lo : p + 1, p + 1 + m : hi]
             sub = a.without(keep)
             tp = p - lo

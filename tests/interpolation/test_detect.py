@@ -375,6 +375,25 @@ def test_a_count_comes_with_the_range_it_is_likely_in():
     assert all(c.low <= round(x) <= c.high for x in (choice.stride, choice.local))  # both counts in it
 
 
+def test_range_holds_a_gap_one_period_longer_than_it_looks():
+    """Joints circling once every 12 frames (30 fps, in place) with 14 frames dropped: the stream
+    looks as if 2 were dropped, and the count says so within a frame. Cuts of 14 frames beside the
+    gap look the same, so the range (by test inversion) holds the true 14, where the count's
+    tolerance and the rehearsal of cuts of the count's length alone end at 4."""
+    fps, period, n, s, frames = 30.0, 12, 14, 40, 120
+    phase = 2 * np.pi * np.arange(frames)[:, None] / period + np.arange(6)[None, :]  # joint j, j rad ahead
+    radius = np.r_[0.0, 0.1, 0.2, 0.3, 0.4, 0.5]  # metres; joint 0, the reference, stays put
+    positions = np.stack([radius * np.cos(phase), np.ones((frames, 6)), radius * np.sin(phase)], -1)
+    full = detect._Arrays._from(
+        positions[:, 0] * [1.0, 0.0, 1.0], positions, positions.reshape(frames, -1), fps, 0.0, 0.0
+    )
+    a = full.without(np.r_[0:s, s + n : frames])  # frames s … s+n-1 dropped: the gap is step s-1 → s
+    c = detect._choose(a, s - 1, 0, len(a.gstep), 1.0)
+    assert abs(c.count - 2) <= 1 and c.ratio is not None  # in place, counted as it looks
+    assert n in detect._plausible_sizes(a, s - 1, 0, len(a.gstep), c.count, False, 1.0)
+    assert c.low <= n <= c.high and detect._tolerance(round(c.count))[1] < n
+
+
 @pytest.mark.parametrize(("count", "low", "high"), [(1, 1, 2), (6, 5, 7), (10, 9, 11), (20, 18, 22), (25, 23, 27)])
 def test_the_least_range_of_a_count_is_its_tolerance(count, low, high):
     """Known answers: within 10% of the count or one frame, whichever is more, never below 1."""
@@ -410,3 +429,17 @@ def test_real_in_place_gap_is_counted_from_the_joints_around_it():
     c = detect.count_choice(cut, 14)
     assert c.ratio is not None and abs(c.ratio - 7) > 20
     assert abs(c.stride - 7) <= 1 and c.low <= 7 <= c.high
+
+
+@pytest.mark.realdata
+def test_real_wave_gap_that_looks_short_is_in_its_range():
+    """A take waving both hands with 14 frames dropped (a case of the sweep behind the range's test
+    inversion, so a known answer): the stream looks as if 3 were dropped, and cuts of 3 frames beside
+    the gap are counted right, so the count's own rehearsal said 1 to 7. Cuts of 14 frames there are
+    counted as short, so the range holds the true 14."""
+    root = require_data("bandai_namco", "sessions", "wave-both-hands")
+    m = bvh.load(root / "dataset-2_wave-both-hands_youthful_022.bvh")
+    cut = m[np.r_[0:87, 101 : m.num_frames]]
+    assert detect.consecutive_gaps(cut) == [86]
+    c = detect.count_choice(cut, 86)
+    assert abs(c.count - 14) > 5 and c.low <= 14 <= c.high
