@@ -118,13 +118,13 @@ the rehearsal scores (:func:`count_choice`), and the least a count's range spans
 
 SIZES_SECONDS = 1.0
 """The longest gap, in seconds, that a count's range tries as the true size (or three times the
-count, if longer; :func:`_plausible_sizes`): as far as the counts read the motion on each side."""
+count, if longer; :func:`_plausible_range`): as far as the counts read the motion on each side."""
 
 SIZES = 10
-"""How many gap sizes, spaced geometrically from one frame, a count's range tries (:func:`_plausible_sizes`)."""
+"""How many gap sizes, spaced geometrically from one frame, a count's range tries (:func:`_plausible_range`)."""
 
 SIZE_PLACES = 8
-"""Places on each side of a gap at which each tried size is cut out (:func:`_plausible_sizes`)."""
+"""Places on each side of a gap at which each tried size is cut out (:func:`_plausible_range`)."""
 
 TRANSIENT = 0.2
 """Relative difference of the mean ground speeds on the two sides of a gap above which the body is
@@ -755,7 +755,7 @@ def estimate_counts(motion: Motion, steps_at, seconds: float = 1.0, takes=None) 
     the count was rehearsed on cuts of the same length beside the gap (:func:`count_choice`), every
     count its errors there point to (the gap's count less each error; on cuts where the body does
     not travel, the step ratio's errors too), and every gap size up to a second (or three times the
-    count) whose cuts beside the gap can be counted as this one was (:func:`_plausible_sizes`: a
+    count) whose cuts beside the gap can be counted as this one was (:func:`_plausible_range`: a
     repeating or slowing motion can hide a longer gap). With ``takes`` it is
     that of the stream's own count widened to the tolerance about the mean with the recordings.
     Parameters and raises: those of :func:`estimate_missing`.
@@ -817,7 +817,7 @@ class CountChoice:
     """The fewest frames likely missing, at least 1: the least of ``count`` less its tolerance
     (:data:`COUNT_TOLERANCE`), the stride and local counts (the step ratio in place of the local
     count where the body does not travel; rounded), ``count`` less its largest error on the
-    rehearsal cuts (rounded) and the gap sizes that could have given ``count`` (:func:`_plausible_sizes`)."""
+    rehearsal cuts (rounded) and the gap sizes that could have given ``count`` (:func:`_plausible_range`)."""
     high: int = 1
     """The most frames likely missing: the most of ``count`` plus its tolerance, the counts ``low``
     takes, ``count`` less its smallest error on the rehearsal cuts and those gap sizes."""
@@ -861,8 +861,6 @@ def _choose(a: _Arrays, t: int, start: int, stop: int, seconds: float) -> CountC
     use_local = local is not None and p < SIGNIFICANCE
     count = local if use_local else n
     low, high = _tolerance(max(1, int(round(count))))
-    for size in _plausible_sizes(a, t, start, stop, count, use_local, seconds):
-        low, high = min(low, size), max(high, size)
     ratio = _in_place_ratio(a, t, start, stop, seconds) if arc is None else None
     for other in (x for x in (n, local, ratio) if x is not None):  # where the counts disagree, all
         low, high = min(low, max(1, int(round(other)))), max(high, int(round(other)))
@@ -871,6 +869,7 @@ def _choose(a: _Arrays, t: int, start: int, stop: int, seconds: float) -> CountC
         errors = np.concatenate([errors, ratio_at[np.isfinite(ratio_at)] - m])  # in place: both counts' errors
         low = min(low, max(1, int(math.floor(count - errors.max() + 0.5))))
         high = max(high, int(math.floor(count - errors.min() + 0.5)))
+    low, high = _plausible_range(a, t, start, stop, count, use_local, seconds, low, high)
     return CountChoice(n, local, stride_only, local_only, p, count, low, high, ratio)
 
 
@@ -1030,48 +1029,54 @@ def _local_count(gstep: np.ndarray, t: int, start: int, stop: int, arc: float, g
     return float(found[np.argmin(np.abs(found - guess))])
 
 
-def _plausible_sizes(
-    a: _Arrays, t: int, start: int, stop: int, count: float, use_local: bool, seconds: float
-) -> list[int]:
-    """The gap sizes that could have given ``count`` at step ``t → t+1`` (known steps ``start …
-    stop``): the range by test inversion, so that it holds gaps the count undercounts.
+def _plausible_range(
+    a: _Arrays, t: int, start: int, stop: int, count: float, use_local: bool, seconds: float, low: int, high: int
+) -> tuple[int, int]:
+    """``low … high`` widened to every gap size that could have given ``count`` at step ``t → t+1``
+    (known steps ``start … stop``): the range by test inversion, so that it holds gaps the count
+    undercounts.
 
     :data:`SIZES` sizes ``k``, geometric from one frame to the larger of three times ``count`` and
     :data:`SIZES_SECONDS` of frames, are each cut out at up to :data:`SIZE_PLACES` evenly spaced
     places on each side (:func:`_rehearse`) and counted by the rule the real gap used (the local
-    count where ``use_local`` and it has an answer, else the stride count). ``k`` is kept where at
-    least three cuts fit and ``count`` (rounded) lies between the least and the most of their
-    counts (rounded), widened by its tolerance (:data:`COUNT_TOLERANCE`, or one frame). A loop over
-    sizes, each over its cuts.
+    count where ``use_local`` and it has an answer, else the stride count). ``k`` could have given
+    ``count`` where at least three cuts fit and ``count`` (rounded) lies between the least and the
+    most of their counts (rounded), widened by its tolerance (:data:`COUNT_TOLERANCE`, or one
+    frame). The range is the span of those sizes and ``low … high``, so the sizes inside ``low …
+    high`` are not tried, and the others are tried from each end inwards up to the first that could
+    have given ``count``. A loop over sizes, each over its cuts.
     """
     m = max(1, int(round(count)))
     tol = max(1.0, COUNT_TOLERANCE * m)
     top = max(3 * m, int(round(SIZES_SECONDS * a.fps)), 2)
-    kept = []
-    for k in np.unique(np.round(np.geomspace(1, top, SIZES)).astype(int)):
-        stride, local, _, _ = _rehearse(a, t, start, stop, int(k), seconds, SIZE_PLACES)
+    sizes = np.unique(np.round(np.geomspace(1, top, SIZES)).astype(int))
+
+    def could(k: int) -> bool:
+        stride, local, _, _ = _rehearse(a, t, start, stop, k, seconds, SIZE_PLACES, use_local)
         got = np.round(np.where(np.isfinite(local), local, stride) if use_local else stride)
-        if got.size >= 3 and got.min() - tol <= m <= got.max() + tol:
-            kept.append(int(k))
-    return kept
+        return got.size >= 3 and got.min() - tol <= m <= got.max() + tol
+
+    high = next((k for k in sizes[sizes > high][::-1].tolist() if could(k)), high)
+    low = next((k for k in sizes[sizes < low].tolist() if could(k)), low)
+    return low, high
 
 
-def _rehearse(a: _Arrays, t: int, start: int, stop: int, m: int, seconds: float = 1.0, places: int | None = None):
+def _rehearse(a: _Arrays, t: int, start: int, stop: int, m: int, seconds: float, places=None, local=True):
     """Both counts of gaps of ``m`` frames rehearsed on the known frames beside the real gap at step
     ``t → t+1`` (known steps ``start … stop``).
 
     On each side (up to ``REHEARSAL_SECONDS``; never across the gap) ``m`` frames are cut out at
     every place that leaves ``LOCAL_SECONDS`` (at least three frames) of known frames on both sides
     of the cut (at most ``places`` of them, evenly spaced, where given), and both counts are made
-    for each cut as for a real gap (a loop over cuts, each count vectorised over its frames). The
-    cuts overlap, so they are not independent trials: the sign test of :func:`estimate_missing` on
-    them overstates the evidence, and its 5% is nominal.
+    for each cut as for a real gap (the local one only with ``local``; a loop over cuts, each count
+    vectorised over its frames). The cuts overlap, so they are not independent trials: the sign
+    test of :func:`estimate_missing` on them overstates the evidence, and its 5% is nominal.
 
     Returns
     -------
     stride : ndarray (C,), the stride count of each cut (the in-place count where the body does
         not travel)
-    local : ndarray (C,), the local count of each cut, NaN where it has none
+    local : ndarray (C,), the local count of each cut, NaN where it has none (or not ``local``)
     travels : ndarray (C,) bool, whether the body travels at the cut
     ratio : ndarray (C,), the step ratio of each cut where the body does not travel, NaN elsewhere
     """
@@ -1087,9 +1092,9 @@ def _rehearse(a: _Arrays, t: int, start: int, stop: int, m: int, seconds: float 
             sub = a.without(keep)
             tp = p - lo
             n, arc = _stride_count(sub, tp, 0, len(sub.gstep), seconds)
-            local = None if arc is None else _local_count(sub.gstep, tp, 0, len(sub.gstep), arc, n, a.fps)
+            fit = None if arc is None or not local else _local_count(sub.gstep, tp, 0, len(sub.gstep), arc, n, a.fps)
             ratio = _in_place_ratio(sub, tp, 0, len(sub.gstep), seconds) if arc is None else np.nan
-            counts.append((n, np.nan if local is None else local, arc is not None, ratio))
+            counts.append((n, np.nan if fit is None else fit, arc is not None, ratio))
     x = np.asarray(counts, dtype=np.float64).reshape(-1, 4)
     return x[:, 0], x[:, 1], x[:, 2] > 0, x[:, 3]
 

@@ -390,8 +390,9 @@ def test_range_holds_a_gap_one_period_longer_than_it_looks():
     a = full.without(np.r_[0:s, s + n : frames])  # frames s … s+n-1 dropped: the gap is step s-1 → s
     c = detect._choose(a, s - 1, 0, len(a.gstep), 1.0)
     assert abs(c.count - 2) <= 1 and c.ratio is not None  # in place, counted as it looks
-    assert n in detect._plausible_sizes(a, s - 1, 0, len(a.gstep), c.count, False, 1.0)
-    assert c.low <= n <= c.high and detect._tolerance(round(c.count))[1] < n
+    low, high = detect._tolerance(round(c.count))
+    assert high < n and detect._plausible_range(a, s - 1, 0, len(a.gstep), c.count, False, 1.0, low, high)[1] >= n
+    assert c.low <= n <= c.high
 
 
 @pytest.mark.parametrize(("count", "low", "high"), [(1, 1, 2), (6, 5, 7), (10, 9, 11), (20, 18, 22), (25, 23, 27)])
