@@ -268,7 +268,9 @@ def _smoother(sigma: float, channels: int, dtype, device):
 
     ``index`` (N, T) of int, optional: frame ``t`` of row ``n`` reads ``δ[n, index[n, t]]`` first;
     with ``index = min(t, length − 1)`` a row padded beyond its length is filtered exactly as the
-    row alone (both ends replicate the end frame).
+    row alone (both ends replicate the end frame). The filter is one (T, T) matrix per length
+    (:func:`_band`), the same for every channel: one matrix product, forward and backward.
+    Raises ValueError where ``δ`` has not ``channels`` channels.
     """
 
     def gather(d: torch.Tensor, index: torch.Tensor | None = None) -> torch.Tensor:
@@ -279,13 +281,29 @@ def _smoother(sigma: float, channels: int, dtype, device):
     radius = max(int(round(3 * sigma)), 1)
     t = torch.arange(-radius, radius + 1, dtype=dtype, device=device)
     kernel = torch.exp(-0.5 * (t / sigma) ** 2)
-    kernel = (kernel / kernel.sum()).expand(channels, 1, -1).contiguous()
+    kernel = kernel / kernel.sum()
+    bands: dict[int, torch.Tensor] = {}
 
     def apply(d: torch.Tensor, index: torch.Tensor | None = None) -> torch.Tensor:
-        padded = torch.nn.functional.pad(gather(d, index).transpose(1, 2), (radius, radius), mode="replicate")
-        return torch.nn.functional.conv1d(padded, kernel, groups=channels).transpose(1, 2)
+        frames = d.shape[1]
+        if d.shape[-1] != channels:
+            raise ValueError(f"the smoother filters latents of {channels} channels, got shape {tuple(d.shape)}")
+        if frames not in bands:
+            bands[frames] = _band(kernel, frames)
+        return torch.matmul(bands[frames], gather(d, index))
 
     return apply
+
+
+def _band(kernel: torch.Tensor, frames: int) -> torch.Tensor:
+    """The (T, T) matrix of the filter ``kernel`` (2r+1,) along ``frames`` = T frames whose ends
+    replicate the end frame: row ``t`` holds ``kernel[k]`` at column ``clamp(t + k − r, 0, T − 1)``,
+    summed where columns coincide."""
+    r = (kernel.shape[0] - 1) // 2
+    rows = torch.arange(frames, device=kernel.device)[:, None].expand(-1, kernel.shape[0])
+    cols = (rows + torch.arange(-r, r + 1, device=kernel.device)).clamp(0, frames - 1)
+    band = torch.zeros(frames, frames, dtype=kernel.dtype, device=kernel.device)
+    return band.index_put_((rows.reshape(-1), cols.reshape(-1)), kernel.repeat(frames), accumulate=True)
 
 
 def smoother(sigma: float, channels: int, dtype=torch.float64, device="cpu") -> Callable[[torch.Tensor], torch.Tensor]:

@@ -65,6 +65,28 @@ def test_smoothed_updates_are_smooth_in_time(tiny_checkpoint, data):
     assert jitter[3.0] < 0.5 * jitter[0.0]
 
 
+def test_smoother_is_the_gaussian_with_replicated_ends():
+    """Known answer: ``G_σ * δ`` along time is Σ_k g_k δ[clamp(t + k)] with g the normalised
+    Gaussian of radius round(3σ) (ends replicate the end frame), the same for every channel; a
+    padded row read through ``index`` is filtered as the row alone; other channel counts are refused."""
+    from motionlab.retargeting import solver
+
+    sigma, T, D = 2.0, 17, 5
+    d = torch.randn(2, T, D, dtype=torch.float64, generator=torch.Generator().manual_seed(0))
+    k = np.arange(-6, 7)
+    g = np.exp(-0.5 * (k / sigma) ** 2) / np.exp(-0.5 * (k / sigma) ** 2).sum()
+    cols = np.clip(np.arange(T)[:, None] + k, 0, T - 1)  # (T, 13)
+    expected = (d.numpy()[:, cols] * g[None, None, :, None]).sum(2)
+    smooth = solver.smoother(sigma, D)
+    assert np.allclose(smooth(d).numpy(), expected, rtol=0, atol=1e-14)
+    index = torch.minimum(torch.arange(T)[None], torch.tensor([[T - 1], [9]]))  # row 1: 10 real frames
+    alone = solver.smoother(sigma, D)(d[1:, :10])
+    assert torch.allclose(smooth(d, index)[1, :10], alone[0], rtol=0, atol=1e-14)
+    assert torch.equal(solver.smoother(0.0, D)(d), d)
+    with pytest.raises(ValueError, match="5 channels"):
+        smooth(d[..., :4])
+
+
 def test_foot_term_pulls_feet_out_of_the_ground(tiny_checkpoint, data):
     """Root placed so low that the feet are under the floor: L_foot must drop."""
     res = solve(
