@@ -175,16 +175,20 @@ def _family_line(cuts) -> str:
             continue
         c = detect.count_choice(g, s - 1)  # one gap, no takes: the count and range of estimate_counts
         local = c.stride if c.local is None else c.local
-        rows.append((n, max(1, round(c.count)), max(1, round(c.stride)), max(1, round(local)), c.low, c.high))
-    x = np.array(rows, dtype=np.float64).reshape(-1, 6)
-    n, count, stride, local, low, high = x.T
+        untried = np.inf if c.untried is None else c.untried
+        rows.append((n, max(1, round(c.count)), max(1, round(c.stride)), max(1, round(local)), c.low, c.high, untried))
+    x = np.array(rows, dtype=np.float64).reshape(-1, 7)
+    n, count, stride, local, low, high, untried = x.T
     inside = (low <= n) & (n <= high)
+    told = ~inside & (n >= untried)  # outside the range, and a size the warning says was not tried
     share = lambda a: f"{np.mean(a):.1%}" if len(a) else "-"  # noqa: E731
     return (
         f"{len(cuts)} cuts, {len(x)} found; exact: count {share(count == n)}, stride count {share(stride == n)}, "
         f"local count {share(local == n)}; within 10% or 1 frame {share(np.abs(count - n) <= np.maximum(1, 0.1 * n))}; "
         f"range holds the truth {share(inside)}, mean width {np.mean(high - low + 1) if len(x) else 0:.1f} frames; "
-        f"wrong and unflagged {share((count != n) & ~inside)}"
+        f"wrong and unflagged {share((count != n) & ~inside)}; "
+        f"range open above (sizes not tried) {share(np.isfinite(untried))}, "
+        f"truth outside but not tried {share(told)}"
     )
 
 

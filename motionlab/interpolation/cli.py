@@ -28,7 +28,8 @@ checked against the file's ``Frame Time`` first: times in another unit (millisec
 that would make the clip more than :data:`MAX_GROWTH` times longer, are refused. Without
 ``--times`` the counts are estimates (the motion cannot say how fast the body moved inside a gap),
 and a warning on stderr says so, with the range each count is likely in
-(:func:`motionlab.interpolation.detect.estimate_counts`).
+(:func:`motionlab.interpolation.detect.estimate_counts`) and, where too few frames beside a gap
+let the range try longer gaps and it reaches the longest it could, the sizes it could not try.
 A clean clip (nothing found) is copied byte for byte. A report lists every gap and how it was
 filled.
 """
@@ -243,12 +244,20 @@ SHOWN_RANGES = 5
 """How many gaps' count ranges the warning of an estimated count lists by name."""
 
 
+def _range_words(c) -> str:
+    """A count's range in words, and the sizes it could not try (:class:`~.detect.MissingCount`)."""
+    words = f"likely {c.low} to {c.high}"
+    if c.untried is not None:
+        words += f"; gaps of {c.untried} or more frames could not be tried beside it"
+    return words
+
+
 def _warn_estimated(src, counted) -> None:
     """On stderr: the missing counts were estimated from the motion, each with the range it is
     likely in (:func:`motionlab.interpolation.detect.estimate_counts`), and how to get them exact."""
     if not counted:
         return
-    shown = [f"{c.count} frames after frame {t} (likely {c.low} to {c.high})" for t, c in counted[:SHOWN_RANGES]]
+    shown = [f"{c.count} frames after frame {t} ({_range_words(c)})" for t, c in counted[:SHOWN_RANGES]]
     if len(counted) > SHOWN_RANGES:
         shown.append(f"and {len(counted) - SHOWN_RANGES} more gaps")
     print(

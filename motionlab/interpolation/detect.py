@@ -744,6 +744,11 @@ class MissingCount:
     """The fewest frames likely missing, at least 1."""
     high: int
     """The most frames likely missing."""
+    untried: int | None = None
+    """Where the range is open above, the shortest gap size that could not be tried as this one's
+    true size (too few known frames beside it: a short clip, a near end or gap), and the range
+    reaches the longest that could; else ``None``. The range says nothing of gaps that long
+    (:func:`_plausible_range`)."""
 
 
 def estimate_counts(motion: Motion, steps_at, seconds: float = 1.0, takes=None) -> list[MissingCount]:
@@ -784,7 +789,7 @@ def estimate_counts(motion: Motion, steps_at, seconds: float = 1.0, takes=None) 
             n = n if rec is None else 0.5 * (n + rec[0])
         count = max(1, int(round(n)))
         band = _tolerance(count)
-        out.append(MissingCount(count, min(low, band[0]), max(high, band[1])))
+        out.append(MissingCount(count, min(low, band[0]), max(high, band[1]), choice.untried))
     return out
 
 
@@ -824,6 +829,9 @@ class CountChoice:
     ratio: float | None = None
     """Where the body does not travel, the step ratio (the joint step across the gap over the
     median joint step around it, less one; :func:`_step_ratio`); ``None`` otherwise."""
+    untried: int | None = None
+    """Where the range is open above (:func:`_plausible_range`: too few known frames beside the gap
+    to try longer sizes, and the range reaches the longest it could try), the next size, else ``None``."""
 
 
 def count_choice(motion: Motion, t: int, start: int = 0, stop: int | None = None, seconds: float = 1.0) -> CountChoice:
@@ -869,8 +877,8 @@ def _choose(a: _Arrays, t: int, start: int, stop: int, seconds: float) -> CountC
         errors = np.concatenate([errors, ratio_at[np.isfinite(ratio_at)] - m])  # in place: both counts' errors
         low = min(low, max(1, int(math.floor(count - errors.max() + 0.5))))
         high = max(high, int(math.floor(count - errors.min() + 0.5)))
-    low, high = _plausible_range(a, t, start, stop, count, use_local, seconds, low, high)
-    return CountChoice(n, local, stride_only, local_only, p, count, low, high, ratio)
+    low, high, untried = _plausible_range(a, t, start, stop, count, use_local, seconds, low, high)
+    return CountChoice(n, local, stride_only, local_only, p, count, low, high, ratio, untried)
 
 
 def _moving_bounds(a: _Arrays, t: int, start: int, stop: int) -> tuple[int, int]:
@@ -1031,25 +1039,31 @@ def _local_count(gstep: np.ndarray, t: int, start: int, stop: int, arc: float, g
 
 def _plausible_range(
     a: _Arrays, t: int, start: int, stop: int, count: float, use_local: bool, seconds: float, low: int, high: int
-) -> tuple[int, int]:
+) -> tuple[int, int, int | None]:
     """``low … high`` widened to every gap size that could have given ``count`` at step ``t → t+1``
     (known steps ``start … stop``): the range by test inversion, so that it holds gaps the count
-    undercounts.
+    undercounts; and the shortest size above it that could not be tried, if any.
 
     :data:`SIZES` sizes ``k``, geometric from one frame to the larger of three times ``count`` and
-    :data:`SIZES_SECONDS` of frames, are each cut out at up to :data:`SIZE_PLACES` evenly spaced
-    places on each side (:func:`_rehearse`) and counted by the rule the real gap used (the local
-    count where ``use_local`` and it has an answer, else the stride count). ``k`` could have given
-    ``count`` where at least three cuts fit and ``count`` (rounded) lies between the least and the
-    most of their counts (rounded), widened by its tolerance (:data:`COUNT_TOLERANCE`, or one
-    frame). The range is the span of those sizes and ``low … high``, so the sizes inside ``low …
-    high`` are not tried, and the others are tried from each end inwards up to the first that could
-    have given ``count``. A loop over sizes, each over its cuts.
+    :data:`SIZES_SECONDS` of frames (:func:`_longest_size`), are each cut out at up to
+    :data:`SIZE_PLACES` evenly spaced places on each side (:func:`_rehearse`) and counted by the
+    rule the real gap used (the local count where ``use_local`` and it has an answer, else the
+    stride count). ``k`` could have given ``count`` where at least three cuts fit and ``count``
+    (rounded) lies between the least and the most of their counts (rounded), widened by its
+    tolerance (:data:`COUNT_TOLERANCE`, or one frame). Where three cuts of the longest size do not
+    fit beside the gap, the sizes stop at the longest that does (:func:`_longest_tried`). The range
+    is the span of the sizes that could have given ``count`` and ``low … high``, so the sizes inside
+    ``low … high`` are not tried, and the others are tried from each end inwards up to the first
+    that could have given ``count``. Where the sizes stopped short and the range reaches the last
+    of them, nothing says that a longer gap would look different: the range is open above, and the
+    third value is the next size, else ``None``. A loop over sizes, each over its cuts.
     """
     m = max(1, int(round(count)))
     tol = max(1.0, COUNT_TOLERANCE * m)
-    top = max(3 * m, int(round(SIZES_SECONDS * a.fps)), 2)
+    top, tried = _longest_size(count, a.fps), _longest_tried(a, t, start, stop)
     sizes = np.unique(np.round(np.geomspace(1, top, SIZES)).astype(int))
+    if tried < top:
+        sizes = np.unique(np.r_[sizes[sizes < tried], tried]) if tried else sizes[:0]
 
     def could(k: int) -> bool:
         stride, local, _, _ = _rehearse(a, t, start, stop, k, seconds, SIZE_PLACES, use_local)
@@ -1058,7 +1072,32 @@ def _plausible_range(
 
     high = next((k for k in sizes[sizes > high][::-1].tolist() if could(k)), high)
     low = next((k for k in sizes[sizes < low].tolist() if could(k)), low)
-    return low, high
+    return low, high, (tried + 1 if tried < top and high >= tried else None)
+
+
+def _longest_size(count: float, fps: float) -> int:
+    """The longest gap size :func:`_plausible_range` tries for a gap counted ``count`` frames."""
+    return max(3 * max(1, int(round(count))), int(round(SIZES_SECONDS * fps)), 2)
+
+
+def _rehearsal_sides(a: _Arrays, t: int, start: int, stop: int) -> tuple[tuple[int, int], tuple[int, int], int]:
+    """The known frames ``lo … hi-1`` on each side of the gap at step ``t → t+1`` (known steps
+    ``start … stop``) that :func:`_rehearse` cuts, up to ``REHEARSAL_SECONDS`` away, and the frames
+    ``edge`` a cut keeps on both its sides (``LOCAL_SECONDS``, at least three)."""
+    far = int(round(REHEARSAL_SECONDS * a.fps))
+    edge = max(3, int(round(LOCAL_SECONDS * a.fps)))  # what the local count fits on
+    return (max(start, t - far), t + 1), (t + 1, min(stop + 1, t + 1 + far)), edge
+
+
+def _longest_tried(a: _Arrays, t: int, start: int, stop: int) -> int:
+    """The longest gap size of which at least three cuts fit beside step ``t → t+1`` (known steps
+    ``start … stop``; :func:`_rehearse` fits ``hi - lo - 2 edge + 1 - m`` cuts of ``m`` frames on a
+    side), 0 if none."""
+    before, after, edge = _rehearsal_sides(a, t, start, stop)
+    spans = np.array([hi - lo - 2 * edge + 1 for lo, hi in (before, after)])
+    sizes = np.arange(1, max(spans.max(), 1) + 1)
+    fits = np.clip(spans[None, :] - sizes[:, None], 0, None).sum(axis=1) >= 3
+    return int(sizes[fits].max()) if fits.any() else 0
 
 
 def _rehearse(a: _Arrays, t: int, start: int, stop: int, m: int, seconds: float, places=None, local=True):
@@ -1080,10 +1119,9 @@ def _rehearse(a: _Arrays, t: int, start: int, stop: int, m: int, seconds: float,
     travels : ndarray (C,) bool, whether the body travels at the cut
     ratio : ndarray (C,), the step ratio of each cut where the body does not travel, NaN elsewhere
     """
-    far = int(round(REHEARSAL_SECONDS * a.fps))
-    edge = max(3, int(round(LOCAL_SECONDS * a.fps)))  # what the local count fits on
+    before, after, edge = _rehearsal_sides(a, t, start, stop)
     counts = []
-    for lo, hi in ((max(start, t - far), t + 1), (t + 1, min(stop + 1, t + 1 + far))):
+    for lo, hi in (before, after):
         at = np.arange(lo + edge - 1, hi - m - edge)
         if places is not None and at.size > places:
             at = at[np.round(np.linspace(0, at.size - 1, places)).astype(int)]

@@ -177,6 +177,20 @@ def test_fill_gaps_says_an_estimated_count_is_one(tmp_path, capsys):
     assert bvh.load(out).num_frames == walk.num_frames - 6 + count
 
 
+def test_fill_gaps_says_which_gap_sizes_its_range_could_not_try(tmp_path, capsys):
+    """A Xia punch take of 105 frames at 120 fps without frames 50-69: beside the gap a cut keeps
+    12 frames on each side, so too few cuts of 25 frames or more fit to try them as the true size;
+    the warning says so after the range."""
+    punch = bvh.load(require_data("xia", "punch", "depressed_18_000.bvh"))
+    gap, out = tmp_path / "gap.bvh", tmp_path / "out.bvh"
+    bvh.save(gap, punch[np.r_[0:50, 70 : punch.num_frames]])
+    assert main(["fill-gaps", str(gap), "-o", str(out), "-q"]) == 0
+    err = capsys.readouterr().err
+    assert re.search(
+        r"after frame 49 \(likely \d+ to \d+; gaps of 25 or more frames could not be tried beside it\)", err
+    ), err
+
+
 def test_fill_gaps_refuses_frame_times_that_do_not_fit(dropped, tmp_path, capsys):
     out = tmp_path / "out.bvh"
     keep = np.r_[0:50, 58:120]

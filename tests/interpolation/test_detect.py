@@ -444,3 +444,29 @@ def test_real_wave_gap_that_looks_short_is_in_its_range():
     assert detect.consecutive_gaps(cut) == [86]
     c = detect.count_choice(cut, 86)
     assert abs(c.count - 14) > 5 and c.low <= 14 <= c.high
+
+
+def test_longest_size_tried_is_the_longest_three_cuts_fit():
+    """Known answer: at 30 fps a cut keeps 3 frames on each side, so beside the gap at step 19 → 20
+    of a 50-frame stream ``hi - lo - 5 - m`` cuts of ``m`` frames fit on a side: 15 - m before it
+    and 25 - m after it, three of them up to m = 22. ``_rehearse`` cuts exactly that many. The body
+    walks at one speed, so cuts of 22 frames are counted 22, not the gap's 1: though longer sizes
+    (up to a second) could not be tried, the range is not open above."""
+    fps, frames = 30.0, 51
+    k = np.arange(frames, dtype=np.float64)
+    positions = np.stack([0.05 * k[:, None] * np.ones((1, 4)), np.ones((frames, 4)), np.zeros((frames, 4))], -1)
+    a = detect._Arrays._from(positions[:, 0] * [1.0, 0.0, 1.0], positions, positions.reshape(frames, -1), fps, 0.0, 0.0)
+    a = a.without(np.r_[0:20, 21:frames])  # one frame dropped: steps 0 … 48, the gap at step 19
+    assert detect._longest_tried(a, 19, 0, len(a.gstep)) == 22
+    assert [detect._rehearse(a, 19, 0, len(a.gstep), m, 1.0, None, False)[0].size for m in (22, 23)] == [3, 2]
+    c = detect._choose(a, 19, 0, len(a.gstep), 1.0)
+    assert round(c.count) == 1 and c.high < 22 and c.untried is None
+    assert detect._plausible_range(a, 19, 0, len(a.gstep), c.count, False, 1.0, 1, 22) == (1, 22, 23)  # reaches 22
+    assert detect._longest_size(3, fps) == 30 and detect._longest_size(12, fps) == 36
+
+
+def test_a_range_beside_enough_frames_tries_every_size():
+    """On issue 39's walk (40 frames before the gap, 30 fps) every size up to a second fits three cuts."""
+    walk = bvh.load(require_data("bandai_namco", "dataset-1", "walk", "dataset-1_walk_normal_001.bvh"))
+    (c,) = detect.estimate_counts(walk[np.r_[0:40, 46 : walk.num_frames]], [39])
+    assert c.untried is None
