@@ -17,7 +17,9 @@ gaps found: how often the count (:func:`motionlab.interpolation.detect.count_cho
 count and the local count (the stride count where it has none) are exact, and how often the range
 that ``fill-gaps`` states without ``--times`` (:func:`motionlab.interpolation.detect.estimate_counts`,
 for one gap without ``--takes`` that of ``count_choice``) holds the true count, and how wide it is; *wrong and unflagged* is a count that is not exact and
-whose range does not hold the truth either.
+whose range does not hold the truth either. *Range open above* is a range that reaches the longest
+size that fits beside its gap (``CountChoice.untried`` set: the warning names the sizes it could
+not try), and *truth outside but not tried* a truth outside the range among those sizes.
 
 ``--in-place N``: the same for actions done in place (``IN_PLACE``: raising and waving hands,
 bowing, kicking, punching, idles), and under each family's line how many of its gaps found are
