@@ -279,7 +279,7 @@ def _smoother(sigma: float, channels: int, dtype, device):
     if sigma <= 0:
         return gather
     radius = max(int(round(3 * sigma)), 1)
-    t = torch.arange(-radius, radius + 1, dtype=dtype, device=device)
+    t = torch.arange(-radius, radius + 1, dtype=torch.float64, device="cpu")
     kernel = torch.exp(-0.5 * (t / sigma) ** 2)
     kernel = kernel / kernel.sum()
     bands: dict[int, torch.Tensor] = {}
@@ -288,8 +288,8 @@ def _smoother(sigma: float, channels: int, dtype, device):
         frames = d.shape[1]
         if d.shape[-1] != channels:
             raise ValueError(f"the smoother filters latents of {channels} channels, got shape {tuple(d.shape)}")
-        if frames not in bands:
-            bands[frames] = _band(kernel, frames)
+        if frames not in bands:  # made on the CPU, so that every device filters with the same numbers
+            bands[frames] = _band(kernel, frames).to(device=device, dtype=dtype)
         return torch.matmul(bands[frames], gather(d, index))
 
     return apply
