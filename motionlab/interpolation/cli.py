@@ -254,12 +254,18 @@ def _range_words(c) -> str:
 
 def _warn_estimated(src, counted) -> None:
     """On stderr: the missing counts were estimated from the motion, each with the range it is
-    likely in (:func:`motionlab.interpolation.detect.estimate_counts`), and how to get them exact."""
+    likely in (:func:`motionlab.interpolation.detect.estimate_counts`), and how to get them exact.
+    ``counted``: ``(after frame t, MissingCount)`` pairs; past :data:`SHOWN_RANGES` of them, how many
+    more, and how many of those have sizes their range could not try."""
     if not counted:
         return
     shown = [f"{c.count} frames after frame {t} ({_range_words(c)})" for t, c in counted[:SHOWN_RANGES]]
     if len(counted) > SHOWN_RANGES:
-        shown.append(f"and {len(counted) - SHOWN_RANGES} more gaps")
+        rest = [c for _, c in counted[SHOWN_RANGES:]]
+        opened = sum(c.untried is not None for c in rest)
+        shown.append(
+            f"and {len(rest)} more gaps" + (f" ({opened} with sizes that could not be tried)" if opened else "")
+        )
     print(
         f"warning: {src}: how many frames are missing is estimated from the motion, which cannot tell it "
         f"exactly: {', '.join(shown)}; pass --times FILE (the capture's frame times) for exact counts",

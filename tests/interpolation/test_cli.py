@@ -191,6 +191,19 @@ def test_fill_gaps_says_which_gap_sizes_its_range_could_not_try(tmp_path, capsys
     ), err
 
 
+def test_the_warning_counts_the_unlisted_gaps_whose_sizes_were_not_all_tried(capsys):
+    """Past the gaps it lists, the warning says how many more there are and how many of those have
+    sizes their range could not try."""
+    from motionlab.interpolation.cli import SHOWN_RANGES, _warn_estimated
+    from motionlab.interpolation.detect import MissingCount
+
+    open_above = [None] * SHOWN_RANGES + [12, None, 30]
+    _warn_estimated("x.bvh", [(10 * i, MissingCount(3, 2, 4, u)) for i, u in enumerate(open_above)])
+    err = capsys.readouterr().err
+    assert "after frame 40 (likely 2 to 4)," in err and "after frame 50" not in err
+    assert "and 3 more gaps (2 with sizes that could not be tried);" in err
+
+
 def test_fill_gaps_refuses_frame_times_that_do_not_fit(dropped, tmp_path, capsys):
     out = tmp_path / "out.bvh"
     keep = np.r_[0:50, 58:120]
