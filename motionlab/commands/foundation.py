@@ -35,11 +35,15 @@ def _info(args) -> int:
     Print a BVH file's skeleton, frame count, frame rate, rest height and whether (and by which rig profile) it maps
     onto the canonical 22-joint humanoid.
     """
-    from motionlab.core import humanoid
+    from motionlab.core import humanoid, motion_files
 
     m = _load(args.file)
+    unit = motion_files.file_unit(m.skeleton)
+    m = motion_files.in_metres(m, unit)
     sk = m.skeleton
     print(f"file      {args.file}")
+    if unit != motion_files.CM:
+        print(f"unit      {unit:.6g} m per file unit (its rig profile's; other files are read as centimetres)")
     print(f"frames    {m.num_frames} at {m.fps:g} fps ({m.duration:.2f} s)")
     print(f"joints    {sk.num_joints} (root {sk.names[0]!r}, {len(sk.end_sites)} end sites)")
     print(f"height    {sk.height():.4f} m (rest pose, all joints)")
@@ -82,7 +86,8 @@ def _convert(args) -> int:
         cli_args.check_size(
             f"--fps {args.fps:g} over {m.duration:g} s", m.duration * args.fps + 1, m.skeleton.num_joints
         )
-    if args.canonical:
+    if args.canonical:  # the 22 joints' names read back as centimetres: write them in centimetres
+        m, unit = motion_files.in_metres(m, unit), motion_files.CM
         try:
             m = humanoid.to_canonical(m)
         except humanoid.RigMappingError as e:
@@ -107,19 +112,27 @@ def _synth(args) -> int:
     cli_args.motion_output("-o", args.output)
     (out,) = check_outputs([("-o", args.output)], args.force)
     joints = len(humanoid.JOINTS)
-    if args.behaviour != "mix" and int(args.seconds * args.fps) < 1:
+    frames = round(args.seconds * args.fps)
+    if args.behaviour != "mix" and frames < 1:
         raise cli_args.CLIError(f"--seconds {args.seconds:g} at --fps {args.fps:g} is less than one frame")
     if args.behaviour != "mix":
         cli_args.check_size(f"--seconds {args.seconds:g} at --fps {args.fps:g}", args.seconds * args.fps, joints)
     skeleton = humanoid.canonical_skeleton(args.height)
     skeleton = humanoid.scale_bones(skeleton, legs=args.legs, arms=args.arms)
     if args.behaviour == "mix":
-        segments = [("idle", 60), ("walk", 150), ("run", 120), ("jump", 70), ("walk", 90), ("squat", 100), ("idle", 60)]
+        seconds = [
+            ("idle", 1.0),
+            ("walk", 2.5),
+            ("run", 2.0),
+            ("jump", 70 / 60),
+            ("walk", 1.5),
+            ("squat", 5 / 3),
+            ("idle", 1.0),
+        ]
+        segments = [(behaviour, max(1, round(s * args.fps))) for behaviour, s in seconds]
         motion = synthetic.sequence(segments, skeleton, fps=args.fps, seed=args.seed)
     else:
-        motion = synthetic.generate(
-            args.behaviour, skeleton, num_frames=int(args.seconds * args.fps), fps=args.fps, seed=args.seed
-        )
+        motion = synthetic.generate(args.behaviour, skeleton, num_frames=frames, fps=args.fps, seed=args.seed)
     motion.name = args.behaviour
     motion_files.save(out, motion, overwrite=args.force, unit=motion_files.CM)
     if not args.quiet:
@@ -153,7 +166,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     with cli_args.command(sub, "convert", _convert) as p:
         p.add_argument("input", help="input .bvh")
         cli_args.add_output(p, "output file: .bvh writes BVH, .glb binary glTF 2.0 (Blender, web viewers, engines)")
-        p.add_argument("--canonical", action="store_true", help="reduce to the canonical 22 joints")
+        p.add_argument(
+            "--canonical",
+            action="store_true",
+            help="reduce to the canonical 22 joints (a .bvh is then written in centimetres)",
+        )
         p.add_argument(
             "--fps", type=cli_args.frame_rate, default=None, help="resample to this frame rate (frames per second)"
         )

@@ -79,7 +79,7 @@ def _cmd_view(args) -> int:
     Play FILE.bvh in a 3D window (where a display exists) or render it off-screen to a movie with -o (needed where
     there is no display). Foot contacts light up red.
     """
-    from motionlab.core import bvh, files
+    from motionlab.core import bvh, files, motion_files
     from motionlab.viz import backend
     from motionlab.viz.export import MOVIE_SUFFIXES, save_movie
     from motionlab.viz.scene import Scene
@@ -95,9 +95,13 @@ def _cmd_view(args) -> int:
             raise CLIError(f"-o must end in .mp4 or .gif, got {str(out)!r}")
         check_outputs([("-o", args.output)], args.force, inputs=[("input", source)])
     try:
-        motion = bvh.load(source, scale=args.unit_scale)
+        motion = bvh.load(source, scale=args.unit_scale or bvh.DEFAULT_SCALE)
     except bvh.BVHError as e:
         raise CLIError(str(e)) from None
+    if motion.num_frames == 0:
+        raise CLIError(f"{source} has no frames to play (its MOTION block says Frames: 0)")
+    if args.unit_scale is None:
+        motion = motion_files.in_metres(motion, motion_files.file_unit(motion.skeleton))
     if args.canonical:
         from motionlab.core import humanoid
 
@@ -175,7 +179,11 @@ def register(subparsers) -> None:
             p,
             "--scale",
             p.add_argument(
-                "--unit-scale", type=positive, default=0.01, help="BVH units to metres (default 0.01: centimetres)"
+                "--unit-scale",
+                type=positive,
+                default=None,
+                help="BVH units to metres (default: the rig profile's unit, CMU's for CMU and Xia rigs, else 0.01 for "
+                "centimetres)",
             ),
         )
         p.add_argument("--start", type=non_negative_int, default=0, help="first frame")

@@ -152,3 +152,54 @@ def test_convert_to_glb_chooses_the_format_by_suffix(clip, tmp_path, capsys):
     assert_glb_matches(tmp_path / "x.glb", bvh.load(clip).resample(15))
     code, _, err = _run(capsys, "convert", clip, "-o", tmp_path / "x.glb")
     assert code == 2 and "--force" in err
+
+
+def _glb_height(path) -> float:
+    """Highest minus lowest node at the first keyframe, metres."""
+    from tests.gltf_reader import read, world_matrices
+
+    y = world_matrices(read(path), 0)[:, 1, 3]
+    return float(y.max() - y.min())
+
+
+def test_a_cmu_clip_keeps_its_size_through_a_canonical_bvh(tmp_path, capsys):
+    """--canonical writes centimetres: the 22 joints' names read back as centimetres, not CMU units."""
+    from tests.conftest import require_data
+
+    src = require_data("cmu", "131", "131_01.bvh")
+    canon = tmp_path / "canon.bvh"
+    for argv in (
+        (src, "-o", tmp_path / "direct.glb", "--canonical"),
+        (src, "-o", canon, "--canonical"),
+        (canon, "-o", tmp_path / "two_steps.glb"),
+    ):
+        code, _, err = _run(capsys, "convert", *argv)
+        assert code == 0, err
+    direct, two_steps = _glb_height(tmp_path / "direct.glb"), _glb_height(tmp_path / "two_steps.glb")
+    assert 1.0 < direct < 2.0
+    assert abs(two_steps - direct) < 1e-4 * direct
+
+
+def test_info_gives_a_cmu_rig_in_metres(capsys):
+    from tests.conftest import require_data
+
+    src = require_data("cmu", "131", "131_01.bvh")
+    code, out, err = _run(capsys, "info", src)
+    assert code == 0, err
+    height = float(out.split("height")[1].split()[0])
+    assert "m per file unit" in out and 1.0 < height < 2.0
+
+
+def test_synth_mix_is_the_same_motion_at_any_frame_rate(tmp_path, capsys):
+    seconds = []
+    for fps in (24, 60):
+        code, _, err = _run(capsys, "synth", "mix", "-o", tmp_path / f"m{fps}.bvh", "--fps", fps)
+        assert code == 0, err
+        seconds.append(bvh.load(tmp_path / f"m{fps}.bvh").duration)
+    assert abs(seconds[0] - seconds[1]) <= 7 / 24  # a frame per segment at most
+
+
+def test_synth_rounds_seconds_to_the_nearest_frame(tmp_path, capsys):
+    code, _, err = _run(capsys, "synth", "walk", "-o", tmp_path / "w.bvh", "--seconds", "0.29", "--fps", "100")
+    assert code == 0, err
+    assert bvh.load(tmp_path / "w.bvh").num_frames == 29

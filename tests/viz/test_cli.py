@@ -107,3 +107,15 @@ def test_open_window_adds_slider_and_timer(can_render):
     assert calls == [{"title": "motionlab view"}]
     assert len(scene.plotter.widgets.slider_widgets) == 1
     scene.close()
+
+
+def test_view_refuses_a_clip_without_frames(tmp_path, capsys):
+    from motionlab import cli
+
+    src = tmp_path / "empty.bvh"
+    src.write_text(
+        "HIERARCHY\nROOT Hips\n{\n OFFSET 0 90 0\n CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation "
+        "Yrotation\n End Site\n {\n  OFFSET 0 10 0\n }\n}\nMOTION\nFrames: 0\nFrame Time: 0.0333333\n"
+    )
+    assert cli.main(["view", str(src), "-o", str(tmp_path / "v.gif")]) == 2
+    assert "no frames" in capsys.readouterr().err and sorted(tmp_path.iterdir()) == [src]
