@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 from pathlib import Path
 
@@ -95,6 +96,11 @@ def register(subparsers) -> None:
         p.add_argument(
             "--blend", type=non_negative_int, default=8, help="transition blend length in frames (default 8)"
         )
+        p.add_argument(
+            "--keep-misses",
+            action="store_true",
+            help="write the nearest path even where a segment's count misses its request by more than 5%% or 2 frames",
+        )
         cli_args.add_force(p, "overwrite the output file")
 
     with cli_args.command(subparsers, "graph-info", _info) as p:
@@ -125,6 +131,10 @@ def _build_outputs(args: argparse.Namespace) -> tuple[Path, Path | None]:
     if args.synthetic and args.folder:
         raise CLIError(f"give a FOLDER of BVH clips or --synthetic, not both (FOLDER {args.folder} and --synthetic)")
     inputs = [("--name-map", args.name_map)]
+    if args.folder and Path(args.folder).is_dir():  # a --report named like a clip must not replace it
+        from motionlab.motion_graphs import clips
+
+        inputs += [("input clip", p) for p in clips.bvh_files(args.folder)]
     out, rep = check_outputs([("-o", out), ("--report", args.report)], args.force, inputs=inputs)
     return out, rep
 
@@ -147,9 +157,18 @@ def _load_clips(args: argparse.Namespace) -> list:
         return motions
     _check_folder_size(args.folder, args.fps)
     try:
-        return clips.load_folder(args.folder, args.fps, name_map, progress=not args.quiet)
+        motions = clips.load_folder(args.folder, args.fps, name_map, progress=not args.quiet)
     except NamingError as e:
         raise CLIError(str(e)) from None
+    skipped = clips.unlabelled_files(args.folder, name_map)
+    if skipped:
+        names = ", ".join(p.name for p in skipped[:5]) + (f" and {len(skipped) - 5} more" if len(skipped) > 5 else "")
+        print(
+            f"skipped {len(skipped)} of {len(skipped) + len(motions)} BVH files whose names give no behaviour_style "
+            f"label ({names}); --name-map labels them (motionlab.motion_graphs.naming)",
+            file=sys.stderr,
+        )
+    return motions
 
 
 def _header_seconds(path: Path) -> float:
@@ -171,9 +190,11 @@ def _header_seconds(path: Path) -> float:
 def _check_folder_size(folder: str, fps: float) -> None:
     """Refuse, before loading, a folder whose clips at ``--fps`` would be more frames than
     :func:`motionlab.cli_args.check_size` allows (read from the files' headers)."""
+    from motionlab.motion_graphs import clips
+
     folder_path = Path(folder)
     if folder_path.is_dir():
-        seconds = sum(_header_seconds(p) for p in folder_path.rglob("*.bvh"))
+        seconds = sum(_header_seconds(p) for p in clips.bvh_files(folder_path))
         cli_args.check_size(f"--fps {fps:g} over the {seconds:.0f} s of clips in {folder}", seconds * fps, 22)
 
 
@@ -225,6 +246,11 @@ def _build(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     g = _build_graph(args, motions)
     dt = time.perf_counter() - t0
+    if not g.alive.any():
+        raise CLIError(
+            f"pruning left none of the {g.num_frames} frames of the {len(motions)} clips alive (no cycle of "
+            f"transitions joins them at --fps {args.fps:g}): the graph could play nothing; raise --fps or --distance-threshold"
+        )
     clock.extend(g.info.get("stages", []))
     g.info["input_clips"] = len(motions)
     with clock("report"):
@@ -297,11 +323,29 @@ def _search(args: argparse.Namespace) -> int:
         dt = time.perf_counter() - t0
     except search.SearchError as e:
         raise CLIError(str(e)) from None
+    _check_misses(result, args.keep_misses)
     motion = synthesis.synthesize(g, result.pieces, blend=args.blend)
     motion_files.save(out, motion, overwrite=args.force, unit=motion_files.file_unit(motion.skeleton))
     print(f"found a {result.num_frames}-frame path ({len(result.pieces)} pieces) in {dt * 1000:.1f} ms -> {out}")
     print(result.report())
     return 0
+
+
+def _check_misses(result, keep: bool) -> None:
+    """Refuse a path whose segments miss their counts by more than the tolerance, unless ``keep``."""
+    from motionlab.motion_graphs import search
+
+    if not result.misses:
+        return
+    text = "; ".join(
+        f"{s.behaviour}:{s.style} asks for {s.frames} frames, and the nearest walk this graph has gives {a} "
+        f"(±{search.tolerance_frames(s.frames)} allowed)"
+        for k, (s, a) in enumerate(zip(result.segments, result.achieved))
+        if k in result.misses
+    )
+    if not keep:
+        raise CLIError(f"{text}; ask for other counts, or --keep-misses writes the nearest path anyway")
+    print(f"warning: {text}; written as asked by --keep-misses", file=sys.stderr)
 
 
 def _info(args: argparse.Namespace) -> int:

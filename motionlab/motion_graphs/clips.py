@@ -28,6 +28,8 @@ from motionlab.motion_graphs.naming import MIXAMO_AJ, NamingError, label_name, p
 __all__ = [
     "prepare",
     "load_folder",
+    "bvh_files",
+    "unlabelled_files",
     "bandai_styles",
     "mixamo_aj",
     "synthetic_library",
@@ -66,10 +68,27 @@ def prepare(motion: Motion, fps: float) -> Motion:
     return out.copy(fps=float(fps)) if same else out
 
 
+def bvh_files(folder: str | os.PathLike) -> list[Path]:
+    """Every file under ``folder`` (recursively) whose suffix is ``.bvh`` in any case, sorted."""
+    return sorted(p for p in Path(folder).rglob("*") if p.suffix.lower() == ".bvh" and p.is_file())
+
+
+def unlabelled_files(folder: str | os.PathLike, name_map=None) -> list[Path]:
+    """The files of :func:`bvh_files` whose names give no label (:func:`.naming.parse_name`):
+    :func:`load_folder` skips them."""
+    out = []
+    for path in bvh_files(folder):
+        try:
+            parse_name(path.stem, name_map)
+        except NamingError:
+            out.append(path)
+    return out
+
+
 def load_folder(
     folder: str | os.PathLike, fps: float = 30.0, name_map=None, strict: bool = False, progress: bool = False
 ) -> list[Motion]:
-    """Every ``.bvh`` under ``folder`` (recursively), reduced, resampled and named by label
+    """Every BVH file under ``folder`` (:func:`bvh_files`), reduced, resampled and named by label
     (``walk_angry_001``: behaviour, style and take, see :mod:`.naming`).
 
     ``name_map``: ``{stem: label text}`` or a callable (:func:`.naming.parse_name`). Files whose
@@ -84,7 +103,7 @@ def load_folder(
     if not folder.is_dir():
         raise FileNotFoundError(f"{folder} is not a folder of BVH files")
     out = []
-    paths = sorted(folder.rglob("*.bvh"))
+    paths = bvh_files(folder)
     if progress:
         from tqdm.auto import tqdm
 
@@ -96,7 +115,10 @@ def load_folder(
             if strict:
                 raise
             continue
-        out.append(prepare(bvh.load(path), fps).copy(name=label_name(label)))
+        motion = bvh.load(path)
+        if motion.num_frames == 0:
+            raise ValueError(f"{path} has no frames (its MOTION block says Frames: 0); a clip of a graph needs some")
+        out.append(prepare(motion, fps).copy(name=label_name(label)))
     if not out:
         raise FileNotFoundError(
             f"no BVH file under {folder} has a behaviour_style name (see motionlab.motion_graphs.naming)"

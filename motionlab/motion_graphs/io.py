@@ -234,6 +234,20 @@ def _mapped(path: Path, fh, info: zipfile.ZipInfo, size: int) -> np.ndarray:
     return np.memmap(path, dtype=dtype, mode="c", offset=offset, shape=shape, order="F" if fortran else "C")
 
 
+def _check_crc(path: Path, fh, info: zipfile.ZipInfo, size: int) -> None:
+    """Raise :class:`GraphError` when a stored member's bytes do not give the CRC-32 its zip entry
+    records (a mapped array is never read through :mod:`zipfile`, which would check it)."""
+    offset = _member_offset(fh, info)
+    if offset + info.file_size > size:
+        raise EOFError("member runs past the end of the file")
+    data = np.memmap(path, dtype=np.uint8, mode="r", offset=offset, shape=(info.file_size,)) if info.file_size else b""
+    if zlib.crc32(data) != info.CRC:
+        raise GraphError(
+            f"{path} is damaged: the bytes of its {info.filename[: -len('.npy')]!r} array do not match the "
+            "checksum written with them; build the graph again (graph-build)"
+        )
+
+
 def _read_meta(z: zipfile.ZipFile) -> dict:
     with z.open("meta.npy") as f:
         m = np.lib.format.read_array(f, allow_pickle=False)
@@ -295,6 +309,8 @@ def _arrays(path: Path) -> tuple[dict, dict]:
         if meta["format"] == FORMAT and stored:
             size = path.stat().st_size
             with open(path, "rb") as fh:
+                for k in keys:
+                    _check_crc(path, fh, names[k], size)
                 return meta, {k: _mapped(path, fh, names[k], size) for k in keys}
         arrays = {}
         for k in keys:
@@ -307,7 +323,7 @@ def load(path: str | os.PathLike) -> MotionGraph:
     """Read a graph written by :func:`save`; its arrays are memory-mapped (module docstring).
 
     Raises :class:`GraphError` naming the file for anything else: a file that is not a zip
-    archive, a truncated or damaged one, an archive without the graph's entries, or a format
+    archive, a truncated or damaged one (every array's CRC-32 is checked), an archive without the graph's entries, or a format
     version it cannot read (``motionlab-graph-1``: rebuild it). ``FileNotFoundError`` when there
     is no file.
     """

@@ -71,6 +71,7 @@ __all__ = [
     "SearchError",
     "RequestTooLong",
     "TOLERANCE",
+    "tolerance_frames",
     "MAX_FRAMES",
     "PoolWalker",
     "pool_walker",
@@ -86,6 +87,11 @@ TOLERANCE = 0.05
 """Documented accuracy: every reachable segment gets its requested length within
 ``max(2 frames, 5%)``; inside that band the walk whose jumps cost least wins (with the default search
 cost, the walk with the fewest jumps; checked by the tests)."""
+
+
+def tolerance_frames(frames: int) -> int:
+    """Frames a segment of ``frames`` requested frames may be off by: ``max(2, ⌊TOLERANCE·frames⌋)``."""
+    return max(2, int(TOLERANCE * frames))
 
 
 JUMP_FRAMES = 8
@@ -167,6 +173,12 @@ class SearchResult:
     def errors(self) -> list[int]:
         return [a - r for a, r in zip(self.achieved, self.requested)]
 
+    @property
+    def misses(self) -> list[int]:
+        """Indices of the segments whose frame count is off by more than :func:`tolerance_frames` allows (the
+        graph has no walk of that length: the nearest was taken)."""
+        return [k for k, (e, r) in enumerate(zip(self.errors, self.requested)) if abs(e) > tolerance_frames(r)]
+
     def transitions(self) -> list[int]:
         """Output frame index where each piece after the first begins."""
         out, t = [], 0
@@ -178,7 +190,8 @@ class SearchResult:
     def report(self) -> str:
         lines = []
         for k, (s, a) in enumerate(zip(self.segments, self.achieved)):
-            lines.append(f"{s.behaviour}:{s.style}: requested {s.frames}, got {a} ({a - s.frames:+d})")
+            off = f", outside the ±{tolerance_frames(s.frames)} allowed" if k in self.misses else ""
+            lines.append(f"{s.behaviour}:{s.style}: requested {s.frames}, got {a} ({a - s.frames:+d}{off})")
             if k < len(self.passing) and self.passing[k]:
                 lines.append(f"  then {self.passing[k]} frames through other styles on the way")
         return "\n".join(lines)
@@ -1033,7 +1046,10 @@ class Planner:
             reach = sorted({f"{k[0]}/{k[1]}" for k in prev})
             behaviours = {k[0] for k in prev}
             if b[0] not in behaviours:
-                why = f"no recorded transition clip leads from behaviour {a[0]!r} (or its styles) to {b[0]!r}"
+                why = (
+                    f"neither a recorded transition clip nor a stance link (a pose the two share) leads from "
+                    f"behaviour {a[0]!r} (or its styles) to {b[0]!r}"
+                )
             else:
                 why = f"no interpolation-space path between styles {a[1]!r} and {b[1]!r} of {b[0]!r}"
             raise SearchError(
@@ -1184,7 +1200,7 @@ class Planner:
                 bar.update(seg.frames)
             cw = self.walker(keys[k])
             name = f"{seg.behaviour}/{seg.style}"
-            slack = max(2, int(TOLERANCE * seg.frames))
+            slack = tolerance_frames(seg.frames)
             if k == len(segs) - 1 or not plans[k]:
                 p, _, n = _walk(cw, enter, [seg.frames], [-1], name, slack)
                 pieces.extend(p)

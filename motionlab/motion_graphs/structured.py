@@ -519,27 +519,40 @@ def _prune_pool(graph: MotionGraph, cmp: _Compare, ks: list[int], opt: _Options,
 def _structure_table(graph: MotionGraph, arr: _Arranged, cuts: _Cuts, opt: _Options) -> dict:
     """Stage 4: the structure table's cells (behaviour → style → takes, spans and counts)."""
     clips = graph.clips
-    loop_kind = EDGE_KINDS.index("loop")
     table: dict = {"behaviours": {}, "links": []}
     for (b, s), ks in sorted(arr.pools.items()):
         st, sp = clips[ks[0]].start, clips[ks[-1]].stop
-        live = graph.alive[graph.src] & graph.alive[graph.dst]
-        inside = live & (graph.src >= st) & (graph.src < sp) & (graph.dst >= st) & (graph.dst < sp)
         takes = [_take_row(graph, c, st, cuts) for c in ks]
         kinds = [t["kind"] for t in takes if t["kind"] is not None]
         table["behaviours"].setdefault(b, {})[s] = {
             "kind": max(sorted(set(kinds)), key=kinds.count) if kinds else None,
             "start": st,
             "frames": sp - st,
-            "alive": int(graph.alive[st:sp].sum()),
             "takes": takes,
             "representative": cuts.rep[(b, s)],
             "representative_cycles": list(cuts.rep_span((b, s), opt.rep_cycles)),
-            "transitions": int(inside.sum()),
-            "loops": int((inside & (graph.kind == loop_kind)).sum()),
             "synthetic": bool(any(clips[c].synthetic for c in ks)),
         }
+    _count_cells(graph, table)
     return table
+
+
+def _count_cells(graph: MotionGraph, table: dict) -> None:
+    """Set each cell's (and take's) ``alive`` frames and the cell's ``transitions`` and ``loops``
+    (alive edges inside the cell) from the graph as it now stands."""
+    loop_kind = EDGE_KINDS.index("loop")
+    live = graph.alive[graph.src] & graph.alive[graph.dst]
+    for cell in (c for styles in table["behaviours"].values() for c in styles.values()):
+        st, sp = cell["start"], cell["start"] + cell["frames"]
+        inside = live & (graph.src >= st) & (graph.src < sp) & (graph.dst >= st) & (graph.dst < sp)
+        cell.update(
+            alive=int(graph.alive[st:sp].sum()),
+            transitions=int(inside.sum()),
+            loops=int((inside & (graph.kind == loop_kind)).sum()),
+        )
+        for take in cell["takes"]:
+            ci = graph.clips[take["clip"]]
+            take["alive"] = int(graph.alive[ci.start : ci.stop].sum())
 
 
 def _take_row(graph: MotionGraph, c: int, st: int, cuts: _Cuts) -> dict:
@@ -550,7 +563,6 @@ def _take_row(graph: MotionGraph, c: int, st: int, cuts: _Cuts) -> dict:
         "take": ci.take,
         "offset": ci.start - st,
         "frames": ci.num_frames,
-        "alive": int(graph.alive[ci.start : ci.stop].sum()),
         "cycles": 0 if cy is None else cy.count,
         "cycle_span": [0, 0] if cy is None else list(cy.span),
         "kind": None if sg is None else sg.kind,
@@ -858,6 +870,7 @@ def _finish(graph: MotionGraph, table: dict, on_route: np.ndarray | None) -> Non
             graph.alive[c.start : c.stop] &= on_route[c.start : c.stop]
     graph.drop_dead_edges()
     _dedupe(graph)
+    _count_cells(graph, table)
     graph.table = table
 
 
@@ -971,12 +984,16 @@ def _trace_route(graph: MotionGraph, order: list[int], edges: list, choice: dict
     }
 
 
+_LINK_WORDS = {"interpolation": "interp.", "stance": "stance"}
+"""How :func:`structure_rows` names a link's kind (else a recorded transition ``clip``)."""
+
+
 def structure_rows(graph: MotionGraph) -> list[dict]:
     """The structure table as rows (behaviour, style, takes, first frame, frames, alive, links out)."""
     links_out: dict[tuple[str, str], list[str]] = {}
     for link in graph.table.get("links", []):
         links_out.setdefault(tuple(link["from"]), []).append(
-            f"{link['to'][0]}/{link['to'][1]} ({'interp.' if link['via'] == 'interpolation' else 'clip'}, {len(link['routes'])})"
+            f"{link['to'][0]}/{link['to'][1]} ({_LINK_WORDS.get(link['via'], 'clip')}, {len(link['routes'])})"
         )
     rows = []
     for b, styles in sorted(graph.table.get("behaviours", {}).items()):

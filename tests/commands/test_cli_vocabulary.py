@@ -55,6 +55,7 @@ VOCABULARY = {
     "--network": ("network", "text", "which retargeting network: auto, real or synthetic"),
     "--canonical": ("canonical", "flag", "reduce the rig to the canonical 22 joints"),
     "--keep-implausible": ("keep_implausible", "flag", "keep outputs that fail the plausibility check"),
+    "--keep-misses": ("keep_misses", "flag", "write a graph-search path whose counts miss the request"),
     "--characters": ("characters", "text", "target characters given as rigs (expand)"),
     "--num-characters": ("num_characters", "positive_int", "how many synthetic characters (demo)"),
     "--root": ("root", "text", "root trajectory rule of retargeting (stride, hips, legs, contacts)"),

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import zipfile
 
 import numpy as np
 import pytest
@@ -178,3 +179,76 @@ def test_old_format_is_named(sgraph, tmp_path):
         np.savez(fh, **arrays)
     with pytest.raises(ValueError, match="old.mlgraph.*motionlab-graph-1.*rebuild"):
         io.load(old)
+
+
+def test_a_count_the_graph_cannot_meet_is_refused_by_name(sgraph, tmp_path, capsys):
+    """walk:normal:4 before a run: the shortest route out of the walk is longer than 4 + 2 frames."""
+    result = search.search(sgraph, "walk:normal:4,run:normal:60")
+    assert result.misses == [0] and "outside the ±2 allowed" in result.report()
+    assert search.search(sgraph, "walk:normal:120,run:normal:60").misses == []
+    g, out = io.save(tmp_path / "g", sgraph), tmp_path / "o.bvh"
+    argv = ["graph-search", str(g), "--request", "walk:normal:4,run:normal:60", "-o", str(out)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert f"walk:normal asks for 4 frames, and the nearest walk this graph has gives {result.achieved[0]}" in err
+    assert "--keep-misses" in err and not out.exists()
+    assert main([*argv, "--keep-misses"]) == 0
+    assert "written as asked by --keep-misses" in capsys.readouterr().err and out.is_file()
+
+
+def test_a_flipped_byte_in_an_array_is_named(sgraph, tmp_path, capsys):
+    path = io.save(tmp_path / "g", sgraph)
+    raw = bytearray(path.read_bytes())
+    with zipfile.ZipFile(path) as z:
+        info = z.getinfo("root_pos.npy")
+    raw[info.header_offset + 30 + len(info.filename) + len(info.extra) + 200] ^= 0xFF  # inside the array's data
+    path.write_bytes(bytes(raw))
+    with pytest.raises(ValueError, match="'root_pos' array"):
+        io.load(path)
+    assert main(["graph-info", str(path)]) == 2 and "damaged" in capsys.readouterr().err
+
+
+def test_the_structure_table_counts_the_graph_as_built(sgraph):
+    """Every cell's alive frames, transitions and loops are the graph's, after the last stage."""
+    live = sgraph.alive[sgraph.src] & sgraph.alive[sgraph.dst]
+    for styles in sgraph.table["behaviours"].values():
+        for cell in styles.values():
+            st, sp = cell["start"], cell["start"] + cell["frames"]
+            inside = live & (sgraph.src >= st) & (sgraph.src < sp) & (sgraph.dst >= st) & (sgraph.dst < sp)
+            assert cell["alive"] == int(sgraph.alive[st:sp].sum())
+            assert cell["transitions"] == int(inside.sum())
+            assert sum(t["alive"] for t in cell["takes"]) == cell["alive"]
+
+
+def test_build_names_skipped_files_reads_any_case_and_protects_its_inputs(library, tmp_path, capsys):
+    from motionlab.core import bvh
+
+    folder = tmp_path / "clips"
+    folder.mkdir()
+    walks = [m for m in library if m.name.startswith("walk_normal")]
+    bvh.save(folder / "walk_normal_001.BVH", walks[0])
+    bvh.save(folder / "walk normal (copy).bvh", walks[0])
+    out = tmp_path / "g.mlgraph"
+    assert main(["graph-build", str(folder), "-o", str(out), "-q"]) == 0
+    err = capsys.readouterr().err
+    assert "skipped 1 of 2 BVH files" in err and "walk normal (copy).bvh" in err
+    assert io.load(out).info["input_clips"] == 1
+    clip = folder / "walk_normal_001.BVH"
+    before = clip.read_bytes()
+    assert main(["graph-build", str(folder), "-o", str(out), "--report", str(clip), "--force", "-q"]) == 2
+    assert "is the input clip file" in capsys.readouterr().err and clip.read_bytes() == before
+
+
+def test_build_refuses_a_clip_without_frames_and_a_graph_with_nothing_alive(library, tmp_path, capsys):
+    from motionlab.core import bvh
+
+    folder = tmp_path / "clips"
+    folder.mkdir()
+    walk = next(m for m in library if m.name.startswith("walk_normal"))
+    bvh.save(folder / "walk_normal_001.bvh", walk)
+    assert main(["graph-build", str(folder), "-o", str(tmp_path / "g"), "--fps", "1", "-q"]) == 2
+    assert "none of the" in capsys.readouterr().err and not (tmp_path / "g.mlgraph").exists()
+    header = bvh.dumps(walk[0:1]).split("Frames:")[0]
+    (folder / "walk_normal_002.bvh").write_text(header + "Frames: 0\nFrame Time: 0.0333333\n")
+    assert main(["graph-build", str(folder), "-o", str(tmp_path / "g"), "-q"]) == 2
+    assert "walk_normal_002.bvh has no frames" in capsys.readouterr().err
