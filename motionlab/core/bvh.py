@@ -620,6 +620,10 @@ def _decode(data: bytes, source: str, first_line: int = 1) -> str:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
         line = first_line + data.count(b"\n", 0, exc.start)
+        if first_line == 1 and data.startswith(b"glTF"):
+            raise BVHError(
+                source, 1, "a binary glTF (.glb) file, not BVH text; motionlab reads motion from BVH"
+            ) from None
         raise BVHError(source, line, f"expected UTF-8 text, found the byte {data[exc.start]:#04x}") from None
 
 
@@ -637,6 +641,8 @@ def _read_header(f, size: int, source: str):
     """The parsed header of a binary stream of ``size`` bytes, the tokens and bytes read so far,
     the byte-order mark's length and whether lines end in CR alone."""
     head = f.read(min(size, _HEADER_START))
+    if head.startswith(b"glTF"):
+        raise BVHError(source, 1, "a binary glTF (.glb) file, not BVH text; motionlab reads motion from BVH")
     bom = 3 if head.startswith(b"\xef\xbb\xbf") else 0
     head, size = head[bom:], size - bom
     # Old Mac files end lines with CR alone: read every CR as a line end when the start has no LF

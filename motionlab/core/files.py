@@ -27,6 +27,7 @@ from pathlib import Path
 __all__ = [
     "TMP_SUFFIX",
     "check_input",
+    "bvh_files",
     "check_output",
     "check_replaceable",
     "exists_message",
@@ -39,6 +40,13 @@ __all__ = [
 
 TMP_SUFFIX = ".motionlab-tmp"
 """Ending of every temporary file a motionlab writer creates."""
+
+
+def bvh_files(folder: str | os.PathLike, recursive: bool = False) -> list[Path]:
+    """The files in ``folder`` (and its subfolders when ``recursive``) whose suffix is ``.bvh`` in
+    any case, sorted."""
+    found = Path(folder).rglob("*") if recursive else Path(folder).glob("*")
+    return sorted(p for p in found if p.suffix.lower() == ".bvh" and p.is_file())
 
 
 def check_input(path: str | os.PathLike, what: str = "input") -> Path:

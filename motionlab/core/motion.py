@@ -165,18 +165,19 @@ class Motion:
         return _fk.local_to_global(self.local_rot, self.skeleton.parents)
 
     # ------------------------------------------------------------------ time
-    def resample(self, fps: float) -> Motion:
+    def resample(self, fps: float, frames: int | None = None) -> Motion:
         """The motion at another frame rate: SLERP for rotations, linear for positions.
 
-        The first frame is kept; the last new frame is the last one at or before the end.
+        The first frame is kept; the last new frame is the last one at or before the end, or, with
+        ``frames``, there are that many new frames and those after the end hold the last pose.
         Frame rates within 1e-4 (relative) of a whole number count as that number: BVH files
         write ``Frame Time: 0.0333333``, which means 30 fps, not 30.0000003.
         """
         fps = _check_fps(fps)
         src = _nominal(self.fps)
-        if abs(_nominal(fps) - src) < 1e-9 * src or self.num_frames < 2:
+        n_new = resampled_frames(self.num_frames, self.fps, fps) if frames is None else int(frames)
+        if (abs(_nominal(fps) - src) < 1e-9 * src or self.num_frames < 2) and n_new == self.num_frames:
             return self.copy(fps=float(fps))
-        n_new = resampled_frames(self.num_frames, self.fps, fps)
         t = np.arange(n_new) * (src / _nominal(fps))  # in source frames
         i0 = np.clip(np.floor(t).astype(np.int64), 0, self.num_frames - 1)
         i1 = np.clip(i0 + 1, 0, self.num_frames - 1)

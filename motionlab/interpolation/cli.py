@@ -109,13 +109,14 @@ def _takes(paths: list[str], src: Path, motion):
     """:class:`~.recorded.RecordedTakes` of the ``--takes`` files (none of them the input), each on
     the input ``motion``'s skeleton and frame rate."""
     from motionlab.core import bvh
+    from motionlab.core.files import bvh_files
     from motionlab.interpolation.recorded import RecordedTakes
 
     files = []
     for path in paths:
         p = Path(path)
         if p.is_dir():  # a session's folder: every take in it but the input
-            found = [f for f in sorted(p.glob("*.bvh")) if f.resolve() != src.resolve()]
+            found = [f for f in bvh_files(p) if f.resolve() != src.resolve()]
             if not found:
                 raise CLIError(f"--takes {path}: a folder without BVH files (other than the input)")
             files += found
@@ -169,6 +170,10 @@ PROGRESS_FRAMES = 2000
 MAX_GROWTH = 10
 """``--times`` may at most make the clip this many times longer: more means wrong times."""
 
+RATE_AGREEMENT = 0.01
+"""``--times`` must step one Frame Time within this fraction (median step): NTSC's 29.97 fps is
+0.1 % from 30, and the nearest two common rates, 24 and 25 fps, are 4 % apart."""
+
 
 def _times_gaps(path: str, src: Path, motion) -> list[tuple[int, int]]:
     """The gaps ``(after frame i, count)`` that the ``--times`` file gives, checked against the
@@ -193,7 +198,13 @@ def _times_gaps(path: str, src: Path, motion) -> list[tuple[int, int]]:
             f"--times {path}: consecutive times are {step:g} apart (median), but the Frame Time of {src} is "
             f"{period:g} s; expected one time per frame in seconds{hint}"
         )
-    missing = gaps.timestamp_gaps(times, motion.fps)
+    if abs(step / period - 1.0) > RATE_AGREEMENT:
+        raise CLIError(
+            f"--times {path}: consecutive times are {step:g} s apart (median; {1 / step:.4g} fps), but the Frame "
+            f"Time of {src} is {period:g} s ({motion.fps:.4g} fps); expected one time per frame of this file, "
+            f"within {RATE_AGREEMENT:.0%}: are they the times of another take or rate?"
+        )
+    missing = gaps.timestamp_gaps(times, 1.0 / step)  # counted in the capture's own frame period
     added = sum(n for _, n in missing)
     if added > (MAX_GROWTH - 1) * motion.num_frames:
         raise CLIError(
@@ -231,6 +242,13 @@ def _check_args(args: argparse.Namespace):
         raise CLIError(
             "--times gives the gaps and their counts, so --takes and --delta would not be used; "
             "give --times alone, or leave it out"
+        )
+    if args.allow and not args.action:
+        raise CLIError("--allow names transitions between --action clips; give the --action NAME=FILE.bvh clips too")
+    if args.action and args.times is not None and args.method != "graph":
+        raise CLIError(
+            "--action builds the action graph that finds the gaps (or, with --method graph, fills them); --times "
+            "gives the gaps, so the graph would not be used: leave out --action, or add --method graph"
         )
     src = files.check_input(args.input)
     inputs = [("input", src), ("--times", args.times)] + [("--takes", t) for t in args.takes]
@@ -294,7 +312,7 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
         raise CLIError(str(e)) from None
     bar = Stages(("find gaps", "fill", "write"), "fill-gaps", disable=args.quiet or motion.num_frames < PROGRESS_FRAMES)
     bar.start("find gaps")
-    graph = _graph(args.action, args.allow, src, motion) if args.method == "graph" else None
+    graph = _graph(args.action, args.allow, src, motion) if args.method == "graph" or args.action else None
     if args.times is not None:
         missing = _times_gaps(args.times, src, motion)
     else:

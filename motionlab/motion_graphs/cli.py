@@ -132,9 +132,9 @@ def _build_outputs(args: argparse.Namespace) -> tuple[Path, Path | None]:
         raise CLIError(f"give a FOLDER of BVH clips or --synthetic, not both (FOLDER {args.folder} and --synthetic)")
     inputs = [("--name-map", args.name_map)]
     if args.folder and Path(args.folder).is_dir():  # a --report named like a clip must not replace it
-        from motionlab.motion_graphs import clips
+        from motionlab.core import files
 
-        inputs += [("input clip", p) for p in clips.bvh_files(args.folder)]
+        inputs += [("input clip", p) for p in files.bvh_files(args.folder, recursive=True)]
     out, rep = check_outputs([("-o", out), ("--report", args.report)], args.force, inputs=inputs)
     return out, rep
 
@@ -190,11 +190,11 @@ def _header_seconds(path: Path) -> float:
 def _check_folder_size(folder: str, fps: float) -> None:
     """Refuse, before loading, a folder whose clips at ``--fps`` would be more frames than
     :func:`motionlab.cli_args.check_size` allows (read from the files' headers)."""
-    from motionlab.motion_graphs import clips
+    from motionlab.core import files
 
     folder_path = Path(folder)
     if folder_path.is_dir():
-        seconds = sum(_header_seconds(p) for p in clips.bvh_files(folder_path))
+        seconds = sum(_header_seconds(p) for p in files.bvh_files(folder_path, recursive=True))
         cli_args.check_size(f"--fps {fps:g} over the {seconds:.0f} s of clips in {folder}", seconds * fps, 22)
 
 

@@ -20,7 +20,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from motionlab import data as _data
-from motionlab.core import bvh, preprocess
+from motionlab.core import bvh, files, preprocess
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
 from motionlab.motion_graphs.naming import MIXAMO_AJ, NamingError, label_name, parse_name
@@ -28,7 +28,6 @@ from motionlab.motion_graphs.naming import MIXAMO_AJ, NamingError, label_name, p
 __all__ = [
     "prepare",
     "load_folder",
-    "bvh_files",
     "unlabelled_files",
     "bandai_styles",
     "mixamo_aj",
@@ -68,16 +67,11 @@ def prepare(motion: Motion, fps: float) -> Motion:
     return out.copy(fps=float(fps)) if same else out
 
 
-def bvh_files(folder: str | os.PathLike) -> list[Path]:
-    """Every file under ``folder`` (recursively) whose suffix is ``.bvh`` in any case, sorted."""
-    return sorted(p for p in Path(folder).rglob("*") if p.suffix.lower() == ".bvh" and p.is_file())
-
-
 def unlabelled_files(folder: str | os.PathLike, name_map=None) -> list[Path]:
-    """The files of :func:`bvh_files` whose names give no label (:func:`.naming.parse_name`):
-    :func:`load_folder` skips them."""
+    """The BVH files under ``folder`` (recursively) whose names give no label
+    (:func:`.naming.parse_name`): :func:`load_folder` skips them."""
     out = []
-    for path in bvh_files(folder):
+    for path in files.bvh_files(folder, recursive=True):
         try:
             parse_name(path.stem, name_map)
         except NamingError:
@@ -88,7 +82,7 @@ def unlabelled_files(folder: str | os.PathLike, name_map=None) -> list[Path]:
 def load_folder(
     folder: str | os.PathLike, fps: float = 30.0, name_map=None, strict: bool = False, progress: bool = False
 ) -> list[Motion]:
-    """Every BVH file under ``folder`` (:func:`bvh_files`), reduced, resampled and named by label
+    """Every BVH file under ``folder`` (recursively, ``.bvh`` in any case), reduced, resampled and named by label
     (``walk_angry_001``: behaviour, style and take, see :mod:`.naming`).
 
     ``name_map``: ``{stem: label text}`` or a callable (:func:`.naming.parse_name`). Files whose
@@ -103,7 +97,7 @@ def load_folder(
     if not folder.is_dir():
         raise FileNotFoundError(f"{folder} is not a folder of BVH files")
     out = []
-    paths = bvh_files(folder)
+    paths = files.bvh_files(folder, recursive=True)
     if progress:
         from tqdm.auto import tqdm
 

@@ -281,28 +281,46 @@ def _why(err: Exception, role: str, path) -> str:
 def _check_name(name: str, what: str) -> None:
     if not name or name in (".", "..") or "/" in name or "\\" in name or name.startswith("."):
         raise ValueError(f"{what} name {name!r} cannot be a folder or file name")
+    if what == "character" and name == MANIFEST:
+        raise ValueError(f"character name {name!r} is the job's manifest file's; name the character otherwise")
 
 
 def find_sources(specs: Sequence[str]) -> list[tuple[str, Path]]:
-    """``(clip name, path)`` for BVH files, folders (their ``*.bvh``, sorted) and glob patterns.
+    """``(clip name, path)`` for BVH files, folders (their BVH files, sorted) and glob patterns; a
+    file named twice (by any path) counts once.
 
-    Clip names are file stems, made unique with the parent folder where stems repeat.
+    Clip names are file stems; where stems repeat, the folders above them are put in front
+    (``take_Run``, then ``a_take_Run``) until every name is unique.
     Raises ``ValueError`` when a spec matches nothing.
     """
-    paths: list[Path] = []
+    paths: dict[Path, Path] = {}
     for spec in specs:
         p = Path(spec)
         if p.is_dir():
-            found = sorted(p.glob("*.bvh"))
+            found = files.bvh_files(p)
         elif p.is_file():
             found = [p]
         else:
             found = sorted(Path(f) for f in glob.glob(str(spec), recursive=True) if f.lower().endswith(".bvh"))
         if not found:
             raise ValueError(f"source {spec!r} matches no BVH file")
-        paths.extend(f for f in found if f not in paths)
-    stems = [p.stem for p in paths]
-    return [(p.stem if stems.count(p.stem) == 1 else f"{p.parent.name}_{p.stem}", p) for p in paths]
+        for f in found:
+            paths.setdefault(f.resolve(), f)
+    return list(zip(_unique_names([Path(os.path.abspath(f)) for f in paths.values()]), paths.values()))
+
+
+def _unique_names(paths: list[Path]) -> list[str]:
+    """A name per distinct absolute path: its stem, with as many folders above it in front as make
+    it unique."""
+    depth = [0] * len(paths)
+    while True:
+        names = ["_".join([*p.parent.parts[max(0, len(p.parent.parts) - d) :], p.stem]) for p, d in zip(paths, depth)]
+        repeated = {n for n in names if names.count(n) > 1}
+        if not repeated:
+            return names
+        for k, n in enumerate(names):
+            if n in repeated:
+                depth[k] += 1
 
 
 def check_output_layout(
@@ -512,12 +530,13 @@ def _row(pr: PairResult, src: _Source, char: Character, limits, suffix: str, out
 
 @dataclass
 class _Source:
-    """What the rows need of a source clip: its path, skating (cm/s), frame rate and SHA-256."""
+    """What the rows need of a source clip: its path, skating (cm/s), frame rate, frames and SHA-256."""
 
     path: str
     skating: float
     fps: float
     digest: str
+    frames: int
 
 
 def _reuse(old: dict | None, file: Path, expected: tuple[str, str, str], output: str) -> str:
@@ -786,7 +805,7 @@ def _finished_output(pair: Pair, job, solved, batch_size: int, seconds: float, c
 def _output(pr: PairResult, sources_by_clip, chars, limits, suffix, options, fps):
     """``(row, file, bytes, plausible, source frames)`` of one retargeted pair, ready to write."""
     src = sources_by_clip[pr.clip]
-    motion = at_rate(pr.result, fps or src.fps, src.fps).motion
+    motion = at_rate(pr.result, fps or src.fps, src.fps, src.frames).motion
     char = chars[pr.character]
     row = _row(pr, src, char, limits, suffix, motion, options)
     data = motion_files.encode(motion, suffix, char.unit)
@@ -902,7 +921,7 @@ class _Sources:
             for c in chars:
                 self._error(clip, c, _why(err, "source", path))
             return
-        self.sources[clip] = _Source(str(path), skating, motion.fps, digest)
+        self.sources[clip] = _Source(str(path), skating, motion.fps, digest, motion.num_frames)
         rates = (motion.fps, self.checkpoint.fps, self.fps or motion.fps)
         if max(rates) - min(rates) > 1e-4 * max(rates):
             self.result.resampled.append(

@@ -430,12 +430,14 @@ def _same_rate(a: float, b: float) -> bool:
     return abs(a - b) <= 1e-4 * max(a, b)
 
 
-def at_rate(result: RetargetResult, fps: float, source_fps: float) -> RetargetResult:
+def at_rate(result: RetargetResult, fps: float, source_fps: float, source_frames: int | None = None) -> RetargetResult:
     """``result`` resampled to ``fps`` (frames per second), with ``resampled`` saying what happened.
 
     ``source_fps`` is the source file's rate; the text names every rate the clip went through
     (source, network, output) whenever one differs from another, so callers can always print it.
-    Rates within 1e-4 (relative) are the same. Plausibility stays that of the solved rate.
+    Rates within 1e-4 (relative) are the same. At the source's rate the output has the source's
+    ``source_frames`` (where given): a frame the network's rate fell short of holds the last pose.
+    Plausibility stays that of the solved rate.
     """
     solved = result.motion.fps
     if _same_rate(fps, solved) and _same_rate(source_fps, solved):
@@ -443,7 +445,8 @@ def at_rate(result: RetargetResult, fps: float, source_fps: float) -> RetargetRe
     note = f"resampled: source {source_fps:g} fps -> network {solved:g} fps -> output {fps:g} fps"
     if _same_rate(fps, solved):
         return replace(result, resampled=note)
-    motion = result.motion.resample(fps)
+    frames = source_frames if _same_rate(fps, source_fps) else None
+    motion = result.motion.resample(fps, frames)
     return replace(result, motion=motion, positions=motion.global_positions(), resampled=note)
 
 
@@ -550,4 +553,4 @@ def retarget(
             res.best_step,
         )
     result = finish(pair, heading_rot, method, history, reason, steps, time.perf_counter() - start, best)
-    return at_rate(result, fps or source.fps, source.fps)
+    return at_rate(result, fps or source.fps, source.fps, source.num_frames)

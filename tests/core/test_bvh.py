@@ -13,6 +13,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from motionlab import synthetic
 from motionlab.core import bvh, humanoid, quat
 from motionlab.core.bvh import BVHError
 from motionlab.core.motion import Motion
@@ -819,3 +820,12 @@ def test_header_reads_no_motion_block_and_names_the_file_and_line_of_a_bad_heade
     bad.write_text(good.replace("Frame Time:", "Frame Tme:"))
     with pytest.raises(BVHError, match=r"bad\.bvh.*line \d+.*Frame Time"):
         bvh.header(bad)
+
+
+def test_a_glb_file_is_named_as_glb(tmp_path):
+    from motionlab.core import gltf
+
+    path = tmp_path / "walk.glb"
+    path.write_bytes(gltf.dumps(synthetic.generate("walk", num_frames=5, fps=30)))
+    with pytest.raises(bvh.BVHError, match=r"walk.glb, line 1: a binary glTF \(.glb\) file, not BVH text"):
+        bvh.load(path)

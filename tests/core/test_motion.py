@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from motionlab import synthetic
 from motionlab.core import fk, quat
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
@@ -261,3 +262,14 @@ def test_check_one_rig_names_the_odd_clip(rng):
     odd = Motion(make_motion(rng, J=4).skeleton, a.local_rot[:, :4], a.root_pos, 30.0, name="odd")
     with pytest.raises(ValueError, match="clip 'odd' uses another skeleton than 'clip'"):
         check_one_rig([a, odd])
+
+
+def test_resample_to_a_frame_count_holds_the_last_pose():
+    m = synthetic.generate("walk", num_frames=20, fps=120)
+    half = m.resample(60)
+    assert half.num_frames == 10  # frames 0, 2, ..., 18 of the source: it ends before frame 19
+    back = half.resample(120, frames=20)
+    assert back.num_frames == 20
+    np.testing.assert_allclose(back.root_pos[:19], m.root_pos[:19], atol=0.02)
+    np.testing.assert_array_equal(back.root_pos[19], back.root_pos[18])
+    assert half.resample(120).num_frames == 19

@@ -223,3 +223,28 @@ def test_fill_gaps_refuses_frame_times_that_do_not_fit(dropped, tmp_path, capsys
     times = _times_file(tmp_path / "t.txt", keep / 30.0)
     assert main(["fill-gaps", str(dropped), "-o", str(out), "--times", str(times), "--takes", str(dropped)]) == 2
     assert "--times gives the gaps" in capsys.readouterr().err
+
+
+def test_fill_gaps_refuses_frame_times_of_another_rate(dropped, tmp_path, capsys):
+    """A log at 18 or 50 Hz beside a 30 fps file: every step would count as a gap, or none."""
+    out, keep = tmp_path / "out.bvh", np.r_[0:50, 58:120]
+    for rate in (18.0, 50.0):
+        times = _times_file(tmp_path / f"t{rate:g}.txt", keep / rate)
+        assert main(["fill-gaps", str(dropped), "-o", str(out), "--times", str(times)]) == 2
+        err = capsys.readouterr().err
+        assert f"{rate:g} fps" in err and "within 1%" in err
+        assert not out.exists()
+    times = _times_file(tmp_path / "ntsc.txt", keep / 29.97)  # NTSC's rate: counted in its own frame period
+    assert main(["fill-gaps", str(dropped), "-o", str(out), "--times", str(times)]) == 0
+    assert bvh.load(out).num_frames == 120
+
+
+def test_fill_gaps_refuses_graph_options_it_would_not_use(dropped, tmp_path, capsys):
+    out = tmp_path / "out.bvh"
+    assert main(["fill-gaps", str(dropped), "-o", str(out), "--allow", "walk -> run"]) == 2
+    assert "--allow names transitions between --action clips" in capsys.readouterr().err
+    assert main(["fill-gaps", str(dropped), "-o", str(out), "--action", f"walk={tmp_path / 'none.bvh'}"]) == 2
+    assert "no such file" in capsys.readouterr().err
+    times = _times_file(tmp_path / "t.txt", np.r_[0:50, 58:120] / 30.0)
+    assert main(["fill-gaps", str(dropped), "-o", str(out), "--action", f"walk={dropped}", "--times", str(times)]) == 2
+    assert "the graph would not be used" in capsys.readouterr().err and not out.exists()

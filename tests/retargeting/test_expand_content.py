@@ -118,3 +118,30 @@ def test_resample_is_reported_also_under_quiet(lib, capsys):
     err = capsys.readouterr().err
     assert "slow.bvh: resampled: source 30 fps -> network 60 fps -> output 30 fps" in err
     assert bvh.load(lib / "o30" / "tall" / "slow.bvh").fps == pytest.approx(30, rel=1e-4)
+
+
+def test_a_source_rate_the_network_cannot_hit_keeps_every_frame(lib, capsys):
+    """120 fps with an even count: the network's 60 fps ends half a frame early; the output keeps all 20."""
+    bvh.save(lib / "clips" / "fast.bvh", synthetic.dataset(1, seed=1, num_frames=20, fps=120)[0])
+    argv = ["expand", str(lib / "clips" / "fast.bvh"), "--preset", "tall", "-o", str(lib / "o120"), "-q"]
+    assert main(argv + ["--steps", "2"]) == 0
+    assert bvh.load(lib / "o120" / "tall" / "fast.bvh").num_frames == 20
+    out = lib / "r120.bvh"
+    assert (
+        main(["retarget", str(lib / "clips" / "fast.bvh"), "--scale", "1.1", "-o", str(out), "-q", "--steps", "2"]) == 0
+    )
+    assert bvh.load(out).num_frames == 20
+
+
+def test_sources_of_one_name_in_folders_of_one_name_are_all_expanded(tmp_path):
+    clip = synthetic.dataset(1, seed=1, num_frames=20, fps=60)[0]
+    for folder in ("a/take", "b/take"):
+        (tmp_path / folder).mkdir(parents=True)
+        bvh.save(tmp_path / folder / "Run.bvh", clip)
+    (tmp_path / "c").mkdir()
+    bvh.save(tmp_path / "c" / "Walk.BVH", clip)
+    specs = [str(tmp_path / "a/take/Run.bvh"), str(tmp_path / "b/take/Run.bvh"), str(tmp_path / "c")]
+    found = ex.find_sources([*specs, str(tmp_path / "a/take/../take/Run.bvh")])  # one file by two paths: once
+    assert [name for name, _ in found] == ["a_take_Run", "b_take_Run", "Walk"]
+    with pytest.raises(ValueError, match="manifest"):
+        ex.characters(f"{ex.MANIFEST}={tmp_path / 'c' / 'Walk.BVH'}")
