@@ -24,8 +24,10 @@ a Hermite curve with the velocities on both sides; ``linear``: the LaFAN1 baseli
 Where the capture logged each frame's time, ``--times FILE`` (one time in seconds per frame,
 :func:`motionlab.interpolation.gaps.load_times`) gives the gaps and their counts exactly
 (:func:`~motionlab.interpolation.gaps.timestamp_gaps`): no rule, no estimate. The times are
-checked against the file's ``Frame Time`` first: times in another unit (milliseconds), or ones
-that would make the clip more than :data:`MAX_GROWTH` times longer, are refused. Without
+checked against the file's ``Frame Time`` first: times in another unit (milliseconds), times whose
+median step is not one Frame Time within :data:`RATE_AGREEMENT` (another take's or rate's), or
+ones that would make the clip more than :data:`MAX_GROWTH` times longer, are refused; the counts
+are read in the times' own median step. Without
 ``--times`` the counts are estimates (the motion cannot say how fast the body moved inside a gap),
 and a warning on stderr says so, with the range each count is likely in
 (:func:`motionlab.interpolation.detect.estimate_counts`) and, where too few frames beside a gap
