@@ -1013,7 +1013,8 @@ class Planner:
 
         Raises
         ------
-        SearchError naming the segment's behaviour or style when the graph lacks it.
+        SearchError naming the segment's behaviour or style when the graph lacks it or has no
+        frame of it alive.
         """
         if seg.behaviour not in self.entries:
             raise SearchError(f"no behaviour {seg.behaviour!r} in the graph; behaviours: {sorted(self.entries)}")
@@ -1021,6 +1022,11 @@ class Planner:
         if seg.style not in styles:
             raise SearchError(
                 f"no style {seg.style!r} of behaviour {seg.behaviour!r} in the graph; its styles: {sorted(styles)}"
+            )
+        if not styles[seg.style].get("alive", 1):
+            raise SearchError(
+                f"{seg.behaviour}/{seg.style} has no frame left alive in this graph (pruning kept none: no cycle of "
+                "transitions joins its takes); build the graph with a larger --distance-threshold"
             )
         return (seg.behaviour, seg.style)
 

@@ -252,3 +252,10 @@ def test_build_refuses_a_clip_without_frames_and_a_graph_with_nothing_alive(libr
     (folder / "walk_normal_002.bvh").write_text(header + "Frames: 0\nFrame Time: 0.0333333\n")
     assert main(["graph-build", str(folder), "-o", str(tmp_path / "g"), "-q"]) == 2
     assert "walk_normal_002.bvh has no frames" in capsys.readouterr().err
+
+
+def test_a_style_with_nothing_alive_is_named(sgraph, tmp_path):
+    g = io.load(io.save(tmp_path / "g", sgraph))
+    g.table["behaviours"]["run"]["normal"]["alive"] = 0
+    with pytest.raises(search.SearchError, match="run/normal has no frame left alive"):
+        search.search(g, "walk:normal:30,run:normal:30")
