@@ -4,9 +4,12 @@ A pose is ``m(t) = [h(t), r_1(t) … r_J(t)]``: the root position ``h`` and ever
 rotation. Between the last known frame ``a`` and the next known frame ``b``:
 
 * rotations: SLERP (:mod:`motionlab.interpolation.slerp`) with a chosen α(k), or
-  ``"hermite"``: the rotation vector relative to ``q_a`` follows a quadratic whose start slope is
-  the angular velocity seen just before the gap, ``q(s) = q_a ⊗ exp(ω_a s + (d − ω_a) s²)`` with
-  ``d = log(q_a⁻¹ q_b)``; when ``ω_a = d`` this *is* SLERP;
+  ``"hermite"``: the rotation vector relative to ``q_a`` follows the cubic Hermite curve from 0 to
+  ``d = log(q_a⁻¹ q_b)`` whose end slopes are the angular velocities seen just before and just
+  after the gap, ``q(s) = q_a ⊗ exp(h₁₀(s) ω_a H + h₀₁(s) d + h₁₁(s) ω_b H)``, each counted over
+  ``H = min(L, horizon)`` frames (:data:`ANGULAR_HORIZON`: a velocity says how a joint goes on for a
+  while, not across a long gap); with no ``ω_b``, the quadratic
+  ``exp(ω_a H s + (d − ω_a H) s²)``; when ``ω_a H = ω_b H = d`` either *is* SLERP;
 * root: linear, or ``"hermite"``: a cubic Hermite curve whose end tangents are the root velocities
   before and after the gap (``p'(0) = v_a L``, ``p'(1) = v_b L``, ``L = N + 1``); with no ``v_b``
   the curve is the quadratic through both ends with start slope ``v_a L``.
@@ -28,6 +31,7 @@ from motionlab.interpolation import alignment
 from motionlab.interpolation.slerp import alphas
 
 __all__ = [
+    "ANGULAR_HORIZON",
     "ROOT_MODES",
     "ROTATION_MODES",
     "interpolate",
@@ -61,6 +65,13 @@ def exp(v) -> np.ndarray:
     return np.concatenate([np.cos(half), v * sinc], axis=-1)
 
 
+ANGULAR_HORIZON = 14 / 30
+"""Seconds over which ``"hermite"`` rotations follow the angular velocities at a gap's ends (14
+frames at 30 fps): of 2–24 frames, the horizon whose fills were closest to the recordings
+(L2P and L2Q against SLERP's, gaps of 5–45 frames) on the LaFAN1-protocol windows of clips kept
+apart from the scored ones (``python -m experiments.interpolation.hermite_horizon``)."""
+
+
 def _check_pair(rot_a, pos_a, rot_b, pos_b):
     rot_a, rot_b = quat.check(rot_a, "rot_a"), quat.check(rot_b, "rot_b")
     pos_a, pos_b = np.asarray(pos_a, dtype=np.float64), np.asarray(pos_b, dtype=np.float64)
@@ -86,6 +97,8 @@ def interpolate(
     vel_a=None,
     vel_b=None,
     ang_vel_a=None,
+    ang_vel_b=None,
+    horizon: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The ``num`` frames between pose ``a`` and pose ``b``.
 
@@ -100,6 +113,9 @@ def interpolate(
     vel_a, vel_b : array (..., 3), optional   root velocity (metres/frame) just before / after
     ang_vel_a : array (..., J, 3), optional   rotation vector per frame just before the gap, in each
                                               joint's own frame: ``log(q[t-1]⁻¹ q[t])``
+    ang_vel_b : array (..., J, 3), optional   the same just after the gap: ``log(q[t]⁻¹ q[t+1])``
+    horizon : float, optional                 frames over which the angular velocities count
+                                              (``H = min(N + 1, horizon)``); None: the whole gap
 
     Returns
     -------
@@ -108,8 +124,8 @@ def interpolate(
 
     Raises
     ------
-    ValueError for an unknown ``root`` or ``rotation`` mode, or angular velocities of the
-    wrong shape.
+    ValueError for an unknown ``root`` or ``rotation`` mode, root or angular velocities of the
+    wrong shape, or a horizon that is not a positive number.
     """
     rot_a, pos_a, rot_b, pos_b = _check_pair(rot_a, pos_a, rot_b, pos_b)
     if root not in ROOT_MODES:
@@ -125,18 +141,16 @@ def interpolate(
     if rotation == "slerp" or ang_vel_a is None:
         rot = quat.slerp(qa, qb, a[:, None])
     else:
-        w0 = np.asarray(ang_vel_a, dtype=np.float64) * length
-        if w0.shape != rot_a.shape[:-1] + (3,):
-            raise ValueError(f"expected ang_vel_a of shape {rot_a.shape[:-1] + (3,)}, got {w0.shape}")
-        d = log(quat.mul(quat.conj(rot_a), rot_b))
-        r = w0[..., None, :, :] * s[:, None, None] + (d - w0)[..., None, :, :] * (s * s)[:, None, None]
-        rot = quat.mul(qa, exp(r))
+        rot = quat.mul(qa, exp(_hermite_rotvec(rot_a, rot_b, ang_vel_a, ang_vel_b, s, _span(length, horizon))))
 
     # ---- root: (..., N, 3)
     pa, pb = pos_a[..., None, :], pos_b[..., None, :]
     if root == "linear" or vel_a is None:
         pos = pa + a[:, None] * (pb - pa)
     else:
+        for name, v in (("vel_a", vel_a), ("vel_b", vel_b)):
+            if v is not None and np.shape(v) != pos_a.shape:
+                raise ValueError(f"expected {name} of shape {pos_a.shape}, got {np.shape(v)}")
         m0 = np.asarray(vel_a, dtype=np.float64)[..., None, :] * length
         ss = s[:, None]
         if vel_b is None:
@@ -149,6 +163,33 @@ def interpolate(
             h11 = ss**3 - ss**2
             pos = h00 * pa + h10 * m0 + h01 * pb + h11 * m1
     return rot, pos
+
+
+def _span(length: int, horizon: float | None) -> float:
+    """Frames the end velocities count over: ``min(length, horizon)`` (``length`` for None)."""
+    if horizon is None:
+        return float(length)
+    if not (np.isfinite(horizon) and horizon > 0):
+        raise ValueError(f"expected a horizon of a positive number of frames, got {horizon!r}")
+    return float(min(length, horizon))
+
+
+def _hermite_rotvec(rot_a, rot_b, ang_vel_a, ang_vel_b, s: np.ndarray, span: float) -> np.ndarray:
+    """(..., N, J, 3) rotation vectors relative to ``rot_a`` at the time fractions ``s`` (N,): the
+    cubic Hermite curve from 0 to ``log(rot_a⁻¹ rot_b)`` with end slopes ``ω span`` (the quadratic
+    with the start slope alone when ``ang_vel_b`` is None)."""
+    shape = rot_a.shape[:-1] + (3,)
+    w = [None if v is None else np.asarray(v, dtype=np.float64) * span for v in (ang_vel_a, ang_vel_b)]
+    for name, v in zip(("ang_vel_a", "ang_vel_b"), w):
+        if v is not None and v.shape != shape:
+            raise ValueError(f"expected {name} of shape {shape}, got {v.shape}")
+    d = log(quat.mul(quat.conj(rot_a), rot_b))[..., None, :, :]
+    w0 = w[0][..., None, :, :]
+    t = s[:, None, None]
+    if w[1] is None:
+        return w0 * t + (d - w0) * t * t
+    w1 = w[1][..., None, :, :]
+    return (t**3 - 2 * t**2 + t) * w0 + (3 * t**2 - 2 * t**3) * d + (t**3 - t**2) * w1
 
 
 def zero_velocity(rot_a, pos_a, num: int) -> tuple[np.ndarray, np.ndarray]:
@@ -210,7 +251,7 @@ def fill_between(
     num = stop - start
     a, b = start - 1, stop
     vel_a, ang_a = _velocities(motion, a, forward=False, joint=joint)
-    vel_b, _ = _velocities(motion, b, forward=True, joint=joint)
+    vel_b, ang_b = _velocities(motion, b, forward=True, joint=joint)
     path = motion.translations()[[a, b], joint]
     rot, pos = interpolate(
         motion.local_rot[a],
@@ -224,6 +265,8 @@ def fill_between(
         vel_a=vel_a,
         vel_b=vel_b,
         ang_vel_a=ang_a,
+        ang_vel_b=ang_b,
+        horizon=ANGULAR_HORIZON * motion.fps,
     )
     out = motion.copy()
     out.local_rot[start:stop] = rot

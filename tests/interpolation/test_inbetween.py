@@ -108,3 +108,45 @@ def test_inputs_not_modified():
     inbetween.fill_between(m, 5, 9, root="hermite", rotation="hermite")
     np.testing.assert_array_equal(m.local_rot, before.local_rot)
     np.testing.assert_array_equal(m.root_pos, before.root_pos)
+
+
+def test_two_sided_hermite_rotation_known_answers():
+    """Both end slopes the chord: SLERP; the curve's end steps are the end velocities (horizon = the gap)."""
+    rng = np.random.default_rng(5)
+    qa, qb = random_quat(rng, (4,)), random_quat(rng, (4,))
+    num = 30
+    chord = inbetween.log(quat.mul(quat.conj(qa), qb)) / (num + 1)
+    args = (qa, np.zeros(3), qb, np.zeros(3), num)
+    r1, _ = inbetween.interpolate(*args, rotation="hermite", ang_vel_a=chord, ang_vel_b=chord)
+    assert_quat_close(r1, inbetween.interpolate(*args)[0], atol=1e-10)
+    w0, w1 = 0.01 * rng.normal(size=(4, 3)), 0.01 * rng.normal(size=(4, 3))
+    qb = quat.mul(qa, inbetween.exp(0.2 * rng.normal(size=(4, 3))))  # a small d: the curvature is O(|d|/L²)
+    rot, _ = inbetween.interpolate(
+        qa, np.zeros(3), qb, np.zeros(3), num, rotation="hermite", ang_vel_a=w0, ang_vel_b=w1
+    )
+    first = inbetween.log(quat.mul(quat.conj(qa), rot[0]))
+    last = inbetween.log(quat.mul(quat.conj(rot[-1]), qb))
+    np.testing.assert_allclose(first, w0, atol=4e-3)  # off by O(|ω|/L + |d|/L²)
+    np.testing.assert_allclose(last, w1, atol=4e-3)
+
+
+def test_hermite_rotation_stays_near_its_key_poses_across_a_long_gap():
+    """A joint turning at 0.1 rad per frame on both sides of an 80-frame gap with equal key poses:
+    r(s) = (h10 + h11)(s) ω H = (2s³ − 3s² + s) ω H, whose largest value is √3/18 ω H."""
+    q = np.tile(quat.IDENTITY, (1, 1))
+    w = np.array([[0.1, 0.0, 0.0]])
+    args = (q, np.zeros(3), q, np.zeros(3), 80)
+
+    def swing(**kw):
+        rot, _ = inbetween.interpolate(*args, rotation="hermite", ang_vel_a=w, ang_vel_b=w, **kw)
+        return float(np.max(np.linalg.norm(inbetween.log(rot), axis=-1)))
+
+    peak = np.sqrt(3) / 18 * 0.1
+    assert swing() == pytest.approx(peak * 81, rel=1e-3)  # H = L: 0.78 rad from both key poses
+    assert swing(horizon=14) == pytest.approx(peak * 14, rel=1e-3)
+    with pytest.raises(ValueError, match="horizon"):
+        swing(horizon=0)
+    with pytest.raises(ValueError, match="ang_vel_b of shape"):
+        inbetween.interpolate(*args, rotation="hermite", ang_vel_a=w, ang_vel_b=np.zeros((2, 3)))
+    with pytest.raises(ValueError, match="vel_b of shape"):
+        inbetween.interpolate(*args, root="hermite", vel_a=np.zeros(3), vel_b=np.zeros((7, 3)))
