@@ -14,6 +14,7 @@ the scored clips' windows then check it.
 
 from __future__ import annotations
 
+import argparse
 import os
 import sys
 from pathlib import Path
@@ -55,7 +56,8 @@ def ratios(windows: bm.Windows, stats, methods: dict) -> dict:
     }
 
 
-def main() -> int:
+def main(argv=None) -> int:
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args(argv)
     root = os.environ.get("MOTIONLAB_DATA")
     if not root:
         sys.exit("set MOTIONLAB_DATA to the shared data folder (e.g. export MOTIONLAB_DATA=/path/to/shared/data)")

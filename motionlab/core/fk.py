@@ -168,13 +168,14 @@ def global_to_local(global_rot, parents) -> np.ndarray:
 
 
 def bone_directions(global_pos, parents) -> np.ndarray:
-    """Unit vectors (..., J, 3) from each joint's parent to the joint (root and zero bones: 0)."""
+    """Unit vectors (..., J, 3) from each joint's parent to the joint (root and zero bones: 0; a
+    bone with a position that is not finite: NaN)."""
     global_pos = np.asarray(global_pos)
     parents = _check_parents(parents, global_pos.shape[-2])
     bones = global_pos - global_pos[..., np.maximum(parents, 0), :]
     bones[..., 0, :] = 0.0
     n = np.linalg.norm(bones, axis=-1, keepdims=True)
-    return np.where(n > 1e-9, bones / np.where(n > 1e-9, n, 1.0), 0.0)
+    return np.where((n > 1e-9) | np.isnan(n), bones / np.where(n > 1e-9, n, 1.0), 0.0)
 
 
 def joint_angles(global_pos, parents) -> np.ndarray:
@@ -182,11 +183,11 @@ def joint_angles(global_pos, parents) -> np.ndarray:
 
     For joint ``j`` with parent ``p`` and grandparent ``g`` this is the angle between the
     directions ``g→p`` and ``p→j`` (0 = straight, π = folded back). Joints whose parent is the
-    root, and zero-length bones, get 0.
+    root, and zero-length bones, get 0; a bone with a position that is not finite, NaN.
     """
     parents = _check_parents(parents, np.shape(global_pos)[-2])
     d = bone_directions(global_pos, parents)
     dp = d[..., np.maximum(parents, 0), :]
     cos = np.clip(np.sum(d * dp, axis=-1), -1.0, 1.0)
     valid = (np.linalg.norm(d, axis=-1) > 0.5) & (np.linalg.norm(dp, axis=-1) > 0.5)
-    return np.where(valid, np.arccos(cos), 0.0)
+    return np.where(valid | np.isnan(cos), np.arccos(cos), 0.0)

@@ -196,6 +196,7 @@ def find_mapping(skeleton: Skeleton, profile: str | dict[str, str | None] | None
     for i, n in enumerate(skeleton.names):
         lookup.setdefault(strip_prefix(n).lower(), i)
     if isinstance(profile, dict):
+        _check_custom(profile)
         candidates = {"custom": {**_profile(), **profile}}
     elif profile is not None:
         if profile not in PROFILES:
@@ -229,6 +230,19 @@ def find_mapping(skeleton: Skeleton, profile: str | dict[str, str | None] | None
     )
 
 
+def _check_custom(profile: dict) -> None:
+    """Refuse a custom profile that names a joint the humanoid has not (a typo would leave the
+    default name in its place) or leaves out the root."""
+    unknown = sorted(set(profile) - set(JOINTS))
+    if unknown:
+        raise RigMappingError(
+            f"custom rig profile names {', '.join(map(repr, unknown))}, not joints of the 22-joint humanoid; "
+            f"its keys are {', '.join(JOINTS)}"
+        )
+    if JOINTS[0] in profile and profile[JOINTS[0]] is None:
+        raise RigMappingError(f"custom rig profile maps {JOINTS[0]!r}, the root, to no joint; it must map to one")
+
+
 def _check_ancestry(skeleton: Skeleton, mapping: RigMapping) -> None:
     """Every mapped joint must descend from the joint its canonical parent maps to."""
     for c in range(1, len(JOINTS)):
@@ -250,8 +264,9 @@ def _check_ancestry(skeleton: Skeleton, mapping: RigMapping) -> None:
 
 
 def is_canonical(skeleton: Skeleton) -> bool:
-    """True when the skeleton already is the 22-joint humanoid (names and parents)."""
-    return tuple(strip_prefix(n) for n in skeleton.names) == JOINTS and np.array_equal(skeleton.parents, PARENTS)
+    """True when the skeleton already is the 22-joint humanoid (names, without a prefix, and parents):
+    what code that looks joints up by :data:`JOINTS` names may read as it is."""
+    return tuple(skeleton.names) == JOINTS and np.array_equal(skeleton.parents, PARENTS)
 
 
 def _reduced_offsets(rest: np.ndarray, source: tuple[int, ...]) -> np.ndarray:

@@ -43,6 +43,8 @@ def _pair(pred, target) -> tuple[np.ndarray, np.ndarray]:
         raise ValueError(
             f"expected two (..., T, J, 3) position arrays of equal shape, got {pred.shape} and {target.shape}"
         )
+    if pred.size == 0:
+        raise ValueError(f"expected positions of at least one frame and joint, got shape {pred.shape}")
     return pred, target
 
 
@@ -50,7 +52,19 @@ def _pos(pos, name: str = "pos") -> np.ndarray:
     pos = np.asarray(pos, dtype=np.float64)
     if pos.ndim < 3 or pos.shape[-1] != 3:
         raise ValueError(f"expected {name} of shape (..., T, J, 3), got {pos.shape}")
+    if pos.shape[-3] == 0:
+        raise ValueError(f"expected {name} of at least one frame, got shape {pos.shape}")
     return pos
+
+
+def _per_height(err: float, height: float | None) -> float:
+    """``err`` divided by ``height`` (None: as it is). Raises ValueError for a height that is not a
+    positive number."""
+    if height is None:
+        return err
+    if not (np.isfinite(height) and height > 0):
+        raise ValueError(f"expected a positive height to normalise by, got {height!r}")
+    return err / height
 
 
 def mse(pred, target, height: float | None = None) -> float:
@@ -61,14 +75,14 @@ def mse(pred, target, height: float | None = None) -> float:
     """
     pred, target = _pair(pred, target)
     err = float(np.mean((pred - target) ** 2))
-    return err / height**2 if height else err
+    return _per_height(_per_height(err, height), height)
 
 
 def mpjpe(pred, target, height: float | None = None) -> float:
     """Mean per-joint position error: mean Euclidean distance (position unit; ÷ height if given)."""
     pred, target = _pair(pred, target)
     err = float(np.mean(np.linalg.norm(pred - target, axis=-1)))
-    return err / height if height else err
+    return _per_height(err, height)
 
 
 def smoothness(pos) -> float:
@@ -108,10 +122,13 @@ def foot_contacts(pos, feet, fps: float, height_threshold: float = 0.05, speed_t
 
 def foot_skating(pos, feet, fps: float, height_threshold: float = 0.05) -> float:
     """Mean horizontal speed (units/s) of the ``feet`` joints over the frames where they touch
-    the ground (height below ``height_threshold``); 0 when no foot ever touches it.
+    the ground (height below ``height_threshold``); 0 when no foot ever touches it, NaN when a
+    foot position is not finite.
     """
     pos = _pos(pos)
     p = pos[..., list(feet), :]
+    if not np.all(np.isfinite(p)):
+        return float("nan")
     if p.shape[-3] < 2:
         return 0.0
     speed = np.linalg.norm(np.diff(p[..., [0, 2]], axis=-3), axis=-1) * fps  # (..., T-1, F)
@@ -127,7 +144,8 @@ def planted_slide(pos, feet, planted, fps: float) -> float:
 
     Unlike :func:`foot_skating`, which decides contact by a height threshold on the motion itself,
     the labels come from elsewhere (e.g. the source's contacts in retargeting), so a foot that
-    floats while it should stand still counts too, and a low swinging foot does not.
+    floats while it should stand still counts too, and a low swinging foot does not. NaN when a
+    foot position is not finite.
 
     Raises
     ------
@@ -138,6 +156,8 @@ def planted_slide(pos, feet, planted, fps: float) -> float:
     p = pos[..., list(feet), :]
     if planted.shape != p.shape[-3:-1]:
         raise ValueError(f"planted_slide: expected planted of shape {p.shape[-3:-1]} (T, feet), got {planted.shape}")
+    if not np.all(np.isfinite(p)):
+        return float("nan")
     if p.shape[-3] < 2:
         return 0.0
     speed = np.linalg.norm(np.diff(p[..., [0, 2]], axis=-3), axis=-1) * fps  # (..., T-1, F)
@@ -148,9 +168,19 @@ def planted_slide(pos, feet, planted, fps: float) -> float:
 
 
 def bone_length_error(pos, parents) -> float:
-    """How much bones stretch over time: mean over bones of std_t(length) / mean_t(length)."""
+    """How much bones stretch over time: mean over bones of std_t(length) / mean_t(length) (bones
+    of no length left out; NaN when a position is not finite).
+
+    Raises
+    ------
+    ValueError when ``parents`` is not one parent index per joint of ``pos``.
+    """
     pos = _pos(pos)
     parents = np.asarray(parents)
+    if parents.shape != pos.shape[-2:-1]:
+        raise ValueError(f"expected one parent per joint, {pos.shape[-2]}, got parents of shape {parents.shape}")
+    if not np.all(np.isfinite(pos)):
+        return float("nan")
     child = np.flatnonzero(parents >= 0)
     lengths = np.linalg.norm(pos[..., child, :] - pos[..., parents[child], :], axis=-1)
     mean = lengths.mean(axis=-2)

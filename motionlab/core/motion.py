@@ -46,6 +46,23 @@ def resampled_frames(frames: int, fps: float, new_fps: float) -> int:
     return int(np.floor((frames - 1) * new / src + 1e-6)) + 1
 
 
+UNIT_TOLERANCE = 1e-3
+"""How far from 1 a rotation's quaternion norm may be (a frame that is not known, NaN, is let be)."""
+
+
+def _check_unit(local_rot: np.ndarray, names) -> None:
+    """Raise ValueError naming the first frame and joint whose quaternion is finite but not a unit
+    quaternion (FK would scale the bones by its squared norm)."""
+    sq = np.einsum("...i,...i->...", local_rot, local_rot)
+    bad = np.abs(sq - 1.0) > 2 * UNIT_TOLERANCE  # |q|² − 1 ≈ 2 (|q| − 1)
+    if np.any(bad):
+        t, j = np.argwhere(bad)[0]
+        raise ValueError(
+            f"local_rot[{t}, {j}] (joint {names[j]!r}, frame {t}) has norm {np.sqrt(sq[t, j]):.6g}, not 1: "
+            "rotations are unit quaternions (normalise them first, e.g. motionlab.core.quat.normalize)"
+        )
+
+
 @dataclass(eq=False)
 class Motion:
     """A skeleton's animation.
@@ -54,6 +71,8 @@ class Motion:
     ----------
     skeleton  : Skeleton with J joints
     local_rot : ndarray, shape (T, J, 4)   unit quaternions (w, x, y, z) relative to the parent
+                                           (within :data:`UNIT_TOLERANCE`, else ValueError; NaN
+                                           marks a frame that is not known)
     root_pos  : ndarray, shape (T, 3)      world position of the root joint, metres
     fps       : float                      frames per second (required: no silent default)
     local_pos : ndarray, shape (T, J, 3), or None
@@ -84,6 +103,7 @@ class Motion:
             self.local_pos = np.asarray(self.local_pos, dtype=self.local_rot.dtype)
             if self.local_pos.shape != (T, J, 3):
                 raise ValueError(f"expected local_pos of shape ({T}, {J}, 3), got {self.local_pos.shape}")
+        _check_unit(self.local_rot, self.skeleton.names)
         self.fps = _check_fps(self.fps)
 
     # ------------------------------------------------------------------ basics
@@ -172,9 +192,15 @@ class Motion:
         ``frames``, there are that many new frames and those after the end hold the last pose.
         Frame rates within 1e-4 (relative) of a whole number count as that number: BVH files
         write ``Frame Time: 0.0333333``, which means 30 fps, not 30.0000003.
+
+        Raises
+        ------
+        ValueError for a rate that is not a positive number, or ``frames`` not a whole number >= 0.
         """
         fps = _check_fps(fps)
         src = _nominal(self.fps)
+        if frames is not None and not (float(frames).is_integer() and frames >= 0):
+            raise ValueError(f"expected frames as a whole number >= 0, got {frames!r}")
         n_new = resampled_frames(self.num_frames, self.fps, fps) if frames is None else int(frames)
         if (abs(_nominal(fps) - src) < 1e-9 * src or self.num_frames < 2) and n_new == self.num_frames:
             return self.copy(fps=float(fps))

@@ -201,13 +201,20 @@ def from_matrix(m) -> np.ndarray:
 
     Raises
     ------
-    ValueError when ``m`` is not (..., 3, 3).
+    ValueError when ``m`` is not (..., 3, 3), or not a rotation: ``MᵀM`` more than 1e-3 from the
+    identity, or a determinant not positive (a reflection).
     """
     m = np.asarray(m)
     if m.ndim < 2 or m.shape[-2:] != (3, 3):
         raise ValueError(f"expected (..., 3, 3) rotation matrices, got shape {m.shape}")
     if not np.issubdtype(m.dtype, np.floating):
         m = m.astype(np.float64)
+    off = np.abs(np.swapaxes(m, -1, -2) @ m - np.eye(3)).max(axis=(-2, -1)) if m.size else np.zeros(0)
+    if np.any(off > 1e-3) or np.any(np.linalg.det(m) <= 0):
+        raise ValueError(
+            "expected rotation matrices (orthonormal, determinant +1); a reflection or a scaled matrix has no "
+            f"quaternion (largest |MᵀM − I| {float(np.max(off, initial=0.0)):.3g})"
+        )
     m00, m11, m22 = m[..., 0, 0], m[..., 1, 1], m[..., 2, 2]
     # four candidate (unnormalised) quaternions, each accurate where its 4·component² is large
     cand = np.stack(
@@ -365,8 +372,8 @@ def slerp(a, b, t) -> np.ndarray:
 def angle_between(a, b) -> np.ndarray:
     """Geodesic angle (radians, in ``[0, π]``) of the rotation taking ``a`` to ``b``."""
     a, b = check(a, "a"), check(b, "b")
-    dot = np.clip(np.abs(np.sum(a * b, axis=-1)), 0.0, 1.0)
-    return 2.0 * np.arccos(dot)
+    d = mul(conj(a), b)  # atan2 rather than arccos of the dot product: accurate near 0 too
+    return 2.0 * np.arctan2(np.linalg.norm(d[..., 1:], axis=-1), np.abs(d[..., 0]))
 
 
 def between(u, v) -> np.ndarray:
@@ -380,7 +387,7 @@ def between(u, v) -> np.ndarray:
     u, v = np.broadcast_arrays(u, v)
     w = 1.0 + np.sum(u * v, axis=-1, keepdims=True)
     xyz = np.cross(u, v)
-    anti = w[..., 0] < 1e-9
+    anti = np.sqrt(w[..., 0] ** 2 + np.sum(xyz * xyz, axis=-1)) < 1e-12  # exactly opposite, to rounding
     if np.any(anti):
         helper = np.where(np.abs(u[..., :1]) < 0.9, np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
         perp = np.cross(u, helper)

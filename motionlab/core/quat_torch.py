@@ -47,6 +47,8 @@ _EPS_NORM = 1e-12
 def _check(q: torch.Tensor, name: str = "q", last: int = 4) -> torch.Tensor:
     if not isinstance(q, torch.Tensor):
         q = torch.as_tensor(q, dtype=torch.get_default_dtype())
+    elif not q.is_floating_point():  # integers would truncate every weight and angle (the NumPy twin's rule)
+        q = q.to(torch.get_default_dtype())
     if q.ndim == 0 or q.shape[-1] != last:
         kind = "quaternions (w, x, y, z)" if last == 4 else "vectors"
         raise ValueError(f"expected {name} as (..., {last}) {kind}, got shape {tuple(q.shape)}")
@@ -161,10 +163,20 @@ def from_matrix(m: torch.Tensor) -> torch.Tensor:
 
     Raises
     ------
-    ValueError when ``m`` is not (..., 3, 3).
+    ValueError when ``m`` is not (..., 3, 3), or not a rotation: ``MᵀM`` more than 1e-3 from the
+    identity, or a determinant not positive (a reflection).
     """
     if m.ndim < 2 or tuple(m.shape[-2:]) != (3, 3):
         raise ValueError(f"expected (..., 3, 3) rotation matrices, got shape {tuple(m.shape)}")
+    if not m.is_floating_point():
+        m = m.to(torch.get_default_dtype())
+    if m.numel():
+        off = (m.transpose(-1, -2) @ m - torch.eye(3, dtype=m.dtype, device=m.device)).abs().amax(dim=(-2, -1))
+        if bool((off > 1e-3).any()) or bool((torch.linalg.det(m) <= 0).any()):
+            raise ValueError(
+                "expected rotation matrices (orthonormal, determinant +1); a reflection or a scaled matrix has no "
+                f"quaternion (largest |MᵀM − I| {float(off.max()):.3g})"
+            )
     m00, m11, m22 = m[..., 0, 0], m[..., 1, 1], m[..., 2, 2]
     cand = torch.stack(
         [

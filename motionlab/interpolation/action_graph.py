@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from motionlab.core.motion import Motion
+from motionlab.core.motion import Motion, check_one_rig
 from motionlab.interpolation.features import distance_matrix, pose_features
 from motionlab.interpolation.keyposes import node_key_frames
 
@@ -79,7 +79,16 @@ class ActionGraph:
 
     # ------------------------------------------------------------------ building
     def add_node(self, name: str, motion: Motion, num_keys: int = 5, seed: int = 0) -> ActionNode:
-        """Add (or replace) the action ``name`` recorded by ``motion`` (at least 2 frames)."""
+        """Add (or replace) the action ``name`` recorded by ``motion`` (at least 2 frames).
+
+        Raises
+        ------
+        ValueError when ``motion`` is on another skeleton or at another frame rate than the
+        graph's other actions.
+        """
+        others = [n.motion for n in self.nodes.values() if n.name != str(name)]
+        if others:
+            check_one_rig([others[0], motion.copy(name=str(name))], group=f"the action {others[0].name!r}")
         feats = pose_features(motion)
         keys, _ = node_key_frames(feats, num_keys, q=4, seed=seed)
         node = ActionNode(str(name), motion, feats, keys)
@@ -94,10 +103,12 @@ class ActionGraph:
                 raise GraphError(f"unknown action {n!r}; the graph has {sorted(self.nodes)}")
 
     def allow(self, transitions: Iterable[str | tuple[str, str]], both_ways: bool = False) -> None:
-        """Add allowed transitions: ``("walk", "stand")`` pairs or ``"walk -> stand"`` strings."""
-        for t in transitions:
-            a, b = parse_transition(t) if isinstance(t, str) else (str(t[0]), str(t[1]))
+        """Add allowed transitions: ``("walk", "stand")`` pairs or ``"walk -> stand"`` strings; all
+        of them or, when one names an unknown action or is malformed, none (the error names it)."""
+        pairs = [parse_transition(t) if isinstance(t, str) else (str(t[0]), str(t[1])) for t in transitions]
+        for a, b in pairs:
             self._need(a, b)
+        for a, b in pairs:
             self.edges.add((a, b))
             if both_ways:
                 self.edges.add((b, a))

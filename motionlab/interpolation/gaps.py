@@ -160,11 +160,14 @@ def timestamp_gaps(times, fps: float) -> list[tuple[int, int]]:
 
     Raises
     ------
-    ValueError unless the timestamps are (T,) and strictly increasing.
+    ValueError unless the timestamps are (T,) and strictly increasing and ``fps`` is a positive
+    number.
     """
     t = np.asarray(times, dtype=np.float64)
     if t.ndim != 1 or not np.all(np.diff(t) > 0):
         raise ValueError("expected strictly increasing timestamps (T,) in seconds")
+    if not (np.isfinite(fps) and fps > 0):
+        raise ValueError(f"expected a frame rate of a positive number of frames per second, got {fps!r}")
     steps = np.rint(np.diff(t) * fps).astype(np.int64)
     return [(int(i), int(s - 1)) for i, s in enumerate(steps) if s > 1]
 
@@ -175,9 +178,15 @@ def insert_missing(motion: Motion, missing: list[tuple[int, int]]) -> tuple[Moti
 
     Raises
     ------
-    ValueError unless every gap lies after a frame ``i`` with 0 <= i < T - 1.
+    ValueError unless every entry is two whole numbers, a count >= 0 after a frame ``i`` with
+    0 <= i < T - 1, and no frame is named twice.
     """
-    order = sorted((int(i), int(n)) for i, n in missing if n > 0)
+    order = sorted(_whole(entry) for entry in missing)
+    after = [i for i, n in order if n > 0]
+    if len(set(after)) < len(after):
+        twice = sorted({i for i in after if after.count(i) > 1})
+        raise ValueError(f"frames missing after frame {twice[0]} are given twice; give one count per place")
+    order = [(i, n) for i, n in order if n > 0]
     rot, root, lpos, gaps = [], [], [], []
     prev, shift = 0, 0
     J = motion.skeleton.num_joints
@@ -198,6 +207,18 @@ def insert_missing(motion: Motion, missing: list[tuple[int, int]]) -> tuple[Moti
     out = Motion(motion.skeleton, np.concatenate(rot), np.concatenate(root), motion.fps,
                  np.concatenate(lpos) if lpos else None, motion.name)  # fmt: skip
     return out, gaps
+
+
+def _whole(entry) -> tuple[int, int]:
+    """``(after frame i, count)`` of an :func:`insert_missing` entry, both whole numbers, count >= 0."""
+    try:
+        i, n = entry
+        ok = float(i).is_integer() and float(n).is_integer() and n >= 0
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise ValueError(f"expected (after frame, count) as two whole numbers, the count >= 0, got {entry!r}")
+    return int(i), int(n)
 
 
 # ---------------------------------------------------------------------------- filling
@@ -664,7 +685,7 @@ def fill(
 
 def _check_fill(motion: Motion, method: str, graph: ActionGraph | None, root: str, feet: str) -> None:
     """The ``ValueError`` of :func:`fill` for an unknown method, root mode or floor rule, or a
-    graph that is missing, empty or on another skeleton than ``motion``."""
+    graph that is missing, empty, or on another skeleton or frame rate than ``motion``."""
     if method not in METHODS:
         raise ValueError(f"unknown filling method {method!r}; expected one of {METHODS}")
     if root not in ROOTS:
@@ -674,9 +695,14 @@ def _check_fill(motion: Motion, method: str, graph: ActionGraph | None, root: st
     if method == "graph":
         if graph is None or not graph.nodes:
             raise ValueError("method='graph' needs an ActionGraph with at least one action")
-        sk = next(iter(graph.nodes.values())).motion.skeleton
-        if sk.names != motion.skeleton.names:
+        clip = next(iter(graph.nodes.values())).motion
+        if clip.skeleton.names != motion.skeleton.names:
             raise ValueError("the action graph's clips use another skeleton than the motion to fill")
+        if abs(clip.fps - motion.fps) > 1e-6 * motion.fps:
+            raise ValueError(
+                f"the action graph's clips are at {clip.fps:g} fps, the motion to fill at {motion.fps:g}: "
+                "resample one (Motion.resample)"
+            )
 
 
 def _fill_inside(out: Motion, start: int, stop: int, method: str, curve: str, root: str, ref: int, feet: str):

@@ -243,11 +243,14 @@ def fill_between(
 
     Raises
     ------
-    ValueError unless the gap has a known frame on each side (1 <= start <= stop <= T-1).
+    ValueError unless the gap has a known frame on each side (1 <= start <= stop <= T-1), or for a
+    ``joint`` other than 0 in a motion without ``local_pos``.
     """
     T = motion.num_frames
     if not (1 <= start <= stop <= T - 1):
         raise ValueError(f"a gap [{start}, {stop}) needs a known frame on each side in a {T}-frame motion")
+    if joint != 0 and motion.local_pos is None:
+        raise ValueError(f"joint={joint} carries the body only in a motion with per-joint translations (local_pos)")
     num = stop - start
     a, b = start - 1, stop
     vel_a, ang_a = _velocities(motion, a, forward=False, joint=joint)

@@ -43,8 +43,8 @@ __all__ = [
 def window_stats(z, window: int) -> np.ndarray:
     """Mean and standard deviation of ``z`` (T, q) over a centred window: (T, 2q).
 
-    The window is ``window`` frames wide (edges padded by repeating the end frames); computed with
-    cumulative sums, no loop over frames.
+    The window is centred, so ``2⌊window/2⌋ + 1`` frames wide (an even ``window`` gains a frame;
+    edges padded by repeating the end frames); computed with cumulative sums, no loop over frames.
 
     Raises
     ------

@@ -122,6 +122,8 @@ class MotionLibrary:
     def _keys(self, gap: int) -> tuple[np.ndarray, np.ndarray]:
         """Candidate start frames ``s`` (those with ``s+gap`` in the same clip, ``s >= 1``) and their keys."""
         s = np.flatnonzero((self.frame >= 1) & (self.frame + gap < self.length))
+        if s.size == 0:
+            raise ValueError(f"no library stretch is {gap + 1} frames long: every clip is shorter")
         e = s + gap
         rot = quat.from_yaw(-self.yaw[s])
         d = quat.rotate(rot, self.ground[e] - self.ground[s])[:, [0, 2]]

@@ -141,15 +141,20 @@ class PPCA:
 
         Raises
         ------
-        ValueError unless ``q`` is smaller than the data dimension D.
+        ValueError unless ``q`` is smaller than the data dimension D and than the number of
+        samples N, and the samples vary (a constant set has no principal directions).
         """
         x = _data(x)
         n, d = x.shape
         if self.q >= d:
             raise ValueError(f"latent size q={self.q} must be smaller than the data dimension D={d}")
+        if self.q >= n:
+            raise ValueError(f"latent size q={self.q} needs more than {self.q} samples, got N={n}")
         self.mean = x.mean(axis=0)
         xc = x - self.mean
         s = xc.T @ xc / n
+        if not np.trace(s) > 0:
+            raise ValueError(f"the {n} samples are all the same: no direction of variance to fit")
         self._s = s
         if self.method == "closed":
             lam, u = np.linalg.eigh(s)

@@ -94,17 +94,9 @@ def _cmd_retarget(args) -> int:
         target = humanoid.scale_bones(target, **scales)
     if not args.target and all(v == 1.0 for v in scales.values()):
         raise CLIError("give --target TARGET.bvh and/or a --scale-* factor: otherwise the target is the source itself")
+    solver = cli_options.solver_config(args)  # refused before a network is trained or loaded
     ckpt = None if args.method == "copy" else cli_options.network_checkpoint(args, real.is_real_rig(source.skeleton))
-    result = retarget(
-        source,
-        target,
-        ckpt,
-        args.method,
-        cli_options.solver_config(args),
-        args.root,
-        progress=not args.quiet,
-        fps=args.fps,
-    )
+    result = retarget(source, target, ckpt, args.method, solver, args.root, progress=not args.quiet, fps=args.fps)
     check = _check_result(args, result)
     data = motion_files.encode(result.motion, suffix, motion_files.file_unit(base.skeleton))  # errors before writing
     outputs = [(out, lambda f: f.write(data), True, "output")]
@@ -292,6 +284,7 @@ def _cmd_evaluate(args) -> int:
     fold_paths = [_fold_path(path, k, args.folds) if path else None for k in range(args.folds)]
     trained = [("--checkpoint", p) for p in fold_paths if p and (args.retrain or not p.is_file())]
     check_outputs(trained, force=True, inputs=[("--csv", args.csv)])  # a checkpoint to train is written later
+    solver = cli_options.solver_config(args)  # refused before a network is trained
     result = Evaluation(rows=[])
     for fold, fpath in zip(folds, fold_paths):
         ckpt = _fold_checkpoint(args, folder, fpath, fold if args.folds > 1 else animations)
@@ -302,7 +295,7 @@ def _cmd_evaluate(args) -> int:
             targets=args.targets,
             animations=fold,
             rows=rows_with_root(args.root, ablations=not args.no_ablations),
-            solver=cli_options.solver_config(args),
+            solver=solver,
             progress=not args.quiet,
         )
         result.rows = part.rows

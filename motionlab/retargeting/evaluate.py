@@ -257,7 +257,7 @@ def evaluate(
             {"target": target, "animation": anim, **_gt_metrics(gt_pos, fps, height, planted[anim])}
         )
         for row in rows:
-            out = _run_row(row, sources[anim], gt_rig.skeleton, checkpoint, solver)
+            out = _run_row(row, sources[anim], gt_rig.skeleton, checkpoint, solver, fps)
             rec = _record(out, gt_pos, fps, height, planted[anim], f"{target}/{anim}")
             result.records.append({"row": row[0], "target": target, "animation": anim, **rec})
     return result
@@ -279,8 +279,9 @@ def _check_inputs(folder: Path, checkpoint, source, targets, animations, rows) -
     return list(animations)
 
 
-def _run_row(row: tuple, source, target, checkpoint: Checkpoint | None, solver: SolverConfig | None):
-    """One row's method on one pair (:func:`retarget`), q_Δ switched off for the call where the row asks."""
+def _run_row(row: tuple, source, target, checkpoint: Checkpoint | None, solver: SolverConfig | None, fps: float):
+    """One row's method on one pair (:func:`retarget`) at ``fps`` (the ground truth's rate), q_Δ
+    switched off for the call where the row asks."""
     _, method, root_mode = row[:3]
     options = dict(row[3]) if len(row) > 3 else {}
     correction = options.pop("correction", True)
@@ -294,7 +295,7 @@ def _run_row(row: tuple, source, target, checkpoint: Checkpoint | None, solver: 
     if model is not None:
         model.use_correction = correction
     try:
-        return retarget(source, target, checkpoint, method, cfg, root_mode)
+        return retarget(source, target, checkpoint, method, cfg, root_mode, fps=fps)
     finally:
         if model is not None:
             model.use_correction = True

@@ -46,6 +46,7 @@ def _cmd_expand(args) -> int:
         ex.check_output_layout(args.output, ex.find_sources(args.sources), targets, "." + args.format)
     except ValueError as e:
         raise CLIError(str(e)) from None
+    solver = cli_options.solver_config(args)  # refused before a network is trained or loaded
     real_source = real.any_real_file([p for _, p in ex.find_sources(args.sources)])
     ckpt = cli_options.network_checkpoint(args, real_source)
     job = ex.expand(
@@ -53,7 +54,7 @@ def _cmd_expand(args) -> int:
         targets,
         args.output,
         ckpt,
-        cli_options.solver_config(args),
+        solver,
         root_mode=args.root,
         force=args.force,
         max_frames=args.batch_frames,

@@ -147,6 +147,11 @@ def check(positions: np.ndarray, target, source: Motion, planted: np.ndarray | N
         raise ValueError(f"{positions.shape[0]} retargeted frames but {source.num_frames} source frames")
     if planted is None:
         planted = contacts.of_motion(source)
+    planted = np.asarray(planted)
+    if planted.dtype != bool:  # 0/1 integers would index rows instead of masking them
+        if not np.isin(planted, (0, 1)).all():
+            raise ValueError(f"expected planted as booleans (or 0/1), got values {np.unique(planted)[:5]}")
+        planted = planted.astype(bool)
     leg = humanoid.leg_length(target)
     foot = _foot_height(positions, target, planted)
     src_pos = source.global_positions()

@@ -44,15 +44,19 @@ def proportion_solver(
     Raises
     ------
     ValueError
-        ``source`` is not a Motion, or its rig does not map onto the humanoid.
+        ``source`` is not a Motion, ``method`` is none of the three, or its rig does not map onto
+        the humanoid.
     CheckpointError
         The shipped network cannot be loaded (``method`` other than ``"copy"``).
     """
     from motionlab import retargeting
+    from motionlab.retargeting import pipeline
     from motionlab.settings import pick
 
     if not isinstance(source, Motion):
         raise ValueError(f"expected a Motion, got {type(source).__name__}")
+    if method not in pipeline.METHODS:
+        raise ValueError(f"method must be one of {pipeline.METHODS}, got {method!r}")
     if not humanoid.is_canonical(source.skeleton):
         source = humanoid.to_canonical(source)
     checkpoint = retargeting.load_default() if method != "copy" else None

@@ -203,9 +203,12 @@ class SolverConfig:
         return terms.get(name).weight
 
     def __post_init__(self) -> None:
-        bad = {k: v for k, v in self.weights.items() if not (isinstance(k, str) and v >= 0)}
+        bad = {k: v for k, v in self.weights.items() if not (isinstance(k, str) and _finite_at_least(v, 0))}
         if bad:
-            raise ValueError(f"weights must map term names to numbers >= 0, got {bad}")
+            raise ValueError(f"weights must map term names to finite numbers >= 0, got {bad}")
+        for name in ("lambda_angle", "lambda_foot", "lambda_contact", "threshold", "min_delta"):
+            if not _finite_at_least(getattr(self, name), 0):
+                raise ValueError(f"{name} must be a finite number >= 0, got {getattr(self, name)!r}")
         if self.init not in INITS:
             raise ValueError(f"init must be one of {INITS}, got {self.init!r}")
         if self.init == "project" and self.theta != "rotations":
@@ -218,16 +221,22 @@ class SolverConfig:
             )
         if self.project_damping is not None and not self.project_damping > 0:
             raise ValueError(f"project_damping must be positive, got {self.project_damping}")
-        if not self.lambda_contact >= 0:
-            raise ValueError(f"lambda_contact must be >= 0, got {self.lambda_contact}")
         if self.theta not in ("rotations", "directions"):
             raise ValueError(f"theta must be 'rotations' or 'directions', got {self.theta!r}")
         if not self.smooth_sigma >= 0:
             raise ValueError(f"smooth_sigma must be >= 0 frames, got {self.smooth_sigma}")
         if self.max_steps < 0 or self.patience < 0:
             raise ValueError(f"max_steps and patience must be >= 0, got {self.max_steps} and {self.patience}")
-        if not self.lr > 0:
-            raise ValueError(f"lr must be positive, got {self.lr}")
+        if not (_finite_at_least(self.lr, 0) and self.lr > 0):
+            raise ValueError(f"lr must be a finite positive number, got {self.lr}")
+
+
+def _finite_at_least(value, low: float) -> bool:
+    """True for a real number, finite and >= ``low``."""
+    try:
+        return bool(np.isfinite(value) and value >= low)
+    except TypeError:
+        return False
 
 
 @dataclass
@@ -326,6 +335,12 @@ def _summed(cfg: SolverConfig, decoded: Decoded, inputs: TermInputs, given: dict
             value = given[term.name]
         elif all(inputs.has(n) for n in term.needs):
             value = term.function(decoded, inputs)
+            if not isinstance(value, torch.Tensor) or value.ndim != 0:
+                shape = tuple(getattr(value, "shape", ()))
+                raise ValueError(
+                    f"loss term {term.name!r} returned {type(value).__name__} of shape {shape}; a term returns "
+                    "one number, a 0-d tensor (terms module docstring)"
+                )
         else:
             values.append(None)
             continue
@@ -1028,6 +1043,15 @@ class _Track:
         self.best_phi[dst] = phi.detach()[src]
 
     def results(self, p: _Problem, seconds: float) -> list[SolverResult]:
+        """Each group's best iterate. Raises ValueError for a group whose ``L_iter`` was never
+        finite (no iterate to return), naming the terms that were not."""
+        for g in range(len(p.bounds) - 1):
+            if not np.isfinite(self.best_value[g]):
+                terms_off = [k for k in self.keys[1:] if not all(np.isfinite(self.histories[g][k]))]
+                raise ValueError(
+                    f"L_iter was not finite at any step of sequence {g} (the terms {terms_off or 'none'} were not): "
+                    "no iterate to return; check the weights and any term you registered"
+                )
         rot = self.best_rot.cpu().numpy().astype(np.float64)
         pos = self.best_pos.cpu().numpy().astype(np.float64)
         bounds, T = p.bounds, rot.shape[1]

@@ -69,6 +69,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from motionlab.retargeting import devices, losses
 
 __all__ = [
@@ -142,7 +144,7 @@ class Term:
     Attributes
     ----------
     name : str           identifier: history key, manifest column, ``--NAME-weight`` option
-    weight : float       default weight (>= 0)
+    weight : float       default weight (finite, >= 0)
     function : callable  ``function(decoded, inputs: TermInputs) -> Tensor ()``
     unit : str           unit of the value ("" for none), for reports
     needs : tuple of str inputs the term cannot be evaluated without (fields or ``extra`` keys)
@@ -163,8 +165,8 @@ class Term:
     def __post_init__(self) -> None:
         if not self.name.isidentifier() or self.name == "loss":
             raise ValueError(f"a term's name must be a Python identifier other than 'loss', got {self.name!r}")
-        if not self.weight >= 0:
-            raise ValueError(f"term {self.name!r}: weight must be >= 0, got {self.weight}")
+        if not (np.isfinite(self.weight) and self.weight >= 0):
+            raise ValueError(f"term {self.name!r}: weight must be a finite number >= 0, got {self.weight}")
         if not callable(self.function):
             raise ValueError(f"term {self.name!r}: function must be callable")
 

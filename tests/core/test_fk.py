@@ -332,3 +332,13 @@ def test_blocked_fk_matches_the_per_joint_definition_across_block_borders():
     s_rot, s_pos = fk_module.fk(local_rot[:12], np.broadcast_to(local_pos[0], (12, 7, 3)), parents)
     np.testing.assert_allclose(b_pos.reshape(12, 7, 3), s_pos, atol=1e-12)
     np.testing.assert_allclose(b_rot.reshape(12, 7, 4), s_rot, atol=1e-12)
+
+
+def test_bone_directions_and_angles_keep_nan():
+    pos = np.array([[[0.0, 0, 0], [0, 1, 0], [np.nan, 2, 0], [0, 3, 0]]])
+    parents = [-1, 0, 1, 2]
+    d = fk.bone_directions(pos, parents)
+    assert np.isnan(d[0, 2]).any() and np.isnan(d[0, 3]).any()
+    np.testing.assert_allclose(d[0, 1], [0, 1, 0])
+    angles = fk.joint_angles(pos, parents)
+    assert np.isnan(angles[0, 2]) and np.isnan(angles[0, 3]) and angles[0, 1] == 0.0

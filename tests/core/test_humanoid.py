@@ -161,3 +161,19 @@ def test_mixamo_heights_match_the_paper():
     path = require_data("mixamo", "Aj", "Running.bvh")
     aj = humanoid.to_canonical_skeleton(bvh.load(path).skeleton)
     assert aj.height() == pytest.approx(1.4197, abs=5e-4)
+
+
+def test_a_custom_profile_with_an_unknown_joint_or_no_root_is_refused():
+    sk = humanoid.canonical_skeleton()
+    with pytest.raises(humanoid.RigMappingError, match="'LeftUpleg'"):
+        humanoid.find_mapping(sk, {"LeftUpleg": "LeftUpLeg"})
+    with pytest.raises(humanoid.RigMappingError, match="the root"):
+        humanoid.find_mapping(sk, {"Hips": None})
+
+
+def test_a_prefixed_humanoid_is_not_taken_for_the_canonical_one():
+    sk = humanoid.canonical_skeleton()
+    prefixed = Skeleton(tuple(f"mixamorig:{n}" for n in sk.names), sk.parents, sk.offsets, sk.end_sites)
+    assert not humanoid.is_canonical(prefixed)
+    assert humanoid.leg_length(prefixed) == pytest.approx(humanoid.leg_length(sk))
+    assert humanoid.is_canonical(humanoid.scale_bones(prefixed, legs=1.1))

@@ -84,3 +84,30 @@ def test_bone_length_error():
     assert metrics.bone_length_error(pos, [-1, 0]) == 0.0
     pos[:, 1, 1] = [1.0, 2.0, 3.0]
     assert metrics.bone_length_error(pos, [-1, 0]) == pytest.approx(np.std([1, 2, 3]) / 2)
+
+
+def test_positions_that_are_not_finite_give_nan_not_a_perfect_score():
+    pos = np.random.default_rng(0).normal(size=(10, 3, 3))
+    pos[4, 1] = np.nan
+    parents = np.array([-1, 0, 1])
+    planted = np.ones((10, 2), bool)
+    assert np.isnan(metrics.foot_skating(pos, [1, 2], 30.0, height_threshold=10.0))
+    assert np.isnan(metrics.planted_slide(pos, [1, 2], planted, 30.0))
+    assert np.isnan(metrics.bone_length_error(pos, parents))
+    assert np.isnan(metrics.bone_length_error(np.full((4, 3, 3), np.nan), parents))
+
+
+def test_metrics_refuse_no_frames_a_bad_height_and_a_parent_list_of_another_length():
+    pos = np.zeros((5, 3, 3))
+    for call in (
+        lambda: metrics.foot_skating(np.zeros((0, 3, 3)), [1], 30.0),
+        lambda: metrics.mse(np.zeros((0, 3, 3)), np.zeros((0, 3, 3))),
+    ):
+        with pytest.raises(ValueError, match="at least one frame"):
+            call()
+    for height in (0.0, -1.0, float("nan")):
+        with pytest.raises(ValueError, match="positive height"):
+            metrics.mpjpe(pos, pos + 1, height=height)
+    assert metrics.mse(pos, pos + 1, height=2.0) == pytest.approx(0.25)
+    with pytest.raises(ValueError, match="one parent per joint"):
+        metrics.bone_length_error(pos, [-1, 0])

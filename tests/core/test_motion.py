@@ -273,3 +273,15 @@ def test_resample_to_a_frame_count_holds_the_last_pose():
     np.testing.assert_allclose(back.root_pos[:19], m.root_pos[:19], atol=0.02)
     np.testing.assert_array_equal(back.root_pos[19], back.root_pos[18])
     assert half.resample(120).num_frames == 19
+
+
+def test_a_motion_refuses_rotations_that_are_not_unit_but_keeps_unknown_frames():
+    m = synthetic.generate("walk", num_frames=5, fps=30)
+    rot = m.local_rot.copy()
+    rot[3, 7] *= 1.1
+    with pytest.raises(ValueError, match=r"local_rot\[3, 7\] \(joint '\w+', frame 3\) has norm 1.1"):
+        m.copy(local_rot=rot)
+    rot[3] = np.nan  # a dropped frame, as gap filling marks it
+    assert np.isnan(m.copy(local_rot=rot).local_rot[3]).all()
+    with pytest.raises(ValueError, match="whole number >= 0"):
+        m.resample(60, frames=-1)

@@ -605,3 +605,25 @@ def test_random_quat_is_unit_and_covers_both_hemispheres(rng):
     assert np.mean(np.abs(q[:, 0])) == pytest.approx(4 / (3 * np.pi), abs=0.02)
     assert random_quat(rng).shape == (4,)
     assert random_quat(rng, 3).shape == (3, 4)
+
+
+def test_from_matrix_refuses_a_reflection_and_a_scaled_matrix():
+    import torch
+
+    from motionlab.core import quat_torch
+
+    for m in (np.diag([1.0, 1.0, -1.0]), 2.0 * np.eye(3), -np.eye(3)):
+        with pytest.raises(ValueError, match="rotation matrices"):
+            quat.from_matrix(m)
+        with pytest.raises(ValueError, match="rotation matrices"):
+            quat_torch.from_matrix(torch.as_tensor(m))
+
+
+def test_between_nearly_opposite_directions_and_small_angles_are_accurate():
+    u = np.array([1.0, 0.0, 0.0])
+    d = 3e-5
+    v = np.array([-np.cos(d), np.sin(d), 0.0])
+    np.testing.assert_allclose(quat.rotate(quat.between(u, v), u), v, atol=1e-10)  # was 4.5e-5 off
+    a = quat.from_axis_angle(np.array([0.0, 1.0, 0.0], np.float32), np.float32(0.0))
+    b = quat.from_axis_angle(np.array([0.0, 1.0, 0.0], np.float32), np.float32(1e-3))
+    assert float(quat.angle_between(a, b)) == pytest.approx(1e-3, rel=1e-4)

@@ -259,3 +259,8 @@ def test_functions_do_not_modify_inputs(rng):
     tq.to_euler(q, "zxy"), tq.slerp(q, r, 0.5), tq.angle_between(q, r), tq.yaw(q)
     for x, s in zip(inputs, saved):
         torch.testing.assert_close(x, s, atol=0, rtol=0)
+
+
+def test_integer_tensors_are_read_as_floats():
+    out = tq.slerp(torch.tensor([1, 0, 0, 0]), torch.tensor([0, 0, 0, 1]), 0.5)
+    torch.testing.assert_close(out, torch.tensor([0.5**0.5, 0.0, 0.0, 0.5**0.5]))

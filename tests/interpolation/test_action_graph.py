@@ -79,3 +79,13 @@ def test_classify_frames_of_known_nodes(graph):
     f = graph.nodes["run"].features[10:13]
     assert graph.classify(f) == ["run"] * 3
     assert len(graph.nodes["walk"].keys) == 5
+
+
+def test_allow_adds_all_or_none_and_a_clip_of_another_rate_is_refused(graph):
+    before = set(graph.edges)
+    with pytest.raises(GraphError, match="'zzz'"):
+        graph.allow([("walk", "run"), ("walk", "zzz")])
+    assert graph.edges == before
+    with pytest.raises(ValueError, match="at 120 fps"):
+        graph.add_node("jog", toy_motion(40, fps=120.0))
+    assert "jog" not in graph.nodes

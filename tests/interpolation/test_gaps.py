@@ -410,3 +410,30 @@ def test_fill_gaps_leaves_the_bandai_root_marker_at_the_origin(tmp_path, capsys)
     hips = np.linalg.norm(pos[40:46, 1] - truth[40:46, 1], axis=-1)
     assert hips.max() < 0.02  # metres: the hips, which carry the walker, follow their path
     capsys.readouterr()
+
+
+def test_insert_missing_refuses_fractions_negatives_and_a_place_given_twice():
+    m = toy_motion(20)
+    for missing, message in (
+        ([(3, 2.7)], "two whole numbers"),
+        ([(3.5, 2)], "two whole numbers"),
+        ([(3, -1)], "the count >= 0"),
+        ([(5, 2), (5, 3)], "after frame 5 are given twice"),
+    ):
+        with pytest.raises(ValueError, match=message):
+            gaps.insert_missing(m, missing)
+    out, holes = gaps.insert_missing(m, [(5.0, 2), (9, 0)])
+    assert holes == [(6, 8)] and out.num_frames == 22
+    for fps in (0.0, float("nan")):
+        with pytest.raises(ValueError, match="frame rate"):
+            gaps.timestamp_gaps([0.0, 0.1, 0.3], fps)
+
+
+def test_graph_fill_refuses_clips_at_another_rate():
+    g = ActionGraph()
+    g.add_node("walk", toy_motion(40, fps=120.0))
+    holed, _ = gaps.insert_missing(toy_motion(40), [(20, 4)])
+    with pytest.raises(ValueError, match="at 120 fps, the motion to fill at 30"):
+        gaps.fill(holed, method="graph", graph=g)
+    with pytest.raises(ValueError, match="local_pos"):
+        inbetween.fill_between(toy_motion(20).copy(local_pos=None), 5, 9, joint=1)

@@ -61,3 +61,13 @@ def test_window_stats_known_values():
     s = keyposes.window_stats(z, 3)
     np.testing.assert_allclose(s[:, 0], [0, 1, 1, 1, 0])
     np.testing.assert_allclose(s[2, 1], np.sqrt(2.0))
+
+
+def test_a_library_of_clips_shorter_than_the_gap_says_so():
+    from motionlab.interpolation.library import MotionLibrary
+
+    from .conftest import toy_motion
+
+    lib = MotionLibrary([toy_motion(10)])
+    with pytest.raises(ValueError, match="no library stretch is 21 frames long"):
+        lib.search(np.zeros((1, 8)), 20)

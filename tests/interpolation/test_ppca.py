@@ -71,3 +71,12 @@ def test_bad_input():
         PPCA(1).fit(np.array([[0.0, np.nan], [1.0, 2.0]]))
     with pytest.raises(ValueError, match="method"):
         PPCA(1, method="svd")
+
+
+def test_ppca_refuses_too_few_samples_and_samples_that_do_not_vary():
+    x = np.random.default_rng(0).normal(size=(3, 8))
+    for method in ("closed", "em"):
+        with pytest.raises(ValueError, match="needs more than 5 samples"):
+            PPCA(5, method=method).fit(x)
+        with pytest.raises(ValueError, match="all the same"):
+            PPCA(3, method=method).fit(np.ones((20, 8)))

@@ -49,3 +49,21 @@ def test_missing_folders_are_named(tmp_path):
         evaluate(tmp_path, None, targets=["Kaya"], rows=[("copy", "copy", "legs")])
     with pytest.raises(FileNotFoundError, match="no training clips"):
         training_clips(tmp_path, "Aj", [])
+
+
+def test_a_clip_at_another_rate_than_the_network_is_scored_at_one_rate(tmp_path):
+    """A 30 fps clip onto its own character: copying rotations is exact, at whatever rate it is scored."""
+    import warnings
+
+    from motionlab import retargeting, synthetic
+    from motionlab.core import bvh
+
+    walk = synthetic.dataset(1, seed=2, num_frames=30, fps=30)[0]
+    for character in ("Src", "Tgt"):
+        (tmp_path / character).mkdir()
+        bvh.save(tmp_path / character / "walk.bvh", walk)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a frame-count mismatch warns
+        res = evaluate(tmp_path, retargeting.load_default("cpu"), source="Src", targets=["Tgt"], animations=["walk"],
+                       rows=[("copy", "copy", "hips")], progress=False)  # fmt: skip
+    assert res.summary()["copy"]["mse_h2"] < 1e-6

@@ -94,3 +94,16 @@ def test_held_out_walk_turn_on_a_mixamo_character_is_not_flagged():
     res = retarget(take, bvh.load(kaya), retargeting.load_default("cpu"))
     assert not res.plausibility.skating
     assert res.plausibility.slide < 0.5 * res.plausibility.slide_limit
+
+
+def test_planted_labels_given_as_zeros_and_ones_mask_like_booleans():
+    from motionlab.core import contacts
+
+    m = synthetic.generate("walk", num_frames=60, fps=60)
+    planted = contacts.of_motion(m)
+    pos = m.global_positions()
+    as_bool = plausibility.check(pos, m.skeleton, m, planted)
+    as_int = plausibility.check(pos, m.skeleton, m, planted.astype(int))
+    assert as_int.foot_height == as_bool.foot_height and np.isfinite(as_bool.foot_height)
+    with pytest.raises(ValueError, match="booleans"):
+        plausibility.check(pos, m.skeleton, m, planted.astype(int) * 2)

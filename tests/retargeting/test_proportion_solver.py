@@ -26,3 +26,8 @@ def test_each_release_equals_a_fresh_full_retarget():
         fresh = retargeting.retarget(clip, target, ckpt, "full", solver=retargeting.SolverConfig(max_steps=30))
         np.testing.assert_array_equal(motion.global_positions(), fresh.motion.global_positions())
         assert history["loss"] == fresh.history["loss"]
+
+
+def test_a_method_it_does_not_know_is_refused_before_the_network_loads():
+    with pytest.raises(ValueError, match="method must be one of"):
+        proportion_solver(synthetic.generate("walk", num_frames=10, fps=60), method="fulll")

@@ -220,15 +220,15 @@ def test_the_papers_two_losses_row_switches_every_other_term_off(monkeypatch):
     from motionlab.retargeting.cli_options import solver_config
 
     used = {}
-    monkeypatch.setattr(evaluate, "retarget", lambda *args: used.__setitem__("cfg", args[4]))
+    monkeypatch.setattr(evaluate, "retarget", lambda *args, **kw: used.__setitem__("cfg", args[4]))
     cfg = solver_config(build_parser().parse_args(["evaluate", "--floor-weight", "3", "--angle-weight", "0.4"]))
     assert (cfg.weight("floor"), cfg.weight("angle"), cfg.weight("contact")) == (3.0, 0.4, 0.5)
     paper = next(r for r in evaluate.ABLATIONS if "paper" in r[0])
-    evaluate._run_row(paper, None, None, None, cfg)
+    evaluate._run_row(paper, None, None, None, cfg, 60.0)
     weights = {t.name: used["cfg"].weight(t.name) for t in terms.registered()}
     assert weights == {"angle": 0.4, "foot": 0.5, "contact": 0.0, "floor": 0.0, "clearance": 0.0}
     without = next(r for r in evaluate.ABLATIONS if "L_clear" in r[0])
-    evaluate._run_row(without, None, None, None, cfg)
+    evaluate._run_row(without, None, None, None, cfg, 60.0)
     weights = {t.name: used["cfg"].weight(t.name) for t in terms.registered()}
     assert weights == {"angle": 0.4, "foot": 0.5, "contact": 0.5, "floor": 3.0, "clearance": 0.0}
 
@@ -254,3 +254,37 @@ def test_the_clearance_input_is_the_sources_swinging_feet_scaled(ckpt, clip):
     )
     history = short.history["clearance"]
     assert history[0] > 0 and history[short.best_step] < history[0]
+
+
+@pytest.fixture
+def broken_term(request):
+    term = terms.register(terms.Term("broken", 1.0, request.param, padded=True))
+    yield term
+    terms.unregister("broken")
+
+
+@pytest.mark.parametrize(
+    ("broken_term", "message"),
+    [
+        (lambda d, i: d.positions.sum() * float("nan"), r"not finite at any step .*\['broken'\]"),
+        (lambda d, i: d.positions[..., 0, 1].mean(dim=-1), "loss term 'broken' returned Tensor of shape"),
+    ],
+    indirect=["broken_term"],
+)
+def test_a_term_that_gives_no_number_is_named_not_returned_as_a_motion(broken_term, message, ckpt, clip):
+    with pytest.raises(ValueError, match=message):
+        retargeting.retarget(clip, _target(clip), ckpt, solver=FAST)
+
+
+def test_weights_that_are_not_finite_or_negative_are_refused_when_made():
+    for changes in (
+        {"weights": {"floor": float("inf")}},
+        {"lambda_angle": float("inf")},
+        {"lambda_foot": -5.0},
+        {"threshold": float("nan")},
+        {"min_delta": -1.0},
+    ):
+        with pytest.raises(ValueError, match="finite number"):
+            SolverConfig(**changes)
+    with pytest.raises(ValueError, match="finite number >= 0"):
+        terms.Term("big", float("inf"), _hands_low)
