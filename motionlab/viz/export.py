@@ -35,6 +35,8 @@ __all__ = [
     "filmstrip",
     "to_png",
     "gif_length",
+    "gif_durations",
+    "GIF_MIN_DELAY",
     "MOVIE_SUFFIXES",
 ]
 
@@ -122,9 +124,10 @@ def save_gif(
     ----------
     motions : Motion, list of Motions, or a Scene (rendered as it is set up)
     path : output file, ``.gif``
-    stride : keep every ``stride``-th frame; default: about 15 frames per second
+    stride : keep every ``stride``-th frame; default: about 15 frames per second (a GIF frame is
+        shown at least :data:`GIF_MIN_DELAY`; the frames' display times add up to real time)
     start, stop : frame range (stop excluded; default: the whole clip)
-    colors : palette size (2..256), shared by all frames
+    colors : palette size (3..256), shared by all frames, the contact colour kept
     loop : play forever
     overwrite : replace an existing file
     **scene_options : passed to :class:`~motionlab.viz.scene.Scene`, e.g. ``camera="frame"``,
@@ -136,31 +139,24 @@ def save_gif(
 
     Raises
     ------
-    ValueError unless 2 <= ``colors`` <= 256.
+    ValueError unless 3 <= ``colors`` <= 256, or for a ``stride`` shorter than :data:`GIF_MIN_DELAY`.
     """
     from PIL import Image
 
     path = _target(path, (".gif",), overwrite)
-    if not 2 <= int(colors) <= 256:
-        raise ValueError(f"colors must be between 2 and 256, got {colors}")
+    if not 3 <= int(colors) <= 256:
+        raise ValueError(f"colors must be between 3 and 256, got {colors}")
     scene, own = _scene(motions, scene_options)
     try:
-        if stride is None:
-            stride = max(1, int(round(scene.fps / 15)))
+        stride = _gif_stride(scene.fps, stride)
         frames = [Image.fromarray(img) for img in scene.frames(_frame_indices(scene, stride, start, stop))]
     finally:
         if own:
             scene.close()
-    # one palette from a few frames side by side, so colours do not flicker between frames
-    picks = frames[:: max(1, len(frames) // 6)][:6]
-    sample = Image.new("RGB", (picks[0].width * len(picks), picks[0].height))
-    for i, im in enumerate(picks):
-        sample.paste(im, (i * im.width, 0))
-    palette = sample.quantize(colors=int(colors), method=Image.Quantize.MEDIANCUT)
+    palette = _palette(frames, int(colors))
     indexed = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in frames]
-    duration = int(round(1000 * stride / scene.fps))
-
     looping = {"loop": 0} if loop else {}  # without the key Pillow writes no loop block: play once
+    duration = gif_durations(len(frames), stride / scene.fps)
 
     def write(tmp: Path) -> None:
         indexed[0].save(
@@ -169,6 +165,56 @@ def save_gif(
 
     _write_atomically(path, write)
     return path
+
+
+GIF_MIN_DELAY = 0.02
+"""Shortest time a GIF frame is shown, seconds: GIF counts in hundredths of a second, and browsers
+show a frame of 0 or 0.01 s for 0.1 s."""
+
+
+def _gif_stride(fps: float, stride: int | None) -> int:
+    """The frame stride of a GIF: ``stride``, or about 15 frames per second when None.
+
+    Raises
+    ------
+    ValueError when ``stride`` would show a frame for less than :data:`GIF_MIN_DELAY`.
+    """
+    if stride is None:
+        return max(1, int(round(fps / 15)), int(np.ceil(GIF_MIN_DELAY * fps - 1e-9)))
+    if stride / fps < GIF_MIN_DELAY - 1e-9:
+        least = int(np.ceil(GIF_MIN_DELAY * fps - 1e-9))
+        raise ValueError(
+            f"a GIF shows a frame for at least {GIF_MIN_DELAY:g} s, and stride {stride} at {fps:g} fps asks for "
+            f"{stride / fps:.4g} s (browsers would play it slowly): use a stride of {least} or more, or an MP4"
+        )
+    return int(stride)
+
+
+def gif_durations(frames: int, seconds: float) -> list[int]:
+    """Display times (milliseconds, whole hundredths of a second, as GIF stores them) of ``frames``
+    frames meant to last ``seconds`` each: each ends at its true time rounded to the hundredth, so
+    the movie plays in real time whatever the frame rate (30 fps: 30, 40, 30, 30, 40, ... ms)."""
+    ends = np.round(np.arange(1, frames + 1) * seconds * 100.0).astype(np.int64)
+    return (10 * np.diff(ends, prepend=0)).tolist()
+
+
+def _palette(frames: list, colors: int):
+    """One palette for every frame (so colours do not flicker): the median cut of a few frames side
+    by side, its last entry the contact colour (a contact shown in none of those frames stays red)."""
+    from PIL import Image
+
+    from motionlab.viz.scene import CONTACT_COLOR, _rgb
+
+    picks = frames[:: max(1, len(frames) // 6)][:6]
+    sample = Image.new("RGB", (picks[0].width * len(picks), picks[0].height))
+    for i, im in enumerate(picks):
+        sample.paste(im, (i * im.width, 0))
+    palette = sample.quantize(colors=colors - 1, method=Image.Quantize.MEDIANCUT)
+    red = [int(round(255 * c)) for c in _rgb(CONTACT_COLOR)]
+    entries = palette.getpalette()[: 3 * (colors - 1)]
+    entries += [0] * (3 * (colors - 1) - len(entries)) + red
+    palette.putpalette(entries)
+    return palette
 
 
 def gif_length(path) -> tuple[int, float]:

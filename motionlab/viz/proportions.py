@@ -242,11 +242,16 @@ class ProportionEditor:
 
         Raises
         ------
-        ValueError naming unknown proportions.
+        ValueError naming unknown proportions, or a value outside its slider's range (a slider
+        would clamp it without a word); no slider changes then.
         """
         unknown = set(factors) - set(GROUPS)
         if unknown:
             raise ValueError(f"unknown proportion(s) {sorted(unknown)}; expected some of {list(GROUPS)}")
+        for name, value in factors.items():
+            low, high = self.sliders[name].min, self.sliders[name].max
+            if not (np.isfinite(value) and low <= value <= high):
+                raise ValueError(f"{name}={value!r} is outside its slider's range, {low:g} to {high:g}")
         self._suspend = True
         try:
             for name, value in factors.items():

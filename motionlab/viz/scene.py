@@ -63,6 +63,11 @@ def _rgb(color) -> np.ndarray:
     return np.asarray(to_rgb(color), dtype=np.float64)
 
 
+MAX_CLEARANCE = 0.1
+"""Body heights a foot joint may stand above its rest height in every frame of a clip and still
+touch the ground (CMU's standing toes: about 0.04); higher, the clip is in the air."""
+
+
 def foot_joints(skeleton: Skeleton) -> list[int]:
     """Indices of the foot and toe joints of any humanoid rig.
 
@@ -84,8 +89,11 @@ def contact_labels(
     """Foot-contact labels (T, J): True where a foot joint is near the ground and nearly still.
 
     A foot joint counts as touching when its height is below its own standing height (rest pose,
-    relative to the lowest joint) plus 2 % of the body height, and it moves slower than 0.3 body
-    heights per second (:func:`motionlab.core.contacts.low_and_slow`, the package's contact rule).
+    relative to the lowest joint, plus the joint's own clearance: the least it stands above that in
+    the clip, as :func:`motionlab.core.contacts.detect_contacts` reads it, up to
+    :data:`MAX_CLEARANCE` body heights; a joint higher in every frame never touches) plus 2 % of
+    the body height, and it moves slower than 0.3 body heights per second
+    (:func:`motionlab.core.contacts.low_and_slow`, the package's contact rule).
 
     Parameters
     ----------
@@ -106,10 +114,11 @@ def contact_labels(
     if not feet:
         return labels
     rest_y = skeleton.rest_positions()[:, 1]
+    rest = rest_y[feet] - rest_y.min()
     height = max(skeleton.height(), 1e-6)
-    labels[:, feet] = _contacts.low_and_slow(
-        positions[:, feet], rest_y[feet] - rest_y.min(), 0.02 * height, 0.3 * height, fps
-    )
+    clearance = np.nanmin(positions[:, feet, 1] - rest, axis=0)  # each joint's own (CMU's ankles and toes)
+    clearance = np.where(clearance <= MAX_CLEARANCE * height, np.maximum(clearance, 0.0), -np.inf)  # in the air
+    labels[:, feet] = _contacts.low_and_slow(positions[:, feet], rest + clearance, 0.02 * height, 0.3 * height, fps)
     return labels
 
 

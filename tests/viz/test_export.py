@@ -72,3 +72,25 @@ def test_snapshot_and_filmstrip(can_render, tmp_path):
     strip = export.filmstrip(m, num=3, **SMALL)
     assert strip.shape == (128, 480, 3)
     assert np.abs(strip[:, :160].astype(int) - strip[:, 320:]).sum() > 0
+
+
+def test_gif_frames_add_up_to_real_time_in_hundredths():
+    """30 fps, every 2nd frame: 66.7 ms each, stored 70, 60, 70, 70, 60 ms (GIF counts hundredths)."""
+    assert export.gif_durations(5, 2 / 30) == [70, 60, 70, 70, 60]
+    assert sum(export.gif_durations(90, 4 / 59.9988)) == pytest.approx(90 * 4 / 59.9988 * 1000, abs=5)
+    assert export._gif_stride(120.0, None) == 8
+    with pytest.raises(ValueError, match="use a stride of 2 or more"):
+        export._gif_stride(60.0, 1)
+
+
+def test_the_gif_palette_keeps_the_contact_colour(can_render, tmp_path):
+    from PIL import Image
+
+    from motionlab.viz.scene import CONTACT_COLOR, _rgb
+
+    grey = [Image.new("RGB", (8, 8), (90 + k, 90 + k, 90 + k)) for k in range(6)]
+    red = tuple(int(round(255 * c)) for c in _rgb(CONTACT_COLOR))
+    palette = export._palette(grey, 16)
+    assert tuple(palette.getpalette()[45:48]) == red
+    swatch = Image.new("RGB", (2, 2), red).quantize(palette=palette, dither=Image.Dither.NONE).convert("RGB")
+    assert swatch.getpixel((0, 0)) == red

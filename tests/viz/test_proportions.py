@@ -179,3 +179,13 @@ def test_preview_can_be_switched_off(can_render):
             assert set(ed.timings) == {"solve", "view", "total"}, kwargs
         finally:
             ed.close()
+
+
+def test_update_refuses_values_its_sliders_would_clamp(editor):
+    before = editor.factors
+    for value in (0.0, -1.0, 2.0, float("nan")):
+        with pytest.raises(ValueError, match="outside its slider's range"):
+            editor.update(legs=value)
+    assert editor.factors == before
+    editor.update(legs=1.2)  # still works afterwards
+    assert editor.factors["legs"] == pytest.approx(1.2)

@@ -199,3 +199,13 @@ def test_full_mixamo_rig(can_render, small):
         assert all(_pixel_near(img, p, 3) for p in pix[::7])
     with Scene(humanoid.to_canonical(m), **small) as sc:
         assert sc.actors[0]._joint_points.n_points == 22
+
+
+def test_contact_labels_find_cmu_feet_whose_rest_pose_lies_flat():
+    """CMU's rest foot lies flat, its standing ankles and toes do not: each joint's own clearance."""
+    from motionlab.core import bvh
+
+    clip = bvh.load(require_data("cmu", "131", "131_03.bvh"))
+    labels = contact_labels(clip.skeleton, clip.global_positions(), clip.fps)
+    feet = foot_joints(clip.skeleton)
+    assert labels[:, feet].mean(axis=0).min() > 0.1
