@@ -559,9 +559,11 @@ def test_held_out_q_experiment(behaviour_clips):
     assert answer in exercises.interpolation.Q_CHOICES
     assert q.check(answer, behaviour_clips).passed
     assert q.check(float(answer), behaviour_clips).passed
-    # alternative: standardised with all frames' statistics (also accepted)
+    # wrong: standardised with all frames' statistics (the held-out frames leak into the model)
     alt = exercises.interpolation._best_q(behaviour_clips, stats="all")
-    assert q.check(alt, behaviour_clips).passed
+    if alt != answer:
+        res = q.check(alt, behaviour_clips)
+        assert not res.passed and "training frames' alone" in res.hint
     # wrong: every second frame held out (interleaved)
     from motionlab.interpolation import features
     from motionlab.interpolation.ppca import PPCA
@@ -901,3 +903,30 @@ def test_the_angle_checks_measure_as_notebook_03_does():
     src = preprocess.prepare(source, ckpt.fps, stand=True)  # notebook 03, section 1
     as_section_5 = float(plots.joint_angle_errors(run.motion.local_rot, src.local_rot).mean())
     assert exercises.foot_weight.check(as_section_5, source, target, ckpt).passed
+
+
+def test_an_answer_that_changes_its_inputs_changes_neither_the_reference_nor_the_next_check():
+    def zero_the_roots(motion):  # wrong, and it writes into the case it is given
+        motion.root_pos[:] = 0.0
+        return exercises.basics._speed_central(motion)
+
+    ex = exercises.joint_speed
+    before = [c[0].root_pos.copy() for c in ex._cases()]
+    assert not ex.check(zero_the_roots).passed
+    for case, root in zip(ex._cases(), before):
+        np.testing.assert_array_equal(case[0].root_pos, root)
+    for variant in (exercises.basics._speed_central_second_order_ends, exercises.basics._speed_central_held_ends):
+        assert ex.check(variant).passed
+    res = ex.check(lambda motion: None)
+    assert not res.passed and "is a `return` missing?" in res.message
+
+
+def test_an_answer_nearer_a_listed_mistake_is_that_mistake():
+    from motionlab.exercises import Mistake, Question
+
+    q = Question("q", lambda: 13.834, mistakes=[Mistake(lambda: 13.867, "the mistake")], atol=0.006, rtol=0.005)
+    assert q.check(13.83).passed and q.check(13.834).passed
+    res = q.check(13.87)
+    assert not res.passed and res.hint == "the mistake"
+    close = Question("q", lambda: -0.0003, mistakes=[Mistake(lambda: 0.0002, "the mistake")], atol=0.0006)
+    assert close.check(-0.0).passed  # the two differ by less than the digits typed: not told apart

@@ -297,11 +297,21 @@ def _speed_backward(motion):  # p[t] - p[t-1], the first frame repeats the one a
     return np.linalg.norm(v, axis=-1) * motion.fps
 
 
+def _speed_central_second_order_ends(motion):  # np.gradient(..., edge_order=2)
+    return np.linalg.norm(np.gradient(motion.global_positions(), axis=0, edge_order=2), axis=-1) * motion.fps
+
+
+def _speed_central_held_ends(motion):  # (p[t+1] - p[t-1]) / 2 with the end frames repeated
+    p = motion.global_positions()
+    p = np.concatenate([p[:1], p, p[-1:]], axis=0)
+    return np.linalg.norm(p[2:] - p[:-2], axis=-1) / 2 * motion.fps
+
+
 joint_speed = Exercise(
     "04 · exercise 2 (joint speed)",
     _speed_central,
     _speed_cases,
-    accept=[_speed_forward, _speed_backward],
+    accept=[_speed_forward, _speed_backward, _speed_central_second_order_ends, _speed_central_held_ends],
     mistakes=[
         Mistake(
             lambda m: _speed_central(m) / m.fps,

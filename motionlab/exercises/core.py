@@ -7,6 +7,7 @@ for ad-hoc checks.
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
@@ -71,6 +72,8 @@ def _difference(got, want, atol: float, sign_free: bool, period: float | None) -
     if len(got_t) != len(want_t):
         return False, f"returned {len(got_t)} value(s), expected {len(want_t)}"
     for g, w in zip(got_t, want_t):
+        if g is None:
+            return False, "returned None: is a `return` missing?"
         try:
             g = _as_array(g)
         except (TypeError, ValueError):
@@ -94,7 +97,9 @@ def _difference(got, want, atol: float, sign_free: bool, period: float | None) -
 
 
 def _call(fn: Callable, args: tuple):
-    return fn(*args)
+    """``fn(*args)`` on a copy of the arguments: an answer that changes its inputs in place changes
+    neither the reference's nor the next call's."""
+    return fn(*copy.deepcopy(args))
 
 
 @dataclass
@@ -214,7 +219,9 @@ class Question:
     The student changes a parameter, runs the experiment in the notebook and types the number it
     gives. The check recomputes the experiment on the *same inputs* the notebook used (its own
     data, real or synthetic), so one key fits every data set, and compares:
-    ``|answer − reference| ≤ atol + rtol · |reference|``.
+    ``|answer − reference| ≤ atol + rtol · |reference|``. An answer within that of a listed
+    mistake too, and nearer to it, is that mistake, where the two values differ by more than
+    ``atol`` (the digits an answer is typed with).
 
     Parameters
     ----------
@@ -236,6 +243,23 @@ class Question:
     def _close(self, answer: float, value: float) -> bool:
         return bool(abs(answer - value) <= self.atol + self.rtol * abs(value))
 
+    def _mistake(self, answer: float, right: float, inputs: tuple) -> Mistake | None:
+        """The listed mistake ``answer`` is: within tolerance of it and, where the right value is
+        within tolerance too, nearer to it, if the two differ by more than ``atol`` (the digits an
+        answer is typed with: closer, the experiment cannot tell them apart, and the answer is right)."""
+        for mistake in self.mistakes:
+            try:
+                value = float(mistake.answer(*inputs))
+            except Exception:  # a mistake that cannot run on these inputs is simply not this one
+                continue
+            if not self._close(answer, value):
+                continue
+            if not self._close(answer, right) or (
+                abs(answer - value) < abs(answer - right) and abs(value - right) > self.atol
+            ):
+                return mistake
+        return None
+
     def check(self, answer, *inputs) -> Result:
         """``✓``, ``…`` (the answer is still ``...``) or ``✗`` with a hint; never shows the reference."""
         head = f"{self.name}: "
@@ -252,16 +276,13 @@ class Question:
             return Result(False, True, f"✗ {head}expected a number, got {type(answer).__name__}")
         if not np.isfinite(value):
             return Result(False, True, f"✗ {head}the answer is NaN or infinite")
-        if self._close(value, float(self.reference(*inputs))):
+        right = float(self.reference(*inputs))
+        mistake = self._mistake(value, right, inputs)
+        if mistake is not None:
+            return Result(False, True, f"✗ {head}{answer} is not right yet. Hint: {mistake.hint}", mistake.hint)
+        if self._close(value, right):
             return Result(True, True, f"✓ {head}{answer} is right")
         for alternative in self.accept:
             if self._close(value, float(alternative(*inputs))):
                 return Result(True, True, f"✓ {head}{answer} is right (an accepted variant)")
-        for mistake in self.mistakes:
-            try:
-                same = self._close(value, float(mistake.answer(*inputs)))
-            except Exception:  # a mistake that cannot run on these inputs is simply not this one
-                same = False
-            if same:
-                return Result(False, True, f"✗ {head}{answer} is not right yet. Hint: {mistake.hint}", mistake.hint)
         return Result(False, True, f"✗ {head}{answer} is not right yet.")

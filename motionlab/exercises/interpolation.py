@@ -61,8 +61,12 @@ def _best_q(clips, split: str = "tail", stats: str = "train") -> int:
 held_out_q = Question(
     "06 · exercise 1 (experiment: q by held-out likelihood)",
     lambda clips: _best_q(clips),
-    accept=[lambda clips: _best_q(clips, stats="all")],
     mistakes=[
+        Mistake(
+            lambda clips: _best_q(clips, stats="all"),
+            "your mean and std come from every frame, the held-out ones too: standardise with the "
+            "training frames' alone, so that nothing of the held-out frames reaches the model.",
+        ),
         Mistake(
             lambda clips: _best_q(clips, split="interleaved"),
             "your test frames interleave the training frames (each sits between two frames the model "
