@@ -85,8 +85,11 @@ limit, rather than running for minutes and filling the disk."""
 
 TOLERANCE = 0.05
 """Documented accuracy: every reachable segment gets its requested length within
-``max(2 frames, 5%)``; inside that band the walk whose jumps cost least wins (with the default search
-cost, the walk with the fewest jumps; checked by the tests)."""
+``max(2 frames, 5%)``; inside that band the walk whose jumps cost least wins among the walks
+through the :data:`SPARSE_JUMPS` cheapest jumps into each frame (with the default search cost,
+the walk with the fewest jumps; checked by the tests). Only where none of those fits the band are
+all jumps tried, so with a custom cost that prices the jumps into one frame differently a
+dearer walk than the cheapest can win."""
 
 
 def tolerance_frames(frames: int) -> int:
@@ -119,13 +122,16 @@ def default_cost(graph: MotionGraph, edges: np.ndarray) -> np.ndarray:
 
 
 def _prices(graph: MotionGraph, edges: np.ndarray, cost) -> np.ndarray:
-    """``cost(graph, edges)``, checked: one finite price >= 0 per edge (float32)."""
+    """``cost(graph, edges)``, checked: one finite price >= 0 per edge, finite in float32 too (the
+    search adds prices in float32; a larger one would read as a jump that cannot be taken)."""
     price = np.asarray(cost(graph, edges), dtype=np.float64)
-    if price.shape != edges.shape or not np.all(np.isfinite(price)) or np.any(price < 0):
+    top = float(np.finfo(np.float32).max) / 1e6  # room for sums of many prices
+    if price.shape != edges.shape or not np.all(np.isfinite(price)) or np.any(price < 0) or np.any(price > top):
         name = getattr(cost, "__name__", repr(cost))
         raise ValueError(
-            f"search cost {name} must return one finite price >= 0 (frames) per edge, shape {edges.shape}; "
-            f"got shape {price.shape}, min {price.min() if price.size else None}"
+            f"search cost {name} must return one finite price >= 0 and at most {top:.3g} (frames) per edge, shape "
+            f"{edges.shape}; got shape {price.shape}, min {price.min() if price.size else None}, "
+            f"max {price.max() if price.size else None}"
         )
     return price.astype(np.float32)
 
@@ -509,7 +515,9 @@ _UNREACHED = np.float32(np.inf)
 
 SPARSE_JUMPS = 2
 """Jumps into each frame (the cheapest) that a walk through a pool tries first: a pool of many
-takes holds dozens of jumps per frame, and the recursion's cost grows with them."""
+takes holds dozens of jumps per frame, and the recursion's cost grows with them. A speed for
+exactness trade: the walk found is the cheapest through these jumps, not through every jump
+(:data:`TOLERANCE`)."""
 
 Jumps = tuple[np.ndarray, np.ndarray, np.ndarray]
 """``(src, dst, price)``: jumps between pool-local frames and what each costs, frames."""

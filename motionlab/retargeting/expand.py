@@ -115,7 +115,19 @@ _TAIL = (
 
 
 def columns() -> tuple[str, ...]:
-    """The manifest's columns: :data:`COLUMNS` with one column per registered loss term (:mod:`.terms`) after ``loss``."""
+    """The manifest's columns: :data:`COLUMNS` with one column per registered loss term (:mod:`.terms`) after ``loss``.
+
+    Raises
+    ------
+    ValueError when a registered term is named like one of the other columns (its value would
+    take that column's place: the output's file name, its status...).
+    """
+    clash = [t.name for t in terms.registered() if t.name in _HEAD + _TAIL]
+    if clash:
+        raise ValueError(
+            f"the loss term(s) {clash} are named like columns of expand's manifest; register them under other names "
+            f"(the manifest's own columns: {', '.join(_HEAD + _TAIL)})"
+        )
     return _HEAD + tuple(t.name for t in terms.registered()) + _TAIL
 
 
@@ -248,12 +260,13 @@ def _sha256(path) -> str:
 
 
 def options_digest(
-    checkpoint: Checkpoint, solver: SolverConfig, root_mode: str, fps: float | None, rest_from=None
+    checkpoint: Checkpoint, solver: SolverConfig, root_mode: str, fps: float | None, rest_from=None, flags=None
 ) -> str:
-    """SHA-256 of everything besides source and character that changes an output: the checkpoint's
-    weights, normalisation and frame rate, the solver settings, the registered loss terms and their
-    weights, the root rule, the output rate and the ``rest_from`` motion (its rest offsets and
-    rotations; nothing when None)."""
+    """SHA-256 of everything besides source and character that changes an output or its row: the
+    checkpoint's weights, normalisation and frame rate, the solver settings, the registered loss
+    terms and their weights, the root rule, the output rate, the ``rest_from`` motion (its rest
+    offsets and rotations; nothing when None) and ``flags``, the thresholds the row's ``flag``
+    is set by."""
     h = hashlib.sha256()
     for name, tensor in sorted(checkpoint.model.state_dict().items()):
         h.update(name.encode())
@@ -261,6 +274,8 @@ def options_digest(
     h.update(np.asarray(checkpoint.stats.mean, dtype=np.float64).tobytes())
     h.update(np.asarray(checkpoint.stats.std, dtype=np.float64).tobytes())
     settings = {"solver": dataclasses.asdict(solver), "root": root_mode, "fps": fps, "ckpt_fps": checkpoint.fps}
+    if flags is not None:
+        settings["flags"] = flags
     settings["terms"] = [[t.name, solver.weight(t.name)] for t in terms.registered()]  # what L_iter sums
     dtype = next(checkpoint.model.parameters()).dtype
     settings["damping"] = solver.project_damping or PROJECT_DAMPING.get(dtype, 1e-3)  # the one project_latent uses
@@ -697,13 +712,15 @@ def _expand(
     if not targets:
         raise ValueError("no target characters given")
     check_output_layout(out, clips, targets, suffix)  # before any work: nothing is written on a refusal
+    columns()  # refuses a loss term named like a manifest column, before any work too
     out.mkdir(parents=True, exist_ok=True)
     known = {(r["character"], r["clip"]): r for r in read_manifest(out)}
     for c in targets:
         _clean_temporaries(out / c.name)
     result = ExpandResult(out)
     rows: dict[tuple[str, str], dict] = {}
-    options = options_digest(checkpoint, solver, root_mode, fps, rest_from)
+    flags = {"max_penetration_cm": max_penetration_cm, "skate_ratio": skate_ratio}
+    options = options_digest(checkpoint, solver, root_mode, fps, rest_from, flags)
     todo = _plan(clips, targets, out, known, force, suffix, options, result, rows)
     gpu = checkpoint.device.type != "cpu"
     workers_here = host.default_workers(checkpoint.device) if host_workers is None else host_workers

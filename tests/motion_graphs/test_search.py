@@ -283,3 +283,8 @@ def test_a_jump_price_below_one_frame_off_meets_the_length():
         cw = search.PoolWalker(0, 10, step, np.array([9]), np.array([0]), 9, 0, price=np.float32([price]))
         _, _, n = search._walk(cw, 0, [12], [-1], slack=2)
         assert n == frames  # 2 frames short cost less than a jump of 8, more than one of 1
+
+
+def test_a_price_beyond_float32_is_refused_not_read_as_no_jump(sgraph):
+    with pytest.raises(ValueError, match="finite price >= 0 and at most"):
+        search.search(sgraph, "walk:normal:60", cost=lambda g, e: np.full(np.shape(e), 1e39))

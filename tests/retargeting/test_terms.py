@@ -288,3 +288,23 @@ def test_weights_that_are_not_finite_or_negative_are_refused_when_made():
             SolverConfig(**changes)
     with pytest.raises(ValueError, match="finite number >= 0"):
         terms.Term("big", float("inf"), _hands_low)
+
+
+def test_a_term_named_like_a_manifest_column_is_refused_before_expand_works(ckpt, clip, tmp_path):
+    terms.register(terms.Term("output", 0.1, _hands_low, padded=True))
+    try:
+        bvh.save(tmp_path / "walk.bvh", clip)
+        with pytest.raises(ValueError, match=r"\['output'\] are named like columns"):
+            ex.expand([str(tmp_path / "walk.bvh")], ex.characters(presets=["tall"]), tmp_path / "out", ckpt, FAST)
+        assert not (tmp_path / "out").exists() or not any((tmp_path / "out").rglob("*.bvh"))
+    finally:
+        terms.unregister("output")
+
+
+def test_expand_redoes_a_row_whose_flag_thresholds_changed(ckpt, clip, tmp_path):
+    bvh.save(tmp_path / "walk.bvh", clip)
+    chars = ex.characters(presets=["tall"])
+    first = ex.expand([str(tmp_path / "walk.bvh")], chars, tmp_path / "out", ckpt, FAST, max_penetration_cm=1.0)
+    again = ex.expand([str(tmp_path / "walk.bvh")], chars, tmp_path / "out", ckpt, FAST, max_penetration_cm=1.0)
+    other = ex.expand([str(tmp_path / "walk.bvh")], chars, tmp_path / "out", ckpt, FAST, max_penetration_cm=2.0)
+    assert (first.done, again.done, other.done) == (1, 0, 1)
