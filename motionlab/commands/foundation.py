@@ -120,16 +120,8 @@ def _synth(args) -> int:
     skeleton = humanoid.canonical_skeleton(args.height)
     skeleton = humanoid.scale_bones(skeleton, legs=args.legs, arms=args.arms)
     if args.behaviour == "mix":
-        seconds = [
-            ("idle", 1.0),
-            ("walk", 2.5),
-            ("run", 2.0),
-            ("jump", 70 / 60),
-            ("walk", 1.5),
-            ("squat", 5 / 3),
-            ("idle", 1.0),
-        ]
-        segments = [(behaviour, max(1, round(s * args.fps))) for behaviour, s in seconds]
+        at_60 = [("idle", 60), ("walk", 150), ("run", 120), ("jump", 70), ("walk", 90), ("squat", 100), ("idle", 60)]
+        segments = [(behaviour, max(1, round(n * args.fps / 60))) for behaviour, n in at_60]  # the same seconds
         motion = synthetic.sequence(segments, skeleton, fps=args.fps, seed=args.seed)
     else:
         motion = synthetic.generate(args.behaviour, skeleton, num_frames=frames, fps=args.fps, seed=args.seed)

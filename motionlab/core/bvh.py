@@ -620,10 +620,6 @@ def _decode(data: bytes, source: str, first_line: int = 1) -> str:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:
         line = first_line + data.count(b"\n", 0, exc.start)
-        if first_line == 1 and data.startswith(b"glTF"):
-            raise BVHError(
-                source, 1, "a binary glTF (.glb) file, not BVH text; motionlab reads motion from BVH"
-            ) from None
         raise BVHError(source, line, f"expected UTF-8 text, found the byte {data[exc.start]:#04x}") from None
 
 

@@ -57,14 +57,14 @@ def _pos(pos, name: str = "pos") -> np.ndarray:
     return pos
 
 
-def _per_height(err: float, height: float | None) -> float:
-    """``err`` divided by ``height`` (None: as it is). Raises ValueError for a height that is not a
-    positive number."""
+def _height(height: float | None) -> float:
+    """The length an error is divided by: ``height``, or 1 for None. Raises ValueError for a height
+    that is not a positive number."""
     if height is None:
-        return err
+        return 1.0
     if not (np.isfinite(height) and height > 0):
         raise ValueError(f"expected a positive height to normalise by, got {height!r}")
-    return err / height
+    return float(height)
 
 
 def mse(pred, target, height: float | None = None) -> float:
@@ -75,14 +75,14 @@ def mse(pred, target, height: float | None = None) -> float:
     """
     pred, target = _pair(pred, target)
     err = float(np.mean((pred - target) ** 2))
-    return _per_height(_per_height(err, height), height)
+    return err / _height(height) ** 2
 
 
 def mpjpe(pred, target, height: float | None = None) -> float:
     """Mean per-joint position error: mean Euclidean distance (position unit; ÷ height if given)."""
     pred, target = _pair(pred, target)
     err = float(np.mean(np.linalg.norm(pred - target, axis=-1)))
-    return _per_height(err, height)
+    return err / _height(height)
 
 
 def smoothness(pos) -> float:

@@ -67,9 +67,8 @@ def exp(v) -> np.ndarray:
 
 ANGULAR_HORIZON = 14 / 30
 """Seconds over which ``"hermite"`` rotations follow the angular velocities at a gap's ends (14
-frames at 30 fps): of 2–24 frames, the horizon whose fills were closest to the recordings
-(L2P and L2Q against SLERP's, gaps of 5–45 frames) on the LaFAN1-protocol windows of clips kept
-apart from the scored ones (``python -m experiments.interpolation.hermite_horizon``)."""
+frames at 30 fps), chosen on clips kept apart from those it is scored on
+(``python -m experiments.interpolation.hermite_horizon``, docs/results_interpolation.md)."""
 
 
 def _check_pair(rot_a, pos_a, rot_b, pos_b):
@@ -157,10 +156,7 @@ def interpolate(
             pos = pa + m0 * ss + (pb - pa - m0) * ss * ss
         else:
             m1 = np.asarray(vel_b, dtype=np.float64)[..., None, :] * length
-            h00 = 2 * ss**3 - 3 * ss**2 + 1
-            h10 = ss**3 - 2 * ss**2 + ss
-            h01 = -2 * ss**3 + 3 * ss**2
-            h11 = ss**3 - ss**2
+            h00, h10, h01, h11 = _hermite_basis(ss)
             pos = h00 * pa + h10 * m0 + h01 * pb + h11 * m1
     return rot, pos
 
@@ -188,8 +184,13 @@ def _hermite_rotvec(rot_a, rot_b, ang_vel_a, ang_vel_b, s: np.ndarray, span: flo
     t = s[:, None, None]
     if w[1] is None:
         return w0 * t + (d - w0) * t * t
-    w1 = w[1][..., None, :, :]
-    return (t**3 - 2 * t**2 + t) * w0 + (3 * t**2 - 2 * t**3) * d + (t**3 - t**2) * w1
+    _, h10, h01, h11 = _hermite_basis(t)
+    return h10 * w0 + h01 * d + h11 * w[1][..., None, :, :]
+
+
+def _hermite_basis(s: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The cubic Hermite basis ``(h00, h10, h01, h11)`` at time fractions ``s`` (any shape)."""
+    return 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, 3 * s**2 - 2 * s**3, s**3 - s**2
 
 
 def zero_velocity(rot_a, pos_a, num: int) -> tuple[np.ndarray, np.ndarray]:

@@ -335,13 +335,14 @@ def _check_misses(result, keep: bool) -> None:
     """Refuse a path whose segments miss their counts by more than the tolerance, unless ``keep``."""
     from motionlab.motion_graphs import search
 
-    if not result.misses:
+    misses = result.misses
+    if not misses:
         return
     text = "; ".join(
         f"{s.behaviour}:{s.style} asks for {s.frames} frames, and the nearest walk this graph has gives {a} "
         f"(±{search.tolerance_frames(s.frames)} allowed)"
         for k, (s, a) in enumerate(zip(result.segments, result.achieved))
-        if k in result.misses
+        if k in misses
     )
     if not keep:
         raise CLIError(f"{text}; ask for other counts, or --keep-misses writes the nearest path anyway")

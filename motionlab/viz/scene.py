@@ -65,7 +65,7 @@ def _rgb(color) -> np.ndarray:
 
 MAX_CLEARANCE = 0.1
 """Body heights a foot joint may stand above its rest height in every frame of a clip and still
-touch the ground (CMU's standing toes: about 0.04); higher, the clip is in the air."""
+touch the ground (a rig's foot joints need not sit at its sole); higher, the clip is in the air."""
 
 
 def foot_joints(skeleton: Skeleton) -> list[int]:
