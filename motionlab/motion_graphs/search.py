@@ -20,10 +20,13 @@ frame counts,
 (``P_c(f)``: the least price of the jumps of a walk of ``c + 1`` frames from ``e`` that ends at
 ``f``; infinite where none does) run once per segment. The exit whose route length ``r``
 satisfies ``c + 1 + r = n`` wins; of the walks within :data:`TOLERANCE`, the one whose jumps
-cost least plus one per frame off the request. Long segments first take the shortest way to the pool's main cycle (its longest jump back inside
+cost least plus one per frame off the request. The recursion runs first over the cheapest jumps
+into each frame (:data:`SPARSE_JUMPS`), then, only where a walk through another jump could cost
+less, over every jump, keeping only the walks that can still cost less: what the recursion
+chooses is the cheapest over every jump. Long segments first take the shortest way to the pool's main cycle (its longest jump back inside
 one take) and repeat it, so the recursion stays short: the *iterative choice of self-loop and
-transition points*. Pools crossed on the way to the next segment are passed by the shortest walk
-to an exit (:func:`walk_to_exit`); the **loop guard** stops it with an error once every frame
+transition points*. Pools crossed on the way to the next segment are passed by the cheapest walk
+to an exit, frames plus prices (:func:`walk_to_exit`); the **loop guard** stops it with an error once every frame
 it can reach has been visited (paper B stops at the second pass of a clip's last self-loop
 point; a pool of many takes has none). A request may ask for at most :data:`MAX_FRAMES` frames.
 
@@ -85,11 +88,11 @@ limit, rather than running for minutes and filling the disk."""
 
 TOLERANCE = 0.05
 """Documented accuracy: every reachable segment gets its requested length within
-``max(2 frames, 5%)``; inside that band the walk whose jumps cost least wins among the walks
-through the :data:`SPARSE_JUMPS` cheapest jumps into each frame (with the default search cost,
-the walk with the fewest jumps; checked by the tests). Only where none of those fits the band are
-all jumps tried, so with a custom cost that prices the jumps into one frame differently a
-dearer walk than the cheapest can win."""
+``max(2 frames, 5%)``; inside that band the walk through its pool whose jumps cost least plus one
+per frame off the request wins, over every jump of the pool (with the default search cost, the
+walk with the fewest jumps; checked against loops by hand in the tests). Each segment's walk is
+the cheapest from where the previous one left off (a long segment first goes round its pool's
+main cycle; the recursion chooses the rest); the request as a whole is not searched at once."""
 
 
 def tolerance_frames(frames: int) -> int:
@@ -259,7 +262,8 @@ class PoolWalker:
     ``price``: what each jump costs, frames on top of the frame it plays (``None``:
     :data:`JUMP_FRAMES` each, as :func:`default_cost`). ``sparse``: ``(src, dst, price)`` of the
     :data:`SPARSE_JUMPS` cheapest jumps into every frame (``None``: all jumps), which the search
-    tries first. A walker keeps what its searches derive from these arrays (its jumps by source
+    tries first (it must hold the cheapest jumps into each frame: the search's proof that no other
+    jump gives a cheaper walk rests on it). A walker keeps what its searches derive from these arrays (its jumps by source
     and by destination): replace none of them once it has searched; make a new walker.
     """
 
@@ -312,6 +316,16 @@ class PoolWalker:
         else:
             jumps.sort()
         return np.concatenate([f, self.loop_src[jumps]]), np.concatenate([f + 1, self.loop_dst[jumps]])
+
+    def _by_destination(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(order, head)``: the jumps ordered by destination frame (stable), those into frame
+        ``f`` at ``order[head[f] : head[f + 1]]`` (made at the first call, then kept)."""
+        if "by destination" not in self._prepared:
+            order = np.argsort(self.loop_dst, kind="stable")
+            head = np.zeros(self.length + 1, dtype=np.int64)
+            np.cumsum(np.bincount(self.loop_dst, minlength=self.length), out=head[1:])
+            self._prepared["by destination"] = (order, head)
+        return self._prepared["by destination"]
 
     def _by_source(self) -> tuple[np.ndarray, np.ndarray]:
         """``(order, head)``: the jumps ordered by source frame, those out of frame ``f`` at
@@ -515,9 +529,10 @@ _UNREACHED = np.float32(np.inf)
 
 SPARSE_JUMPS = 2
 """Jumps into each frame (the cheapest) that a walk through a pool tries first: a pool of many
-takes holds dozens of jumps per frame, and the recursion's cost grows with them. A speed for
-exactness trade: the walk found is the cheapest through these jumps, not through every jump
-(:data:`TOLERANCE`)."""
+takes holds dozens of jumps per frame, and the recursion's cost grows with them. A walk through
+any other jump pays at least the least price of those jumps; where the walk found costs more,
+every jump is tried, in tables that keep only the walks that can still cost less (so the walk
+found is the cheapest through every jump; :data:`TOLERANCE`)."""
 
 Jumps = tuple[np.ndarray, np.ndarray, np.ndarray]
 """``(src, dst, price)``: jumps between pool-local frames and what each costs, frames."""
@@ -557,7 +572,7 @@ def _prepare(cw: PoolWalker, jumps: Jumps | None) -> tuple:
     if key in cw._prepared:
         return cw._prepared[key]
     src, dst, price = cw.jumps() if jumps is None else jumps
-    order = np.argsort(dst, kind="stable")
+    order = cw._by_destination()[0] if jumps is None else np.argsort(dst, kind="stable")
     src, dst, price = src[order], dst[order], price[order]
     rank = np.arange(dst.size) - np.searchsorted(dst, dst)  # k-th jump into its frame
     n = cw.length
@@ -661,21 +676,129 @@ def _walk(
     steps = max(n - played for n in need) + max(cw.cycle, 2)
     steps = max(steps, 2)
     need_c = np.array(need) - played - 1
-    # first the cheapest jump into each frame and just the rows an exact length needs (a pool of
-    # many takes holds dozens of jumps per frame, and the recursion's cost grows with them);
-    # when that gives no walk of exactly the requested length, every jump and the full width
+    # first the cheapest jumps into each frame and just the rows the tolerance needs (a pool of
+    # many takes holds dozens of jumps per frame, and the recursion's cost grows with them); a
+    # walk through any other jump pays at least the least price of those jumps, so when the
+    # walk found costs no more, it is the cheapest of all; else every jump, and when no walk
+    # lies within the tolerance, the full width
     short = min(steps, int(need_c.max()) + slack + 2)
-    for rows, jumps, widest in ((short, cw.sparse, slack), (steps, None, steps)):
-        reach = _reach(cw, start, rows, jumps)
-        best = _choose(reach, need_c, ex, rows, widest, slack)
-        if best is not None:
-            break
+    jumps, reach = cw.sparse, _reach(cw, start, short, cw.sparse)
+    best = _choose(reach, need_c, ex, short, slack, slack)
+    if best is None:
+        jumps, reach = None, _reach(cw, start, steps)
+        best = _choose(reach, need_c, ex, steps, steps, slack)
+    elif jumps is not None and best[3] > _least_beyond(cw):
+        cheaper = _cheaper_walk(cw, start, short, need_c, ex, slack, best[3])
+        if cheaper is not None:
+            jumps, (reach, best) = None, cheaper
     if best is None:
         raise SearchError(f"{name}: no walk from frame {start} reaches any exit")
-    r, c, x = best
+    r, c, x = best[:3]
     frames = _backtrack(cw, reach, c, x, jumps)
     pieces.extend(_runs(cw, frames))
     return pieces, r, played + c + 1
+
+
+def _cheaper_walk(cw: PoolWalker, start: int, rows: int, need_c: np.ndarray, ex: np.ndarray, slack: int, bound: float):
+    """``(reach, choice)``: :func:`_choose`'s walk over every jump when it costs less than
+    ``bound``, else ``None``. The tables (:func:`_reach_below`) are made for bounds doubling from
+    twice the least price of a jump up to ``bound``: a walk cheaper than the table's bound costs
+    no more than the walks it keeps, so the first table holding one holds the cheapest."""
+    first_row = max(int(need_c.min()) - slack, 0)
+    least = float(cw.jumps()[2].min())
+    below = min(2 * least, bound) if least > 0 else bound
+    while True:
+        reach = _reach_below(cw, start, rows, below, first_row)
+        found = _choose(reach, need_c, ex, rows, slack, slack)
+        if found is not None and found[3] < below:
+            return reach, found
+        if below >= bound:
+            return None
+        reach, below = None, min(2 * below, bound)  # (the table freed before the next is made)
+
+
+def _reach_below(
+    cw: PoolWalker, start: int, rows: int, bound: float, first_row: int = 0, exits: np.ndarray | None = None
+) -> np.ndarray:
+    """:func:`_reach` over every jump, kept to the walks that can still cost less than ``bound``:
+    a walk of ``c + 1`` frames ending at ``f`` is left out (``inf``) when its cost plus the
+    least it must still pay is ``bound`` or more. The cost: the price of its jumps, and, with
+    ``exits``, one per frame. What it must still pay: without ``exits``, to last until row
+    ``first_row``, the least price of a jump for each jump it needs, when after ``f``'s own run of
+    steps each jump is followed by at most the pool's longest run (a step keeps that sum); with
+    ``exits``, one per move of the fewest moves from ``f`` to an exit. The entries of the walks
+    kept equal :func:`_reach`'s; jumps are gathered from the frames kept, so a tight bound makes
+    rows cheap."""
+    src, dst, price = cw.jumps()
+    order, head = cw._by_source()
+    n = cw.length
+    at_end = np.where(cw.step, n, np.arange(n))
+    run = np.minimum.accumulate(at_end[::-1])[::-1] - np.arange(n)  # steps from each frame on
+    longest, least = int(run.max()) + 1, float(price.min()) if price.size else 0.0
+    per_frame, rest = (0.0, np.zeros(n)) if exits is None else (1.0, _moves_to(cw, exits))
+    prep = _prepare(cw, None)  # all jumps by destination, when more than a few enter a frame
+    grouped = prep[1:] if prep[0] == "grouped" else None
+    out = np.full((max(rows, 1), n), _UNREACHED, dtype=np.float32)
+    out[0, start] = 0
+    step_ok = cw.step[:-1]
+    for c in range(1, rows):
+        prev, cur = out[c - 1], out[c]
+        np.copyto(cur[1:], prev[:-1], where=step_ok)
+        limit = bound - per_frame * (c + 1)  # what the price of a walk of c + 1 frames must stay below
+        if exits is not None:  # a step can take a walk further from the exits
+            cur[cur + rest >= limit] = _UNREACHED
+        a = np.flatnonzero(prev + (rest - per_frame) < limit - least)  # a jump is one move nearer at most
+        count = head[a + 1] - head[a]
+        if grouped is not None and 4 * int(count.sum()) > src.size:  # most jumps leave a frame kept: all
+            to, value = grouped[3], np.minimum.reduceat(prev[grouped[0]] + grouped[1], grouped[2])
+        elif a.size:
+            at = order[np.repeat(head[a] - np.cumsum(count) + count, count) + np.arange(int(count.sum()))]
+            to, value = dst[at], prev[src[at]] + price[at]
+        else:
+            continue
+        must = rest[to] + least * np.ceil(np.maximum(first_row - c - run[to], 0) / longest)
+        keep = value + must < limit
+        np.minimum.at(cur, to[keep], value[keep])
+    return out
+
+
+def _moves_to(cw: PoolWalker, exits: np.ndarray) -> np.ndarray:
+    """(n,) float: the fewest moves (steps and jumps) from each frame to one of ``exits``
+    (``inf`` where none leads): a breadth-first search backwards (kept in the walker)."""
+    frontier = np.unique(np.asarray(exits, dtype=np.int64))
+    key = ("moves to", frontier.tobytes())
+    if key in cw._prepared:
+        return cw._prepared[key]
+    order, head = cw._by_destination()
+    moves = cw._prepared[key] = np.full(cw.length, np.inf)
+    moves[frontier] = 0
+    while frontier.size:
+        g = frontier[frontier > 0]
+        count = head[frontier + 1] - head[frontier]
+        at = order[np.repeat(head[frontier] - np.cumsum(count) + count, count) + np.arange(int(count.sum()))]
+        f = np.concatenate([g[cw.step[g - 1]] - 1, cw.loop_src[at]])
+        f = np.unique(f[np.isinf(moves[f])])
+        moves[f] = moves[frontier[0]] + 1
+        frontier = f
+    return moves
+
+
+def _least_beyond(cw: PoolWalker) -> float:
+    """The least price of the walker's jumps that ``cw.sparse`` leaves out (``inf``: none), given
+    that ``cw.sparse`` holds the cheapest jumps into each frame: the price that follows them in
+    each frame's jumps, sorted by price. Kept in the walker."""
+    if "beyond" not in cw._prepared:
+        src, dst, price = cw.jumps()
+        kept = np.bincount(cw.sparse[1], minlength=cw.length) if cw.sparse is not None else np.zeros(cw.length, int)
+        if price.size and price.min() == price.max():  # one price: any jump left out costs it
+            left = np.bincount(dst, minlength=cw.length) > kept
+            cw._prepared["beyond"] = float(price[0]) if left.any() else np.inf
+        else:
+            o = np.lexsort((price, dst))
+            rank = np.arange(dst.size) - np.searchsorted(dst[o], dst[o])  # position among the jumps into dst
+            left = rank >= kept[dst[o]]
+            cw._prepared["beyond"] = float(price[o][left].min()) if left.any() else np.inf
+    return cw._prepared["beyond"]
 
 
 def _straight(cw: PoolWalker, start: int, frames: int) -> bool:
@@ -684,10 +807,10 @@ def _straight(cw: PoolWalker, start: int, frames: int) -> bool:
 
 
 def _choose(reach: np.ndarray, need_c: np.ndarray, ex: np.ndarray, steps: int, widest: int, slack: int = 0):
-    """``(option, row, exit frame)``: of the walks within ``slack`` rows of an option's requested
-    row, the cheapest, at the price of its jumps plus one per frame off the request (the nearer
-    length on ties); when there is none, the walk nearest the requested length (``None``: none
-    within ``widest`` rows of it)."""
+    """``(option, row, exit frame, key)``: of the walks within ``slack`` rows of an option's
+    requested row, the cheapest, at the price of its jumps plus one per frame off the request
+    (``key``; the nearer length on ties); when there is none, the walk nearest the requested
+    length (``None``: none within ``widest`` rows of it)."""
     best, best_key = None, None
     for order, delta in enumerate(_deltas(widest + 1)):
         if best is not None and (abs(delta) > slack or abs(delta) >= best_key[0]):
@@ -697,7 +820,7 @@ def _choose(reach: np.ndarray, need_c: np.ndarray, ex: np.ndarray, steps: int, w
             continue
         key = (found[3] + abs(delta), order)
         if best is None or key < best_key:
-            best, best_key = found[:3], key
+            best, best_key = (*found[:3], key[0]), key
     return best
 
 
@@ -725,8 +848,9 @@ def walk_to_exit(
 ) -> tuple[list[tuple[int, int, int]], int, int]:
     """The cheapest walk through a pool from ``start`` to one of ``exits`` (pool-local frames).
 
-    Cost: frames plus the price of its jumps (the walker's search cost), over the cheapest jumps
-    into each frame; the shortest walk (a breadth-first search) when nothing cheaper is found.
+    Cost: frames plus the price of its jumps (the walker's search cost), over every jump of the
+    pool; of equally cheap walks the shortest, then the first exit. The shortest walk (a
+    breadth-first search) when none is cheaper.
 
     Returns
     -------
@@ -756,15 +880,28 @@ def _walk_to_exit(
     frames, r = _path(cw, start, None, name, distinct)
     bound = len(frames) + _paid(cw, frames)  # what the shortest walk costs
     # a cheaper walk has fewer frames than ``bound`` (each frame costs one) and visits no frame
-    # twice (a loop costs at least a frame), so it has at most ``cw.length`` frames
-    rows = min(int(np.ceil(bound)), cw.length)
-    reach = _reach(cw, start, rows, cw.sparse)
-    ex, first = distinct  # an exit frame given twice costs the same: its first index stands for it
-    cost = np.arange(1, rows + 1)[:, None] + reach[:, ex].astype(np.float64)
-    c, k = np.unravel_index(int(np.argmin(cost)), cost.shape)  # shortest first, then the first exit
-    if cost[c, k] < bound:
-        frames, r = _backtrack(cw, reach, int(c), int(ex[k]), cw.sparse), int(first[k])
+    # twice (a loop costs at least a frame), so it has at most ``cw.length`` frames. First the
+    # cheapest jumps into each frame: a walk through another jump costs at least two frames and
+    # that jump's price, so only when the walk found costs as much is every jump tried
+    jumps, found = None, bound
+    if cw.sparse is not None:
+        jumps, reach = cw.sparse, _reach(cw, start, min(int(np.ceil(bound)), cw.length), cw.sparse)
+        found = min(bound, _cheapest_exit(reach, distinct[0])[0])
+    if cw.sparse is None or found >= 2 + _least_beyond(cw):  # the walks costing at most ``found``
+        rows, below = min(int(np.ceil(found)), cw.length), found * (1 + 1e-6)
+        jumps, reach = None, _reach_below(cw, start, rows, below, exits=distinct[0])
+    cost, c, k = _cheapest_exit(reach, distinct[0])
+    if cost < bound:
+        return _runs(cw, _backtrack(cw, reach, c, int(distinct[0][k]), jumps)), int(distinct[1][k]), c + 1
     return _runs(cw, frames), r, len(frames)
+
+
+def _cheapest_exit(reach: np.ndarray, ex: np.ndarray) -> tuple[float, int, int]:
+    """``(cost, row, k)``: the walk of ``reach`` to an exit ``ex[k]`` that costs least, a frame
+    costing one (the shortest first, then the first exit; ``inf`` cost when none)."""
+    cost = np.arange(1, reach.shape[0] + 1)[:, None] + reach[:, ex].astype(np.float64)
+    c, k = np.unravel_index(int(np.argmin(cost)), cost.shape)
+    return float(cost[c, k]), int(c), int(k)
 
 
 def _walks_to_exit(cw: PoolWalker, starts, distinct: tuple, name: str) -> dict:
@@ -804,8 +941,7 @@ def _walks_to_exit(cw: PoolWalker, starts, distinct: tuple, name: str) -> dict:
             if moves[s] >= 0:
                 nearest[s] = (int(distinct[1][k_of[s]]), int(moves[s]) + 1)
                 bounds[s] = (moves[s] + 1 + lo[s], moves[s] + 1 + hi[s])
-    jumps = cw.jumps() if cw.sparse is None else cw.sparse
-    best = _back_costs(cw, jumps, distinct[0], list(bounds), max((b[1] for b in bounds.values()), default=0))
+    best = _back_costs(cw, distinct[0], list(bounds), max((b[1] for b in bounds.values()), default=0))
     out: dict = {}
     for s in starts:
         if s not in bounds:  # no exit reachable: the forward walk's loop-guard error
@@ -839,9 +975,7 @@ def _nearest_back(cw: PoolWalker, exits: np.ndarray, starts: list[int]):
     for its jumps (:func:`_paid`'s price per move)."""
     n = cw.length
     if "into" not in cw._prepared:
-        order = np.argsort(cw.loop_dst, kind="stable")
-        head = np.zeros(n + 1, dtype=np.int64)
-        np.cumsum(np.bincount(cw.loop_dst, minlength=n), out=head[1:])
+        order, head = cw._by_destination()
         src = cw.loop_src[order]
         is_step = (cw.loop_dst[order] == src + 1) & cw.step[src]
         cw._prepared["into"] = (head, src, np.where(is_step, 0.0, _pair_least(cw)[order]))
@@ -891,8 +1025,8 @@ def _pair_least(cw: PoolWalker) -> np.ndarray:
     return cw._prepared["pair_least"]
 
 
-def _back_costs(cw: PoolWalker, jumps: Jumps, exits: np.ndarray, wanted, cutoff: float) -> dict:
-    """Dijkstra's search backwards from ``exits`` over the steps and ``jumps`` (whole-number
+def _back_costs(cw: PoolWalker, exits: np.ndarray, wanted, cutoff: float) -> dict:
+    """Dijkstra's search backwards from ``exits`` over the steps and the walker's jumps (whole-number
     prices): ``frame -> (cost, moves, k)``, the least ``(cost, moves, k)`` (compared in that
     order) over the walks from the frame to exit ``exits[k]``, a move costing one plus its
     price. Stops once every frame of ``wanted`` is settled, or at costs of ``cutoff - 1`` and
@@ -901,14 +1035,12 @@ def _back_costs(cw: PoolWalker, jumps: Jumps, exits: np.ndarray, wanted, cutoff:
     The costs are whole numbers, so the frames are settled cost by cost (Dial's buckets), all
     frames of one cost at once: each takes the least ``(moves, k)`` among its moves into frames
     settled before."""
-    src, dst, price = jumps
+    src, _, price = cw.jumps()
     n = cw.length
+    order, head = cw._by_destination()
     if "back" not in cw._prepared:  # the jumps into each frame
-        order = np.argsort(dst, kind="stable")
-        head = np.zeros(n + 1, dtype=np.int64)
-        np.cumsum(np.bincount(dst, minlength=n), out=head[1:])
-        cw._prepared["back"] = (head, src[order].astype(np.int64), price[order].astype(np.int64) + 1)
-    head, into, weight = cw._prepared["back"]
+        cw._prepared["back"] = (src[order].astype(np.int64), price[order].astype(np.int64) + 1)
+    into, weight = cw._prepared["back"]
     big = exits.size + 1  # (moves, k) as one number: moves * big + k
     settled = np.full(n, -1, dtype=np.int64)  # cost, -1 before settled
     key_of = np.zeros(n, dtype=np.int64)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pytest
 
+from motionlab import data
 from motionlab.motion_graphs import clips, distance, structured
 
 STYLES = {
@@ -22,3 +23,18 @@ def library():
 @pytest.fixture(scope="session")
 def sgraph(library):
     return structured.build_structured(library, THRESHOLD)
+
+
+def session_walk_takes(per_style: int, styles=("normal", "elderly", "feminine")) -> list:
+    """The first ``per_style`` dataset-2 walk takes of each style (real mocap), prepared at 30 fps
+    and named by their files; the test is skipped without the data."""
+    from motionlab.core import bvh
+
+    if not data.has_data("bandai_namco", "sessions", "walk"):
+        pytest.skip(f"needs real mocap (bandai_namco/sessions/walk): {data.HOW_TO}")
+    root = data.data_root() / "bandai_namco" / "sessions" / "walk"
+    return [
+        clips.prepare(bvh.load(path), 30.0).copy(name=path.stem)
+        for style in styles
+        for path in sorted(root.glob(f"dataset-2_walk_{style}_*.bvh"))[:per_style]
+    ]

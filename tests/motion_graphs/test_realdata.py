@@ -8,7 +8,7 @@ import pytest
 
 from motionlab import data
 from motionlab.motion_graphs import clips, search, structured
-from tests.motion_graphs.conftest import THRESHOLD
+from tests.motion_graphs.conftest import THRESHOLD, session_walk_takes
 
 pytestmark = pytest.mark.realdata
 
@@ -31,16 +31,9 @@ def test_bandai_walk_styles_end_to_end():
 def test_session_takes_pool_and_connect():
     """Four takes each of three dataset-2 walk styles: one style per name, whatever the take;
     the behaviour's largest component holds >= 90% of its frames; every style reaches every other."""
-    from motionlab.core import bvh
     from motionlab.motion_graphs import distance, report
 
-    if not data.has_data("bandai_namco", "sessions", "walk"):
-        pytest.skip(f"needs real mocap (bandai_namco/sessions/walk): {data.HOW_TO}")
-    root = data.data_root() / "bandai_namco" / "sessions" / "walk"
-    ms = []
-    for style in ("normal", "elderly", "feminine"):
-        for path in sorted(root.glob(f"dataset-2_walk_{style}_*.bvh"))[:4]:
-            ms.append(clips.prepare(bvh.load(path), 30.0).copy(name=path.stem))
+    ms = session_walk_takes(4)
     g = structured.build_structured(ms, distance.threshold_from(0.03))
     assert sorted(g.table["behaviours"]["walk"]) == ["elderly", "feminine", "normal"]
     assert all(len(c["takes"]) == 4 for c in g.table["behaviours"]["walk"].values())
