@@ -50,7 +50,10 @@ def requests(g, count: int = COUNT, seed: int = 0) -> list[str]:
 def graph(path: str | None):
     """The graph of ``path``, or built from the session folder at the default threshold."""
     if path:
-        return io.load(path)
+        try:
+            return io.load(path)
+        except (OSError, ValueError) as e:  # a missing or damaged file: its own message, no traceback
+            sys.exit(str(e))
     folder = data.data_root() / "bandai_namco" / "sessions"
     if not folder.is_dir():
         sys.exit(f"needs real mocap ({folder}): {data.HOW_TO}")

@@ -306,9 +306,7 @@ class PoolWalker:
         order, head = self._by_source()
         if frames.size > 1 and not np.all(frames[1:] > frames[:-1]):
             frames = np.unique(frames)  # a frame given twice gives its jumps once
-        first, count = head[frames], head[frames + 1] - head[frames]
-        at = np.repeat(first - np.cumsum(count) + count, count) + np.arange(int(count.sum()))
-        jumps = order[at]
+        jumps = order[_spans(head, frames)[0]]
         if jumps.size * 32 > order.size:  # in their stored order: a mark per jump beats a sort
             mark = np.zeros(order.size, dtype=bool)
             mark[jumps] = True
@@ -731,9 +729,7 @@ def _reach_below(
     rows cheap."""
     src, dst, price = cw.jumps()
     order, head = cw._by_source()
-    n = cw.length
-    at_end = np.where(cw.step, n, np.arange(n))
-    run = np.minimum.accumulate(at_end[::-1])[::-1] - np.arange(n)  # steps from each frame on
+    n, run = cw.length, _runs_of_steps(cw)
     longest, least = int(run.max()) + 1, float(price.min()) if price.size else 0.0
     per_frame, rest = (0.0, np.zeros(n)) if exits is None else (1.0, _moves_to(cw, exits))
     prep = _prepare(cw, None)  # all jumps by destination, when more than a few enter a frame
@@ -748,11 +744,10 @@ def _reach_below(
         if exits is not None:  # a step can take a walk further from the exits
             cur[cur + rest >= limit] = _UNREACHED
         a = np.flatnonzero(prev + (rest - per_frame) < limit - least)  # a jump is one move nearer at most
-        count = head[a + 1] - head[a]
-        if grouped is not None and 4 * int(count.sum()) > src.size:  # most jumps leave a frame kept: all
+        if grouped is not None and 4 * int((head[a + 1] - head[a]).sum()) > src.size:  # most jumps: all
             to, value = grouped[3], np.minimum.reduceat(prev[grouped[0]] + grouped[1], grouped[2])
         elif a.size:
-            at = order[np.repeat(head[a] - np.cumsum(count) + count, count) + np.arange(int(count.sum()))]
+            at = order[_spans(head, a)[0]]
             to, value = dst[at], prev[src[at]] + price[at]
         else:
             continue
@@ -760,6 +755,23 @@ def _reach_below(
         keep = value + must < limit
         np.minimum.at(cur, to[keep], value[keep])
     return out
+
+
+def _spans(head: np.ndarray, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(at, count)``: the positions ``head[f] … head[f + 1] - 1`` of each of ``frames`` in turn
+    (the jumps out of, or into, each frame of an ordering such as :meth:`PoolWalker._by_source`),
+    and how many each frame has."""
+    first, count = head[frames], head[frames + 1] - head[frames]
+    return np.repeat(first - np.cumsum(count) + count, count) + np.arange(int(count.sum())), count
+
+
+def _runs_of_steps(cw: PoolWalker) -> np.ndarray:
+    """(n,) int: the steps a walk can take from each frame on without a jump (kept in the walker)."""
+    if "runs of steps" not in cw._prepared:
+        n = cw.length
+        at_end = np.where(cw.step, n, np.arange(n))
+        cw._prepared["runs of steps"] = np.minimum.accumulate(at_end[::-1])[::-1] - np.arange(n)
+    return cw._prepared["runs of steps"]
 
 
 def _moves_to(cw: PoolWalker, exits: np.ndarray) -> np.ndarray:
@@ -774,9 +786,7 @@ def _moves_to(cw: PoolWalker, exits: np.ndarray) -> np.ndarray:
     moves[frontier] = 0
     while frontier.size:
         g = frontier[frontier > 0]
-        count = head[frontier + 1] - head[frontier]
-        at = order[np.repeat(head[frontier] - np.cumsum(count) + count, count) + np.arange(int(count.sum()))]
-        f = np.concatenate([g[cw.step[g - 1]] - 1, cw.loop_src[at]])
+        f = np.concatenate([g[cw.step[g - 1]] - 1, cw.loop_src[order[_spans(head, frontier)[0]]]])
         f = np.unique(f[np.isinf(moves[f])])
         moves[f] = moves[frontier[0]] + 1
         frontier = f
@@ -987,8 +997,7 @@ def _nearest_back(cw: PoolWalker, exits: np.ndarray, starts: list[int]):
     while frontier.size and (moves[want] < 0).any():
         g = frontier[frontier > 0]
         g = g[cw.step[g - 1]]
-        count = head[frontier + 1] - head[frontier]
-        at = np.repeat(head[frontier] - np.cumsum(count) + count, count) + np.arange(int(count.sum()))
+        at, count = _spans(head, frontier)
         f = np.concatenate([g - 1, into[at]])
         g = np.concatenate([g, np.repeat(frontier, count)])
         p = np.concatenate([np.zeros(f.size - at.size), pay[at]])
@@ -1063,8 +1072,7 @@ def _back_costs(cw: PoolWalker, exits: np.ndarray, wanted, cutoff: float) -> dic
         step_from = g[(g > 0)]
         step_from = step_from[cw.step[step_from - 1]]
         buckets.setdefault(cost + 1, []).append((step_from - 1, key_of[step_from] + big))
-        count = head[g + 1] - head[g]
-        at = np.repeat(head[g] - np.cumsum(count) + count, count) + np.arange(int(count.sum()))
+        at, count = _spans(head, g)
         w, k2 = weight[at], np.repeat(key_of[g], count) + big
         for level in np.unique(w).tolist():
             on = w == level
