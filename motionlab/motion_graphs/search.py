@@ -536,6 +536,43 @@ Jumps = tuple[np.ndarray, np.ndarray, np.ndarray]
 """``(src, dst, price)``: jumps between pool-local frames and what each costs, frames."""
 
 
+class _Kept:
+    """A walk table (see :func:`_reach`) that stores only its entries below ``inf``: ``frames[c]``
+    (sorted) and ``values[c]``, row ``c``'s, for a table of ``n`` columns. Indexed as the dense
+    table is where the search reads one: ``t[c]`` (a row), ``t[c, x]`` and ``t[rows, cols]``
+    (arrays broadcast together; a slice of rows), ``t.shape``."""
+
+    def __init__(self, frames: list[np.ndarray], values: list[np.ndarray], n: int) -> None:
+        self.shape = (len(frames), n)
+        count = [f.size for f in frames]
+        self._head = np.concatenate([[0], np.cumsum(count)])  # row c at head[c] : head[c + 1]
+        self._keys = np.repeat(np.arange(len(frames), dtype=np.int64), count) * n + np.concatenate(frames)
+        self._values = np.concatenate(values).astype(np.float32)  # (keys sorted: by row, then frame)
+
+    def __getitem__(self, key) -> np.ndarray:
+        if not isinstance(key, tuple):  # one row, dense
+            c, row = int(key), np.full(self.shape[1], _UNREACHED)
+            at = slice(self._head[c], self._head[c + 1])
+            row[self._keys[at] - c * self.shape[1]] = self._values[at]
+            return row
+        rows, cols = key
+        if isinstance(rows, (int, np.integer)) and isinstance(cols, (int, np.integer)):  # one entry
+            want = int(rows) * self.shape[1] + int(cols)
+            at = min(int(self._keys.searchsorted(want)), self._keys.size - 1)
+            return self._values[at] if self._keys[at] == want else _UNREACHED
+        if isinstance(rows, slice):
+            rows = np.arange(self.shape[0])[rows][:, None]
+        rows, cols = np.broadcast_arrays(np.asarray(rows, dtype=np.int64), np.asarray(cols, dtype=np.int64))
+        want = rows * self.shape[1] + cols
+        at = np.minimum(np.searchsorted(self._keys, want), self._keys.size - 1)  # (row 0 is never empty)
+        out = np.where(self._keys[at] == want, self._values[at], _UNREACHED)
+        return out[()] if out.ndim == 0 else out
+
+
+Table = np.ndarray | _Kept
+"""A walk table: (rows, n) entries, dense (:func:`_reach`) or only those kept (:func:`_reach_below`)."""
+
+
 def _reach(cw: PoolWalker, start: int, steps: int, jumps: Jumps | None = None) -> np.ndarray:
     """(steps, L) float32: the least price of the jumps of a walk of ``c + 1`` frames from
     ``start`` that ends at each frame (``inf`` where no walk of that length ends there).
@@ -612,17 +649,23 @@ def _reach_few(steps: int, n: int, start: int, step_ok: np.ndarray, src_of: list
     return out[:, :n]
 
 
-def _backtrack(cw: PoolWalker, reach: np.ndarray, c: int, x: int, jumps: Jumps | None = None) -> list[int]:
+def _backtrack(cw: PoolWalker, reach: Table, c: int, x: int, jumps: Jumps | None = None) -> list[int]:
     """Frames of the cheapest walk reaching ``x`` after ``c + 1`` frames (reverse-engineered
     from ``reach``, see :func:`_reach`, made with the same ``jumps``)."""
     src, dst, price = cw.jumps() if jumps is None else jumps
+    if jumps is None:
+        order, head = cw._by_destination()
+    else:
+        order = np.argsort(dst, kind="stable")
+        head = np.searchsorted(dst[order], np.arange(cw.length + 1))
     frames = [x]
     while c > 0:
         p = reach[c, x]
         if x > 0 and cw.step[x - 1] and reach[c - 1, x - 1] == p:
             x -= 1
         else:
-            cand = src[(dst == x) & (reach[c - 1, src] + price == p)]
+            into = order[head[x] : head[x + 1]]  # the jumps into x, in their order
+            cand = src[into][reach[c - 1, src[into]] + price[into] == p]
             if cand.size == 0:
                 raise GraphError("internal: walk reconstruction failed")
             x = int(cand[0])
@@ -717,7 +760,7 @@ def _cheaper_walk(cw: PoolWalker, start: int, rows: int, need_c: np.ndarray, ex:
 
 def _reach_below(
     cw: PoolWalker, start: int, rows: int, bound: float, first_row: int = 0, exits: np.ndarray | None = None
-) -> np.ndarray:
+) -> _Kept:
     """:func:`_reach` over every jump, kept to the walks that can still cost less than ``bound``:
     a walk of ``c + 1`` frames ending at ``f`` is left out (``inf``) when its cost plus the
     least it must still pay is ``bound`` or more. The cost: the price of its jumps, and, with
@@ -725,8 +768,8 @@ def _reach_below(
     ``first_row``, the least price of a jump for each jump it needs, when after ``f``'s own run of
     steps each jump is followed by at most the pool's longest run (a step keeps that sum); with
     ``exits``, one per move of the fewest moves from ``f`` to an exit. The entries of the walks
-    kept equal :func:`_reach`'s; jumps are gathered from the frames kept, so a tight bound makes
-    rows cheap."""
+    kept equal :func:`_reach`'s; jumps are gathered from the frames kept, and only the entries
+    kept are stored (:class:`_Kept`), so a tight bound makes the table small and its rows cheap."""
     src, dst, price = cw.jumps()
     order, head = cw._by_source()
     n, run = cw.length, _runs_of_steps(cw)
@@ -734,27 +777,34 @@ def _reach_below(
     per_frame, rest = (0.0, np.zeros(n)) if exits is None else (1.0, _moves_to(cw, exits))
     prep = _prepare(cw, None)  # all jumps by destination, when more than a few enter a frame
     grouped = prep[1:] if prep[0] == "grouped" else None
-    out = np.full((max(rows, 1), n), _UNREACHED, dtype=np.float32)
-    out[0, start] = 0
-    step_ok = cw.step[:-1]
+    prev, cur = np.full(n, _UNREACHED), np.full(n, _UNREACHED)  # two rows in turn, inf but for the kept
+    cur[start] = 0
+    frames, values = [np.array([start])], [cur[[start]]]
+    step_out = np.append(cw.step[:-1], False)  # a step leaves the frame
     for c in range(1, rows):
-        prev, cur = out[c - 1], out[c]
-        np.copyto(cur[1:], prev[:-1], where=step_ok)
+        prev, cur = cur, prev
+        if c >= 2:
+            cur[frames[c - 2]] = _UNREACHED
         limit = bound - per_frame * (c + 1)  # what the price of a walk of c + 1 frames must stay below
+        a = frames[-1]
+        stepped, value = a[step_out[a]] + 1, prev[a[step_out[a]]]
         if exits is not None:  # a step can take a walk further from the exits
-            cur[cur + rest >= limit] = _UNREACHED
-        a = np.flatnonzero(prev + (rest - per_frame) < limit - least)  # a jump is one move nearer at most
+            near = value + rest[stepped] < limit
+            stepped, value = stepped[near], value[near]
+        cur[stepped] = value
+        a = a[prev[a] + (rest[a] - per_frame) < limit - least]  # a jump is one move nearer at most
         if grouped is not None and 4 * int((head[a + 1] - head[a]).sum()) > src.size:  # most jumps: all
             to, value = grouped[3], np.minimum.reduceat(prev[grouped[0]] + grouped[1], grouped[2])
-        elif a.size:
+        else:
             at = order[_spans(head, a)[0]]
             to, value = dst[at], prev[src[at]] + price[at]
-        else:
-            continue
         must = rest[to] + least * np.ceil(np.maximum(first_row - c - run[to], 0) / longest)
         keep = value + must < limit
         np.minimum.at(cur, to[keep], value[keep])
-    return out
+        touched = np.concatenate([stepped, to[keep]])  # the row's frames: few, sorted; many, one pass
+        frames.append(np.unique(touched) if touched.size * 32 < n else np.flatnonzero(cur < _UNREACHED))
+        values.append(cur[frames[-1]])
+    return _Kept(frames, values, n)
 
 
 def _spans(head: np.ndarray, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -816,7 +866,7 @@ def _straight(cw: PoolWalker, start: int, frames: int) -> bool:
     return frames >= 1 and start + frames <= cw.length and bool(cw.step[start : start + frames - 1].all())
 
 
-def _choose(reach: np.ndarray, need_c: np.ndarray, ex: np.ndarray, steps: int, widest: int, slack: int = 0):
+def _choose(reach: Table, need_c: np.ndarray, ex: np.ndarray, steps: int, widest: int, slack: int = 0):
     """``(option, row, exit frame, key)``: of the walks within ``slack`` rows of an option's
     requested row, the cheapest, at the price of its jumps plus one per frame off the request
     (``key``; the nearer length on ties); when there is none, the walk nearest the requested
@@ -834,7 +884,7 @@ def _choose(reach: np.ndarray, need_c: np.ndarray, ex: np.ndarray, steps: int, w
     return best
 
 
-def _cheapest(reach: np.ndarray, c: np.ndarray, ex: np.ndarray, steps: int):
+def _cheapest(reach: Table, c: np.ndarray, ex: np.ndarray, steps: int):
     """``(option, row, frame, price)`` of the walk whose jumps cost least, ending in row ``c[r]``
     at option ``r``'s exit frame (or, ``-1``, at any frame); ``None`` when there is none."""
     ok = np.flatnonzero((c >= 0) & (c < steps))
@@ -906,7 +956,7 @@ def _walk_to_exit(
     return _runs(cw, frames), r, len(frames)
 
 
-def _cheapest_exit(reach: np.ndarray, ex: np.ndarray) -> tuple[float, int, int]:
+def _cheapest_exit(reach: Table, ex: np.ndarray) -> tuple[float, int, int]:
     """``(cost, row, k)``: the walk of ``reach`` to an exit ``ex[k]`` that costs least, a frame
     costing one (the shortest first, then the first exit; ``inf`` cost when none)."""
     cost = np.arange(1, reach.shape[0] + 1)[:, None] + reach[:, ex].astype(np.float64)

@@ -96,6 +96,28 @@ def test_a_walk_to_an_exit_is_the_cheapest(seed, uniform):
     assert played + paid == pytest.approx(want, rel=1e-5, abs=1e-4)
 
 
+@pytest.mark.parametrize("seed", range(20))
+def test_the_pruned_table_keeps_the_recursions_entries(seed):
+    """:func:`search._reach_below` stores only the walks it keeps: each entry it has equals the
+    full recursion's (:func:`search._reach`, every jump), read as the search reads a table (a row,
+    one entry, rows by columns); with no bound it keeps them all; a walk cheaper than the bound
+    that lasts to the table's last row is kept."""
+    rng, cw = _pool(seed, bool(seed % 2))
+    start, rows = int(rng.integers(0, cw.length)), int(rng.integers(2, 25))
+    full = search._reach(cw, start, rows)
+    everything = search._reach_below(cw, start, rows, np.inf)
+    assert np.array_equal(everything[:, np.arange(cw.length)], full)
+    assert all(np.array_equal(everything[c], full[c]) for c in range(rows))
+    bound = float(np.quantile(full[np.isfinite(full)], 0.5)) + 1e-3
+    kept = search._reach_below(cw, start, rows, bound, first_row=rows - 1)
+    dense = kept[:, np.arange(cw.length)]
+    on = np.isfinite(dense)
+    assert np.array_equal(dense[on], full[on]) and (dense[on] < bound).all()
+    assert all(kept[c, x] == dense[c, x] for c, x in zip(rng.integers(0, rows, 50), rng.integers(0, cw.length, 50)))
+    last = np.isfinite(full[-1]) & (full[-1] < bound)
+    assert on[-1][last].all()
+
+
 @pytest.mark.realdata
 def test_walks_through_real_takes_are_the_cheapest():
     """Three dataset-2 walk styles, eight takes each: every walk of two requested lengths from
