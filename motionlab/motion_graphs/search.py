@@ -749,7 +749,7 @@ def _cheaper_walk(cw: PoolWalker, start: int, rows: int, need_c: np.ndarray, ex:
     least = float(cw.jumps()[2].min())
     below = min(2 * least, bound) if least > 0 else bound
     while True:
-        reach = _reach_below(cw, start, rows, below, first_row)
+        reach = _reach_below(cw, start, rows, below, first_row, ends=ex if (ex >= 0).all() else None)
         found = _choose(reach, need_c, ex, rows, slack, slack)
         if found is not None and found[3] < below:
             return reach, found
@@ -759,22 +759,41 @@ def _cheaper_walk(cw: PoolWalker, start: int, rows: int, need_c: np.ndarray, ex:
 
 
 def _reach_below(
-    cw: PoolWalker, start: int, rows: int, bound: float, first_row: int = 0, exits: np.ndarray | None = None
+    cw: PoolWalker,
+    start: int,
+    rows: int,
+    bound: float,
+    first_row: int = 0,
+    exits: np.ndarray | None = None,
+    ends: np.ndarray | None = None,
 ) -> _Kept:
     """:func:`_reach` over every jump, kept to the walks that can still cost less than ``bound``:
     a walk of ``c + 1`` frames ending at ``f`` is left out (``inf``) when its cost plus the
     least it must still pay is ``bound`` or more. The cost: the price of its jumps, and, with
-    ``exits``, one per frame. What it must still pay: without ``exits``, to last until row
-    ``first_row``, the least price of a jump for each jump it needs, when after ``f``'s own run of
-    steps each jump is followed by at most the pool's longest run (a step keeps that sum); with
-    ``exits``, one per move of the fewest moves from ``f`` to an exit. The entries of the walks
-    kept equal :func:`_reach`'s; jumps are gathered from the frames kept, and only the entries
-    kept are stored (:class:`_Kept`), so a tight bound makes the table small and its rows cheap."""
+    ``exits`` (a walk to one of them), one per frame. What it must still pay: the least price of
+    a jump for each jump it must still make, the more of two counts: the jumps it needs to last
+    until row ``first_row``, when after ``f``'s own run of steps each jump is followed by at most
+    the pool's longest run, and the fewest jumps from ``f`` to one of ``exits`` or ``ends`` (the
+    frames a segment's walk must end at; ``None``: any frame); with ``exits``, also one per move
+    of the fewest moves from ``f`` to an exit. The entries of the walks kept equal
+    :func:`_reach`'s; jumps are gathered from the frames kept, and only the entries kept are
+    stored (:class:`_Kept`), so a tight bound makes the table small and its rows cheap."""
     src, dst, price = cw.jumps()
     order, head = cw._by_source()
     n, run = cw.length, _runs_of_steps(cw)
     longest, least = int(run.max()) + 1, float(price.min()) if price.size else 0.0
     per_frame, rest = (0.0, np.zeros(n)) if exits is None else (1.0, _moves_to(cw, exits))
+    to_end = exits if exits is not None else ends
+    hops = np.zeros(n) if to_end is None else _jumps_to(cw, to_end)
+
+    settled = rest + least * hops  # what a walk pays from each frame on, its length aside
+
+    def must(f: np.ndarray, c: int) -> np.ndarray:  # what a walk at f after c + 1 frames must still pay
+        if c >= first_row:
+            return settled[f]
+        length = np.ceil(np.maximum(first_row - c - run[f], 0) / longest)
+        return rest[f] + least * np.maximum(hops[f], length)
+
     prep = _prepare(cw, None)  # all jumps by destination, when more than a few enter a frame
     grouped = prep[1:] if prep[0] == "grouped" else None
     prev, cur = np.full(n, _UNREACHED), np.full(n, _UNREACHED)  # two rows in turn, inf but for the kept
@@ -787,22 +806,21 @@ def _reach_below(
             cur[frames[c - 2]] = _UNREACHED
         limit = bound - per_frame * (c + 1)  # what the price of a walk of c + 1 frames must stay below
         a = frames[-1]
-        stepped, value = a[step_out[a]] + 1, prev[a[step_out[a]]]
-        if exits is not None:  # a step can take a walk further from the exits
-            near = value + rest[stepped] < limit
-            stepped, value = stepped[near], value[near]
-        cur[stepped] = value
-        a = a[prev[a] + (rest[a] - per_frame) < limit - least]  # a jump is one move nearer at most
+        stepped = a[step_out[a]]
+        # a jump is one move, and one of the jumps still to make, nearer at most
+        a = a[prev[a] + (rest[a] - per_frame) + least * np.maximum(hops[a], 1) < limit]
         if grouped is not None and 4 * int((head[a + 1] - head[a]).sum()) > src.size:  # most jumps: all
             to, value = grouped[3], np.minimum.reduceat(prev[grouped[0]] + grouped[1], grouped[2])
-        else:
+        elif a.size:
             at = order[_spans(head, a)[0]]
             to, value = dst[at], prev[src[at]] + price[at]
-        must = rest[to] + least * np.ceil(np.maximum(first_row - c - run[to], 0) / longest)
-        keep = value + must < limit
-        np.minimum.at(cur, to[keep], value[keep])
-        touched = np.concatenate([stepped, to[keep]])  # the row's frames: few, sorted; many, one pass
-        frames.append(np.unique(touched) if touched.size * 32 < n else np.flatnonzero(cur < _UNREACHED))
+        else:
+            to, value = a, prev[a]  # (none)
+        to, value = np.concatenate([stepped + 1, to]), np.concatenate([prev[stepped], value])
+        keep = value + must(to, c) < limit  # (a step can take a walk past its exits)
+        to, value = to[keep], value[keep]
+        np.minimum.at(cur, to, value)
+        frames.append(np.unique(to) if to.size * 256 < n else np.flatnonzero(cur < _UNREACHED))  # few: sorted
         values.append(cur[frames[-1]])
     return _Kept(frames, values, n)
 
@@ -841,6 +859,29 @@ def _moves_to(cw: PoolWalker, exits: np.ndarray) -> np.ndarray:
         moves[f] = moves[frontier[0]] + 1
         frontier = f
     return moves
+
+
+def _jumps_to(cw: PoolWalker, ends: np.ndarray) -> np.ndarray:
+    """(n,) float: the fewest jumps a walk makes from each frame to one of ``ends``, steps free
+    (``inf`` where none leads): a breadth-first search backwards, one jump per level, each level
+    closed under steps backwards (kept in the walker)."""
+    reached = np.unique(np.asarray(ends, dtype=np.int64))
+    key = ("jumps to", reached.tobytes())
+    if key not in cw._prepared:
+        n = cw.length
+        run_of = np.concatenate([[0], np.cumsum(~cw.step[:-1])])  # frames joined by steps share a run
+        order, head = cw._by_destination()
+        hops = cw._prepared[key] = np.full(n, np.inf)
+        level = 0
+        while reached.size:
+            last = np.full(int(run_of[-1]) + 1, -1)
+            np.maximum.at(last, run_of[reached], reached)  # in each run, the last frame reached
+            new = np.flatnonzero((np.arange(n) <= last[run_of]) & np.isinf(hops))  # steps lead there
+            hops[new] = level
+            source = np.zeros(n, dtype=bool)
+            source[cw.loop_src[order[_spans(head, new)[0]]]] = True  # of the jumps into them
+            reached, level = np.flatnonzero(source & np.isinf(hops)), level + 1
+    return cw._prepared[key]
 
 
 def _least_beyond(cw: PoolWalker) -> float:

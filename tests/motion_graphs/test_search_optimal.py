@@ -96,6 +96,50 @@ def test_a_walk_to_an_exit_is_the_cheapest(seed, uniform):
     assert played + paid == pytest.approx(want, rel=1e-5, abs=1e-4)
 
 
+@pytest.mark.parametrize("uniform", [False, True])
+@pytest.mark.parametrize("seed", range(30))
+def test_a_segment_walk_to_given_exits_is_the_cheapest(seed, uniform):
+    """Options that end at given frames (a segment followed by another pool's link): of the walks
+    within the tolerance of an option's length ending at its exit, the cheapest key, over every
+    jump (the tables over every jump are pruned by the jumps still needed to reach an exit)."""
+    rng, cw = _pool(seed, uniform)
+    start, k = int(rng.integers(0, cw.length)), int(rng.integers(1, 4))
+    exits, needs = rng.integers(0, cw.length, k), rng.integers(4, 30, k)
+    slack = search.tolerance_frames(int(needs.max()))
+    least = _least_prices(cw, start, int(needs.max()) + slack)
+    want = min(
+        least[n - 1, x] + abs(n - need)
+        for x, need in zip(exits, needs)
+        for n in range(max(need - slack, 1), need + slack + 1)
+    )
+    if not np.isfinite(want):
+        return
+    pieces, r, played = search._walk(cw, start, needs.tolist(), exits.tolist(), slack=slack)
+    frames, paid = _frames_and_price(cw, pieces)
+    assert frames[0] == start and frames[-1] == exits[r] and len(frames) == played
+    assert paid + abs(played - needs[r]) == pytest.approx(want, rel=1e-5, abs=1e-4)
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_the_fewest_jumps_to_an_exit_agree_with_loops(seed):
+    """:func:`search._jumps_to`: the fewest jumps from each frame to one of the exits, steps
+    free, against relaxing every move by hand until nothing changes."""
+    rng, cw = _pool(seed, False)
+    exits = rng.integers(0, cw.length, int(rng.integers(1, 4)))
+    want = np.full(cw.length, np.inf)
+    want[exits] = 0
+    changed = True
+    while changed:
+        changed = False
+        for f in range(cw.length - 1):
+            if cw.step[f] and want[f + 1] < want[f]:
+                want[f], changed = want[f + 1], True
+        for s, d in zip(cw.loop_src, cw.loop_dst):
+            if want[d] + 1 < want[s]:
+                want[s], changed = want[d] + 1, True
+    assert np.array_equal(search._jumps_to(cw, exits), want)
+
+
 @pytest.mark.parametrize("seed", range(20))
 def test_the_pruned_table_keeps_the_recursions_entries(seed):
     """:func:`search._reach_below` stores only the walks it keeps: each entry it has equals the
