@@ -786,13 +786,14 @@ def _reach_below(
     to_end = exits if exits is not None else ends
     hops = np.zeros(n) if to_end is None else _jumps_to(cw, to_end)
 
-    settled = rest + least * hops  # what a walk pays from each frame on, its length aside
+    to_pay = least * hops if least > 0 else np.where(np.isinf(hops), np.inf, 0.0)  # (inf: no end reached)
+    settled = rest + to_pay  # what a walk pays from each frame on, its length aside
 
     def must(f: np.ndarray, c: int) -> np.ndarray:  # what a walk at f after c + 1 frames must still pay
         if c >= first_row:
             return settled[f]
         length = np.ceil(np.maximum(first_row - c - run[f], 0) / longest)
-        return rest[f] + least * np.maximum(hops[f], length)
+        return rest[f] + np.maximum(to_pay[f], least * length)
 
     prep = _prepare(cw, None)  # all jumps by destination, when more than a few enter a frame
     grouped = prep[1:] if prep[0] == "grouped" else None
@@ -808,7 +809,7 @@ def _reach_below(
         a = frames[-1]
         stepped = a[step_out[a]]
         # a jump is one move, and one of the jumps still to make, nearer at most
-        a = a[prev[a] + (rest[a] - per_frame) + least * np.maximum(hops[a], 1) < limit]
+        a = a[prev[a] + (rest[a] - per_frame) + np.maximum(to_pay[a], least) < limit]
         if grouped is not None and 4 * int((head[a + 1] - head[a]).sum()) > src.size:  # most jumps: all
             to, value = grouped[3], np.minimum.reduceat(prev[grouped[0]] + grouped[1], grouped[2])
         elif a.size:
