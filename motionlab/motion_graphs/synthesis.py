@@ -102,7 +102,12 @@ def synthesize(
         raise ValueError(f"blend must be a non-negative number of frames, got {blend}")
     if align not in ("foot", "root"):
         raise ValueError(f"align must be 'foot' or 'root', got {align!r}")
+    for n, (c, a, b) in enumerate(pieces):
+        info = graph.clips[c]
+        if not (0 <= a <= b < info.num_frames):
+            raise ValueError(f"piece {n}: frames {a}..{b} outside clip {info.name!r} ({info.num_frames} frames)")
     stance = _FEET if humanoid.is_canonical(graph.skeleton) else []
+    yaw_of = _source_headings(graph, pieces)
     rots, poss = [], []
     windows = []  # (output index of first blended frame, length)
     out_len = 0
@@ -110,8 +115,6 @@ def synthesize(
     prev_global = None
     for n, (c, a, b) in enumerate(pieces):
         info = graph.clips[c]
-        if not (0 <= a <= b < info.num_frames):
-            raise ValueError(f"piece {n}: frames {a}..{b} outside clip {info.name!r} ({info.num_frames} frames)")
         idx = np.arange(info.start + a, info.start + b + 1)
         rot, pos = _frames_pose(graph, idx)
         if n == 0:
@@ -121,12 +124,13 @@ def synthesize(
             anchor = info.start + a - 1 if a > 0 else info.start + a
             contiguous = prev_global is not None and prev_global + 1 == info.start + a
             dyaw, shift, yaw_prev = _placement(
-                graph, anchor, prev_end_rot, prev_end_pos, stance if align == "foot" else []
+                graph, anchor, yaw_of[anchor], prev_end_rot, prev_end_pos, stance if align == "foot" else []
             )
             rot, pos = _place(rot, pos, dyaw, shift)
             if blend > 0 and not contiguous:
                 k = min(blend, len(idx))
-                rot, pos = _cross_fade(graph, rot, pos, prev_global, prev_end_pos, yaw_prev, k)
+                fade = (prev_global, yaw_of[prev_global])
+                rot, pos = _cross_fade(graph, rot, pos, fade, prev_end_pos, yaw_prev, k)
                 windows.append((out_len, k))
             rots.append(rot)
             poss.append(pos)
@@ -141,35 +145,50 @@ def synthesize(
     return motion
 
 
-def _placement(graph: MotionGraph, anchor: int, prev_rot: np.ndarray, prev_pos: np.ndarray, stance: list[int]):
-    """Turn about the vertical (rad) and ground shift (3,) that put global frame ``anchor`` where
-    the previous run ends (pose ``prev_rot`` (J, 4), root ``prev_pos`` (3,)); with ``stance`` foot
-    joints, the shift lands the anchor's foot under the previous pose's lowest foot instead of
-    its root. Also returns the previous pose's heading (rad)."""
+def _source_headings(graph: MotionGraph, pieces: Sequence[tuple[int, int, int]]) -> dict[int, float]:
+    """Heading (rad) of each graph frame that synthesis aligns or fades from, as it is in the
+    graph: each run's anchor (the frame before its first, or its first) and each run's last
+    frame; one forward-kinematics pass for all."""
+    frames = set()
+    for c, a, b in pieces:
+        start = graph.clips[c].start
+        frames.update((start + max(a - 1, 0), start + b))
+    idx = np.array(sorted(frames))
+    return dict(zip(idx.tolist(), _heading_of(graph, *_frames_pose(graph, idx)).tolist()))
+
+
+def _placement(
+    graph: MotionGraph, anchor: int, anchor_yaw: float, prev_rot: np.ndarray, prev_pos: np.ndarray, stance: list[int]
+):
+    """Turn about the vertical (rad) and ground shift (3,) that put global frame ``anchor`` (its
+    heading ``anchor_yaw``, rad) where the previous run ends (pose ``prev_rot`` (J, 4), root
+    ``prev_pos`` (3,)); with ``stance`` foot joints, the shift lands the anchor's foot under the
+    previous pose's lowest foot instead of its root. Also returns the previous pose's heading (rad)."""
     a_rot, a_pos = _frames_pose(graph, np.array([anchor]))
-    yaw_prev = _heading_of(graph, prev_rot[None], prev_pos[None])[0]
-    dyaw = float(yaw_prev - _heading_of(graph, a_rot, a_pos)[0])
+    prev_pose = _positions(graph, prev_rot[None], prev_pos[None])
+    yaw_prev = heading(prev_pose)[0]
+    dyaw = float(yaw_prev - anchor_yaw)
     shift = prev_pos - quat.rotate(quat.from_yaw(np.array(dyaw)), a_pos[0])
     shift[1] = 0.0
     if stance:
         # move the anchor pose so its lowest foot joint lands on the previous pose's
-        prev_pose = _positions(graph, prev_rot[None], prev_pos[None])[0]
+        prev_pose = prev_pose[0]
         placed = _positions(graph, *_place(a_rot, a_pos, dyaw, shift))[0]
         foot = stance[int(np.argmin(prev_pose[stance, 1]))]
         shift = shift + (prev_pose[foot] - placed[foot]) * np.array([1.0, 0.0, 1.0])
     return dyaw, shift, yaw_prev
 
 
-def _cross_fade(graph: MotionGraph, rot, pos, prev_global: int, prev_end_pos, yaw_prev: float, k: int):
+def _cross_fade(graph: MotionGraph, rot, pos, fade: tuple[int, float], prev_end_pos, yaw_prev: float, k: int):
     """The first ``k`` frames of a placed run (``rot`` (n, J, 4), ``pos`` (n, 3)) cross-faded from
-    what the previous clip would have played after global frame ``prev_global``, placed like the
-    previous run; new arrays."""
+    what the previous clip would have played after global frame ``fade[0]`` (its heading in the
+    graph ``fade[1]``, rad), placed like the previous run; new arrays."""
+    prev_global, yaw_src = fade
     pinfo = graph.clips[int(graph.clip_of(prev_global))]
     cont = np.clip(np.arange(prev_global + 1, prev_global + 1 + k), pinfo.start, pinfo.stop - 1)
     c_rot, c_pos = _frames_pose(graph, cont)
-    p_rot, p_pos = _frames_pose(graph, np.array([prev_global]))
+    p_pos = graph.root_pos[[prev_global]]
     # map source frames of the previous clip onto the output through its last frame
-    yaw_src = _heading_of(graph, p_rot, p_pos)[0]
     c_rot, c_pos = _place(c_rot, c_pos, float(yaw_prev - yaw_src), np.zeros(3))
     p_pos_placed = quat.rotate(quat.from_yaw(np.array(float(yaw_prev - yaw_src))), p_pos[0])
     c_pos = c_pos + (prev_end_pos - p_pos_placed) * np.array([1.0, 0.0, 1.0])
