@@ -7,7 +7,9 @@ UTF-8 bytes of a JSON object — format version, fps, joint names, clips, struct
 info and the graph's :meth:`~.graph.MotionGraph.summary` — and the routes of the structure
 table's links as arrays ``route_*`` (read back as :class:`Routes`). Because the members are stored, not
 compressed, :func:`load` *maps* the arrays (``numpy.memmap``, copy-on-write) instead of reading
-them: opening a graph reads only its JSON, and a search reads only the pages it touches. Each
+them: opening a graph reads each member once, in blocks, to check its CRC-32 (so a damaged file
+is named, and the pages read do not stay in the process's memory), and a search then keeps only
+the pages it touches. Each
 member's data starts at a multiple of :data:`ALIGN` bytes (padding in its zip header), so the
 mapped arrays are aligned; files of this version written without the padding load as well.
 
@@ -234,14 +236,24 @@ def _mapped(path: Path, fh, info: zipfile.ZipInfo, size: int) -> np.ndarray:
     return np.memmap(path, dtype=dtype, mode="c", offset=offset, shape=shape, order="F" if fortran else "C")
 
 
+_CRC_BLOCK = 1 << 20
+"""Bytes read at a time to check a member's CRC-32."""
+
+
 def _check_crc(path: Path, fh, info: zipfile.ZipInfo, size: int) -> None:
     """Raise :class:`GraphError` when a stored member's bytes do not give the CRC-32 its zip entry
     records (a mapped array is never read through :mod:`zipfile`, which would check it)."""
     offset = _member_offset(fh, info)
     if offset + info.file_size > size:
         raise EOFError("member runs past the end of the file")
-    data = np.memmap(path, dtype=np.uint8, mode="r", offset=offset, shape=(info.file_size,)) if info.file_size else b""
-    if zlib.crc32(data) != info.CRC:
+    crc, left, block = 0, info.file_size, memoryview(bytearray(_CRC_BLOCK))
+    fh.seek(offset)
+    while left:  # read in blocks, not mapped: the pages read do not stay in the process's memory
+        got = fh.readinto(block[: min(left, _CRC_BLOCK)])
+        if not got:
+            raise EOFError("member runs past the end of the file")
+        crc, left = zlib.crc32(block[:got], crc), left - got
+    if crc != info.CRC:
         raise GraphError(
             f"{path} is damaged: the bytes of its {info.filename[: -len('.npy')]!r} array do not match the "
             "checksum written with them; build the graph again (graph-build)"

@@ -196,8 +196,13 @@ def test_a_count_the_graph_cannot_meet_is_refused_by_name(sgraph, tmp_path, caps
     assert "written as asked by --keep-misses" in capsys.readouterr().err and out.is_file()
 
 
-def test_a_flipped_byte_in_an_array_is_named(sgraph, tmp_path, capsys):
+@pytest.mark.parametrize("block", [None, 64])
+def test_a_flipped_byte_in_an_array_is_named(sgraph, tmp_path, capsys, monkeypatch, block):
+    """Also with the checksum read in many small blocks (``block``), as large arrays are."""
+    if block:
+        monkeypatch.setattr(io, "_CRC_BLOCK", block)
     path = io.save(tmp_path / "g", sgraph)
+    io.load(path)  # the file as written passes
     raw = bytearray(path.read_bytes())
     with zipfile.ZipFile(path) as z:
         info = z.getinfo("root_pos.npy")
