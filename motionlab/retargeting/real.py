@@ -77,7 +77,7 @@ DEFAULT_ANIMATIONS = (
 
 PINNED_BACK_END = {
     "ATEN_CPU_CAPABILITY": "avx2",
-    "MKL_CBWR": "AVX2",
+    "MKL_CBWR": "COMPATIBLE",
     "OMP_NUM_THREADS": "1",
     "MKL_NUM_THREADS": "1",
     "OPENBLAS_NUM_THREADS": "1",
@@ -85,9 +85,10 @@ PINNED_BACK_END = {
     "NPY_DISABLE_CPU_FEATURES": "X86_V4 AVX512_ICL AVX512_SPR",
 }
 """The numeric back end the cached network is trained under (a child process): torch's AVX2
-kernels, MKL's AVX2 branch, OpenBLAS's Haswell kernels, numpy without AVX-512, one thread. It
-differs from CI's pinned test pass only in MKL's branch (that pass takes the compatible path);
-``docs/reproducibility.md`` compares the weights each gives."""
+kernels, MKL's compatible code path (the one branch MKL takes alike on Intel and AMD processors:
+asked for its AVX2 branch, it takes that branch on Intel but its own choice on AMD, and the two
+give different weights), OpenBLAS's Haswell kernels, numpy without AVX-512, one thread; CI's
+pinned test pass uses the same settings. ``docs/reproducibility.md`` compares the weights."""
 NETWORKS = ("auto", "real", "synthetic")
 """The choices of :func:`choose` (and the CLI's ``--network``)."""
 TRAINING_CODE = (
@@ -181,10 +182,15 @@ def train_config(**changes):
 
 def cache_key(paths: Sequence[str | os.PathLike], config, model_config: ModelConfig | None = None) -> str:
     """SHA-256 (hex) of what the trained network depends on: each clip's name and bytes (in
-    order), ``config`` and ``model_config`` (defaults if None), the source of :data:`TRAINING_CODE`
-    and torch's version. Raises ``FileNotFoundError`` for a missing clip."""
+    order), ``config`` and ``model_config`` (defaults if None), the source of :data:`TRAINING_CODE`,
+    torch's version and :data:`PINNED_BACK_END`. Raises ``FileNotFoundError`` for a missing clip."""
     h = hashlib.sha256()
-    settings = {"train": asdict(config), "model": (model_config or ModelConfig()).to_dict(), "torch": torch.__version__}
+    settings = {
+        "train": asdict(config),
+        "model": (model_config or ModelConfig()).to_dict(),
+        "torch": torch.__version__,
+        "back end": PINNED_BACK_END,
+    }
     h.update(json.dumps(settings, sort_keys=True).encode())
     for name in TRAINING_CODE:
         h.update(name.encode() + b"\0" + (_PACKAGE / name).read_bytes())

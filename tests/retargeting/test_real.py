@@ -63,9 +63,12 @@ def test_a_miss_trains_and_caches_a_hit_loads(clips, trainings, tmp_path):
     assert _same_weights(first, second)
 
 
-def test_the_key_changes_with_clips_settings_and_network(clips):
+def test_the_key_changes_with_clips_settings_and_network(clips, monkeypatch):
     key = real.cache_key(clips, FAST, TINY)
     assert real.cache_key(clips, FAST, TINY) == key
+    with monkeypatch.context() as m:  # another back end trains other weights (docs/reproducibility.md)
+        m.setitem(real.PINNED_BACK_END, "MKL_CBWR", "AVX2")
+        assert real.cache_key(clips, FAST, TINY) != key
     assert real.cache_key(clips, TrainConfig(steps=3, batch_size=2, device="cpu"), TINY) != key
     assert real.cache_key(clips, FAST, ModelConfig()) != key
     assert real.cache_key(clips[::-1], FAST, TINY) != key
