@@ -165,14 +165,13 @@ def _placement(
     ``prev_pos`` (3,)); with ``stance`` foot joints, the shift lands the anchor's foot under the
     previous pose's lowest foot instead of its root. Also returns the previous pose's heading (rad)."""
     a_rot, a_pos = _frames_pose(graph, np.array([anchor]))
-    prev_pose = _positions(graph, prev_rot[None], prev_pos[None])
-    yaw_prev = heading(prev_pose)[0]
+    prev_pose = _positions(graph, prev_rot[None], prev_pos[None])[0]
+    yaw_prev = float(heading(prev_pose))
     dyaw = float(yaw_prev - anchor_yaw)
     shift = prev_pos - quat.rotate(quat.from_yaw(np.array(dyaw)), a_pos[0])
     shift[1] = 0.0
     if stance:
         # move the anchor pose so its lowest foot joint lands on the previous pose's
-        prev_pose = prev_pose[0]
         placed = _positions(graph, *_place(a_rot, a_pos, dyaw, shift))[0]
         foot = stance[int(np.argmin(prev_pose[stance, 1]))]
         shift = shift + (prev_pose[foot] - placed[foot]) * np.array([1.0, 0.0, 1.0])

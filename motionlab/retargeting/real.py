@@ -85,10 +85,9 @@ PINNED_BACK_END = {
     "NPY_DISABLE_CPU_FEATURES": "X86_V4 AVX512_ICL AVX512_SPR",
 }
 """The numeric back end the cached network is trained under (a child process): torch's AVX2
-kernels, MKL's compatible code path (the one branch MKL takes alike on Intel and AMD processors:
-asked for its AVX2 branch, it takes that branch on Intel but its own choice on AMD, and the two
-give different weights), OpenBLAS's Haswell kernels, numpy without AVX-512, one thread; CI's
-pinned test pass uses the same settings. ``docs/reproducibility.md`` compares the weights."""
+kernels, MKL's compatible code path (the one branch MKL takes alike on Intel and AMD
+processors), OpenBLAS's Haswell kernels, numpy without AVX-512, one thread; CI's pinned test pass
+uses the same settings. ``docs/reproducibility.md`` compares the weights of other back ends."""
 NETWORKS = ("auto", "real", "synthetic")
 """The choices of :func:`choose` (and the CLI's ``--network``)."""
 TRAINING_CODE = (
