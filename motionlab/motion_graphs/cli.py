@@ -21,6 +21,8 @@ import argparse
 import json
 import sys
 import time
+from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager
 from pathlib import Path
 
 from motionlab import cli_args
@@ -107,13 +109,32 @@ def register(subparsers) -> None:
         p.add_argument("graph", help=".mlgraph file")
 
 
-def _load_graph(path: str):
+def _load_graph(path: str, verify: bool = True):
     from motionlab.motion_graphs import graph, io
 
     try:
-        return io.load(path)
+        return io.load(path, verify=verify)
     except graph.GraphError as e:
         raise CLIError(str(e)) from None
+
+
+@contextmanager
+def _verified(path: str):
+    """The graph at ``path``, loaded without its arrays' CRC-32s, which a thread checks meanwhile
+    (:func:`motionlab.motion_graphs.io.verify`, on another core while the caller searches); on
+    leaving, the check is awaited, and a damaged file raises :class:`CLIError` before anything
+    made from it is written (also when the work inside failed: the damage is the cause named)."""
+    from motionlab.motion_graphs import graph, io
+
+    with ThreadPoolExecutor(1) as pool:
+        checked = pool.submit(io.verify, path)
+        try:
+            yield _load_graph(path, verify=False)
+        finally:
+            try:
+                checked.result()
+            except graph.GraphError as e:
+                raise CLIError(str(e)) from None
 
 
 def _build_outputs(args: argparse.Namespace) -> tuple[Path, Path | None]:
@@ -313,18 +334,18 @@ def _search(args: argparse.Namespace) -> int:
         ) from None
     except ValueError as e:
         raise CLIError(f"--request: {e}") from None
-    g = _load_graph(args.graph)
-    try:
-        t0 = time.perf_counter()
-        if g.table.get("behaviours"):
-            result = search.search(g, segs, progress=not args.quiet)
-        else:
-            result = search.search_standard(g, segs)
-        dt = time.perf_counter() - t0
-    except search.SearchError as e:
-        raise CLIError(str(e)) from None
-    _check_misses(result, args.keep_misses)
-    motion = synthesis.synthesize(g, result.pieces, blend=args.blend)
+    with _verified(args.graph) as g:
+        try:
+            t0 = time.perf_counter()
+            if g.table.get("behaviours"):
+                result = search.search(g, segs, progress=not args.quiet)
+            else:
+                result = search.search_standard(g, segs)
+            dt = time.perf_counter() - t0
+        except search.SearchError as e:
+            raise CLIError(str(e)) from None
+        _check_misses(result, args.keep_misses)
+        motion = synthesis.synthesize(g, result.pieces, blend=args.blend)
     motion_files.save(out, motion, overwrite=args.force, unit=motion_files.file_unit(motion.skeleton))
     print(f"found a {result.num_frames}-frame path ({len(result.pieces)} pieces) in {dt * 1000:.1f} ms -> {out}")
     print(result.report())

@@ -8,8 +8,9 @@ info and the graph's :meth:`~.graph.MotionGraph.summary` — and the routes of t
 table's links as arrays ``route_*`` (read back as :class:`Routes`). Because the members are stored, not
 compressed, :func:`load` *maps* the arrays (``numpy.memmap``, copy-on-write) instead of reading
 them: opening a graph reads each member once, in blocks, to check its CRC-32 (so a damaged file
-is named, and the pages read do not stay in the process's memory), and a search then keeps only
-the pages it touches. Each
+is named, and the pages read do not stay in the process's memory; ``load(..., verify=False)``
+leaves that to :func:`verify`, which ``graph-search`` runs in a thread while it searches), and a
+search then keeps only the pages it touches. Each
 member's data starts at a multiple of :data:`ALIGN` bytes (padding in its zip header), so the
 mapped arrays are aligned; files of this version written without the padding load as well.
 
@@ -34,7 +35,7 @@ from motionlab.core import files
 from motionlab.core.skeleton import Skeleton
 from motionlab.motion_graphs.graph import ClipInfo, GraphError, MotionGraph
 
-__all__ = ["save", "load", "writer", "read_meta", "Routes", "FORMAT", "READABLE"]
+__all__ = ["save", "load", "verify", "writer", "read_meta", "Routes", "FORMAT", "READABLE"]
 
 FORMAT = "motionlab-graph-3"
 """Version 3: uncompressed members, mapped on load; ``meta`` is UTF-8 bytes and holds the summary."""
@@ -295,44 +296,84 @@ def read_meta(path: str | os.PathLike) -> dict:
     """The JSON part of a graph file (format, fps, clips, table, info and, from version 3 on,
     ``summary``) without touching its arrays. Raises as :func:`load`."""
     path = _open(path)
-    try:
+
+    def meta() -> dict:
         with zipfile.ZipFile(path) as z:
             if "meta.npy" not in z.namelist():
                 raise GraphError(f"{path} is not a motion graph file (no 'meta' entry)")
             return _read_meta(z)
+
+    return _named(path, meta)
+
+
+def _members(path: Path, z: zipfile.ZipFile) -> tuple[dict, dict, bool]:
+    """Meta, the zip entries of the arrays by name, and whether they are mapped (version 3, stored)."""
+    names = {n[: -len(".npy")]: z.getinfo(n) for n in z.namelist() if n.endswith(".npy")}
+    if "meta" not in names:
+        raise GraphError(f"{path} is not a motion graph file (no 'meta' entry)")
+    meta = _read_meta(z)
+    missing = [k for k in ARRAYS if k not in names]
+    if missing:
+        raise GraphError(f"{path} is not a complete motion graph file (missing {missing})")
+    entries = {k: names[k] for k in ARRAYS + tuple(k for k in ROUTE_ARRAYS if k in names)}
+    mapped = meta["format"] == FORMAT and all(e.compress_type == zipfile.ZIP_STORED for e in entries.values())
+    return meta, entries, mapped
+
+
+def _arrays(path: Path, verify: bool) -> tuple[dict, dict]:
+    """Meta and arrays of a graph file: mapped for version 3 (their CRC-32s checked first when
+    ``verify``), read whole for version 2 (:mod:`zipfile` checks them as it reads)."""
+    with zipfile.ZipFile(path) as z:
+        meta, entries, mapped = _members(path, z)
+        if mapped:
+            size = path.stat().st_size
+            with open(path, "rb") as fh:
+                for e in entries.values() if verify else ():
+                    _check_crc(path, fh, e, size)
+                return meta, {k: _mapped(path, fh, e, size) for k, e in entries.items()}
+        arrays = {}
+        for k, e in entries.items():
+            with z.open(e) as f:
+                arrays[k] = np.lib.format.read_array(f, allow_pickle=False)
+        return meta, arrays
+
+
+def _named(path: Path, read):
+    """``read()``, its errors turned into :class:`GraphError` naming ``path``."""
+    try:
+        return read()
     except GraphError as e:
         raise GraphError(str(e) if str(path) in str(e) else f"{path}: {e}") from None
     except (ValueError, OSError, EOFError, zipfile.BadZipFile, zlib.error) as e:
         raise _damaged(path, e) from None
 
 
-def _arrays(path: Path) -> tuple[dict, dict]:
-    """Meta and arrays of a graph file: mapped for version 3, read whole for version 2."""
-    with zipfile.ZipFile(path) as z:
-        names = {n[: -len(".npy")]: z.getinfo(n) for n in z.namelist() if n.endswith(".npy")}
-        if "meta" not in names:
-            raise GraphError(f"{path} is not a motion graph file (no 'meta' entry)")
-        meta = _read_meta(z)
-        missing = [k for k in ARRAYS if k not in names]
-        if missing:
-            raise GraphError(f"{path} is not a complete motion graph file (missing {missing})")
-        keys = ARRAYS + tuple(k for k in ROUTE_ARRAYS if k in names)
-        stored = all(names[k].compress_type == zipfile.ZIP_STORED for k in keys)
-        if meta["format"] == FORMAT and stored:
+def verify(path: str | os.PathLike) -> None:
+    """Check the CRC-32 of every array of a graph file against its zip entry, as :func:`load`
+    does unless told not to: the file is read once, in blocks, and nothing is kept.
+
+    Raises as :func:`load` does for a damaged, truncated or foreign file.
+    """
+    path = _open(path)
+
+    def crcs() -> None:
+        with zipfile.ZipFile(path) as z:
+            _, entries, mapped = _members(path, z)
+        if mapped:  # (version 2's compressed arrays are checked by zipfile as load reads them)
             size = path.stat().st_size
             with open(path, "rb") as fh:
-                for k in keys:
-                    _check_crc(path, fh, names[k], size)
-                return meta, {k: _mapped(path, fh, names[k], size) for k in keys}
-        arrays = {}
-        for k in keys:
-            with z.open(names[k]) as f:
-                arrays[k] = np.lib.format.read_array(f, allow_pickle=False)
-        return meta, arrays
+                for e in entries.values():
+                    _check_crc(path, fh, e, size)
+
+    _named(path, crcs)
 
 
-def load(path: str | os.PathLike) -> MotionGraph:
+def load(path: str | os.PathLike, verify: bool = True) -> MotionGraph:
     """Read a graph written by :func:`save`; its arrays are memory-mapped (module docstring).
+
+    ``verify=False`` leaves out the check of the arrays' CRC-32s: then call :func:`verify` (for
+    example in a thread while the graph is searched, as ``graph-search`` does) before anything
+    made from the graph is trusted or written.
 
     Raises :class:`GraphError` naming the file for anything else: a file that is not a zip
     archive, a truncated or damaged one (every array's CRC-32 is checked), an archive without the graph's entries, or a format
@@ -340,12 +381,7 @@ def load(path: str | os.PathLike) -> MotionGraph:
     is no file.
     """
     path = _open(path)
-    try:
-        meta, arrays = _arrays(path)
-    except GraphError as e:
-        raise GraphError(str(e) if str(path) in str(e) else f"{path}: {e}") from None
-    except (ValueError, OSError, EOFError, zipfile.BadZipFile, zlib.error) as e:
-        raise _damaged(path, e) from None
+    meta, arrays = _named(path, lambda: _arrays(path, verify))
     try:
         sk = Skeleton(
             tuple(meta["names"]),

@@ -211,6 +211,21 @@ def test_a_flipped_byte_in_an_array_is_named(sgraph, tmp_path, capsys, monkeypat
     with pytest.raises(ValueError, match="'root_pos' array"):
         io.load(path)
     assert main(["graph-info", str(path)]) == 2 and "damaged" in capsys.readouterr().err
+    io.load(path, verify=False)  # the check left to the caller ...
+    with pytest.raises(ValueError, match=f"{path.name}.*'root_pos' array"):
+        io.verify(path)  # ... which finds it
+    out = tmp_path / "x.bvh"
+    argv = ["graph-search", str(path), "--request", "walk:normal:60", "-o", str(out)]
+    assert main(argv) == 2  # graph-search checks in a thread while it searches, and writes nothing
+    assert "'root_pos' array" in capsys.readouterr().err and not out.exists()
+
+    def garbled(*args, **kwargs):  # a search that the damaged bytes sent astray: the damage is named
+        raise IndexError("index 10**9 is out of bounds")
+
+    monkeypatch.setattr(search, "search", garbled)
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "'root_pos' array" in err and "Traceback" not in err and not out.exists()
 
 
 def test_the_structure_table_counts_the_graph_as_built(sgraph):
