@@ -512,6 +512,7 @@ def test_with_the_rules_on_the_device_the_host_waits_once_every_few_steps(tiny_c
     jobs, n = _jobs(tiny_checkpoint), device_loop.CHECK_EVERY
     counts = {}
     for steps in (2 * n, 4 * n):  # 2n + 1 and 4n + 1 evaluations: 3 and 5 checks
+        monkeypatch.setattr(devices, "_INDEX", {})  # each run makes the index tensors (whichever tests ran before)
         with _HostTraffic() as traffic:
             batching.solve_jobs(tiny_checkpoint, jobs, SolverConfig(max_steps=steps, threshold=0.0, patience=0))
         counts[steps] = traffic.count
@@ -527,7 +528,7 @@ def test_the_step_a_cuda_graph_records_neither_waits_nor_copies(tiny_checkpoint)
     step first runs ``graphs.WARMUP`` times eagerly, where what is made once per device (the index
     tensors of ``devices.index``) is made: the runs after as many are the ones checked, so that
     the test does not depend on which tests ran before it."""
-    from motionlab.retargeting import devices, graphs
+    from motionlab.retargeting import graphs
 
     traffic, unrecordable = [], []
     real = graphs.StepGraph
