@@ -12,7 +12,11 @@
 #   expand32  the same in float32 (the dtype rule's speed);
 #   table1    Table 1 (motionlab evaluate --no-ablations) on cuda, training the network there; the
 #             checkpoint is kept (OUT/motionlab_Aj.pt) so the CPU can evaluate the same network;
-#   profile   benchmarks/profile_expand_gpu.py (where the solve's time goes; PROFILE_ARGS: its options).
+#   profile   benchmarks/profile_expand_gpu.py (where the solve's time goes; PROFILE_ARGS: its options);
+#   notebooks the retargeting notebooks (02, 03, 04, 07) on $DEV as a user with a GPU runs them
+#             (MOTIONLAB_DEVICE=$DEV, quick mode, the shipped network: no course data, so nothing is
+#             trained), lax: every cell runs and every assert holds (the test suite itself runs
+#             them on the CPU, where their stored outputs were made).
 # Usage: DATA=mixamo.tar.xz REF=ref_cpu.tar.xz OUT=folder bash benchmarks/gpu_check.sh
 # (DATA: a tar of MOTIONLAB_DATA's mixamo/ folder; REF: a tar of a folder ref_cpu/ written on the CPU by
 # `python benchmarks/bench_expand.py --clips all --table1-characters --device cpu --skip-per-process
@@ -53,7 +57,16 @@ for s in ${STAGES:-pytest expand64 expand32 table1}; do
         timeout 300 $PY -m motionlab evaluate --device "$DEV" --checkpoint "$OUT/motionlab_Aj.pt" --no-ablations -q \
             --csv "$OUT/table1_$DEV.csv" 2>&1 | tee "$OUT/table1_$DEV.txt" ;;
     profile) timeout 240 $PY benchmarks/profile_expand_gpu.py --device "$DEV" ${PROFILE_ARGS:-} $( [ "$CLIPS" = all ] || echo --clips "$CLIPS" ) ;;
-    *) echo "unknown stage $s (pytest expand64 eager fk workers expand32 table1 profile)"; exit 2 ;;
+    notebooks)
+        if $PY -c "import nbval, ipykernel" 2>/dev/null; then
+            env -u MOTIONLAB_DATA MOTIONLAB_DEVICE="$DEV" MOTIONLAB_QUICK=1 MPLBACKEND=Agg PYVISTA_OFF_SCREEN=true \
+                timeout 300 $PY -m pytest --nbval-lax -q -p no:cacheprovider notebooks/02_training_autoencoder.ipynb \
+                notebooks/03_latent_iteration.ipynb notebooks/04_playback_and_bone_proportions.ipynb \
+                notebooks/07_expanding_a_database.ipynb 2>&1 | tail -15
+        else
+            echo "notebooks: skipped, nbval or ipykernel is not installed here"
+        fi ;;
+    *) echo "unknown stage $s (pytest expand64 eager fk workers expand32 table1 profile notebooks)"; exit 2 ;;
     esac
 done
 stage done

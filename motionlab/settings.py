@@ -5,6 +5,10 @@
 ``MOTIONLAB_CACHE``
     folder of the network trained on real motion on first use (default ``~/.cache/motionlab``;
     see :mod:`motionlab.retargeting.real`).
+``MOTIONLAB_DEVICE``
+    the torch device the retargeting network runs on when none is named (default: CUDA when
+    available, else the CPU; see :mod:`motionlab.retargeting.devices`). The test suite sets it to
+    ``cpu``: its known answers and the notebooks' stored outputs were made on the CPU.
 ``MOTIONLAB_QUICK``
     when set to 1/true/yes, notebooks and long-running demos use a reduced mode
     (fewer training steps, fewer clips) through the same code path. CI sets it.

@@ -31,20 +31,20 @@ __all__ = [
 
 
 def check_device(device: str | None) -> None:
-    """Refuse a ``--device`` this machine does not have (:func:`devices.pick`) before a command does any work.
+    """Refuse a ``--device`` this machine does not have (:func:`devices.pick`), or without one a
+    default that ``MOTIONLAB_DEVICE`` names and this machine does not have, before a command does
+    any work.
 
     Raises
     ------
-    CLIError naming ``--device`` and the devices this machine has.
+    CLIError naming ``--device`` (or ``MOTIONLAB_DEVICE``) and the devices this machine has.
     """
-    if device is None:
-        return
     from motionlab.retargeting import devices
 
     try:
         devices.pick(device)
     except ValueError as e:
-        raise CLIError(f"--device: {e}") from None
+        raise CLIError(f"--device: {e}" if device is not None else str(e)) from None
 
 
 def load_checkpoint(path: str | None, device: str | None):
@@ -219,7 +219,9 @@ def add_solver_args(p: argparse.ArgumentParser) -> None:
 
 def add_device(p: argparse.ArgumentParser) -> None:
     """``--device``: the torch device of a command that runs the network."""
-    p.add_argument("--device", help="torch device (default: cuda if available, else cpu)")
+    p.add_argument(
+        "--device", help="torch device (default: $MOTIONLAB_DEVICE if set, else cuda if available, else cpu)"
+    )
 
 
 def add_run_options(p: argparse.ArgumentParser, force_help: str) -> None:

@@ -1,6 +1,8 @@
 """Which torch device the retargeting network runs on: the one home of the default and its checks.
 
-The default is CUDA when ``torch.cuda.is_available()``, else the CPU. A device that is named
+The default is the device ``MOTIONLAB_DEVICE`` names when it is set (``cpu`` keeps a GPU machine
+on the CPU, as the test suite does: its known answers and the notebooks' stored outputs were made
+there), else CUDA when ``torch.cuda.is_available()``, else the CPU. A device that is named
 (``--device``, ``TrainConfig.device``, :func:`motionlab.retargeting.load`) must exist on this
 machine: :func:`pick` refuses a name torch does not know and a CUDA (or MPS) device this torch
 cannot use, with a :class:`ValueError` saying which devices there are, instead of a torch
@@ -13,9 +15,14 @@ explicitly. ``tests/retargeting/test_devices.py`` checks that rule on the CPU.
 
 from __future__ import annotations
 
+import os
+
 import torch
 
-__all__ = ["pick", "available", "index"]
+__all__ = ["pick", "available", "index", "DEVICE_ENV"]
+
+DEVICE_ENV = "MOTIONLAB_DEVICE"
+"""The environment variable that names the default device."""
 
 _INDEX: dict = {}
 
@@ -32,16 +39,24 @@ def available() -> list[str]:
 
 
 def pick(device: str | torch.device | None = None) -> torch.device:
-    """``device`` checked, or the default (CUDA when available, else the CPU).
+    """``device`` checked, or the default: the device :data:`DEVICE_ENV` names, else CUDA when
+    available, else the CPU.
 
     Raises
     ------
     ValueError
-        ``device`` is not a torch device name, or names a CUDA / MPS device this machine or this
-        build of torch does not have (the message lists the devices there are).
+        ``device`` (or :data:`DEVICE_ENV`, named in the message) is not a torch device name, or
+        names a CUDA / MPS device this machine or this build of torch does not have (the message
+        lists the devices there are).
     """
     if device is None:
-        return torch.device("cuda" if torch.cuda.is_available() else "cpu")
+        named = os.environ.get(DEVICE_ENV, "").strip()
+        if not named:
+            return torch.device("cuda" if torch.cuda.is_available() else "cpu")
+        try:
+            return pick(named)
+        except ValueError as e:
+            raise ValueError(f"{DEVICE_ENV}: {e}") from None
     try:
         dev = torch.device(device)
     except (RuntimeError, TypeError):

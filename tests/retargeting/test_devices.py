@@ -299,7 +299,30 @@ def test_a_device_that_is_not_there_is_refused_clearly():
         with pytest.raises(ValueError, match="no usable CUDA GPU"):
             devices.pick("cuda")
     assert devices.pick("cpu") == torch.device("cpu")
-    assert devices.pick() == torch.device("cuda" if torch.cuda.is_available() else "cpu")
+
+
+def test_the_default_device_is_the_one_motionlab_device_names(monkeypatch):
+    """On a GPU machine the default is CUDA unless ``MOTIONLAB_DEVICE`` names another (the test
+    suite sets ``cpu``, conftest.py); a name that is not there is refused with the variable named."""
+    monkeypatch.setattr(torch.cuda, "is_available", lambda: True)
+    monkeypatch.setattr(torch.cuda, "device_count", lambda: 1)
+    monkeypatch.delenv(devices.DEVICE_ENV, raising=False)
+    assert devices.pick() == torch.device("cuda")
+    for named, device in (("cpu", "cpu"), (" cuda:0 ", "cuda:0"), ("", "cuda")):
+        monkeypatch.setenv(devices.DEVICE_ENV, named)
+        assert devices.pick() == torch.device(device)
+        assert devices.pick("cpu") == torch.device("cpu")  # a device named in the call wins
+    for named, problem in (("bogus", "'bogus' is not a torch device"), ("cuda:3", "there are 1 CUDA GPU")):
+        monkeypatch.setenv(devices.DEVICE_ENV, named)
+        with pytest.raises(ValueError, match=f"^MOTIONLAB_DEVICE: device .*{problem}"):
+            devices.pick()
+
+
+def test_the_suite_runs_on_the_cpu(monkeypatch):
+    """What the tests and the stored notebook outputs compare was made on the CPU: a GPU machine
+    runs them there too, unless MOTIONLAB_DEVICE was set before pytest (conftest.py)."""
+    monkeypatch.setattr(torch.cuda, "is_available", lambda: True)
+    assert os.environ[devices.DEVICE_ENV] != "" and devices.pick() == torch.device(os.environ[devices.DEVICE_ENV])
 
 
 @pytest.mark.parametrize(
@@ -318,6 +341,10 @@ def test_the_cli_refuses_a_bad_device_in_one_line(command, tmp_path, monkeypatch
     assert main([*command, "--device", "bogus"]) == 2
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "--device" in err and "'bogus' is not a torch device" in err
+    monkeypatch.setenv(devices.DEVICE_ENV, "bogus")  # the default named by the environment
+    assert main(command) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "MOTIONLAB_DEVICE: device 'bogus' is not a torch device" in err
     if not torch.cuda.is_available():
         assert main([*command, "--device", "cuda"]) == 2
         assert "no usable CUDA GPU" in capsys.readouterr().err
