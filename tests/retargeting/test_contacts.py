@@ -188,7 +188,7 @@ def test_projection_reaches_the_source_rotations():
         after = ckpt.model.decode(project_latent(ckpt.model, phi0, target, offsets), offsets).local_rot
 
     def degrees(q):
-        return np.degrees(2 * np.arccos(np.clip(np.abs((q * target).sum(-1)).numpy(), 0, 1)))
+        return np.degrees(2 * np.arccos(np.clip(np.abs((q * target).sum(-1).numpy()), 0, 1)))
 
     assert degrees(before).max() > 2.0  # the encoder alone is degrees off somewhere
     assert np.median(degrees(after)) < 0.05 and degrees(after).max() < 0.1 * degrees(before).max()
