@@ -261,6 +261,14 @@ def _check_crc(path: Path, fh, info: zipfile.ZipInfo, size: int) -> None:
         )
 
 
+def _check_crcs(path: Path, entries: dict) -> None:
+    """:func:`_check_crc` of every zip entry of ``entries`` (name -> ZipInfo), one pass over the file."""
+    size = path.stat().st_size
+    with open(path, "rb") as fh:
+        for e in entries.values():
+            _check_crc(path, fh, e, size)
+
+
 def _read_meta(z: zipfile.ZipFile) -> dict:
     with z.open("meta.npy") as f:
         m = np.lib.format.read_array(f, allow_pickle=False)
@@ -326,10 +334,10 @@ def _arrays(path: Path, verify: bool) -> tuple[dict, dict]:
     with zipfile.ZipFile(path) as z:
         meta, entries, mapped = _members(path, z)
         if mapped:
+            if verify:
+                _check_crcs(path, entries)
             size = path.stat().st_size
             with open(path, "rb") as fh:
-                for e in entries.values() if verify else ():
-                    _check_crc(path, fh, e, size)
                 return meta, {k: _mapped(path, fh, e, size) for k, e in entries.items()}
         arrays = {}
         for k, e in entries.items():
@@ -360,10 +368,7 @@ def verify(path: str | os.PathLike) -> None:
         with zipfile.ZipFile(path) as z:
             _, entries, mapped = _members(path, z)
         if mapped:  # (version 2's compressed arrays are checked by zipfile as load reads them)
-            size = path.stat().st_size
-            with open(path, "rb") as fh:
-                for e in entries.values():
-                    _check_crc(path, fh, e, size)
+            _check_crcs(path, entries)
 
     _named(path, crcs)
 
