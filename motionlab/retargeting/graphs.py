@@ -9,9 +9,12 @@ same tensors (updated in place), the same shapes (every row of the batch, also r
 has stopped: they are masked, :mod:`.device_loop`) and nothing that waits for the device.
 
 :class:`StepGraph` records a step on CUDA and replays it; elsewhere it runs the same step eagerly,
-so the CPU exercises the same all-rows arithmetic (a test compares it with the solver's host
-loop, another checks that the step reads nothing back from the device and copies nothing from the
-host, which a graph could not record).
+so the CPU exercises the same all-rows arithmetic. Three tests check on the CPU what a GPU would
+otherwise find out: the step gives the solver's host loop's numbers; it reads nothing back from
+the device and copies nothing from the host (a graph could not record either); and replayed as a
+graph replays it (``tests/retargeting/replay.py`` re-runs the recorded aten ops on the same
+tensors) it gives the eager step's numbers, so it depends on no Python number, no tensor replaced
+between steps and no state left out of ``keep``.
 
 **On by default on CUDA**; ``MOTIONLAB_CUDA_GRAPHS=0`` switches it off (:func:`enabled`): the
 iteration then runs the host loop, as on the CPU, and ``benchmarks/gpu_check.sh`` (stage

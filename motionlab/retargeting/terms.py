@@ -11,6 +11,13 @@ branching on tensor values), since :func:`motionlab.retargeting.solver.solve_man
 the sequences of a batch. ``needs`` names the inputs it cannot do without (``"planted"``…); where
 one is missing the term is not evaluated and its value is 0.
 
+On a GPU the whole step of the iteration is recorded once as a CUDA graph and replayed
+(:mod:`.graphs`): the function runs while the step is recorded, not at every step. Its value may
+depend on its arguments alone: a Python number it changes or reads (a call counter, an annealed
+weight) keeps its recorded value, and a tensor it reads from elsewhere must be updated in place,
+never replaced. ``tests/retargeting/replay.py`` replays a step on the CPU as a graph does
+(``test_a_loss_term_that_keeps_python_state_is_not_replayed``).
+
 The iteration (:mod:`motionlab.retargeting.solver`) sums ``weight × value`` over the registered
 terms, in registration order: ``L_iter = Σ_k w_k · L_k``. A term's weight comes from
 ``SolverConfig.weights[name]`` when given, else (for the three terms the paper and motionlab

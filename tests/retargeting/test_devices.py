@@ -32,6 +32,7 @@ import motionlab
 from motionlab import retargeting, synthetic
 from motionlab.core import bvh, humanoid
 from motionlab.retargeting import batching, devices
+from motionlab.retargeting.losses import LAMBDA_FLOOR
 from motionlab.retargeting.pipeline import prepare_pair, prepare_source
 from motionlab.retargeting.solver import SolverConfig
 from motionlab.retargeting.train import TrainConfig, train
@@ -611,3 +612,98 @@ def test_the_graph_switch_takes_0_or_1_and_is_on_by_default_on_cuda(monkeypatch)
     monkeypatch.setenv("MOTIONLAB_CUDA_GRAPHS", "true")
     with pytest.raises(ValueError, match="MOTIONLAB_CUDA_GRAPHS must be 0 .* or 1 .*, got 'true'"):
         graphs.enabled("cpu")
+
+
+# ------------------------------------------------------- a CUDA graph's replay, done on the CPU
+def _solved_as(step_graph, checkpoint, jobs, cfg):
+    """``batching.solve_jobs`` through the loop a GPU runs (:mod:`device_loop`), its step made
+    by ``step_graph`` (None: ``graphs.StepGraph``, which on the CPU runs it eagerly)."""
+    from motionlab.retargeting import graphs
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(graphs, "enabled", lambda device: True)
+        if step_graph is not None:
+            mp.setattr(graphs, "StepGraph", step_graph)
+        return batching.solve_jobs(checkpoint, jobs, cfg)
+
+
+def test_a_replay_keeps_what_a_cuda_graph_keeps():
+    """:class:`replay.Replayed` on known answers: values changed in place are seen, a state the
+    step carries advances once per run, and what a graph does not replay is not replayed either
+    (a Python number keeps its recorded value, a replaced tensor is not read, and a state not
+    listed in ``keep`` carries the warm-up runs' changes)."""
+    from motionlab.retargeting import graphs
+    from tests.retargeting.replay import Replayed
+
+    leaf = torch.zeros(3, dtype=torch.float64, requires_grad=True)
+    counter, loose = torch.zeros((), dtype=torch.int64), torch.zeros((), dtype=torch.int64)
+    scale, calls = [torch.ones((), dtype=torch.float64)], [0]
+    quadratic = _quadratic_step(leaf)
+
+    def step():
+        counter.add_(1)
+        loose.add_(1)
+        calls[0] += 1
+        (loss,) = quadratic()
+        return loss, (leaf * calls[0]).sum().detach(), scale[0] * 1.0
+
+    graph = Replayed(step, leaf, keep=[counter])
+    assert graph.recorded and graph.ops > 10
+    assert (int(counter), int(loose), calls[0]) == (0, graphs.WARMUP, graphs.WARMUP + 1)  # recording ran nothing
+    scale[0] = torch.full((), 2.0, dtype=torch.float64)  # replaced, not updated in place
+    for n, x in enumerate((0.0, 1.0, -2.0), start=1):
+        with torch.no_grad():
+            leaf.fill_(x)
+        loss, by_calls, scaled = graph.run()
+        assert float(loss) == 3 * (2 * x + 1) ** 2 and leaf.grad.tolist() == [4 * (2 * x + 1)] * 3
+        assert (int(counter), int(loose)) == (n, graphs.WARMUP + n)
+        assert float(by_calls) == 3 * x * (graphs.WARMUP + 1) and float(scaled) == 1.0
+    assert calls[0] == graphs.WARMUP + 1
+
+
+REPLAY_CFG = SolverConfig(max_steps=40, patience=3, min_delta=0.02, weights={"floor": LAMBDA_FLOOR})
+"""Groups that stop at different steps (a plateau and the step limit), the floor term on."""
+
+
+def test_the_iteration_replayed_as_a_cuda_graph_gives_the_eager_loops_numbers(tiny_checkpoint):
+    """The whole step (every row's losses and gradient, the stopping rule, backtracking, Adam's
+    update, padded rows) recorded once and replayed as a CUDA graph replays it gives every step
+    count, stop, history and output of the same loop run eagerly, bit for bit: the step reads no
+    Python number that changes, no tensor that is replaced between steps, and every state it
+    carries is restored after the warm-up (on a GPU, anything else is a silently different
+    result: replacing ``steps.m`` instead of updating it in place, or leaving Adam's moments out
+    of ``keep``, fails here)."""
+    from tests.retargeting.replay import Replayed
+
+    jobs = _jobs(tiny_checkpoint, 3)
+    eager = _solved_as(None, tiny_checkpoint, jobs, REPLAY_CFG)
+    replayed = _solved_as(Replayed, tiny_checkpoint, jobs, REPLAY_CFG)
+    assert {r.stop_reason for r in eager} == {"plateau", "max_steps"}
+    for a, b in zip(eager, replayed):
+        assert (a.steps, a.stop_reason, a.best_step, a.history) == (b.steps, b.stop_reason, b.best_step, b.history)
+        assert np.array_equal(a.positions, b.positions) and np.array_equal(a.local_rot, b.local_rot)
+        assert torch.equal(a.phi, b.phi)
+
+
+def test_a_loss_term_that_keeps_python_state_is_not_replayed(tiny_checkpoint):
+    """The hazard :mod:`motionlab.retargeting.terms` warns a term's author of: on a GPU a term's
+    function runs only while the step is recorded, so a term that counts its calls in Python
+    (here, a weight annealed over the steps) is frozen at its recorded value, and the replay's
+    numbers differ from the eager loop's."""
+    from motionlab.retargeting import terms
+    from tests.retargeting.replay import Replayed
+
+    calls = [0]
+
+    def annealed(decoded, inputs):
+        calls[0] += 1
+        return min(calls[0] / 10, 1.0) * decoded.positions[..., 1].square().mean()
+
+    jobs = _jobs(tiny_checkpoint, 2)
+    terms.register(terms.Term("annealed", 1.0, annealed, padded=True))
+    try:
+        eager = _solved_as(None, tiny_checkpoint, jobs, FAST)
+        replayed = _solved_as(Replayed, tiny_checkpoint, jobs, FAST)
+    finally:
+        terms.unregister("annealed")
+    assert eager[0].history["annealed"] != replayed[0].history["annealed"]
