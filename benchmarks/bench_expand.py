@@ -37,6 +37,10 @@ outputs can be compared with a CPU run's byte for byte::
         --skip-per-process --skip-ray --keep REF
     python benchmarks/bench_expand.py --clips 8 --table1-characters --device cpu --pad \
         --skip-per-process --skip-ray --device-loop --reference REF
+
+``--device-loop replay`` does more of what a GPU does: each batch's step is recorded once and
+replayed as a CUDA graph replays it (``tests/retargeting/replay.py``, on any device, about half
+the eager speed), so a CPU run shows whether the recorded step gives the host loop's outputs.
 """
 
 from __future__ import annotations
@@ -263,14 +267,22 @@ def main() -> None:
     p.add_argument("--verify", metavar="OUT", help="only check OUT's outputs against the single-pair path")
     p.add_argument(
         "--device-loop",
-        action="store_true",
-        help="run the iteration's rules as on a GPU (motionlab.retargeting.device_loop), eagerly on any device",
+        nargs="?",
+        const="eager",
+        choices=("eager", "replay"),
+        help="run the iteration's rules as on a GPU (motionlab.retargeting.device_loop) on any device: "
+        "eagerly (the default), or its step recorded once and replayed as a CUDA graph does",
     )
     args = p.parse_args()
     if args.device_loop:  # the switch a GPU takes (graphs.enabled), taken on every device
         from motionlab.retargeting import graphs
 
         graphs.enabled = lambda device: True
+        if args.device_loop == "replay":
+            sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+            from tests.retargeting.replay import Replayed
+
+            graphs.StepGraph = Replayed
     if args.memory:
         return _memory(args)
     if args.verify:
