@@ -14,8 +14,8 @@ gives a result on the GPU that differs from the CPU's, silently. CI has no GPU, 
 * the "recording" runs the step once eagerly under a :class:`TorchDispatchMode` that lists
   every aten op (forward and backward) with its arguments, the tensors kept as the objects
   themselves (their memory, as a graph keeps addresses) and every other argument as recorded;
-  every tensor that existed before the step and that an op writes to is copied first and put
-  back afterwards, since a recording runs nothing;
+  what an op writes to in memory the step did not allocate (a tensor that existed before the
+  step, or a view of one) is copied first and put back afterwards, since a recording runs nothing;
 * each :meth:`Replayed.run` re-runs the listed ops on the listed arguments and copies each
   fresh result into the tensor the recording made (a graph writes its results to the same
   memory every time), so a later op and the caller read them there.
@@ -49,24 +49,30 @@ def _written(func, args, kwargs) -> list[torch.Tensor]:
     return out
 
 
+def _memory(t: torch.Tensor) -> int:
+    return t.untyped_storage().data_ptr()
+
+
 class _Recorder(TorchDispatchMode):
     """Runs each op and lists it as ``(func, args, kwargs, results)``; before an op first writes
-    to a tensor made outside the step, keeps a copy of that tensor in ``before``."""
+    to memory the step did not allocate (a tensor made before it, or a view of one), keeps a
+    copy of what it writes to in ``before``."""
 
     def __init__(self):
         super().__init__()
         self.ops: list[tuple] = []
-        self.made: set[int] = set()  # ids of tensors some listed op returned (kept alive by ``ops``)
+        self.made: set[int] = set()  # memory some listed op allocated (kept alive by ``ops``)
         self.before: dict[int, tuple[torch.Tensor, torch.Tensor]] = {}
 
     def __torch_dispatch__(self, func, types, args=(), kwargs=None):
         kwargs = kwargs or {}
         for t in _written(func, args, kwargs):
-            if id(t) not in self.made and id(t) not in self.before:
+            if t.numel() and _memory(t) not in self.made and id(t) not in self.before:
                 self.before[id(t)] = (t, t.detach().clone())
         results = func(*args, **kwargs)
         self.ops.append((func, args, kwargs, results))
-        self.made.update(id(t) for t in _tensors(results))
+        if not any(r.alias_info is not None for r in func._schema.returns):
+            self.made.update(_memory(t) for t in _tensors(results) if t.numel())
         return results
 
 
