@@ -67,6 +67,12 @@ def register(subparsers) -> None:
             "--neighbours", type=positive_int, default=3, help="takes each take of a style is compared with (default 3)"
         )
         p.add_argument("--name-map", help="JSON file {clip stem: 'behaviour_style[_take]'} for names that do not parse")
+        p.add_argument(
+            "--behaviour-folders",
+            action="store_true",
+            help="each subfolder holds one behaviour's clips and is named after it; a file name then gives the "
+            "style and take (Xia et al.'s run/angry_13_000.bvh: run, angry, take 13-000)",
+        )
         p.add_argument("--report", help="also write the build report as JSON to this file")
         p.add_argument(
             "--backend",
@@ -178,15 +184,18 @@ def _load_clips(args: argparse.Namespace) -> list:
         return motions
     _check_folder_size(args.folder, args.fps)
     try:
-        motions = clips.load_folder(args.folder, args.fps, name_map, progress=not args.quiet)
+        motions = clips.load_folder(
+            args.folder, args.fps, name_map, progress=not args.quiet, behaviour_folders=args.behaviour_folders
+        )
     except NamingError as e:
         raise CLIError(str(e)) from None
-    skipped = clips.unlabelled_files(args.folder, name_map)
+    skipped = clips.unlabelled_files(args.folder, name_map, args.behaviour_folders)
     if skipped:
         names = ", ".join(p.name for p in skipped[:5]) + (f" and {len(skipped) - 5} more" if len(skipped) > 5 else "")
+        hint = "" if args.behaviour_folders else ", or --behaviour-folders where each subfolder holds one behaviour"
         print(
             f"skipped {len(skipped)} of {len(skipped) + len(motions)} BVH files whose names give no behaviour_style "
-            f"label ({names}); --name-map labels them (motionlab.motion_graphs.naming)",
+            f"label ({names}); --name-map labels them{hint} (motionlab.motion_graphs.naming)",
             file=sys.stderr,
         )
     return motions

@@ -67,26 +67,40 @@ def prepare(motion: Motion, fps: float) -> Motion:
     return out.copy(fps=float(fps)) if same else out
 
 
-def unlabelled_files(folder: str | os.PathLike, name_map=None) -> list[Path]:
+def _label(path: Path, folder: Path, name_map, behaviour_folders: bool):
+    """The label of the file ``path`` under ``folder`` (:func:`.naming.parse_name`; with
+    ``behaviour_folders``, a file in a subfolder takes that folder's name as its behaviour)."""
+    behaviour = path.parent.name if behaviour_folders and path.parent != Path(folder) else None
+    return parse_name(path.stem, name_map, behaviour)
+
+
+def unlabelled_files(folder: str | os.PathLike, name_map=None, behaviour_folders: bool = False) -> list[Path]:
     """The BVH files under ``folder`` (recursively) whose names give no label
     (:func:`.naming.parse_name`): :func:`load_folder` skips them."""
     out = []
     for path in files.bvh_files(folder, recursive=True):
         try:
-            parse_name(path.stem, name_map)
+            _label(path, folder, name_map, behaviour_folders)
         except NamingError:
             out.append(path)
     return out
 
 
 def load_folder(
-    folder: str | os.PathLike, fps: float = 30.0, name_map=None, strict: bool = False, progress: bool = False
+    folder: str | os.PathLike,
+    fps: float = 30.0,
+    name_map=None,
+    strict: bool = False,
+    progress: bool = False,
+    behaviour_folders: bool = False,
 ) -> list[Motion]:
     """Every BVH file under ``folder`` (recursively, ``.bvh`` in any case), reduced, resampled and named by label
     (``walk_angry_001``: behaviour, style and take, see :mod:`.naming`).
 
     ``name_map``: ``{stem: label text}`` or a callable (:func:`.naming.parse_name`). Files whose
     names give no label are skipped, or raise with ``strict=True``. ``progress``: a tqdm bar.
+    ``behaviour_folders``: each subfolder holds the clips of one behaviour, its name (Xia et al.'s
+    ``run/angry_13_000.bvh``; :mod:`.naming`).
 
     Raises
     ------
@@ -96,7 +110,7 @@ def load_folder(
     folder = Path(folder)
     if not folder.is_dir():
         raise FileNotFoundError(f"{folder} is not a folder of BVH files")
-    out = []
+    out, first_error = [], None
     paths = files.bvh_files(folder, recursive=True)
     if progress:
         from tqdm.auto import tqdm
@@ -104,18 +118,20 @@ def load_folder(
         paths = tqdm(paths, desc="loading", unit="file", leave=False)
     for path in paths:
         try:
-            label = parse_name(path.stem, name_map)
-        except NamingError:
+            label = _label(path, folder, name_map, behaviour_folders)
+        except NamingError as e:
             if strict:
                 raise
+            first_error = first_error or f"{path}: {e}"
             continue
         motion = bvh.load(path)
         if motion.num_frames == 0:
             raise ValueError(f"{path} has no frames (its MOTION block says Frames: 0); a clip of a graph needs some")
         out.append(prepare(motion, fps).copy(name=label_name(label)))
     if not out:
+        why = f"; the first: {first_error}" if first_error else ""
         raise FileNotFoundError(
-            f"no BVH file under {folder} has a behaviour_style name (see motionlab.motion_graphs.naming)"
+            f"no BVH file under {folder} has a behaviour_style name (see motionlab.motion_graphs.naming){why}"
         )
     return out
 

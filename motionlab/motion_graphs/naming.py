@@ -12,11 +12,17 @@ name                                        label
 ``dataset-2_walk_angry_001``                Bandai Namco: walk/angry, take ``001``
 ``dataset-2_walk_angry_017``                the same style, take ``017`` (pooled with take 001)
 ``Walk_angry_3``                            walk/angry, take ``3``
+``run/angry_13_000`` (behaviour folders)    Xia et al.: run/angry, take ``13-000``
 ==========================================  =========================================
 
 A take number never creates a style: a recording session delivers many takes of one behaviour
 in one style, and the structured graph pools them (every take of ``walk/angry`` is material of
-that one style). Labels are lower case. Names that fit none of these forms (most Mixamo clips)
+that one style). So a style is never a number: ``Idle_1``, CMU's ``131_03`` and Xia et al.'s
+``angry_13_000`` give no label by their names alone. Xia et al. file each behaviour in a folder
+of its own (``run/angry_13_000.bvh``: style, then numbers); read with ``behaviour=`` the folder's
+name (``graph-build --behaviour-folders``), a name is then the style up to its first number and
+the take from there, unless it names that behaviour itself (``walk/Walk_happily``) or a
+transition. Labels are lower case. Names that fit none of these forms (most Mixamo clips)
 are looked up in a *name map* ``{clip stem: "behaviour_style[_take]" or "b1_s1_to_b2_s2"}``,
 or passed through a callable ``name_map(stem) -> label text | ClipLabel | None`` for other
 naming schemes; :data:`MIXAMO_AJ` maps the Mixamo Aj clips of the shared data.
@@ -87,20 +93,28 @@ _TRANSITION = re.compile(
     rf"^transition[_ ](?P<b1>{_TOKEN})_(?P<s1>{_TOKEN})[_ ](?P<b2>{_TOKEN})_(?P<s2>{_TOKEN})$", re.IGNORECASE
 )
 _BASIC = re.compile(rf"^(?P<b>{_TOKEN})_(?P<s>{_TOKEN})$")
-_TAKE = re.compile(rf"^(?P<b>{_TOKEN})_(?P<s>{_TOKEN})_(?P<take>\d+)$")
+_TAKE = re.compile(rf"^(?P<b>{_TOKEN})_(?P<s>{_TOKEN})_(?P<take>\d+(?:-\d+)*)$")
 
 
 def _label(text: str) -> ClipLabel | None:
     m = _TRANSITION.match(text) or _TO.match(text)
-    if m:
+    if m and not (m["s1"].isdigit() or m["s2"].isdigit()):
         return ClipLabel("transition", m["b1"].lower(), m["s1"].lower(), m["b2"].lower(), m["s2"].lower())
-    m = _TAKE.match(text)
-    if m and m["b"].lower() not in ("to", "transition"):
-        return ClipLabel("basic", m["b"].lower(), m["s"].lower(), take=m["take"])
-    m = _BASIC.match(text)
-    if m and m["b"].lower() not in ("to", "transition"):
-        return ClipLabel("basic", m["b"].lower(), m["s"].lower())
+    m = _TAKE.match(text) or _BASIC.match(text)
+    if m and m["b"].lower() not in ("to", "transition") and not m["s"].isdigit():
+        return ClipLabel("basic", m["b"].lower(), m["s"].lower(), take=m.groupdict().get("take"))
     return None
+
+
+def _in_folder(stem: str, behaviour: str) -> ClipLabel | None:
+    """``stem`` read as ``<style>[_<number>…]`` of ``behaviour`` (the style's words joined by
+    ``-``, the numbers the take); ``None`` when it is not of that form."""
+    words = stem.split("_")
+    k = next((i for i, w in enumerate(words) if w.isdigit()), len(words))
+    style, numbers = "-".join(words[:k]), words[k:]
+    if not re.fullmatch(_TOKEN, style) or style.isdigit() or not all(w.isdigit() for w in numbers):
+        return None
+    return ClipLabel("basic", behaviour.lower(), style.lower(), take="-".join(numbers) or None)
 
 
 NameMap = Mapping[str, str] | Callable[[str], "str | ClipLabel | None"]
@@ -125,7 +139,7 @@ def _mapped(stem: str, name_map: NameMap) -> ClipLabel | None:
     return label
 
 
-def parse_name(name: str, name_map: NameMap | None = None) -> ClipLabel:
+def parse_name(name: str, name_map: NameMap | None = None, behaviour: str | None = None) -> ClipLabel:
     """The label a clip name stands for.
 
     Parameters
@@ -134,6 +148,8 @@ def parse_name(name: str, name_map: NameMap | None = None) -> ClipLabel:
     name_map : optional ``{stem: label text}`` (exact stem) or a callable that takes the stem
         and returns label text, a ``ClipLabel`` or ``None``; consulted first, ``None`` / a missing
         stem falls back to the built-in forms
+    behaviour : optional behaviour of the clip's folder (module docstring): a basic clip whose
+        name does not name this behaviour is read as ``<style>[_<number>…]`` of it
 
     Raises
     ------
@@ -147,14 +163,23 @@ def parse_name(name: str, name_map: NameMap | None = None) -> ClipLabel:
         if label is not None:
             return label
     m = _BANDAI.match(stem)
-    if m:
-        return ClipLabel("basic", m["b"].lower(), m["s"].lower(), take=m["take"])
-    label = _label(stem)
+    label = ClipLabel("basic", m["b"].lower(), m["s"].lower(), take=m["take"]) if m else _label(stem)
+    if behaviour is not None and (label is None or label.kind == "basic" and label.behaviour != behaviour.lower()):
+        if not re.fullmatch(_TOKEN, behaviour):
+            raise NamingError(f"folder name {behaviour!r} is not a behaviour name (letters, digits and '-' only)")
+        label = _in_folder(stem, behaviour)
+        if label is None:
+            raise NamingError(
+                f"cannot read a style from clip name {stem!r} in behaviour folder {behaviour!r}: expected "
+                "'<style>' or '<style>_<number>…' (angry_13_000), or an entry in the name map"
+            )
     if label is None:
         raise NamingError(
             f"cannot read behaviour and style from clip name {stem!r}: expected 'Behaviour_style' "
             "(Walk_creepingly), 'Behaviour_style_take' (Walk_creepingly_2), 'B1_s1_to_B2_s2' or 'Transition_B1_s1_B2_s2' for transition clips, "
-            "'dataset-1_<behaviour>_<style>_<take>' (Bandai Namco), or an entry in the name map"
+            "'dataset-1_<behaviour>_<style>_<take>' (Bandai Namco), or an entry in the name map; a style is not a "
+            "number (where each folder holds one behaviour, as Xia et al.'s run/angry_13_000.bvh, the folders name "
+            "the behaviours: graph-build --behaviour-folders)"
         )
     return label
 

@@ -279,3 +279,24 @@ def test_a_style_with_nothing_alive_is_named(sgraph, tmp_path):
     g.table["behaviours"]["run"]["normal"]["alive"] = 0
     with pytest.raises(search.SearchError, match="run/normal has no frame left alive"):
         search.search(g, "walk:normal:30,run:normal:30")
+
+
+def test_build_reads_behaviour_folders(tmp_path, capsys):
+    """Xia et al.'s layout, ``<behaviour>/<style>_<numbers>.bvh``: without ``--behaviour-folders``
+    its files give no label and are skipped with the option named (they used to read as behaviour
+    ``angry``, style ``13``); with it, every behaviour is its folder's."""
+    from tests.conftest import require_data
+
+    xia = require_data("xia")
+    out = tmp_path / "xia.mlgraph"
+    assert main(["graph-build", str(xia), "-o", str(out), "-q"]) == 0
+    assert "skipped 9 of 11 BVH files" in capsys.readouterr().err  # the two left: walk/normal_ganimator, proud_…
+    assert main(["graph-build", str(xia), "-o", str(out), "-q", "--force", "--behaviour-folders"]) == 0
+    table = io.load(out).table["behaviours"]
+    assert {b: sorted(styles) for b, styles in table.items()} == {
+        "jump": ["neutral"],
+        "punch": ["depressed"],
+        "run": ["angry", "depressed", "old"],
+        "walk": ["neutral", "normal-ganimator", "proud-ganimator", "sexy", "strutting"],
+    }
+    assert len(table["walk"]["sexy"]["takes"]) == 2
