@@ -21,11 +21,13 @@ that one style). So a style is never a number: ``Idle_1``, CMU's ``131_03`` and 
 ``angry_13_000`` give no label by their names alone. Xia et al. file each behaviour in a folder
 of its own (``run/angry_13_000.bvh``: style, then numbers); read with ``behaviour=`` the folder's
 name (``graph-build --behaviour-folders``), a name is then the style up to its first number and
-the take from there, unless it names that behaviour itself (``walk/Walk_happily``) or a
-transition. Labels are lower case. Names that fit none of these forms (most Mixamo clips)
-are looked up in a *name map* ``{clip stem: "behaviour_style[_take]" or "b1_s1_to_b2_s2"}``,
-or passed through a callable ``name_map(stem) -> label text | ClipLabel | None`` for other
-naming schemes; :data:`MIXAMO_AJ` maps the Mixamo Aj clips of the shared data.
+the take from there, unless it names that behaviour itself (``walk/Walk_happily``), a
+transition, or is a Bandai Namco name (which names its behaviour in any folder).
+
+Labels are lower case. Names that fit none of these forms (most Mixamo clips) are looked up in a
+*name map* ``{clip stem: "behaviour_style[_take]" or "b1_s1_to_b2_s2"}``, or passed through a
+callable ``name_map(stem) -> label text | ClipLabel | None`` for other naming schemes;
+:data:`MIXAMO_AJ` maps the Mixamo Aj clips of the shared data.
 
 Taught in ``notebooks/05_motion_graphs.ipynb``.
 """
@@ -163,7 +165,9 @@ def parse_name(name: str, name_map: NameMap | None = None, behaviour: str | None
         if label is not None:
             return label
     m = _BANDAI.match(stem)
-    label = ClipLabel("basic", m["b"].lower(), m["s"].lower(), take=m["take"]) if m else _label(stem)
+    if m:  # the studio's own labels, in any folder
+        return ClipLabel("basic", m["b"].lower(), m["s"].lower(), take=m["take"])
+    label = _label(stem)
     if behaviour is not None and (label is None or label.kind == "basic" and label.behaviour != behaviour.lower()):
         if not re.fullmatch(_TOKEN, behaviour):
             raise NamingError(f"folder name {behaviour!r} is not a behaviour name (letters, digits and '-' only)")

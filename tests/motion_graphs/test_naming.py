@@ -68,6 +68,7 @@ def test_a_number_is_never_a_style(name):
         ("normal_ganimator", "walk", "walk_normal-ganimator", None),  # no number: the whole name is the style
         ("Walk_happily", "walk", "walk_happily", None),  # a name that names the folder's behaviour reads as always
         ("dataset-2_walk_active_001", "walk", "walk_active_001", "001"),
+        ("dataset-1_kick_normal_001", "behaviours", "kick_normal_001", "001"),  # Bandai Namco's names say it all
         ("Walk_happily_to_Run_fast", "walk", "walk_happily_to_run_fast", None),  # a transition reads as always
     ],
 )
