@@ -193,6 +193,10 @@ def _load_clips(args: argparse.Namespace) -> list:
     if skipped:
         names = ", ".join(p.name for p in skipped[:5]) + (f" and {len(skipped) - 5} more" if len(skipped) > 5 else "")
         hint = "" if args.behaviour_folders else ", or --behaviour-folders where each subfolder holds one behaviour"
+        try:
+            clips.file_label(skipped[0], args.folder, name_map, args.behaviour_folders)
+        except NamingError as e:
+            hint += f". The first: {e}"
         print(
             f"skipped {len(skipped)} of {len(skipped) + len(motions)} BVH files whose names give no behaviour_style "
             f"label ({names}); --name-map labels them{hint} (motionlab.motion_graphs.naming)",

@@ -29,6 +29,7 @@ __all__ = [
     "prepare",
     "load_folder",
     "unlabelled_files",
+    "file_label",
     "bandai_styles",
     "mixamo_aj",
     "synthetic_library",
@@ -67,9 +68,11 @@ def prepare(motion: Motion, fps: float) -> Motion:
     return out.copy(fps=float(fps)) if same else out
 
 
-def _label(path: Path, folder: Path, name_map, behaviour_folders: bool):
-    """The label of the file ``path`` under ``folder`` (:func:`.naming.parse_name`; with
-    ``behaviour_folders``, a file in a subfolder takes that folder's name as its behaviour)."""
+def file_label(path: Path, folder: str | os.PathLike, name_map=None, behaviour_folders: bool = False):
+    """The label of the BVH file ``path`` under ``folder`` (:func:`.naming.parse_name`; with
+    ``behaviour_folders``, a file in a subfolder takes that folder's name as its behaviour).
+
+    Raises :class:`.naming.NamingError` naming what the file's name lacks."""
     behaviour = path.parent.name if behaviour_folders and path.parent != Path(folder) else None
     return parse_name(path.stem, name_map, behaviour)
 
@@ -80,7 +83,7 @@ def unlabelled_files(folder: str | os.PathLike, name_map=None, behaviour_folders
     out = []
     for path in files.bvh_files(folder, recursive=True):
         try:
-            _label(path, folder, name_map, behaviour_folders)
+            file_label(path, folder, name_map, behaviour_folders)
         except NamingError:
             out.append(path)
     return out
@@ -118,7 +121,7 @@ def load_folder(
         paths = tqdm(paths, desc="loading", unit="file", leave=False)
     for path in paths:
         try:
-            label = _label(path, folder, name_map, behaviour_folders)
+            label = file_label(path, folder, name_map, behaviour_folders)
         except NamingError as e:
             if strict:
                 raise

@@ -23,7 +23,7 @@ gives a result on the GPU that differs from the CPU's, silently. CI has no GPU, 
 Results that are views of their inputs (``detach``, ``expand``, in-place ops…) are the recorded
 views themselves, which see their base's new values. With the same ops on the same values in
 the same order, a replay gives the eager step's numbers bit for bit, unless the step depends on
-something a graph does not replay: what :func:`~tests.retargeting.test_devices` compares.
+something a graph does not replay, which the replay tests of ``test_devices.py`` check.
 """
 
 from __future__ import annotations
@@ -54,9 +54,9 @@ def _memory(t: torch.Tensor) -> int:
 
 
 class _Recorder(TorchDispatchMode):
-    """Runs each op and lists it as ``(func, args, kwargs, results)``; before an op first writes
-    to memory the step did not allocate (a tensor made before it, or a view of one), keeps a
-    copy of what it writes to in ``before``."""
+    """Runs each op and lists it as ``(func, args, kwargs, tensors it made)`` (``None`` for a
+    view); before an op first writes to memory the step did not allocate (a tensor made before
+    it, or a view of one), keeps a copy of what it writes to in ``before``."""
 
     def __init__(self):
         super().__init__()
@@ -70,20 +70,20 @@ class _Recorder(TorchDispatchMode):
             if t.numel() and _memory(t) not in self.made and id(t) not in self.before:
                 self.before[id(t)] = (t, t.detach().clone())
         results = func(*args, **kwargs)
-        self.ops.append((func, args, kwargs, results))
-        if not any(r.alias_info is not None for r in func._schema.returns):
+        view = any(r.alias_info is not None for r in func._schema.returns)  # of its inputs, or an input itself
+        self.ops.append((func, args, kwargs, None if view else _tensors(results)))
+        if not view:
             self.made.update(_memory(t) for t in _tensors(results) if t.numel())
         return results
 
 
 def _replay(ops: list[tuple]) -> None:
-    """Re-run the listed ops; a fresh result is copied into the one the recording made."""
+    """Re-run the listed ops; a fresh result is copied into the one the recording made (a view's
+    recorded result, ``None`` here, already sees its base's new values)."""
     with torch.no_grad():
         for func, args, kwargs, recorded in ops:
             fresh = func(*args, **kwargs)
-            if any(r.alias_info is not None for r in func._schema.returns):
-                continue  # a view of its inputs or the input itself: the recorded one sees the new values
-            for old, new in zip(_tensors(recorded), _tensors(fresh)):
+            for old, new in zip(recorded or (), _tensors(fresh)):
                 old.copy_(new)
 
 
