@@ -47,7 +47,8 @@ def check_pair(ckpt, source, src: pipeline.PreparedSource, gt_rig, solver=None) 
     gt = preprocess.prepare(gt_rig, ckpt.fps, stand=True)
     n = min(gt.num_frames, src.motion.num_frames)
     planted = src.planted[0].cpu().numpy()[:n]
-    truth = plausibility.check(gt.global_positions()[:n], gt.skeleton, _cut(src.motion, n), planted)
+    soles = (src.sole, pipeline.target_sole(gt.skeleton))  # each rig on its own sole, as the pipeline checks
+    truth = plausibility.check(gt.global_positions()[:n], gt.skeleton, _cut(src.motion, n), planted, soles)
     out = retargeting.retarget(source, gt_rig.skeleton, ckpt, "full", solver)
     deepest = humanoid.JOINTS[int(np.argmin(out.positions[..., 1].min(axis=0)))]
     return truth, out.plausibility, deepest

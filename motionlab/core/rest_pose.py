@@ -36,7 +36,8 @@ its world positions unchanged.
 **The sole.** A rig's lowest joint (a toe) sits inside the foot, above the floor by the foot's
 own sole: :func:`sole_height`, read from the rest root offset where that places the rig on the
 floor. The canonical standing pose keeps that height, so a standing skeleton's lowest joint is at
-its sole height, and at 0 when the rest offsets do not say where the floor is.
+its sole height, and at 0 when the rest offsets do not say where the floor is (retargeting then
+takes a target's sole from its take, :func:`motionlab.retargeting.pipeline.target_skeleton`).
 
 The motion is re-expressed on the new rest offsets with world positions unchanged: with
 ``A_j`` the rotation that carries joint ``j``'s child offsets from the old rest to the new one,
@@ -67,6 +68,7 @@ __all__ = [
     "standing",
     "standing_skeleton",
     "sole_height",
+    "on_sole",
 ]
 
 TOLERANCE_DEG = 40.0
@@ -203,9 +205,10 @@ def sole_height(skeleton: Skeleton) -> float | None:
     The rest pose is placed by the root's rest offset, as a BVH file places it: a rig exported
     standing on the floor (Mixamo's) puts its lowest joint, a toe inside the foot, a sole's
     height above it. The height counts only when it could be a sole: at least 0 (to a
-    micrometre, a file's rounding) and below the ankles (the foot joints) above the lowest joint.
-    Otherwise (CMU's root offset at the origin, Bandai Namco's flat rest) the rest offsets do not
-    say where the floor is: None.
+    micrometre, a file's rounding) and below the knees (the Leg joints) above the lowest joint, a
+    rig standing on its feet. (Not below the ankles: CMU's takes plant their toes higher above
+    their floor than its standing ankles stand above its toes.) Otherwise (CMU's root offset at
+    the origin, Bandai Namco's flat rest) the rest offsets do not say where the floor is: None.
 
     Raises ValueError when the skeleton is not canonical.
     """
@@ -213,8 +216,17 @@ def sole_height(skeleton: Skeleton) -> float | None:
         raise ValueError("sole_height() needs a 22-joint canonical skeleton (humanoid.to_canonical_skeleton)")
     y = skeleton.rest_positions()[:, 1]
     lowest = float(y.min())
-    ankles = float(y[[_J.index("LeftFoot"), _J.index("RightFoot")]].min()) - lowest
-    return max(lowest, 0.0) if -1e-6 <= lowest < ankles else None
+    knees = float(y[[_J.index("LeftLeg"), _J.index("RightLeg")]].min()) - lowest
+    return max(lowest, 0.0) if -1e-6 <= lowest < knees else None
+
+
+def on_sole(skeleton: Skeleton, sole: float) -> Skeleton:
+    """``skeleton`` with its root's rest offset moved up or down so that its lowest rest joint stands
+    ``sole`` metres above the floor; every other offset as it was. :func:`sole_height` reads ``sole``
+    back when it can be a sole."""
+    offsets = skeleton.offsets.copy()
+    offsets[0, 1] += sole - skeleton.rest_positions()[:, 1].min()
+    return Skeleton(skeleton.names, skeleton.parents, offsets, skeleton.end_sites)
 
 
 def _apply(motion: Motion, turn: np.ndarray, sole: float = 0.0) -> Motion:

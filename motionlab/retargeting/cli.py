@@ -62,7 +62,7 @@ def _cmd_retarget(args) -> int:
     """
     from motionlab.core import files, humanoid, motion_files, rest_pose
     from motionlab.retargeting import real
-    from motionlab.retargeting.pipeline import retarget
+    from motionlab.retargeting.pipeline import retarget, target_skeleton
 
     cli_options.check_device(args.device)
     out = Path(args.output)
@@ -84,7 +84,7 @@ def _cmd_retarget(args) -> int:
     try:
         source = rest_pose.on_reference(source, reference, args.source)
         base = rest_pose.on_reference(base, reference, args.target or args.source)
-        target = rest_pose.standing_skeleton(base, f"target file {args.target or args.source}")[0]
+        target = target_skeleton(base, f"target file {args.target or args.source}")
     except humanoid.RigMappingError as e:
         raise rig_error(e, "target", args.target) from None
     scales = dict(

@@ -75,7 +75,7 @@ from motionlab.retargeting.batching import (
     solve_jobs,
 )
 from motionlab.retargeting.checkpoint import Checkpoint
-from motionlab.retargeting.pipeline import at_rate, prepare_pair, prepare_source
+from motionlab.retargeting.pipeline import at_rate, prepare_pair, prepare_source, target_skeleton
 from motionlab.retargeting.solver import PROJECT_DAMPING, SolverConfig
 
 __all__ = [
@@ -233,7 +233,7 @@ def characters(*specs: str, presets: Iterable[str] = (), rest_from=None) -> list
         digest = _sha256(p)
         try:
             rig = rest_pose.on_reference(bvh.load(p), rest_from, f"character file {p}")
-            sk = rest_pose.standing_skeleton(rig, f"character file {p}")[0]
+            sk = target_skeleton(rig, f"character file {p}")
             out.append(Character(name, sk, str(p), digest=digest, unit=motion_files.file_unit(rig.skeleton)))
         except _ERRORS as err:
             out.append(Character(name, None, str(p), _why(err, "character", p), digest))

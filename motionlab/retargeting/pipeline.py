@@ -30,10 +30,11 @@ about the world origin, with one ratio for the ground plane and one for the heig
   standing pose keeps its feet on the ground whatever rest pose each studio rigged; and raised by
   ``d = s_B − r_y s_A``, ``s`` being each rig's *sole*, the height of its toe joints above the
   floor when they stand on it: a sole does not grow with the leg, so B's planted toe stands on
-  B's own sole, not on A's scaled. B's sole is read from its rest root offset
-  (:func:`motionlab.core.rest_pose.sole_height`; 0 when the rest offsets do not place the rig on
-  the floor); A's the same way, or, when its rest does not say, from the clip itself
-  (:func:`source_sole`: where its toes stand while planted);
+  B's own sole, not on A's scaled. Each rig's sole is read from its rest root offset
+  (:func:`motionlab.core.rest_pose.sole_height`) where that places the rig on the floor;
+  otherwise from the take itself (:func:`source_sole`: where its toes stand while planted), A's
+  from the source clip and B's from the target's take (:func:`target_skeleton`; 0 when B is a
+  bare skeleton), so a clip copied onto its own rig keeps its root where it was;
 * the heading (facing direction) of every frame is A's: the network's root rotation, expressed
   in A's heading frame, is turned back by A's heading.
 
@@ -84,6 +85,7 @@ __all__ = [
     "term_inputs",
     "source_contacts",
     "source_sole",
+    "target_sole",
     "sole_lift",
     "contact_stride",
     "at_rate",
@@ -229,7 +231,8 @@ root; at 30 fps a run's stances are too short for the detector (``docs/rigs.md``
 
 
 def source_sole(source: Motion, canonical: Motion) -> float:
-    """A's sole (metres): the height of its toe joints above the floor when they stand on it.
+    """A rig's sole (metres) from a take: the height of its toe joints above the floor when they
+    stand on it. A's from the source clip; B's from the target's take (:func:`target_skeleton`).
 
     From the rig's rest root offset when that places the rig on the floor
     (:func:`motionlab.core.rest_pose.sole_height`); otherwise the median height of the toe joints
@@ -238,7 +241,7 @@ def source_sole(source: Motion, canonical: Motion) -> float:
 
     Parameters
     ----------
-    source : the source Motion on its own rig (its rest offsets as the file has them)
+    source : the take, a Motion on its own rig (its rest offsets as the file has them)
     canonical : the same motion on the canonical 22 joints (:func:`preprocess.prepare`)
     """
     sole = rest_pose.sole_height(humanoid.to_canonical_skeleton(source.skeleton))
@@ -249,17 +252,26 @@ def source_sole(source: Motion, canonical: Motion) -> float:
     return float(np.median(heights)) if heights.size else 0.0
 
 
+def target_sole(target: Skeleton) -> float:
+    """B's sole (metres) from B's canonical standing skeleton (:func:`target_skeleton`): the
+    height its lowest rest joint stands at (:func:`rest_pose.sole_height`), 0 when that says nothing."""
+    return rest_pose.sole_height(target) or 0.0
+
+
 def sole_lift(source: PreparedSource, target: Skeleton, r_y: float) -> float:
     """``d = s_B − r_y s_A`` (metres): how far B's root is raised above A's scaled root so that B
     stands on its own sole (module docstring); ``target`` is B's canonical standing skeleton."""
-    return (rest_pose.sole_height(target) or 0.0) - r_y * source.sole
+    return target_sole(target) - r_y * source.sole
 
 
 def target_skeleton(target: Skeleton | Motion, what: str = "target") -> Skeleton:
-    """B's canonical 22-joint skeleton in its standing rest pose (:func:`rest_pose.standing_skeleton`).
+    """B's canonical 22-joint skeleton in its standing rest pose (:func:`rest_pose.standing_skeleton`),
+    its lowest joint at B's sole (:func:`rest_pose.sole_height`, read by :func:`sole_lift`).
 
-    ``target`` is a rig (Skeleton) or a Motion on it; the motion is used only when the rest
-    offsets do not stand. A canonical skeleton is returned as it is.
+    ``target`` is a rig (Skeleton) or a Motion on it. The motion is used when the rest offsets do
+    not stand, and when they do not say where the floor is: the sole is then where the take's toes
+    stand while planted (:func:`source_sole`), as B's own takes stand; a bare Skeleton's is 0. A
+    canonical skeleton is returned as it is.
 
     Raises :class:`humanoid.RigMappingError` naming the joints that cannot be mapped and
     :class:`rest_pose.RestPoseError` (naming ``what``) when no standing pose can be found.
@@ -270,6 +282,9 @@ def target_skeleton(target: Skeleton | Motion, what: str = "target") -> Skeleton
     out = rest_pose.standing_skeleton(target, what)[0]
     if out.height() <= 1e-6:
         raise ValueError("the target skeleton has zero height")
+    take = isinstance(target, Motion) and target.num_frames > 1
+    if take and rest_pose.sole_height(humanoid.to_canonical_skeleton(sk)) is None:
+        out = rest_pose.on_sole(out, source_sole(target, preprocess.prepare(target, None, stand=True)))
     return out
 
 
@@ -420,7 +435,7 @@ def finish(
     motion = Motion(pair.target, local_rot, pair.root_pos, src.motion.fps, None, name)
     positions = motion.global_positions()
     planted = None if src.planted is None else src.planted[0].cpu().numpy()
-    check = plausibility.check(positions, pair.target, src.motion, planted)
+    check = plausibility.check(positions, pair.target, src.motion, planted, (src.sole, target_sole(pair.target)))
     return RetargetResult(
         motion, positions, method, pair.root_scale, history or {}, stop_reason, steps, seconds, check, "", best_step
     )

@@ -7,7 +7,8 @@ A retargeted clip of B is **plausible** when, with ``leg`` = B's thigh + shin
 
 * **feet on the floor** (``foot``): on the frames where A's foot joints are planted
   (:func:`pipeline.source_contacts`), the median height of B's same joints above their own
-  contact height (rest height above the lowest rest joint, :func:`contacts.rest_heights`), as a
+  contact height (rest height above the lowest rest joint, :func:`contacts.rest_heights`) on B's
+  own sole (the height its lowest joint stands at, :func:`pipeline.source_sole`), as a
   fraction of ``leg``, is within :data:`FOOT_TOL` of the same measure of A on A's legs — a
   tenth of the leg is a few centimetres on a human and still tells a planted foot from a lifted
   one. The test is against A's own value so that a source recorded a little above its floor
@@ -63,7 +64,8 @@ class Plausibility:
 
     Attributes
     ----------
-    foot_height : float     median height of B's planted foot joints above contact height, / leg (nan: no contacts)
+    foot_height : float     median height of B's planted foot joints above contact height on B's sole, / leg
+                            (nan: no contacts)
     source_foot_height : float   the same for A, / A's leg
     lowest : float          lowest joint height over the clip, / leg (negative: under the floor)
     source_lowest : float   the same for A, / A's leg
@@ -115,15 +117,18 @@ def _hip_ratio(positions: np.ndarray, skeleton) -> float:
     return float(np.median(positions[:, 0, 1]) / standing) if standing > 0 else float("nan")
 
 
-def _foot_height(positions: np.ndarray, skeleton, planted: np.ndarray) -> float:
-    """Median height of the planted foot joints above their contact height, / leg (nan: none planted)."""
+def _foot_height(positions: np.ndarray, skeleton, planted: np.ndarray, sole: float) -> float:
+    """Median height of the planted foot joints above their contact height on the rig's ``sole``
+    (metres), / leg (nan: none planted)."""
     if not np.any(planted):
         return float("nan")
-    heights = positions[:, list(contacts.CONTACT_JOINTS), 1] - contacts.rest_heights(skeleton)[None]
+    heights = positions[:, list(contacts.CONTACT_JOINTS), 1] - contacts.rest_heights(skeleton)[None] - sole
     return float(np.median(heights[planted]) / humanoid.leg_length(skeleton))
 
 
-def check(positions: np.ndarray, target, source: Motion, planted: np.ndarray | None = None) -> Plausibility:
+def check(
+    positions: np.ndarray, target, source: Motion, planted: np.ndarray | None = None, soles: tuple = (0.0, 0.0)
+) -> Plausibility:
     """The plausibility tests of the module docstring.
 
     Parameters
@@ -132,6 +137,9 @@ def check(positions: np.ndarray, target, source: Motion, planted: np.ndarray | N
     target : Skeleton                B's canonical skeleton in its standing rest pose
     source : Motion                  A on the canonical 22 joints in its standing rest pose, T frames
     planted : ndarray (T, 4) of bool, optional   A's planted foot joints (default: detected on ``source``)
+    soles : (float, float)           A's and B's soles, metres (:func:`pipeline.source_sole`,
+                                     :func:`pipeline.target_sole`): each rig's feet are measured
+                                     on its own sole (default: both on the floor)
     (``positions`` are at ``source.fps``: the slide is per second of it)
 
     Returns
@@ -153,9 +161,9 @@ def check(positions: np.ndarray, target, source: Motion, planted: np.ndarray | N
             raise ValueError(f"expected planted as booleans (or 0/1), got values {np.unique(planted)[:5]}")
         planted = planted.astype(bool)
     leg = humanoid.leg_length(target)
-    foot = _foot_height(positions, target, planted)
+    foot = _foot_height(positions, target, planted, soles[1])
     src_pos = source.global_positions()
-    src_foot = _foot_height(src_pos, source.skeleton, planted)
+    src_foot = _foot_height(src_pos, source.skeleton, planted, soles[0])
     lowest = float(positions[..., 1].min() / leg)
     src_lowest = float(src_pos[..., 1].min() / humanoid.leg_length(source.skeleton))
     hip, src_hip = _hip_ratio(positions, target), _hip_ratio(src_pos, source.skeleton)

@@ -248,13 +248,14 @@ def _raised(skeleton: Skeleton, dy: float) -> Skeleton:
 
 def test_sole_height_is_the_lowest_rest_joint_above_the_floor_when_it_can_be_a_sole():
     """Read from the rest root offset: the synthetic character's toe 1 cm up; a rig placed lower
-    than the floor (CMU's root at the origin) or with its toes above its ankles' height says nothing."""
+    than the floor (CMU's root at the origin) or with its toes above its knees' height says nothing."""
     sk = humanoid.canonical_skeleton()
     assert rest_pose.sole_height(sk) == pytest.approx(0.01)
     assert rest_pose.sole_height(_raised(sk, 0.02)) == pytest.approx(0.03)
     assert rest_pose.sole_height(_raised(sk, -0.02)) is None
     assert rest_pose.sole_height(_raised(sk, -sk.offsets[0, 1])) is None  # the root at the origin
-    assert rest_pose.sole_height(_raised(sk, 0.5)) is None  # higher than a foot
+    assert rest_pose.sole_height(_raised(sk, 0.1)) == pytest.approx(0.11)  # above the ankles (0.06), as CMU's takes
+    assert rest_pose.sole_height(_raised(sk, 0.46)) is None  # above the knees (0.47): not standing on its feet
     with pytest.raises(ValueError, match="canonical"):
         rest_pose.sole_height(bvh.load(require_data("cmu", "131", "131_01.bvh")).skeleton)
 

@@ -6,12 +6,14 @@ import numpy as np
 import pytest
 
 from motionlab import retargeting, synthetic
-from motionlab.core import contacts, humanoid, quat, rest_pose
+from motionlab.cli import main
+from motionlab.core import bvh, contacts, humanoid, preprocess, quat, rest_pose
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
-from motionlab.retargeting import pipeline
+from motionlab.retargeting import expand, pipeline
 from motionlab.retargeting.pipeline import hip_height, leg_chain, retarget, root_scale
 from motionlab.retargeting.solver import SolverConfig
+from tests.conftest import require_data
 
 
 @pytest.fixture(scope="module")
@@ -112,6 +114,39 @@ def test_a_target_stands_on_its_own_sole():
         assert out.motion.root_pos[0, 1] == pytest.approx(
             out.root_scale[1] * a.offsets[0, 1] + (1 - out.root_scale[1]) * s_a
         )
+
+
+def test_a_take_copied_onto_its_own_rig_stays_where_it_was(tmp_path):
+    """B's sole comes from B's take when its rest says nothing (CMU, Bandai Namco), as A's does:
+    a take copied onto its own rig keeps every joint where it was. A bare skeleton of that rig
+    has no floor to go by: its lowest joint stands at 0, the take lowered by its sole."""
+    walk = synthetic.generate("walk", humanoid.canonical_skeleton(), num_frames=120, fps=60, seed=0)
+    offsets = walk.skeleton.offsets.copy()
+    offsets[0] = 0.0  # the rest says nothing of the floor
+    lost = walk.copy(skeleton=Skeleton(walk.skeleton.names, walk.skeleton.parents, offsets))
+    lost = lost.copy(root_pos=lost.root_pos + [0.0, 0.03, 0.0])  # a take recorded 3 cm higher
+    sole = pipeline.source_sole(lost, lost)
+    assert sole == pytest.approx(0.03, abs=0.002)
+    assert rest_pose.sole_height(pipeline.target_skeleton(lost)) == pytest.approx(sole)
+    np.testing.assert_allclose(retarget(lost, lost, None, "copy").positions, lost.global_positions(), atol=1e-12)
+    bare = retarget(lost, lost.skeleton, None, "copy")
+    np.testing.assert_allclose(bare.positions, lost.global_positions() - [0.0, sole, 0.0], atol=1e-12)
+    check = bare.plausibility  # each rig's feet on its own sole: A's on 3 cm, B's on 0, the same feet
+    assert check.foot_height == pytest.approx(check.source_foot_height, abs=1e-12)
+    path = tmp_path / "lost.bvh"
+    bvh.save(path, lost)
+    (character,) = expand.characters(str(path))  # expand's targets read the sole as retarget does
+    assert rest_pose.sole_height(character.skeleton) == pytest.approx(sole, abs=1e-4)
+
+
+def test_a_bandai_namco_take_copied_onto_its_own_rig_stays_where_it_was(tmp_path):
+    """The real case: Bandai Namco's rest lies flat, and its joints stand 4-7 cm above its floor."""
+    take = require_data("bandai_namco", "dataset-2", "run", "dataset-2_run_normal_001.bvh")
+    out = tmp_path / "out.bvh"
+    assert main(["retarget", str(take), "--target", str(take), "--method", "copy", "-o", str(out), "-q"]) == 0
+    source = preprocess.prepare(bvh.load(take), None, stand=True).global_positions()
+    assert np.median(source[..., 1].min(axis=1)) > 0.04  # the floor is under the joints
+    np.testing.assert_allclose(bvh.load(out).global_positions(), source, atol=1e-4)  # BVH's printed digits
 
 
 def test_leg_chain_is_the_summed_leg_bones():

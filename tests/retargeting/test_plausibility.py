@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from motionlab import retargeting, synthetic
-from motionlab.core import humanoid
+from motionlab.core import contacts, humanoid
 from motionlab.retargeting import plausibility
 from motionlab.retargeting.pipeline import retarget
 from motionlab.retargeting.solver import SolverConfig
@@ -41,6 +41,24 @@ def test_lifted_sunk_stretched_outputs_fail(walked):
     stretched = res.positions.copy()
     stretched[:, humanoid.JOINTS.index("LeftHand")] *= 1.1
     assert plausibility.check(stretched, res.motion.skeleton, src).failed == ("bones",)
+
+
+def test_each_rig_s_feet_are_measured_on_its_own_sole(walked):
+    """A rig whose takes stand higher above their floor (CMU's toes 0.08 leg, Bandai Namco's 0.05)
+    is not a lifted foot: raised by its sole, B's feet measure as they did on the floor; the same
+    raise with no sole given is a lifted foot."""
+    res, src = walked
+    leg = humanoid.leg_length(res.motion.skeleton)
+    sole = 1.5 * plausibility.FOOT_TOL * leg
+    planted = contacts.of_motion(src)
+    on_floor = plausibility.check(res.positions, res.motion.skeleton, src, planted)
+    raised = res.positions + [0.0, sole, 0.0]
+    on_sole = plausibility.check(raised, res.motion.skeleton, src, planted, soles=(0.0, sole))
+    assert on_sole.foot_height == pytest.approx(on_floor.foot_height) and "foot" not in on_sole.failed
+    assert "foot" in plausibility.check(raised, res.motion.skeleton, src, planted).failed
+    lifted_source = src.copy(root_pos=src.root_pos + [0.0, sole, 0.0])  # A on its own sole: the same measure
+    both = plausibility.check(raised, res.motion.skeleton, lifted_source, planted, soles=(sole, sole))
+    assert both.source_foot_height == pytest.approx(on_floor.source_foot_height)
 
 
 def test_root_rule_that_sinks_short_legs_is_flagged():
