@@ -139,13 +139,20 @@ def test_a_take_copied_onto_its_own_rig_stays_where_it_was(tmp_path):
     assert rest_pose.sole_height(character.skeleton) == pytest.approx(sole, abs=1e-4)
 
 
-def test_a_bandai_namco_take_copied_onto_its_own_rig_stays_where_it_was(tmp_path):
-    """The real case: Bandai Namco's rest lies flat, and its joints stand 4-7 cm above its floor."""
-    take = require_data("bandai_namco", "dataset-2", "run", "dataset-2_run_normal_001.bvh")
+@pytest.mark.parametrize(
+    "parts",
+    [
+        ("bandai_namco", "dataset-2", "run", "dataset-2_run_normal_001.bvh"),  # its rest lies flat
+        ("cmu", "131", "131_01.bvh"),  # its root at the origin; toes planted higher than its rest ankles
+    ],
+)
+def test_a_real_take_copied_onto_its_own_rig_stays_where_it_was(tmp_path, parts):
+    """The real cases: rests that say nothing of a floor, takes whose joints stand above it."""
+    take = require_data(*parts)
     out = tmp_path / "out.bvh"
     assert main(["retarget", str(take), "--target", str(take), "--method", "copy", "-o", str(out), "-q"]) == 0
     source = preprocess.prepare(bvh.load(take), None, stand=True).global_positions()
-    assert np.median(source[..., 1].min(axis=1)) > 0.04  # the floor is under the joints
+    assert np.median(source[..., 1].min(axis=1)) > 0.05 * humanoid.leg_length(pipeline.target_skeleton(bvh.load(take)))
     np.testing.assert_allclose(bvh.load(out).global_positions(), source, atol=1e-4)  # BVH's printed digits
 
 
