@@ -18,7 +18,8 @@ with ``output_format="glb"``) plus ``OUT/manifest.csv``, one row per (clip, char
   an output only when its file exists and its row's SHA-256 of the source file
   (``source_sha256``), of the character (``character_sha256``: the file's bytes, or a preset's
   factors) and of every option that changes the result (``options_sha256``: the checkpoint's
-  weights, the solver settings, the root rule and the output frame rate) are those of this run;
+  weights, the solver settings, the root rule, the output frame rate and motionlab's own code,
+  :data:`RESULT_CODE`: another version may write other outputs) are those of this run;
   everything else is redone and :attr:`ExpandResult.redone` says why. A kill at any moment loses
   at most the batch in flight. An output that exists but is not in the manifest is someone else's file and is
   only replaced with ``force=True``. A clip that cannot be read or mapped is recorded as an
@@ -47,6 +48,7 @@ from __future__ import annotations
 import contextlib
 import csv
 import dataclasses
+import functools
 import glob
 import hashlib
 import io
@@ -90,6 +92,8 @@ __all__ = [
     "check_output_layout",
     "read_manifest",
     "options_digest",
+    "code_digest",
+    "RESULT_CODE",
     "ExpandResult",
     "expand",
     "prepare_clip",
@@ -259,15 +263,31 @@ def _sha256(path) -> str:
     return h.hexdigest()
 
 
+RESULT_CODE = ("core", "retargeting")
+"""The package's folders whose Python source is part of :func:`options_digest`: a run with another
+motionlab (an upgrade, an edit) redoes the rows an older one wrote instead of keeping them."""
+
+
+@functools.cache
+def code_digest() -> bytes:
+    """SHA-256 of every module under :data:`RESULT_CODE`: each path (relative to the package) and its bytes."""
+    h = hashlib.sha256()
+    package = Path(__file__).resolve().parent.parent
+    for folder in RESULT_CODE:
+        for path in sorted((package / folder).rglob("*.py")):
+            h.update(path.relative_to(package).as_posix().encode() + b"\0" + path.read_bytes())
+    return h.digest()
+
+
 def options_digest(
     checkpoint: Checkpoint, solver: SolverConfig, root_mode: str, fps: float | None, rest_from=None, flags=None
 ) -> str:
     """SHA-256 of everything besides source and character that changes an output or its row: the
     checkpoint's weights, normalisation and frame rate, the solver settings, the registered loss
     terms and their weights, the root rule, the output rate, the ``rest_from`` motion (its rest
-    offsets and rotations; nothing when None) and ``flags``, the thresholds the row's ``flag``
-    is set by."""
-    h = hashlib.sha256()
+    offsets and rotations; nothing when None), ``flags``, the thresholds the row's ``flag``
+    is set by, and motionlab's code (:func:`code_digest`)."""
+    h = hashlib.sha256(code_digest())
     for name, tensor in sorted(checkpoint.model.state_dict().items()):
         h.update(name.encode())
         h.update(tensor.detach().cpu().double().numpy().tobytes())
@@ -447,7 +467,8 @@ class ExpandResult:
     seconds : float         wall time of the run
     batches : int           latent-iteration batches run
     redone : dict           why outputs that existed were redone: reason -> count (``source changed``,
-                            ``character changed``, ``options changed``, ``file missing``)
+                            ``character changed``, ``options changed``: also motionlab's code,
+                            ``file missing``)
     resampled : list of str   one line per source whose frame rate changed on the way
     implausible : int       outputs of this run that failed a plausibility test
     timings : dict          wall time, seconds: ``load`` (plan the batches, and read and prepare

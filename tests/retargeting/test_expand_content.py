@@ -84,6 +84,16 @@ def test_changed_option_is_redone(lib, ckpt, change):
     assert _run(lib, ckpt, **change).skipped == 2  # and then kept
 
 
+def test_another_motionlab_redoes_what_an_older_one_wrote(lib, ckpt, monkeypatch):
+    """An upgrade may write other outputs (stop 66 raised every Bandai Namco target by its sole):
+    its rows are redone, not kept."""
+    _run(lib, ckpt)
+    assert _run(lib, ckpt).skipped == 2
+    monkeypatch.setattr(ex, "code_digest", lambda: b"another motionlab")
+    job = _run(lib, ckpt)
+    assert job.done == 2 and job.redone == {"options changed": 2}
+
+
 def test_missing_file_and_old_manifest_are_redone(lib, ckpt):
     _run(lib, ckpt)
     (lib / "out" / "hero" / "walk.bvh").unlink()
