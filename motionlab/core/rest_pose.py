@@ -53,7 +53,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from motionlab.core import humanoid, quat
+from motionlab.core import contacts, humanoid, quat
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
 
@@ -69,6 +69,8 @@ __all__ = [
     "standing_skeleton",
     "sole_height",
     "on_sole",
+    "SOLE_FPS",
+    "take_sole",
 ]
 
 TOLERANCE_DEG = 40.0
@@ -218,6 +220,21 @@ def sole_height(skeleton: Skeleton) -> float | None:
     lowest = float(y.min())
     knees = float(y[[_J.index("LeftLeg"), _J.index("RightLeg")]].min()) - lowest
     return max(lowest, 0.0) if -1e-6 <= lowest < knees else None
+
+
+SOLE_FPS = 60.0
+"""Rate (frames/s) at which :func:`take_sole` detects the planted toes: the retargeting networks'
+own, so every method of a pair gets the same root; at 30 fps a run's stances are too short for
+the detector (``docs/rigs.md``)."""
+
+
+def take_sole(motion: Motion) -> float:
+    """A rig's sole (metres) from a take on the canonical 22 joints: the median height of its toe
+    joints over the frames where, at :data:`SOLE_FPS`, they are planted
+    (:func:`contacts.planted_toe_heights`); 0 when none is."""
+    clip = motion if motion.fps == SOLE_FPS else motion.resample(SOLE_FPS)
+    heights = contacts.planted_toe_heights(clip)
+    return float(np.median(heights)) if heights.size else 0.0
 
 
 def on_sole(skeleton: Skeleton, sole: float) -> Skeleton:
@@ -405,12 +422,16 @@ def on_reference(rig: Motion, reference: Motion | None, what: str = "motion") ->
     pose when both are on one rig (:func:`same_rig`); ``rig`` itself otherwise or without a reference.
 
     ``reference`` is a Motion on any mappable rig (``--rest-from FILE.bvh``); the result's rest
-    offsets stand, so retargeting uses them as they are. Raises :class:`RestPoseError` when the
-    reference has no standing pose and :class:`humanoid.RigMappingError`.
+    offsets stand, so retargeting uses them as they are, its lowest joint on the take's sole
+    (:func:`take_sole`; 0 for a single frame or toes planted under the floor). Raises
+    :class:`RestPoseError` when the reference has no standing pose and :class:`humanoid.RigMappingError`.
     """
     if reference is None:
         return rig
     motion, ref = humanoid.to_canonical(rig), humanoid.to_canonical(reference)
     if not same_rig(motion.skeleton, ref.skeleton):
         return rig
-    return standing(motion, what, humanoid.family(rig.skeleton), reference=ref)[0]
+    out = standing(motion, what, humanoid.family(rig.skeleton), reference=ref)[0]
+    if out.num_frames < 2:
+        return out
+    return out.copy(skeleton=on_sole(out.skeleton, max(take_sole(out), 0.0)))

@@ -224,20 +224,13 @@ def source_contacts(source: Motion) -> np.ndarray:
     return contacts.of_motion(source)
 
 
-SOLE_FPS = 60.0
-"""Rate (frames/s) at which :func:`source_sole` detects the planted toes: the networks' own
-(:attr:`Checkpoint.fps`'s default), whatever the method, so every method of a pair gets the same
-root; at 30 fps a run's stances are too short for the detector (``docs/rigs.md``)."""
-
-
 def source_sole(source: Motion, canonical: Motion) -> float:
     """A rig's sole (metres) from a take: the height of its toe joints above the floor when they
     stand on it. A's from the source clip; B's from the target's take (:func:`target_skeleton`).
 
     From the rig's rest root offset when that places the rig on the floor
     (:func:`motionlab.core.rest_pose.sole_height`); otherwise the median height of the toe joints
-    over the frames where the clip, at :data:`SOLE_FPS`, plants them (:func:`source_contacts`);
-    0 when it plants none.
+    over the frames where the clip plants them (:func:`rest_pose.take_sole`); 0 when it plants none.
 
     Parameters
     ----------
@@ -245,11 +238,7 @@ def source_sole(source: Motion, canonical: Motion) -> float:
     canonical : the same motion on the canonical 22 joints (:func:`preprocess.prepare`)
     """
     sole = rest_pose.sole_height(humanoid.to_canonical_skeleton(source.skeleton))
-    if sole is not None:
-        return sole
-    clip = canonical if canonical.fps == SOLE_FPS else canonical.resample(SOLE_FPS)
-    heights = contacts.planted_toe_heights(clip)
-    return float(np.median(heights)) if heights.size else 0.0
+    return sole if sole is not None else rest_pose.take_sole(canonical)
 
 
 def target_sole(target: Skeleton) -> float:
@@ -285,7 +274,7 @@ def target_skeleton(target: Skeleton | Motion, what: str = "target") -> Skeleton
         raise ValueError("the target skeleton has zero height")
     take = isinstance(target, Motion) and target.num_frames > 1
     if take and rest_pose.sole_height(humanoid.to_canonical_skeleton(sk)) is None:
-        out = rest_pose.on_sole(out, source_sole(target, preprocess.prepare(target, None, stand=True)))
+        out = rest_pose.on_sole(out, rest_pose.take_sole(preprocess.prepare(target, None, stand=True)))
     return out
 
 

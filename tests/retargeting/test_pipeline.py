@@ -137,6 +137,10 @@ def test_a_take_copied_onto_its_own_rig_stays_where_it_was(tmp_path):
     bvh.save(path, lost)
     (character,) = expand.characters(str(path))  # expand's targets read the sole as retarget does
     assert rest_pose.sole_height(character.skeleton) == pytest.approx(sole, abs=1e-4)
+    other = lost.copy(local_rot=lost.local_rot[::-1].copy())  # --rest-from: another take of the rig
+    stood = rest_pose.on_reference(lost, other)
+    assert rest_pose.sole_height(stood.skeleton) == pytest.approx(sole)  # the take's own sole, not 0
+    np.testing.assert_allclose(retarget(stood, stood, None, "copy").positions, lost.global_positions(), atol=1e-12)
 
 
 @pytest.mark.parametrize(
