@@ -32,9 +32,10 @@ about the world origin, with one ratio for the ground plane and one for the heig
   floor when they stand on it: a sole does not grow with the leg, so B's planted toe stands on
   B's own sole, not on A's scaled. Each rig's sole is read from its rest root offset
   (:func:`motionlab.core.rest_pose.sole_height`) where that places the rig on the floor;
-  otherwise from the take itself (:func:`source_sole`: where its toes stand while planted), A's
-  from the source clip and B's from the target's take (:func:`target_skeleton`; 0 when B is a
-  bare skeleton), so a clip copied onto its own rig keeps its root where it was;
+  otherwise from a take (:func:`motionlab.core.rest_pose.take_sole`: where its toes stand while
+  planted), A's from the source clip (:func:`source_sole`) and B's from the target's take
+  (:func:`target_skeleton`; 0 when B is a bare skeleton), so a clip copied onto its own rig keeps
+  its root where it was;
 * the heading (facing direction) of every frame is A's: the network's root rotation, expressed
   in A's heading frame, is turned back by A's heading.
 
@@ -225,8 +226,8 @@ def source_contacts(source: Motion) -> np.ndarray:
 
 
 def source_sole(source: Motion, canonical: Motion) -> float:
-    """A rig's sole (metres) from a take: the height of its toe joints above the floor when they
-    stand on it. A's from the source clip; B's from the target's take (:func:`target_skeleton`).
+    """A's sole (metres): the height of its toe joints above the floor when they stand on it
+    (B's is :func:`target_sole`).
 
     From the rig's rest root offset when that places the rig on the floor
     (:func:`motionlab.core.rest_pose.sole_height`); otherwise the median height of the toe joints
@@ -234,7 +235,7 @@ def source_sole(source: Motion, canonical: Motion) -> float:
 
     Parameters
     ----------
-    source : the take, a Motion on its own rig (its rest offsets as the file has them)
+    source : the source Motion on its own rig (its rest offsets as the file has them)
     canonical : the same motion on the canonical 22 joints (:func:`preprocess.prepare`)
     """
     sole = rest_pose.sole_height(humanoid.to_canonical_skeleton(source.skeleton))
@@ -258,10 +259,10 @@ def target_skeleton(target: Skeleton | Motion, what: str = "target") -> Skeleton
     its lowest joint at B's sole (:func:`rest_pose.sole_height`, read by :func:`sole_lift`).
 
     ``target`` is a rig (Skeleton) or a Motion on it. The motion is used when the rest offsets do
-    not stand, and when they do not say where the floor is: the sole is then where the take's toes
-    stand while planted (:func:`source_sole`), as B's own takes stand; a bare Skeleton's is 0, and
-    so is that of a take whose planted toes stand under its floor (a sole is not negative,
-    :func:`rest_pose.sole_height`). A canonical skeleton is returned as it is.
+    not stand, and when they do not say where the floor is: the sole is then where the take's
+    toes stand while planted (:func:`rest_pose.take_sole`), as B's own takes stand. A bare
+    Skeleton's is 0, and so is that of a take whose planted toes stand under its floor (a sole is
+    not negative, :func:`rest_pose.sole_height`). A canonical skeleton is returned as it is.
 
     Raises :class:`humanoid.RigMappingError` naming the joints that cannot be mapped and
     :class:`rest_pose.RestPoseError` (naming ``what``) when no standing pose can be found.
