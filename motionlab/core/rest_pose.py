@@ -206,11 +206,13 @@ def sole_height(skeleton: Skeleton) -> float | None:
 
     The rest pose is placed by the root's rest offset, as a BVH file places it: a rig exported
     standing on the floor (Mixamo's) puts its lowest joint, a toe inside the foot, a sole's
-    height above it. The height counts only when it could be a sole: at least 0 (to a
-    micrometre, a file's rounding) and below the knees (the Leg joints) above the lowest joint, a
-    rig standing on its feet. (Not below the ankles: CMU's takes plant their toes higher above
-    their floor than its standing ankles stand above its toes.) Otherwise (CMU's root offset at
-    the origin, Bandai Namco's flat rest) the rest offsets do not say where the floor is: None.
+    height above it. The height counts only when it could be the sole of a rig standing on its
+    feet: below the knees (the Leg joints) above the lowest joint, and above minus the ankles
+    (the foot joints) above it, so sunk in the floor, as the toes of a take planted under its
+    floor are, by less than the ankles stand; within a micrometre under 0 it is 0 (a file's
+    rounding). (Not below the ankles: CMU's takes plant their toes higher above their floor than
+    its standing ankles stand above its toes.) Otherwise (CMU's root offset at the origin, Bandai
+    Namco's flat rest) the rest offsets do not say where the floor is: None.
 
     Raises ValueError when the skeleton is not canonical.
     """
@@ -219,7 +221,10 @@ def sole_height(skeleton: Skeleton) -> float | None:
     y = skeleton.rest_positions()[:, 1]
     lowest = float(y.min())
     knees = float(y[[_J.index("LeftLeg"), _J.index("RightLeg")]].min()) - lowest
-    return max(lowest, 0.0) if -1e-6 <= lowest < knees else None
+    ankles = float(y[[_J.index("LeftFoot"), _J.index("RightFoot")]].min()) - lowest
+    if not -ankles < lowest < knees:
+        return None
+    return max(lowest, 0.0) if lowest >= -1e-6 else lowest
 
 
 SOLE_FPS = 60.0
@@ -423,7 +428,7 @@ def on_reference(rig: Motion, reference: Motion | None, what: str = "motion") ->
 
     ``reference`` is a Motion on any mappable rig (``--rest-from FILE.bvh``); the result's rest
     offsets stand, so retargeting uses them as they are, its lowest joint on the take's sole
-    (:func:`take_sole`; 0 for a single frame or toes planted under the floor). Raises
+    (:func:`take_sole`; 0 for a single frame). Raises
     :class:`RestPoseError` when the reference has no standing pose and :class:`humanoid.RigMappingError`.
     """
     if reference is None:
@@ -434,4 +439,4 @@ def on_reference(rig: Motion, reference: Motion | None, what: str = "motion") ->
     out = standing(motion, what, humanoid.family(rig.skeleton), reference=ref)[0]
     if out.num_frames < 2:
         return out
-    return out.copy(skeleton=on_sole(out.skeleton, max(take_sole(out), 0.0)))
+    return out.copy(skeleton=on_sole(out.skeleton, take_sole(out)))

@@ -260,9 +260,9 @@ def target_skeleton(target: Skeleton | Motion, what: str = "target") -> Skeleton
 
     ``target`` is a rig (Skeleton) or a Motion on it. The motion is used when the rest offsets do
     not stand, and when they do not say where the floor is: the sole is then where the take's
-    toes stand while planted (:func:`rest_pose.take_sole`), as B's own takes stand. A bare
-    Skeleton's is 0, and so is that of a take whose planted toes stand under its floor (a sole is
-    not negative, :func:`rest_pose.sole_height`). A canonical skeleton is returned as it is.
+    toes stand while planted (:func:`rest_pose.take_sole`; below 0 for a take planted under its
+    floor), as B's own takes stand. A bare Skeleton's is 0. A canonical skeleton is returned as
+    it is.
 
     Raises :class:`humanoid.RigMappingError` naming the joints that cannot be mapped and
     :class:`rest_pose.RestPoseError` (naming ``what``) when no standing pose can be found.

@@ -247,12 +247,13 @@ def _raised(skeleton: Skeleton, dy: float) -> Skeleton:
 
 
 def test_sole_height_is_the_lowest_rest_joint_above_the_floor_when_it_can_be_a_sole():
-    """Read from the rest root offset: the synthetic character's toe 1 cm up; a rig placed lower
-    than the floor (CMU's root at the origin) or with its toes above its knees' height says nothing."""
+    """Read from the rest root offset: the synthetic character's toe 1 cm up; a rig with its ankles
+    under the floor (CMU's root at the origin) or its toes above its knees' height says nothing."""
     sk = humanoid.canonical_skeleton()
     assert rest_pose.sole_height(sk) == pytest.approx(0.01)
     assert rest_pose.sole_height(_raised(sk, 0.02)) == pytest.approx(0.03)
-    assert rest_pose.sole_height(_raised(sk, -0.02)) is None
+    assert rest_pose.sole_height(_raised(sk, -0.02)) == pytest.approx(-0.01)  # toes in the floor, ankles not
+    assert rest_pose.sole_height(_raised(sk, -0.08)) is None  # the ankles (0.06 up) in the floor too
     assert rest_pose.sole_height(_raised(sk, -sk.offsets[0, 1])) is None  # the root at the origin
     assert rest_pose.sole_height(_raised(sk, 0.1)) == pytest.approx(0.11)  # above the ankles (0.06), as CMU's takes
     assert rest_pose.sole_height(_raised(sk, 0.46)) is None  # above the knees (0.47): not standing on its feet
@@ -266,7 +267,7 @@ def test_the_standing_pose_keeps_the_rigs_sole():
     turn = np.tile([1.0, 0, 0, 0], (22, 1))
     for side in ("Left", "Right"):  # arms down: the rest is turned, the legs are not
         turn[humanoid.JOINTS.index(f"{side}Arm")] = quat.from_axis_angle([0.0, 0.0, 1.0], np.radians(-70))
-    for dy, sole in ((0.0, 0.01), (0.015, 0.025), (-0.03, 0.0)):
+    for dy, sole in ((0.0, 0.01), (0.015, 0.025), (-0.03, -0.02), (-0.1, 0.0)):
         moved = _repose(walk, turn)
         moved = Motion(_raised(moved.skeleton, dy), moved.local_rot, moved.root_pos, moved.fps)
         out, pose = rest_pose.standing(moved)

@@ -116,7 +116,8 @@ def test_a_target_stands_on_its_own_sole():
         )
 
 
-def test_a_take_copied_onto_its_own_rig_stays_where_it_was(tmp_path):
+@pytest.mark.parametrize("dy", [0.03, -0.005], ids=["above", "under"])
+def test_a_take_copied_onto_its_own_rig_stays_where_it_was(tmp_path, dy):
     """B's sole comes from B's take when its rest says nothing (CMU, Bandai Namco), as A's does:
     a take copied onto its own rig keeps every joint where it was. A bare skeleton of that rig
     has no floor to go by: its lowest joint stands at 0, the take lowered by its sole."""
@@ -124,9 +125,9 @@ def test_a_take_copied_onto_its_own_rig_stays_where_it_was(tmp_path):
     offsets = walk.skeleton.offsets.copy()
     offsets[0] = 0.0  # the rest says nothing of the floor
     lost = walk.copy(skeleton=Skeleton(walk.skeleton.names, walk.skeleton.parents, offsets))
-    lost = lost.copy(root_pos=lost.root_pos + [0.0, 0.03, 0.0])  # a take recorded 3 cm higher
+    lost = lost.copy(root_pos=lost.root_pos + [0.0, dy, 0.0])  # a take recorded higher, or under its floor
     sole = pipeline.source_sole(lost, lost)
-    assert sole == pytest.approx(0.03, abs=0.002)
+    assert sole == pytest.approx(dy, abs=0.002)
     assert rest_pose.sole_height(pipeline.target_skeleton(lost)) == pytest.approx(sole)
     np.testing.assert_allclose(retarget(lost, lost, None, "copy").positions, lost.global_positions(), atol=1e-12)
     bare = retarget(lost, lost.skeleton, None, "copy")
