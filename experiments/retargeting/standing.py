@@ -11,6 +11,9 @@ the rig profile's). Part 2 prints, for the run clips of Mixamo's Aj and of Banda
 hip height over the standing hip height (the plausibility check's ``hips`` measure) and the median
 knee bend on the frames with a planted foot (contacts at the network's 60 fps), and the same ratio of the clip retargeted onto the
 Bandai Namco rig (copying rotations: the root, hence the hips, is the same for every method).
+``--soles`` adds part 3: for the CMU and Xia takes and every tenth Bandai Namco take, the sole each
+take plants its toes on (:func:`motionlab.core.rest_pose.take_sole`, as a fraction of the leg) and
+how many of them the take's own target skeleton keeps (:func:`pipeline.target_skeleton`).
 """
 
 from __future__ import annotations
@@ -100,9 +103,30 @@ def run_heights(root) -> None:
         )
 
 
+def soles(root) -> None:
+    """Print, per rig family, the range of the takes' soles / leg and how many targets keep theirs."""
+    families = {
+        "cmu": sorted(root.glob("cmu/*/*.bvh")),
+        "xia": sorted(root.glob("xia/*/*.bvh")),
+        "bandai": sorted(root.glob("bandai_namco/**/*.bvh"))[::10],
+    }
+    print(f"\n{'family':<8} {'takes':>5} {'sole / leg':>17} {'kept as target':>15}")
+    for family, files in families.items():
+        ratios, kept = [], 0
+        for f in files:
+            motion = bvh.load(f)
+            sole = rest_pose.take_sole(preprocess.prepare(motion, None, stand=True))
+            target = pipeline.target_skeleton(motion)
+            ratios.append(sole / humanoid.leg_length(target))
+            kept += abs(pipeline.target_sole(target) - sole) <= 1e-9
+        if files:
+            print(f"{family:<8} {len(files):>5} {min(ratios):>+8.4f}..{max(ratios):>+7.4f} {kept:>15}")
+
+
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--old", action="store_true", help="also the take's own most upright frame (no rig profile)")
+    ap.add_argument("--soles", action="store_true", help="also each rig family's take soles (part 3)")
     args = ap.parse_args(argv)
     if not data.has_data():
         raise SystemExit("needs MOTIONLAB_DATA")
@@ -110,6 +134,8 @@ def main(argv=None) -> None:
     start = time.perf_counter()
     refusals(dataset2_takes(root), args.old)
     run_heights(root)
+    if args.soles:
+        soles(root)
     print(f"{time.perf_counter() - start:.0f} s")
 
 

@@ -36,8 +36,10 @@ its world positions unchanged.
 **The sole.** A rig's lowest joint (a toe) sits inside the foot, above the floor by the foot's
 own sole: :func:`sole_height`, read from the rest root offset where that places the rig on the
 floor. The canonical standing pose keeps that height, so a standing skeleton's lowest joint is at
-its sole height, and at 0 when the rest offsets do not say where the floor is (retargeting then
-takes a target's sole from its take, :func:`motionlab.retargeting.pipeline.target_skeleton`).
+its sole height, and at 0 when the rest offsets do not say where the floor is. Where a take is
+at hand the sole is then where its toes stand while planted (:func:`take_sole`): a take stood on
+another's pose (:func:`on_reference`) and a retargeting target
+(:func:`motionlab.retargeting.pipeline.target_skeleton`) stand on it.
 
 The motion is re-expressed on the new rest offsets with world positions unchanged: with
 ``A_j`` the rotation that carries joint ``j``'s child offsets from the old rest to the new one,
@@ -210,9 +212,8 @@ def sole_height(skeleton: Skeleton) -> float | None:
     feet: below the knees (the Leg joints) above the lowest joint, and above minus the ankles
     (the foot joints) above it, so sunk in the floor, as the toes of a take planted under its
     floor are, by less than the ankles stand; within a micrometre under 0 it is 0 (a file's
-    rounding). (Not below the ankles: CMU's takes plant their toes higher above their floor than
-    its standing ankles stand above its toes.) Otherwise (CMU's root offset at the origin, Bandai
-    Namco's flat rest) the rest offsets do not say where the floor is: None.
+    rounding). Otherwise (CMU's root offset at the origin, Bandai Namco's flat rest) the rest
+    offsets do not say where the floor is: None.
 
     Raises ValueError when the skeleton is not canonical.
     """

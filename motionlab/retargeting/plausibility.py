@@ -8,8 +8,9 @@ A retargeted clip of B is **plausible** when, with ``leg`` = B's thigh + shin
 * **feet on the floor** (``foot``): on the frames where A's foot joints are planted
   (:func:`pipeline.source_contacts`), the median height of B's same joints above their own
   contact height (rest height above the lowest rest joint, :func:`contacts.rest_heights`) on B's
-  own sole (the height its lowest joint stands at, :func:`pipeline.source_sole`), as a
-  fraction of ``leg``, is within :data:`FOOT_TOL` of the same measure of A on A's legs — a
+  own sole (the height its lowest joint stands at, :func:`pipeline.target_sole`), as a
+  fraction of ``leg``, is within :data:`FOOT_TOL` of the same measure of A on A's legs and sole
+  (:func:`pipeline.source_sole`) — a
   tenth of the leg is a few centimetres on a human and still tells a planted foot from a lifted
   one. The test is against A's own value so that a source recorded a little above its floor
   (mocap markers, a rig's foot joints off the sole) does not condemn every output: it flags
