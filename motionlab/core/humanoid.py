@@ -363,7 +363,7 @@ def to_canonical(motion: Motion, profile=None, tolerance: float = 1e-4) -> Motio
 
     bone = pos[:, 1:] - pos[:, PARENTS[1:]]
     local_bones = quat.rotate(quat.conj(rot[:, PARENTS[1:]]), bone)  # (T, 21, 3) in the parent frame
-    deviation = np.linalg.norm(local_bones - offsets[1:], axis=-1).max(axis=0)
+    deviation = np.linalg.norm(local_bones - offsets[1:], axis=-1).max(axis=0, initial=0.0)  # 0 frames: 0
     local_pos = None
     if deviation.max() > tolerance * height:
         # a dropped joint between two kept ones rotates (e.g. CMU's LHipJoint in Xia's data), or

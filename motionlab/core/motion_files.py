@@ -23,7 +23,7 @@ from pathlib import Path
 
 from motionlab.core.motion import Motion
 
-__all__ = ["SUFFIXES", "ASF_UNIT", "CM", "output_suffix", "file_unit", "in_metres", "encode", "save"]
+__all__ = ["SUFFIXES", "ASF_UNIT", "CM", "output_suffix", "file_unit", "in_metres", "load_metres", "encode", "save"]
 
 SUFFIXES = {".bvh": "BVH text", ".glb": "binary glTF 2.0"}
 """The suffixes a motion is written to, and what each writes."""
@@ -78,6 +78,18 @@ def in_metres(motion: Motion, unit: float = CM) -> Motion:
         return motion
     local_pos = None if motion.local_pos is None else motion.local_pos * factor
     return motion.copy(skeleton=motion.skeleton.scaled(factor), root_pos=motion.root_pos * factor, local_pos=local_pos)
+
+
+def load_metres(path: str | os.PathLike) -> Motion:
+    """The BVH file ``path`` in metres: read (:func:`motionlab.core.bvh.load`) and scaled by its
+    length unit (:func:`file_unit`), so that a CMU-skeleton file's lengths are metres too.
+
+    Raises what :func:`motionlab.core.bvh.load` raises.
+    """
+    from motionlab.core import bvh
+
+    motion = bvh.load(path)
+    return in_metres(motion, file_unit(motion.skeleton))
 
 
 def encode(motion: Motion, suffix: str, unit: float = CM) -> bytes:

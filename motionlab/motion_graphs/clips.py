@@ -1,7 +1,9 @@
 """Clip sets for motion graphs: real mocap through ``MOTIONLAB_DATA``, synthetic otherwise.
 
-Every clip is reduced to the 22-joint humanoid and one frame rate with
-:func:`motionlab.core.preprocess.prepare`, so all rigs are handled the same way, and renamed to
+Every clip is read in metres (:func:`motionlab.core.motion_files.load_metres`: a CMU-skeleton
+file's unit is not the centimetre, and the graph's thresholds are metres), reduced to the
+22-joint humanoid and one frame rate with :func:`motionlab.core.preprocess.prepare`, so all rigs
+are handled the same way, and renamed to
 its label (``walk_angry``, ``idle_normal_to_walk_catwalk``) so that graph tables read well.
 
 * :func:`bandai_styles` — Bandai Namco dataset-1 walk/run/dash in 15 styles (30 fps);
@@ -20,7 +22,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from motionlab import data as _data
-from motionlab.core import bvh, files, preprocess
+from motionlab.core import files, motion_files, preprocess
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
 from motionlab.motion_graphs.naming import MIXAMO_AJ, NamingError, label_name, parse_name
@@ -127,7 +129,7 @@ def load_folder(
                 raise
             first_error = first_error or f"{path}: {e}"
             continue
-        motion = bvh.load(path)
+        motion = motion_files.load_metres(path)
         if motion.num_frames == 0:
             raise ValueError(f"{path} has no frames (its MOTION block says Frames: 0); a clip of a graph needs some")
         out.append(prepare(motion, fps).copy(name=label_name(label)))
@@ -154,7 +156,7 @@ def bandai_styles(
         for s in styles or BANDAI_STYLES:
             path = root / b / f"dataset-1_{b}_{s}_001.bvh"
             if path.is_file():
-                out.append(prepare(bvh.load(path), fps).copy(name=f"{b}_{s}"))
+                out.append(prepare(motion_files.load_metres(path), fps).copy(name=f"{b}_{s}"))
     if not out:
         raise _data.DataNotFound(f"no dataset-1 clips for {list(behaviours)} under {root}")
     return out
@@ -172,7 +174,7 @@ def mixamo_aj(fps: float = 30.0, name_map: Mapping[str, str] = MIXAMO_AJ) -> lis
     for stem, text in name_map.items():
         path = root / f"{stem}.bvh"
         if path.is_file():
-            out.append(prepare(bvh.load(path), fps).copy(name=text))
+            out.append(prepare(motion_files.load_metres(path), fps).copy(name=text))
     if not out:
         raise _data.DataNotFound(f"none of {sorted(name_map)} under {root}")
     return out

@@ -84,6 +84,14 @@ def test_mixamo_reduction_is_exact(prefix, rng):
     assert quat.angle_between(reduced.global_rotations(), full_rot).max() < 1e-6
 
 
+def test_a_motion_without_frames_reduces_to_one_without_frames(rng):
+    """``convert --canonical`` of a file with ``Frames: 0`` names what is wrong (no frames to
+    write) instead of NumPy's "zero-size array to reduction operation maximum"."""
+    rig = _mixamo_like()
+    reduced = humanoid.to_canonical(_random_motion(rig, rng)[:0])
+    assert (reduced.num_frames, reduced.skeleton.names) == (0, humanoid.JOINTS)
+
+
 def test_rotating_dropped_joint_keeps_positions_exact(rng):
     rig = _mixamo_like()
     motion = _random_motion(rig, rng)  # Pelvis and Spine1_split rotate here

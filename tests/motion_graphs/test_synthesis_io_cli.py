@@ -301,3 +301,32 @@ def test_build_reads_behaviour_folders(tmp_path, capsys):
         "walk": ["neutral", "normal-ganimator", "proud-ganimator", "sexy", "strutting"],
     }
     assert len(table["walk"]["sexy"]["takes"]) == 2
+
+
+def test_a_cmu_skeleton_folder_is_read_in_metres(library, tmp_path, capsys):
+    """A CMU-skeleton file's length unit is not the centimetre (``motion_files.ASF_UNIT``): its
+    clips are read in metres, the unit of every threshold of a graph (they were read as
+    centimetres, a walker 0.18 of its size, so the 0.04 m distance threshold let in poses about
+    5.6 times further apart), and the search's output is the walker's size."""
+    from motionlab.core import bvh, motion_files
+    from motionlab.motion_graphs import clips
+
+    cmu_names = {"Spine": "LowerBack", "Spine1": "Spine", "Spine2": "Spine1", "Head": "Neck1"}
+    factor = motion_files.CM / motion_files.ASF_UNIT  # metres -> ASF units, as bvh.load reads them
+    folder = tmp_path / "clips"
+    folder.mkdir()
+    walks = [m for m in library if m.name.startswith("walk_normal")]
+    for i, m in enumerate(walks):
+        sk = m.skeleton.renamed([cmu_names.get(n, n) for n in m.skeleton.names]).scaled(factor)
+        bvh.save(folder / f"walk_normal_{i + 1:03d}.bvh", m.copy(skeleton=sk, root_pos=m.root_pos * factor))
+    loaded = clips.load_folder(folder)
+    assert [motion_files.file_unit(bvh.load(p).skeleton) for p in sorted(folder.iterdir())] == [
+        motion_files.ASF_UNIT
+    ] * len(walks)
+    for got, want in zip(loaded, walks):
+        np.testing.assert_allclose(got.root_pos, want.root_pos, atol=1e-5)
+    graph, out = tmp_path / "g.mlgraph", tmp_path / "w.bvh"
+    assert main(["graph-build", str(folder), "-o", str(graph), "-q"]) == 0
+    assert main(["graph-search", str(graph), "--request", "walk:normal:60", "-o", str(out), "-q"]) == 0
+    hips = bvh.load(out).root_pos[:, 1]  # a 22-joint output, written in centimetres
+    assert np.median(hips) == pytest.approx(np.median(walks[0].root_pos[:, 1]), rel=0.05)
