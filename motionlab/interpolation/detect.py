@@ -14,7 +14,9 @@ stream beside it, time-warped by the tempi :data:`TRACK_RATES`, and
 with ``s(t)`` the stream's joint step into frame ``t``, ``ρ`` the matched tempo and
 ``s̄_graph(i)`` the graph clip's joint step at the matched frame (mean over ``i−2 … i+2``, never
 below :data:`STEP_FLOOR`). The typical value around ``t`` is the larger of the medians of
-:data:`WINDOW` values on each side and of the two adjacent values, so only an isolated jump counts.
+:data:`WINDOW` values on each side and of the two adjacent values, so only an isolated jump counts;
+an adjacent value that is itself more than Δ times its own side medians is left out (two gaps one
+frame apart would each hide the other).
 With nothing missing ``D ≈ 1``; with ``n`` frames missing ``D ≈ n+1``. ``D > Δ`` flags a gap
 (:data:`DELTA` = 2.5: one missing frame gives ``D ≈ 2`` and is not flagged).
 
@@ -225,8 +227,24 @@ def _side_medians(steps: np.ndarray, window: int) -> tuple[np.ndarray, np.ndarra
     return before, after
 
 
-def consecutive_ratio(motion: Motion, window: int = WINDOW) -> tuple[np.ndarray, np.ndarray]:
-    """``D(t) = s(t) / max(median before, median after, s(t−1), s(t+1))`` for every step, and the
+def _typical(values: np.ndarray, window: int, delta: float, floor: float = 0.0) -> np.ndarray:
+    """The typical value around each of ``values`` (T,): the larger of the medians of ``window``
+    values on each side and of the two adjacent values, where an adjacent value counts only when
+    it is not itself more than ``delta`` times the larger of its own side medians and ``floor``
+    (two gaps one frame apart: each would vouch for the other). NaN where nothing is known."""
+    before, after = _side_medians(values, window)
+    side = np.fmax(np.fmax(before, after), floor)
+    pad = np.array([np.nan])
+    near = []
+    for v, s in ((values[:-1], side[:-1]), (values[1:], side[1:])):
+        near.append(np.where(v > delta * s, np.nan, v))
+    prev, nxt = np.concatenate([pad, near[0]]), np.concatenate([near[1], pad])
+    return np.fmax(np.fmax(before, after), np.fmax(prev, nxt))
+
+
+def consecutive_ratio(motion: Motion, window: int = WINDOW, delta: float = DELTA) -> tuple[np.ndarray, np.ndarray]:
+    """``D(t) = s(t) / max(median before, median after, s(t−1), s(t+1))`` for every step, a
+    neighbouring step left out where it is itself a jump by ``delta`` (:func:`_typical`), and the
     steps ``s``.
 
     Returns
@@ -235,11 +253,8 @@ def consecutive_ratio(motion: Motion, window: int = WINDOW) -> tuple[np.ndarray,
     steps : ndarray (T-1,)   metres per stream step (:func:`joint_steps`)
     """
     steps = joint_steps(motion)
-    before, after = _side_medians(steps, int(window))
-    prev = np.concatenate([[np.nan], steps[:-1]])
-    nxt = np.concatenate([steps[1:], [np.nan]])
-    typical = np.fmax(np.fmax(before, after), np.fmax(prev, nxt))
     floor = STEP_FLOOR * body_height(motion) / motion.fps
+    typical = _typical(steps, int(window), delta, floor)
     typical = np.where(np.isfinite(typical), np.maximum(typical, floor), np.inf)
     ratio = np.where(steps > floor, steps / typical, 0.0)
     return ratio, steps
@@ -251,7 +266,7 @@ def consecutive_gaps(motion: Motion, delta: float = DELTA, window: int = WINDOW)
     delta = check_delta(delta)
     if motion.num_frames < 3:
         return []
-    ratio, _ = consecutive_ratio(motion, window)
+    ratio, _ = consecutive_ratio(motion, window, delta)
     return [int(t) for t in np.flatnonzero(ratio > delta)]
 
 
@@ -438,7 +453,7 @@ def track(
     first = np.cumsum([0] + [len(x) for x in speeds])[:-1]  # each node's first row in the joined speeds
     joined = np.concatenate(speeds)
     predicted = np.interp(first[node] + at, np.arange(len(joined)), joined) * rate  # metres per stream step
-    dist = _distances(motion, predicted)
+    dist = _distances(motion, predicted, delta)
     frame_of = np.concatenate([[starting.time[0]], at + np.where(use_back, rate, 0.0)])
     node_of = np.concatenate([[starting.node[0]], node])
     return GraphTrack([names[c] for c in node_of], np.rint(frame_of).astype(np.int64), dist, delta)
@@ -501,16 +516,15 @@ def _step_matches(ending: _Match, starting: _Match, k: int, T: int):
     return use_back, node, rate, at
 
 
-def _distances(motion: Motion, predicted: np.ndarray) -> np.ndarray:
+def _distances(motion: Motion, predicted: np.ndarray, delta: float) -> np.ndarray:
     """``D`` (T,) of every stream frame (frame 0: 0) from the predicted steps (T-1,), metres per
     stream step: ``r = s / prediction`` over the typical ``r`` around each step (module
-    docstring), 0 where the stream's step is below :data:`STEP_FLOOR`."""
+    docstring, :func:`_typical` with ``delta``), 0 where the stream's step is below
+    :data:`STEP_FLOOR`."""
     floor = STEP_FLOOR * body_height(motion) / motion.fps
     s = joint_steps(motion)
     r = s / np.maximum(predicted, floor)
-    before, after = _side_medians(r, WINDOW)
-    near = np.fmax(np.concatenate([[np.nan], r[:-1]]), np.concatenate([r[1:], [np.nan]]))
-    typical = np.fmax(np.fmax(before, after), near)
+    typical = _typical(r, WINDOW, delta)
     typical = np.where(np.isfinite(typical) & (typical > 0), typical, np.inf)
     return np.concatenate([[0.0], np.where(s > floor, r / typical, 0.0)])
 

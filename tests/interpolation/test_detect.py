@@ -23,6 +23,20 @@ def test_clean_motion_has_no_gaps_and_a_cut_is_found():
     assert detect.detect(cut) == [(59, count)]
 
 
+@pytest.mark.parametrize("apart", [1, 2])
+def test_two_gaps_one_frame_apart_are_both_found(apart):
+    """Each gap's step was the other's neighbour, and a neighbour counts as typical: with one frame
+    between them neither was found ("no dropped frames found"). A neighbour that is itself a jump
+    against its own side medians no longer vouches for a step, on the stream and on the graph."""
+    m = toy_motion(150)
+    cut = m[np.r_[0:60, 65 : 65 + apart, 70 + apart : 150]]
+    want = [59, 59 + apart]
+    assert detect.consecutive_gaps(cut) == want
+    g = ActionGraph()
+    g.add_node("walk", toy_motion(90, phase=0.3))
+    assert detect.graph_gaps(cut, g) == want
+
+
 @pytest.mark.parametrize("bad", [-1, 0, 1.0, float("nan"), float("inf"), "abc"])
 def test_nonsense_delta_is_refused(bad):
     with pytest.raises(ValueError, match="above 1"):
