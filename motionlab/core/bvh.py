@@ -998,12 +998,36 @@ def _rotation_angles(local_rot: np.ndarray, layouts, names, precision: int) -> d
                 f"cannot write joint {names[joints[n]]!r}: its channels have {have}, but at frame {t} it rotates "
                 f"{np.degrees(error[t, n]):.4g} degrees outside them; give it rotation channels in skeleton.channels"
             )
-        # written angles lie in (-180, 180]: -180 and 180 (the same turn) must not flip between writes
+        # frame 0's angles lie in (-180, 180]: -180 and 180 (the same turn) must not flip between writes
         degrees = np.degrees(split)
         degrees[degrees <= -180.0 + 0.5 * 10.0**-precision] += 360.0
+        degrees = _continuous(degrees)
         for n, j in enumerate(joints):
             angles[j] = degrees[:, n]
     return angles
+
+
+def _continuous(degrees: np.ndarray) -> np.ndarray:
+    """Euler angles (T, n, k), degrees, each frame's own, as curves without jumps.
+
+    With three axes a rotation has two triples, ``(a, b, c)`` and ``(a + 180, 180 - b, c + 180)``;
+    each frame takes the one nearer the frame before's choice (whether a frame swaps is the parity
+    of the swaps up to it, so no loop over frames). Then whole turns are added so that no channel
+    steps by more than 180 degrees. Frame 0 keeps its values; every frame keeps its rotation.
+    """
+    if len(degrees) < 2:
+        return degrees
+    if degrees.shape[-1] == 3:
+        other = degrees + np.array([180.0, 0.0, 180.0])
+        other[..., 1] = 180.0 - degrees[..., 1]
+
+        def apart(x, y):  # (T-1, n): summed turn between two triples, each channel modulo 360
+            return np.abs((x - y + 180.0) % 360.0 - 180.0).sum(-1)
+
+        swap = apart(other[1:], degrees[:-1]) < apart(degrees[1:], degrees[:-1])
+        odd = np.concatenate([np.zeros_like(swap[:1]), np.cumsum(swap, axis=0) % 2 == 1])
+        degrees = np.where(odd[..., None], other, degrees)
+    return np.unwrap(degrees, period=360.0, axis=0)
 
 
 def _channel_columns(translations, angles, layouts, skeleton: Skeleton, scale: float, pos_tol: float) -> list:

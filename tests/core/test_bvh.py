@@ -482,6 +482,32 @@ def test_save_load_round_trip(tmp_path):
     assert back.name == "out"
 
 
+def _frame_rows(text: str) -> np.ndarray:
+    """The MOTION block's numbers, (T, channels)."""
+    lines = text.split("Frame Time:")[1].strip().splitlines()[1:]
+    return np.array([[float(v) for v in line.split()] for line in lines])
+
+
+def test_written_euler_curves_have_no_jumps():
+    """A joint that spins (three turns about Y) and one that pitches through 90 degrees about its
+    middle axis are written as smooth curves: each frame on the triple nearer the frame before's,
+    whole turns added, every frame's rotation kept. Each frame written on its own wrapped the
+    spin at 180 (a 360-degree jump in the file) and swapped triples where the pitch passed 90."""
+    sk = Skeleton(("Hips", "Spine"), np.array([-1, 0]), np.array([[0.0, 1.0, 0.0], [0.0, 0.3, 0.0]]))
+    t = np.linspace(0.0, 1.0, 121)[:, None]
+    spin = quat.from_axis_angle(np.array([0.0, 1.0, 0.0]), 6 * np.pi * t[:, 0])
+    tilt = quat.mul(quat.from_axis_angle(np.array([1.0, 0.0, 0.0]), np.radians(150.0) * t[:, 0]),
+                    quat.from_axis_angle(np.array([0.0, 1.0, 0.0]), np.radians(20.0) * t[:, 0]))  # fmt: skip
+    m = Motion(sk, np.stack([spin, tilt], axis=1), np.zeros((121, 3)) + [0.0, 1.0, 0.0], 30.0)
+    text = bvh.dumps(m)
+    rows = _frame_rows(text)
+    assert np.abs(np.diff(rows, axis=0)).max() < 10.0  # 9 degrees a frame at most, in every channel
+    assert np.abs(rows[0]).max() <= 180.0  # frame 0 as each frame was written before
+    back = bvh.loads(text)
+    assert quat.angle_between(back.local_rot, m.local_rot).max() < 1e-6
+    assert bvh.dumps(back) == text
+
+
 def test_save_refuses_to_overwrite(tmp_path):
     m = bvh.loads(MIXED)
     path = tmp_path / "clip.bvh"
