@@ -18,7 +18,8 @@ both sides (ground speed, travel direction, step phase) and, with ``--takes``, a
 other recordings of the action need between the poses at the gap's ends (the two averaged,
 :mod:`motionlab.interpolation.recorded`); the frames are inserted and filled: by
 default the whole body continues the recorded strides on both sides across the gap
-(:mod:`motionlab.interpolation.stride`); where the motion does not repeat, SLERP with the root
+(:mod:`motionlab.interpolation.stride`); where the motion does not repeat, or where SLERP fills
+cuts of the gap's size near it better (:func:`motionlab.interpolation.gaps.fill`), SLERP with the root
 given by ``--gap-root`` (``stride``: the strides' root path where one side repeats, else ``hermite``,
 a Hermite curve with the velocities on both sides; ``linear``: the LaFAN1 baseline).
 Where the capture logged each frame's time, ``--times FILE`` (one time in seconds per frame,
@@ -54,7 +55,8 @@ def register(subparsers) -> None:
         cli_args.add_output(p, "where to write the filled motion: .bvh, or .glb for binary glTF 2.0")
         p.add_argument("--method", choices=("stride", "slerp", "hermite", "graph"), default="stride",
                        help="stride: the strides on both sides continued (default; slerp where the motion does not "
-                       "repeat); slerp: SLERP; hermite: velocity-matched; graph: key-pose guided (needs --action)")  # fmt: skip
+                       "repeat or slerp fills cuts of the gap's size near it better); slerp: SLERP; hermite: "
+                       "velocity-matched; graph: key-pose guided (needs --action)")  # fmt: skip
         p.add_argument("--curve", choices=("linear", "ease", "smoothstep"), default="linear",
                        help="α(k) curve of the blend weights across a gap")  # fmt: skip
         root = p.add_argument("--gap-root", dest="root", choices=("stride", "hermite", "linear"), default="stride",

@@ -54,6 +54,7 @@ from motionlab.interpolation.stride import side_speeds, stride_fill, stride_path
 
 __all__ = [
     "METHODS",
+    "REHEARSALS",
     "ROOTS",
     "FEET",
     "FilledGap",
@@ -69,6 +70,10 @@ __all__ = [
 ]
 
 METHODS = ("slerp", "hermite", "stride", "graph")
+
+REHEARSALS = 8
+"""The most cuts of a gap's size near it on which the stride fill is rehearsed against SLERP
+(:func:`_stride_rehearsed`); each costs two fills."""
 ROOTS = ("stride", "hermite", "linear")
 FEET = ("plant", "lift")
 """How :func:`fill` keeps filled feet out of the floor: ``"plant"`` bends each sunk leg
@@ -640,7 +645,9 @@ def fill(
         velocities around the gap), ``"stride"`` (the whole body continued from the recorded
         strides on both sides, :mod:`.stride`, the root leaving and reaching the gap at the
         velocities measured outside it where the two sides' speeds differ,
-        :func:`.detect.changes_speed`; SLERP with ``root`` where no stride is found) or
+        :func:`.detect.changes_speed`; SLERP with ``root`` where no stride is found, or where
+        SLERP fills up to :data:`REHEARSALS` cuts of the gap's size in the known frames within
+        :data:`.detect.REHEARSAL_SECONDS` of it nearer the truth) or
         ``"graph"`` (needs ``graph``: key-pose-guided filling within
         an action, key poses of intermediate actions across actions; the root through the gap's
         ends and key poses is then made C1 by :func:`smooth_root`)
@@ -705,14 +712,16 @@ def _check_fill(motion: Motion, method: str, graph: ActionGraph | None, root: st
             )
 
 
-def _fill_inside(out: Motion, start: int, stop: int, method: str, curve: str, root: str, ref: int, feet: str):
+def _fill_inside(out: Motion, start: int, stop: int, method: str, curve: str, root: str, ref: int, feet: str,
+                 rehearse: bool = True):  # fmt: skip
     """One gap ``[start, stop)`` with known frames on both sides, filled without a graph (methods
-    ``"slerp"``, ``"hermite"``, ``"stride"`` of :func:`fill`) and kept out of the floor by the
-    :data:`FEET` rule ``feet``; returns the filled motion and its :class:`FilledGap`."""
+    ``"slerp"``, ``"hermite"``, ``"stride"`` of :func:`fill`; a stride fill only where it passes the
+    rehearsal, :func:`_stride_rehearsed`, unless ``rehearse`` is off) and kept out of the floor by
+    the :data:`FEET` rule ``feet``; returns the filled motion and its :class:`FilledGap`."""
     a, b = start - 1, stop
     if method == "stride":
         strided = stride_fill(out, a, b, ref)
-        if strided is not None:
+        if strided is not None and (not rehearse or _stride_rehearsed(out, start, stop, (curve, root, ref, feet))):
             out = _floor_rule(feet)(_follow_strides(strided[0], a, b, ref, strided[1]), a, b)
             return out, FilledGap(start, stop, "stride")
     mode = "hermite" if method == "hermite" else "linear"  # stride: SLERP where no stride is found
@@ -724,6 +733,42 @@ def _fill_inside(out: Motion, start: int, stop: int, method: str, curve: str, ro
         out = smooth_root(out, [a, b], joint=ref)
     out = _floor_rule(feet)(out, a, b)
     return out, FilledGap(start, stop, "slerp" if method == "stride" else method)
+
+
+def _rehearsal_cuts(motion: Motion, start: int, stop: int) -> list[int]:
+    """Starts of at most :data:`REHEARSALS` cuts of the gap's size (``stop − start`` frames) in the
+    known frames within :data:`.detect.REHEARSAL_SECONDS` of the gap, a known frame on each side of
+    each cut, evenly spread over both sides."""
+    n, reach = stop - start, int(round(detect.REHEARSAL_SECONDS * motion.fps))
+    known = np.isfinite(motion.local_rot).all(axis=(1, 2)) & np.isfinite(motion.root_pos).all(axis=1)
+    ok = np.convolve(known, np.ones(n + 2), "valid") == n + 2  # ok[c - 1]: frames c-1 … c+n known
+    first, last = max(1, start - reach), min(stop + reach, motion.num_frames - 1) - n  # cut and frame after it
+    places = first + np.flatnonzero(ok[first - 1 : max(last, first - 1)])
+    if len(places) > REHEARSALS:
+        places = places[np.linspace(0, len(places) - 1, REHEARSALS).round().astype(int)]
+    return [int(c) for c in places]
+
+
+def _stride_rehearsed(motion: Motion, start: int, stop: int, how: tuple) -> bool:
+    """Whether the stride fill keeps the gap ``[start, stop)``: it does unless the fill used where
+    no stride is found (SLERP) comes nearer the truth on the rehearsal cuts
+    (:func:`_rehearsal_cuts`; every joint's world position, mean over the cuts' frames): each gap
+    gets the fill that did better on the stream itself, near it. ``how``: ``(curve, root,
+    reference joint, feet)`` of :func:`_fill_inside`."""
+    n = stop - start
+    truth = motion.global_positions()
+    error = {"stride": 0.0, "slerp": 0.0}
+    for c in _rehearsal_cuts(motion, start, stop):
+        holed = motion.copy()
+        for values in (holed.local_rot, holed.root_pos, holed.local_pos):
+            if values is not None:
+                values[c : c + n] = np.nan
+        for method in error:
+            filled, _ = _fill_inside(holed, c, c + n, method, *how, rehearse=False)
+            error[method] += float(
+                np.linalg.norm(filled[c : c + n].global_positions() - truth[c : c + n], axis=-1).mean()
+            )
+    return error["stride"] <= error["slerp"]
 
 
 def _place_path(out: Motion, a: int, b: int, graph: ActionGraph, ref: int):

@@ -17,16 +17,17 @@ So the gap is predicted from both sides and the two predictions are blended:
 * **backward from after the gap** (known frames from ``b``): the same with the first stride
   ``[b, b + P]``, run backwards;
 * each prediction is bent to meet **both** ends of the gap by a correction linear in time: the
-  forward one by ``(k/N)`` of its miss at ``b`` (positions) and the pose difference between frame
-  ``a`` and the frame one stride before it fading out (``1 − k/N``, rotations); the backward one
-  mirrored. This absorbs a stride a little slower or faster than the gap's and a missing count
-  off by a frame;
+  forward one by ``(k/N)`` of its miss at ``b`` (positions and rotations, the reference joint's
+  included) and the pose difference between frame ``a`` and the frame one stride before it fading
+  out (``1 − k/N``, rotations); the backward one mirrored. This absorbs a stride a little slower or
+  faster than the gap's, a period read a few frames off, and a missing count off by a frame;
 * the two are blended with weights ``1 − k/N`` and ``k/N`` (``N = b − a``): positions linearly,
   joint rotations by SLERP.
 
 Where no stride is found (both sides shorter than ``MIN_STRIDES`` strides, a motion that does
-not repeat) :func:`stride_fill` returns ``None`` and :func:`.gaps.fill` falls back to SLERP with the
-Hermite root. Fractional frames are read linearly (positions) and by SLERP (rotations).
+not repeat) :func:`stride_fill` returns ``None`` and :func:`.gaps.fill` falls back to SLERP; it
+also does where SLERP fills cuts of the gap's size near it better (``gaps.fill``'s rehearsal:
+across a gap of a few frames the two ends say almost everything). Fractional frames are read linearly (positions) and by SLERP (rotations).
 
 How it compares with SLERP and a Hermite root on the shared walks and runs:
 ``docs/results_interpolation.md`` (``python -m experiments.interpolation.check_gaps``).
@@ -164,27 +165,37 @@ def _turned(rot: np.ndarray, chain: list[int], joint: int, yaw: np.ndarray) -> n
 def _bend(side: _Side, motion: Motion, frames: np.ndarray, period: float, far: tuple, w: np.ndarray, poses: bool,
           joint: int):  # fmt: skip
     """Make a side's prediction meet both ends: its path by ``w`` (N+1,) times its miss at the far
-    end (``far = (index into the prediction, reference joint position (3,))``); with ``poses``, its
-    rotations and translations by the difference between its own end frame and the frame one
-    stride before it, fading as ``1 − w`` (but for the reference joint ``joint``, whose heading
-    :func:`_continue` turned, and the joints above it)."""
+    end (``far = (index into the prediction, reference joint position (3,), frame)``); with
+    ``poses``, its rotations and translations by the difference between its own end frame and the
+    frame one stride before it, fading as ``1 − w``, then by the difference between the far end's
+    frame and the prediction there, growing as ``w`` (but for the reference joint ``joint``, whose
+    heading :func:`_continue` turned, and the joints above it)."""
     end = len(frames) - 1
     side.path = side.path + w[:, None] * (far[1] - side.path[far[0]])
     if not poses:
         return side
     rot = motion.local_rot[frames]
     back = sample_rotations(rot, np.array([end - period]))[0]  # (J, 4)
-    diff = quat.mul(rot[end], quat.inv(back))  # (J, 4): this stride's end against the last
-    fade = quat.slerp(np.broadcast_to(np.array([1.0, 0.0, 0.0, 0.0]), diff.shape), diff,
-                      np.broadcast_to((1.0 - w)[:, None], side.rot.shape[:-1]))  # fmt: skip
-    fade[:, motion.skeleton.ancestors(joint) + [joint]] = quat.IDENTITY  # the carrier is turned, not faded
-    side.rot = quat.normalize(quat.mul(fade, side.rot))
+    above = motion.skeleton.ancestors(joint)  # as recorded
+    side.rot = _bent(side.rot, quat.mul(rot[end], quat.inv(back)), 1.0 - w, above + [joint])  # joint: turned
+    side.rot = _bent(side.rot, quat.mul(motion.local_rot[far[2]], quat.inv(side.rot[far[0]])), w, above)
     if side.local_pos is not None:
         lp = motion.local_pos[frames]
         side.local_pos = side.local_pos + (1.0 - w)[:, None, None] * (
             lp[end] - sample_rows(lp, np.array([end - period]))[0]
         )
+        side.local_pos = side.local_pos + w[:, None, None] * (motion.local_pos[far[2]] - side.local_pos[far[0]])
     return side
+
+
+def _bent(rot: np.ndarray, diff: np.ndarray, weight: np.ndarray, carrier: list) -> np.ndarray:
+    """Rotations ``rot`` (K, J, 4) turned by ``weight`` (K,) of the turns ``diff`` (J, 4), but the
+    joints ``carrier``."""
+    turn = quat.slerp(
+        np.broadcast_to(quat.IDENTITY, diff.shape), diff, np.broadcast_to(weight[:, None], rot.shape[:-1])
+    )
+    turn[:, carrier] = quat.IDENTITY
+    return quat.normalize(quat.mul(turn, rot))
 
 
 def _predict(motion: Motion, a: int, b: int, joint: int, with_poses: bool):
@@ -196,7 +207,10 @@ def _predict(motion: Motion, a: int, b: int, joint: int, with_poses: bool):
     w = k / n
     _, ends = reference_transform(motion, np.array([a, b]), joint=joint)
     sides = []
-    for frames, offsets, far, weight in ((before, k, (-1, ends[1]), w), (after[::-1], n - k, (0, ends[0]), 1.0 - w)):
+    for frames, offsets, far, weight in (
+        (before, k, (-1, ends[1], b), w),
+        (after[::-1], n - k, (0, ends[0], a), 1.0 - w),
+    ):
         if len(frames) - 1 < MIN_STRIDES * period:
             sides.append(None)
             continue
