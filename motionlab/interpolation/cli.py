@@ -25,10 +25,11 @@ a Hermite curve with the velocities on both sides; ``linear``: the LaFAN1 baseli
 Where the capture logged each frame's time, ``--times FILE`` (one time in seconds per frame,
 :func:`motionlab.interpolation.gaps.load_times`) gives the gaps and their counts exactly
 (:func:`~motionlab.interpolation.gaps.timestamp_gaps`): no rule, no estimate. The times are
-checked against the file's ``Frame Time`` first: times in another unit (milliseconds), times whose
-median step is not one Frame Time within :data:`RATE_AGREEMENT` (another take's or rate's), or
-ones that would make the clip more than :data:`MAX_GROWTH` times longer, are refused; the counts
-are read in the times' own median step. Without
+checked against the file's ``Frame Time`` first: times in another unit (milliseconds), times of
+which no step is one Frame Time within :data:`RATE_AGREEMENT` and whose median step is not either
+(another take's or rate's), or ones that would make the clip more than :data:`MAX_GROWTH` times
+longer, are refused; the counts are read in the times' own frame period (the median of their
+steps of one Frame Time). Without
 ``--times`` the counts are estimates (the motion cannot say how fast the body moved inside a gap),
 and a warning on stderr says so, with the range each count is likely in
 (:func:`motionlab.interpolation.detect.estimate_counts`) and, where too few frames beside a gap
@@ -175,8 +176,9 @@ MAX_GROWTH = 10
 """``--times`` may at most make the clip this many times longer: more means wrong times."""
 
 RATE_AGREEMENT = 0.01
-"""``--times`` must step one Frame Time within this fraction (median step): NTSC's 29.97 fps is
-0.1 % from 30, and the nearest two common rates, 24 and 25 fps, are 4 % apart."""
+"""``--times`` must step one Frame Time within this fraction (the median of the steps that do, or
+of all steps where none does): NTSC's 29.97 fps is 0.1 % from 30, and the nearest two common
+rates, 24 and 25 fps, are 4 % apart."""
 
 
 def _times_gaps(path: str, src: Path, motion) -> list[tuple[int, int]]:
@@ -193,11 +195,13 @@ def _times_gaps(path: str, src: Path, motion) -> list[tuple[int, int]]:
     except ValueError as e:
         raise CLIError(f"--times: {e}") from None
     period = 1.0 / motion.fps
-    step = float(np.median(np.diff(times))) if len(times) > 1 else period
-    if not 0.5 <= step / period < 2.0:
-        units = {"milliseconds": 1e3, "microseconds": 1e6, "nanoseconds": 1e9}
-        hint = next((f"; they look like {u}: divide them by {f:.0f}" for u, f in units.items()
-                     if 0.5 <= step / period / f < 2.0), "")  # fmt: skip
+    steps = np.diff(times)
+    one = steps[np.abs(steps / period - 1.0) <= RATE_AGREEMENT]  # the capture period where frames follow
+    step = float(np.median(one if one.size else steps)) if len(times) > 1 else period
+    units = {"milliseconds": 1e3, "microseconds": 1e6, "nanoseconds": 1e9}
+    hint = next((f"; they look like {u}: divide them by {f:.0f}" for u, f in units.items()
+                 if 0.5 <= step / period / f < 2.0), "")  # fmt: skip
+    if hint:
         raise CLIError(
             f"--times {path}: consecutive times are {step:g} apart (median), but the Frame Time of {src} is "
             f"{period:g} s; expected one time per frame in seconds{hint}"
@@ -205,8 +209,9 @@ def _times_gaps(path: str, src: Path, motion) -> list[tuple[int, int]]:
     if abs(step / period - 1.0) > RATE_AGREEMENT:
         raise CLIError(
             f"--times {path}: consecutive times are {step:g} s apart (median; {1 / step:.4g} fps), but the Frame "
-            f"Time of {src} is {period:g} s ({motion.fps:.4g} fps); expected one time per frame of this file, "
-            f"within {RATE_AGREEMENT:.0%}: are they the times of another take or rate?"
+            f"Time of {src} is {period:g} s ({motion.fps:.4g} fps), and no two frames are one Frame Time apart; "
+            f"expected one time per frame of this file, within {RATE_AGREEMENT:.0%}: are they the times of "
+            "another take or rate?"
         )
     missing = gaps.timestamp_gaps(times, 1.0 / step)  # counted in the capture's own frame period
     added = sum(n for _, n in missing)
@@ -329,8 +334,12 @@ def run_fill_gaps(args: argparse.Namespace) -> int:
         _warn_estimated(src, counted)
     if not args.quiet:
         print(f"{src}: {motion.num_frames} frames at {motion.fps:g} fps")
+    used = detect.DELTA if delta is None else delta
     nothing = (
-        f"no dropped frames in the times of {args.times}" if args.times else "no dropped frames found (D > Δ nowhere)"
+        f"no dropped frames in the times of {args.times}"
+        if args.times
+        else f"no dropped frames found (D > Δ = {used:g} nowhere; one dropped frame doubles a step, D about 2, "
+        "which only a --delta below 2 flags, fast motion too; --times FILE gives every gap exactly)"
     )
     if not missing:
         bar.close()

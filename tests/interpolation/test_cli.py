@@ -68,7 +68,9 @@ def test_fill_gaps_on_a_clean_clip_writes_an_unchanged_copy(tmp_path, capsys):
     bvh.save(clean, toy_motion(120))
     out = tmp_path / "copy.bvh"
     assert main(["fill-gaps", str(clean), "-o", str(out)]) == 0
-    assert "unchanged copy" in capsys.readouterr().out
+    said = capsys.readouterr().out
+    assert "unchanged copy" in said
+    assert "Δ = 2.5 nowhere" in said and "one dropped frame" in said  # what the default cannot see, and how to
     assert out.read_bytes() == clean.read_bytes()
 
 
@@ -237,6 +239,23 @@ def test_fill_gaps_refuses_frame_times_of_another_rate(dropped, tmp_path, capsys
     times = _times_file(tmp_path / "ntsc.txt", keep / 29.97)  # NTSC's rate: counted in its own frame period
     assert main(["fill-gaps", str(dropped), "-o", str(out), "--times", str(times)]) == 0
     assert bvh.load(out).num_frames == 120
+
+
+def test_frame_times_with_most_frames_dropped_are_read_in_their_one_frame_steps(tmp_path, capsys):
+    """Every other frame dropped but for the first ten: the median step is two Frame Times, and
+    the times were refused as another rate's; their steps of one Frame Time give the period."""
+    m = toy_motion(120)
+    keep = np.r_[0:10, 10:120:2]
+    stream = tmp_path / "stream.bvh"
+    bvh.save(stream, m[keep])
+    out = tmp_path / "out.bvh"
+    times = _times_file(tmp_path / "t.txt", keep / 30.0)
+    assert main(["fill-gaps", str(stream), "-o", str(out), "--times", str(times)]) == 0
+    assert bvh.load(out).num_frames == 119  # frames 0 … 118: nothing was dropped after the last kept one
+    every_other = _times_file(tmp_path / "e.txt", np.arange(0, 120, 2) / 30.0)  # as a 15 fps log would be
+    bvh.save(stream, m[::2].copy(fps=30.0), overwrite=True)  # a 30 fps file that lost every other frame
+    assert main(["fill-gaps", str(stream), "-o", str(tmp_path / "e.bvh"), "--times", str(every_other)]) == 2
+    assert "no two frames are one Frame Time apart" in capsys.readouterr().err
 
 
 def test_fill_gaps_refuses_graph_options_it_would_not_use(dropped, tmp_path, capsys):
