@@ -18,7 +18,9 @@ frame counts,
    \qquad P_0(e) = 0,
 
 (``P_c(f)``: the least price of the jumps of a walk of ``c + 1`` frames from ``e`` that ends at
-``f``; infinite where none does) run once per segment. The exit whose route length ``r``
+``f``; infinite where none does) run once per segment. A segment enters where the previous one's
+route left it; the first enters at its pool's first alive frame, or where no walk from there
+meets its count, at another alive frame (:data:`START_TRIES`). The exit whose route length ``r``
 satisfies ``c + 1 + r = n`` wins; of the walks within :data:`TOLERANCE`, the one whose jumps
 cost least plus one per frame off the request. The recursion runs first over the cheapest jumps
 into each frame (:data:`SPARSE_JUMPS`), then, only where a walk through another jump could cost
@@ -76,6 +78,7 @@ __all__ = [
     "TOLERANCE",
     "tolerance_frames",
     "MAX_FRAMES",
+    "START_TRIES",
     "PoolWalker",
     "pool_walker",
     "walk_to_exit",
@@ -85,6 +88,12 @@ MAX_FRAMES = 100_000
 """Longest request, frames in all segments together (55 minutes at 30 fps). The synthesised
 motion is held in memory and written as one BVH file; longer requests are refused, naming this
 limit, rather than running for minutes and filling the disk."""
+
+START_TRIES = 32
+"""A request's first segment walks from its pool's first alive frame (on the main cycle); where
+that walk misses the segment's count by more than the tolerance, the walk is tried from up to
+this many other alive frames of the pool, evenly spread, and the first that meets it is kept:
+nothing fixes where a motion begins (:func:`_first_walk`)."""
 
 TOLERANCE = 0.05
 """Documented accuracy: every reachable segment gets its requested length within
@@ -738,6 +747,24 @@ def _walk(
     frames = _backtrack(cw, reach, c, x, jumps)
     pieces.extend(_runs(cw, frames))
     return pieces, r, played + c + 1
+
+
+def _first_walk(cw: PoolWalker, start: int, need: list[int], exits: list[int], name: str, slack: int):
+    """:func:`_walk` from ``start``, or where it misses its option's count by more than ``slack``,
+    from the first of :data:`START_TRIES` other alive frames of the pool whose walk meets it (the
+    one from ``start`` where none does)."""
+    walk = _walk(cw, start, need, exits, name, slack)
+    if abs(walk[2] - need[walk[1]]) <= slack:
+        return walk
+    alive = np.flatnonzero(cw.alive) if cw.alive is not None else np.arange(cw.length)
+    for other in alive[np.unique(np.linspace(0, alive.size - 1, min(START_TRIES, alive.size)).astype(np.int64))]:
+        try:
+            tried = _walk(cw, int(other), need, exits, name, slack)
+        except SearchError:  # no exit from there
+            continue
+        if abs(tried[2] - need[tried[1]]) <= slack:
+            return tried
+    return walk
 
 
 def _cheaper_walk(cw: PoolWalker, start: int, rows: int, need_c: np.ndarray, ex: np.ndarray, slack: int, bound: float):
@@ -1447,8 +1474,9 @@ class Planner:
             cw = self.walker(keys[k])
             name = f"{seg.behaviour}/{seg.style}"
             slack = tolerance_frames(seg.frames)
+            walk = _first_walk if k == 0 else _walk
             if k == len(segs) - 1 or not plans[k]:
-                p, _, n = _walk(cw, enter, [seg.frames], [-1], name, slack)
+                p, _, n = walk(cw, enter, [seg.frames], [-1], name, slack)
                 pieces.extend(p)
                 achieved.append(n)
                 if k < len(segs) - 1:  # the same style again: continue from a frame that follows
@@ -1458,7 +1486,7 @@ class Planner:
                 continue
             options, _, exits = self.options(plans[k])
             own = np.array([seg.frames - o[0]["frames"] for o in options])  # the route out counts here
-            p, r, n = _walk(cw, enter, np.maximum(own, 1).tolist(), exits, name, slack)
+            p, r, n = walk(cw, enter, np.maximum(own, 1).tolist(), exits, name, slack)
             route, more_frames, enter = options[r]
             pieces.extend(p)
             pieces.extend(tuple(x) for x in route["pieces"])
