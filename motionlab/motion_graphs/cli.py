@@ -98,7 +98,8 @@ def register(subparsers) -> None:
             "--request",
             required=True,
             help='segments "behaviour:style:frames,...", e.g. "walk:angry:300,run:normal:200" '
-            "(at most 100000 frames in all)",
+            "(at most 100000 frames in all); a segment's frames include the recorded route out of it "
+            "(a blend of two styles or a transition clip) into the next",
         )
         cli_args.add_output(p, "motion file to write: .bvh, or .glb for binary glTF 2.0")
         p.add_argument(
