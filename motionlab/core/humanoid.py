@@ -21,6 +21,7 @@ Taught in ``notebooks/01_preprocessing.ipynb``.
 
 from __future__ import annotations
 
+import os
 import re
 from dataclasses import dataclass
 
@@ -192,9 +193,12 @@ def find_mapping(skeleton: Skeleton, profile: str | dict[str, str | None] | None
     ------
     RigMappingError naming the canonical joints that could not be found.
     """
+    bare = [strip_prefix(n) for n in skeleton.names]
+    shared = _shared_prefix(bare)
     lookup: dict[str, int] = {}
-    for i, n in enumerate(skeleton.names):
-        lookup.setdefault(strip_prefix(n).lower(), i)
+    for i, n in enumerate(bare):
+        lookup.setdefault(n.lower(), i)
+        lookup.setdefault(n[len(shared) :].lower(), i)
     if isinstance(profile, dict):
         _check_custom(profile)
         candidates = {"custom": {**_profile(), **profile}}
@@ -220,14 +224,28 @@ def find_mapping(skeleton: Skeleton, profile: str | dict[str, str | None] | None
             mapping = RigMapping(pname, tuple(source))
             _check_ancestry(skeleton, mapping)
             return mapping
-        if best is None or len(missing) < len(best[2]):
-            best = (len(missing), pname, missing)
+        found = sum(i >= 0 for i in source)
+        if best is None or (found, -len(missing)) > best[0]:
+            best = ((found, -len(missing)), pname, missing)
     assert best is not None
+    closest = (
+        f"closest profile {best[1]!r} misses {', '.join(best[2])}"
+        if best[0][0]
+        else f"no profile finds any of its joints (its names: {', '.join(skeleton.names[:4])}, …)"
+    )
     raise RigMappingError(
         f"skeleton with root {skeleton.names[0]!r} ({skeleton.num_joints} joints) does not map onto the "
-        f"22-joint humanoid: closest profile {best[1]!r} misses {', '.join(best[2])}.",
+        f"22-joint humanoid: {closest}.",
         "Pass profile={canonical: rig name} to map it by hand.",
     )
+
+
+def _shared_prefix(names: list[str]) -> str:
+    """The prefix every joint name shares, up to its last ``_``, ``.`` or ``-`` (``mixamorig_``,
+    where an exporter replaced the namespace's colon), else ``""``: it names no joint."""
+    prefix = os.path.commonprefix(names) if len(names) > 1 else ""
+    cut = max(prefix.rfind(c) for c in "_.-")
+    return prefix[: cut + 1]
 
 
 def _check_custom(profile: dict) -> None:

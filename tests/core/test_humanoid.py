@@ -66,7 +66,7 @@ def test_strip_prefix():
     assert humanoid.strip_prefix("Hips") == "Hips"
 
 
-@pytest.mark.parametrize("prefix", ["", "mixamorig:", "newVegas:"])
+@pytest.mark.parametrize("prefix", ["", "mixamorig:", "newVegas:", "mixamorig_", "Armature.mixamorig-"])
 def test_mixamo_reduction_is_exact(prefix, rng):
     rig = _mixamo_like(prefix)
     mapping = humanoid.find_mapping(rig)
@@ -99,6 +99,16 @@ def test_rotating_dropped_joint_keeps_positions_exact(rng):
     assert reduced.local_pos is not None
     full = motion.global_positions()[:, list(humanoid.find_mapping(rig).source)]
     np.testing.assert_allclose(reduced.global_positions(), full, atol=1e-9)
+
+
+def test_a_rig_whose_names_no_profile_knows_is_not_given_a_closest_profile():
+    """Every profile misses every joint of it: naming the one with the fewest joints to miss
+    (Bandai Namco's, whose Spine2 is None) as "closest" misled."""
+    sk = humanoid.canonical_skeleton()
+    odd = sk.renamed([f"bone{j:02d}" for j in range(sk.num_joints)])
+    with pytest.raises(humanoid.RigMappingError, match="no profile finds any of its joints") as e:
+        humanoid.find_mapping(odd)
+    assert "closest" not in str(e.value)
 
 
 def test_unmappable_rig_names_missing_joints():
