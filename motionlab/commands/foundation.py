@@ -69,14 +69,32 @@ def _info(args) -> int:
     return 0
 
 
+def _canonical(m, args):
+    """``m`` on the 22 joints, their rest the rig's standing pose (as retargeting reads it: a rig
+    whose rest offsets lie flat, Bandai Namco's, stands in its T-pose), every joint where it was;
+    the file's own rest where the rig has no standing pose, said unless ``--quiet``."""
+    from motionlab.core import humanoid, rest_pose
+
+    try:
+        reduced = humanoid.to_canonical(m)
+    except humanoid.RigMappingError as e:
+        raise rig_error(e, "input", args.input) from None
+    try:
+        return rest_pose.standing(reduced, family=humanoid.family(m.skeleton))[0]
+    except rest_pose.RestPoseError as e:
+        if not args.quiet:
+            print(f"{args.input}: rest pose kept as the file's ({e})")
+        return reduced
+
+
 def _convert(args) -> int:
     """reduce a BVH file to the 22-joint humanoid and/or resample it; write BVH or glTF (.glb)
 
-    Read a BVH file, optionally reduce it to the canonical 22 joints (--canonical) and resample it (--fps), and
-    write it as BVH (OUTPUT ending in .bvh, in the input's length unit) or binary glTF 2.0 (.glb, in metres;
-    docs/gltf.md).
+    Read a BVH file, optionally reduce it to the canonical 22 joints on their standing rest pose (--canonical) and
+    resample it (--fps), and write it as BVH (OUTPUT ending in .bvh, in the input's length unit) or binary glTF 2.0
+    (.glb, in metres; docs/gltf.md).
     """
-    from motionlab.core import humanoid, motion_files
+    from motionlab.core import motion_files
 
     cli_args.motion_output("-o", args.output)
     (out,) = check_outputs([("-o", args.output)], args.force, inputs=[("input", args.input)])
@@ -88,10 +106,7 @@ def _convert(args) -> int:
         )
     if args.canonical:  # the 22 joints' names read back as centimetres: write them in centimetres
         m, unit = motion_files.in_metres(m, unit), motion_files.CM
-        try:
-            m = humanoid.to_canonical(m)
-        except humanoid.RigMappingError as e:
-            raise rig_error(e, "input", args.input) from None
+        m = _canonical(m, args)
     if args.fps is not None:
         m = m.resample(args.fps)
     motion_files.save(out, m, overwrite=args.force, unit=unit)
@@ -161,7 +176,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         p.add_argument(
             "--canonical",
             action="store_true",
-            help="reduce to the canonical 22 joints (a .bvh is then written in centimetres)",
+            help="reduce to the canonical 22 joints, their rest the rig's standing pose (a .bvh is then written in "
+            "centimetres)",
         )
         p.add_argument(
             "--fps", type=cli_args.frame_rate, default=None, help="resample to this frame rate (frames per second)"

@@ -180,6 +180,29 @@ def test_a_cmu_clip_keeps_its_size_through_a_canonical_bvh(tmp_path, capsys):
     assert abs(two_steps - direct) < 1e-4 * direct
 
 
+@pytest.mark.parametrize(
+    "clip", ["bandai_namco/dataset-1/walk/dataset-1_walk_active_001.bvh", "cmu/131/131_01.bvh", "mixamo/Aj/Running.bvh"]
+)
+def test_a_canonical_file_stands_in_its_rigs_standing_pose(tmp_path, capsys, clip):
+    """The 22 joints rest in the standing pose retargeting reads off the rig: Bandai Namco's rest
+    offsets lie flat, and a canonical file that kept them read as a Mixamo rig standing 2.7 cm
+    taller than its source (the most upright frame's pose). Every joint stays where it was."""
+    from motionlab.core import motion_files, rest_pose
+    from tests.conftest import require_data
+
+    src = require_data(*clip.split("/"))
+    out = tmp_path / "canon.bvh"
+    code, _, err = _run(capsys, "convert", src, "-o", out, "--canonical", "-q")
+    assert code == 0, err
+    source = motion_files.load_metres(src)
+    canon = bvh.load(out)
+    standing = rest_pose.standing(humanoid.to_canonical(source), family=humanoid.family(source.skeleton))[0]
+    assert canon.skeleton.height() == pytest.approx(standing.skeleton.height(), abs=1e-5)
+    assert rest_pose.standing(canon)[0].skeleton.height() == pytest.approx(standing.skeleton.height(), abs=1e-4)
+    want = humanoid.to_canonical(source).global_positions()
+    np.testing.assert_allclose(canon.global_positions(), want, atol=1e-5 * np.abs(want).max())
+
+
 def test_info_gives_a_cmu_rig_in_metres(capsys):
     from tests.conftest import require_data
 
