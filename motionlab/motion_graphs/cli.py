@@ -152,6 +152,10 @@ def _build_outputs(args: argparse.Namespace) -> tuple[Path, Path | None]:
         raise CLIError(f"-o {out} is a folder; expected a graph file name, such as {out / 'graph.mlgraph'}")
     if out.suffix == "":
         out = out.with_suffix(".mlgraph")
+    if out.suffix.lower() in (".bvh", ".glb", ".json"):  # a motion or report name: the graph would be taken for one
+        raise CLIError(
+            f"-o {out} names a {out.suffix} file; a graph is written as .mlgraph, such as {out.with_suffix('.mlgraph')}"
+        )
     if args.report and args.standard:
         raise CLIError("--report needs a structured graph (leave out --standard, or leave out --report)")
     if not args.synthetic and not args.folder:

@@ -240,6 +240,14 @@ def test_the_structure_table_counts_the_graph_as_built(sgraph):
             assert sum(t["alive"] for t in cell["takes"]) == cell["alive"]
 
 
+@pytest.mark.parametrize("name", ["g.bvh", "g.GLB", "g.json"])
+def test_a_graph_is_not_written_under_a_motion_or_report_name(tmp_path, capsys, name):
+    """A graph written as ``g.bvh`` was then skipped, with a warning, by the next build of its folder."""
+    assert main(["graph-build", "--synthetic", "-o", str(tmp_path / name), "-q"]) == 2
+    assert "a graph is written as .mlgraph" in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())
+
+
 def test_build_names_skipped_files_reads_any_case_and_protects_its_inputs(library, tmp_path, capsys):
     from motionlab.core import bvh
 
