@@ -684,7 +684,7 @@ def fill(
         if method == "graph":
             out, gap = _fill_through_graph(out, start, stop, graph, curve, ref, feet)
         else:
-            out, gap = _fill_inside(out, start, stop, method, curve, root, ref, feet)
+            out, gap = _fill_inside(out, start, stop, method, curve, root, ref, feet, rehearse=motion)
         out = carry_by_reference(out, start - 1, stop, ref)  # the joints above the reference joint as recorded
         report.append(gap)
     return out, report
@@ -713,15 +713,18 @@ def _check_fill(motion: Motion, method: str, graph: ActionGraph | None, root: st
 
 
 def _fill_inside(out: Motion, start: int, stop: int, method: str, curve: str, root: str, ref: int, feet: str,
-                 rehearse: bool = True):  # fmt: skip
+                 rehearse: Motion | None = None):  # fmt: skip
     """One gap ``[start, stop)`` with known frames on both sides, filled without a graph (methods
-    ``"slerp"``, ``"hermite"``, ``"stride"`` of :func:`fill`; a stride fill only where it passes the
-    rehearsal, :func:`_stride_rehearsed`, unless ``rehearse`` is off) and kept out of the floor by
-    the :data:`FEET` rule ``feet``; returns the filled motion and its :class:`FilledGap`."""
+    ``"slerp"``, ``"hermite"``, ``"stride"`` of :func:`fill`; with ``rehearse``, the motion as
+    recorded, its gaps NaN, a stride fill only where it passes the rehearsal on it,
+    :func:`_stride_rehearsed`) and kept out of the floor by the :data:`FEET` rule ``feet``; returns
+    the filled motion and its :class:`FilledGap`."""
     a, b = start - 1, stop
     if method == "stride":
         strided = stride_fill(out, a, b, ref)
-        if strided is not None and (not rehearse or _stride_rehearsed(out, start, stop, (curve, root, ref, feet))):
+        if strided is not None and (
+            rehearse is None or _stride_rehearsed(rehearse, start, stop, (curve, root, ref, feet))
+        ):
             out = _floor_rule(feet)(_follow_strides(strided[0], a, b, ref, strided[1]), a, b)
             return out, FilledGap(start, stop, "stride")
     mode = "hermite" if method == "hermite" else "linear"  # stride: SLERP where no stride is found
@@ -753,8 +756,9 @@ def _stride_rehearsed(motion: Motion, start: int, stop: int, how: tuple) -> bool
     """Whether the stride fill keeps the gap ``[start, stop)``: it does unless the fill used where
     no stride is found (SLERP) comes nearer the truth on the rehearsal cuts
     (:func:`_rehearsal_cuts`; every joint's world position, mean over the cuts' frames): each gap
-    gets the fill that did better on the stream itself, near it. ``how``: ``(curve, root,
-    reference joint, feet)`` of :func:`_fill_inside`."""
+    gets the fill that did better on the stream itself, near it. ``motion``: as recorded, its
+    gaps NaN (a gap filled before is no truth to rehearse on); ``how``: ``(curve, root, reference
+    joint, feet)`` of :func:`_fill_inside`."""
     n = stop - start
     truth = motion.global_positions()
     error = {"stride": 0.0, "slerp": 0.0}
@@ -764,7 +768,7 @@ def _stride_rehearsed(motion: Motion, start: int, stop: int, how: tuple) -> bool
             if values is not None:
                 values[c : c + n] = np.nan
         for method in error:
-            filled, _ = _fill_inside(holed, c, c + n, method, *how, rehearse=False)
+            filled, _ = _fill_inside(holed, c, c + n, method, *how)
             error[method] += float(
                 np.linalg.norm(filled[c : c + n].global_positions() - truth[c : c + n], axis=-1).mean()
             )

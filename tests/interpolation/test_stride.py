@@ -137,3 +137,18 @@ def test_a_short_gap_is_filled_about_as_well_as_slerp_fills_it(rel):
                     np.linalg.norm(filled[start : start + n].global_positions() - truth, axis=-1).mean()
                 )
     assert np.mean(errors["stride"]) <= 1.5 * np.mean(errors["slerp"])
+
+
+def test_the_rehearsal_takes_no_filled_frame_for_truth(monkeypatch):
+    """Two gaps 20 frames apart: the second's rehearsal sees the first as missing, as recorded,
+    not as the frames the first fill made up."""
+    m = toy_motion(300)
+    holed, spans = gaps.insert_missing(gap_eval.cut(gap_eval.cut(m, 140, 4), 100, 4), [(99, 4), (135, 4)])
+    seen = []
+    real = gaps._stride_rehearsed
+    monkeypatch.setattr(gaps, "_stride_rehearsed", lambda motion, *a: seen.append(motion) or real(motion, *a))
+    gaps.fill(holed, method="stride")
+    assert len(seen) == 2
+    for motion in seen:
+        for start, stop in spans:
+            assert np.isnan(motion.local_rot[start:stop]).all()
