@@ -4,7 +4,9 @@ One rule for every command that writes a motion (``convert``, ``synth``, ``retar
 ``fill-gaps``, ``graph-search``, ``expand``):
 
 * ``.bvh`` writes BVH text (:func:`motionlab.core.bvh.dumps`), in the length unit of the file the
-  motion was read from, so a converted file keeps its numbers;
+  motion was read from, so a converted file keeps its numbers; a 22-joint humanoid (whose names
+  read back as centimetres) is given in metres by its writer (:func:`in_metres`) and so written
+  in centimetres;
 * ``.glb`` writes binary glTF 2.0 (:func:`motionlab.core.gltf.dumps`), whose unit is the metre;
 * any other suffix (``.gltf``, ``.fbx``, ``.txt``, none) is refused before any work.
 

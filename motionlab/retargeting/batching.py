@@ -165,12 +165,14 @@ def plan_batches(pairs: Sequence[Pair], max_frames: int, pad: bool = False) -> l
     return batches
 
 
-def quality(result: RetargetResult) -> dict[str, float]:
+def quality(result: RetargetResult, unit: float = 0.01) -> dict[str, float]:
     """Foot penetration (cm, mean depth of the four foot joints below y = 0) and skating (cm/s,
     mean horizontal foot speed while touching the ground) of a retargeted clip
-    (:func:`motionlab.core.metrics.foot_penetration` / :func:`~motionlab.core.metrics.foot_skating`)."""
+    (:func:`motionlab.core.metrics.foot_penetration` / :func:`~motionlab.core.metrics.foot_skating`).
+    ``unit``: metres per length unit of the target's file (:func:`motionlab.core.motion_files.file_unit`;
+    its positions were read as centimetres)."""
     feet = [humanoid.JOINTS.index(f) for f in humanoid.FEET]
-    pos = result.positions
+    pos = result.positions * (unit / 0.01)  # metres
     return {
         "penetration_cm": 100.0 * metrics.foot_penetration(pos, feet),
         "skating_cm_s": 100.0 * metrics.foot_skating(pos, feet, result.motion.fps),

@@ -98,14 +98,16 @@ def _cmd_retarget(args) -> int:
     ckpt = None if args.method == "copy" else cli_options.network_checkpoint(args, real.is_real_rig(source.skeleton))
     result = retarget(source, target, ckpt, args.method, solver, args.root, progress=not args.quiet, fps=args.fps)
     check = _check_result(args, result)
-    data = motion_files.encode(result.motion, suffix, motion_files.file_unit(base.skeleton))  # errors before writing
+    metres = motion_files.file_unit(base.skeleton) / motion_files.CM  # the target's file was read as centimetres
+    motion = motion_files.in_metres(result.motion, motion_files.file_unit(base.skeleton))
+    data = motion_files.encode(motion, suffix)  # 22 joints: centimetres in BVH; errors before writing
     outputs = [(out, lambda f: f.write(data), True, "output")]
     if npz is not None:  # both files or neither
         arrays = dict(
-            local_rot=result.motion.local_rot,
-            root_pos=result.motion.root_pos,
-            positions=result.positions,
-            offsets=result.motion.skeleton.offsets,
+            local_rot=motion.local_rot,
+            root_pos=motion.root_pos,
+            positions=metres * result.positions,
+            offsets=motion.skeleton.offsets,
             parents=result.motion.skeleton.parents,
             fps=result.motion.fps,
         )

@@ -528,7 +528,7 @@ class ExpandResult:
 def _row(pr: PairResult, src: _Source, char: Character, limits, suffix: str, out_motion, options: str) -> dict:
     res = pr.result
     h = res.history
-    q = quality(res)
+    q = quality(res, char.unit)
     flags = []
     if q["penetration_cm"] > limits[0]:
         flags.append("penetration")
@@ -846,7 +846,7 @@ def _output(pr: PairResult, sources_by_clip, chars, limits, suffix, options, fps
     motion = at_rate(pr.result, fps or src.fps, src.fps, src.frames).motion
     char = chars[pr.character]
     row = _row(pr, src, char, limits, suffix, motion, options)
-    data = motion_files.encode(motion, suffix, char.unit)
+    data = motion_files.encode(motion_files.in_metres(motion, char.unit), suffix)  # 22 joints: centimetres in BVH
     return row, row["output"], data, pr.result.plausibility.ok, pr.result.motion.num_frames
 
 
@@ -863,7 +863,8 @@ def prepare_clip(path, rest_from, targets, root_mode, solver, checkpoint=None):
     motion = rest_pose.on_reference(bvh.load(path), rest_from, str(path))
     prepared = prepare_source(motion, checkpoint, "full", solver)
     feet = [humanoid.JOINTS.index(f) for f in humanoid.FEET]
-    skating = 100.0 * metrics.foot_skating(prepared.motion.global_positions(), feet, prepared.motion.fps)
+    metres = motion_files.file_unit(motion.skeleton) / motion_files.CM  # the file was read as centimetres
+    skating = 100.0 * metrics.foot_skating(metres * prepared.motion.global_positions(), feet, prepared.motion.fps)
     jobs = {}
     for name, skeleton in targets:
         try:

@@ -583,6 +583,44 @@ def test_expand_writes_a_cmu_character_in_metres_in_gltf():
     assert (cmu.unit, mixamo.unit) == (motion_files.ASF_UNIT, motion_files.CM)
 
 
+def test_a_retargeted_cmu_character_reads_back_at_its_size(tmp_path, capsys):
+    """The 22 joints are written in centimetres: a BVH that kept CMU's unit under canonical names
+    read back as a 0.22 m figure (info, convert, view), where its .glb was 1.28 m. ``expand``'s
+    files and manifest say the same size."""
+    from motionlab.core import motion_files, rest_pose
+    from tests.conftest import require_data
+
+    source, target = require_data("mixamo", "Aj", "Run_Arc_Left.bvh"), require_data("cmu", "131", "131_02.bvh")
+    out = tmp_path / "out.bvh"
+    code, _, err = _run(capsys, "retarget", source, "--target", target, "--method", "copy", "-o", out, "-q")
+    assert code == 0, err
+    standing = rest_pose.standing(humanoid.to_canonical(motion_files.load_metres(target)))[0]
+    assert bvh.load(out).skeleton.height() == pytest.approx(standing.skeleton.height(), rel=1e-4)  # 1.24 m
+    code, _, err = _run(
+        capsys, "expand", source, "--characters", f"CMU={target}", "--network", "synthetic", "--steps", "2",
+        "-o", tmp_path / "x", "-q",
+    )  # fmt: skip
+    assert code == 0, err
+    assert bvh.load(tmp_path / "x" / "CMU" / "Run_Arc_Left.bvh").skeleton.height() == pytest.approx(
+        standing.skeleton.height(), rel=1e-4
+    )
+
+
+def test_manifest_quality_is_measured_in_metres_of_the_target():
+    """Feet 2 units up in a CMU file (11 cm) do not touch the ground; read as centimetres they did."""
+    from types import SimpleNamespace
+
+    from motionlab.core import motion_files
+    from motionlab.retargeting import batching
+
+    pos = np.zeros((30, 22, 3))
+    pos[:, :, 1] = 0.02  # as read: 2 file units
+    pos[:, :, 0] = np.linspace(0.0, 0.3, 30)[:, None]  # sliding 0.3 units a second
+    result = SimpleNamespace(positions=pos, motion=SimpleNamespace(fps=30.0))
+    assert batching.quality(result)["skating_cm_s"] > 0  # centimetres: on the ground, sliding
+    assert batching.quality(result, motion_files.ASF_UNIT)["skating_cm_s"] == 0.0  # 11 cm up: in the air
+
+
 def test_an_input_that_is_a_named_pipe_is_refused_not_waited_on(tmp_path, capsys):
     os.mkfifo(tmp_path / "pipe.bvh")
     code, _, err = _run(capsys, "convert", tmp_path / "pipe.bvh", "-o", tmp_path / "x.bvh")

@@ -7,7 +7,7 @@ import pytest
 
 from motionlab import retargeting, synthetic
 from motionlab.cli import main
-from motionlab.core import bvh, contacts, humanoid, preprocess, quat, rest_pose
+from motionlab.core import bvh, contacts, humanoid, motion_files, preprocess, quat, rest_pose
 from motionlab.core.motion import Motion
 from motionlab.core.skeleton import Skeleton
 from motionlab.retargeting import expand, pipeline
@@ -156,8 +156,10 @@ def test_a_real_take_copied_onto_its_own_rig_stays_where_it_was(tmp_path, parts)
     take = require_data(*parts)
     out = tmp_path / "out.bvh"
     assert main(["retarget", str(take), "--target", str(take), "--method", "copy", "-o", str(out), "-q"]) == 0
-    source = preprocess.prepare(bvh.load(take), None, stand=True).global_positions()
-    assert np.median(source[..., 1].min(axis=1)) > 0.05 * humanoid.leg_length(pipeline.target_skeleton(bvh.load(take)))
+    source = preprocess.prepare(motion_files.load_metres(take), None, stand=True).global_positions()
+    rig = pipeline.target_skeleton(motion_files.load_metres(take))
+    assert np.median(source[..., 1].min(axis=1)) > 0.05 * humanoid.leg_length(rig)
+    # the 22 joints are written in centimetres, whatever the take's unit (CMU's is 1/0.45 inch)
     np.testing.assert_allclose(bvh.load(out).global_positions(), source, atol=1e-4)  # BVH's printed digits
 
 
