@@ -50,7 +50,7 @@ from motionlab.interpolation.features import pose_features
 from motionlab.interpolation.footing import lowest_joints, plant_feet
 from motionlab.interpolation.library import MotionLibrary
 from motionlab.interpolation.slerp import alphas
-from motionlab.interpolation.stride import side_speeds, stride_fill, stride_path
+from motionlab.interpolation.stride import SIDE_SECONDS, side_speeds, stride_fill, stride_path
 
 __all__ = [
     "METHODS",
@@ -759,7 +759,9 @@ def _stride_rehearsed(motion: Motion, start: int, stop: int, how: tuple) -> bool
     gets the fill that did better on the stream itself, near it. ``motion``: as recorded, its
     gaps NaN (a gap filled before is no truth to rehearse on); ``how``: ``(curve, root, reference
     joint, feet)`` of :func:`_fill_inside`."""
-    n = stop - start
+    n, reach = stop - start, int(np.ceil((detect.REHEARSAL_SECONDS + SIDE_SECONDS) * motion.fps)) + 2
+    lo = max(0, start - reach)  # what a cut's fills read: its strides, within SIDE_SECONDS of it
+    motion, start, stop = motion[lo : stop + reach], start - lo, stop - lo
     truth = motion.global_positions()
     error = {"stride": 0.0, "slerp": 0.0}
     for c in _rehearsal_cuts(motion, start, stop):
