@@ -1001,19 +1001,21 @@ def _rotation_angles(local_rot: np.ndarray, layouts, names, precision: int) -> d
         # frame 0's angles lie in (-180, 180]: -180 and 180 (the same turn) must not flip between writes
         degrees = np.degrees(split)
         degrees[degrees <= -180.0 + 0.5 * 10.0**-precision] += 360.0
-        degrees = _continuous(degrees)
+        degrees = _continuous(degrees, min(1.0, 50.0 * 10.0**-precision))  # far above the digits' rounding
         for n, j in enumerate(joints):
             angles[j] = degrees[:, n]
     return angles
 
 
-def _continuous(degrees: np.ndarray) -> np.ndarray:
+def _continuous(degrees: np.ndarray, margin: float) -> np.ndarray:
     """Euler angles (T, n, k), degrees, each frame's own, as curves without jumps.
 
     With three axes a rotation has two triples, ``(a, b, c)`` and ``(a + 180, 180 - b, c + 180)``;
-    each frame takes the one nearer the frame before's choice (whether a frame swaps is the parity
-    of the swaps up to it, so no loop over frames). Then whole turns are added so that no channel
-    steps by more than 180 degrees. Frame 0 keeps its values; every frame keeps its rotation.
+    each frame takes the other triple where it lies nearer the frame before's choice by more than
+    ``margin`` (whether a frame swaps is the parity of the swaps up to it, so no loop over frames).
+    Then whole turns are added where a channel steps by more than 180 + ``margin`` degrees. Frame
+    0 keeps its values; every frame keeps its rotation. The margins keep a file read and written
+    again on the same choices where a tie (a step of exactly 180) meets the printed digits' rounding.
     """
     if len(degrees) < 2:
         return degrees
@@ -1024,10 +1026,12 @@ def _continuous(degrees: np.ndarray) -> np.ndarray:
         def apart(x, y):  # (T-1, n): summed turn between two triples, each channel modulo 360
             return np.abs((x - y + 180.0) % 360.0 - 180.0).sum(-1)
 
-        swap = apart(other[1:], degrees[:-1]) < apart(degrees[1:], degrees[:-1])
+        swap = apart(other[1:], degrees[:-1]) + margin < apart(degrees[1:], degrees[:-1])
         odd = np.concatenate([np.zeros_like(swap[:1]), np.cumsum(swap, axis=0) % 2 == 1])
         degrees = np.where(odd[..., None], other, degrees)
-    return np.unwrap(degrees, period=360.0, axis=0)
+    step = np.diff(degrees, axis=0)
+    turns = -np.floor((step + 180.0 - margin) / 360.0)  # 0 for steps in [-180 + margin, 180 + margin)
+    return degrees + 360.0 * np.concatenate([np.zeros_like(turns[:1]), np.cumsum(turns, axis=0)])
 
 
 def _channel_columns(translations, angles, layouts, skeleton: Skeleton, scale: float, pos_tol: float) -> list:
