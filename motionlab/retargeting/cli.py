@@ -98,8 +98,8 @@ def _cmd_retarget(args) -> int:
     ckpt = None if args.method == "copy" else cli_options.network_checkpoint(args, real.is_real_rig(source.skeleton))
     result = retarget(source, target, ckpt, args.method, solver, args.root, progress=not args.quiet, fps=args.fps)
     check = _check_result(args, result)
-    metres = motion_files.file_unit(base.skeleton) / motion_files.CM  # the target's file was read as centimetres
-    motion = motion_files.in_metres(result.motion, motion_files.file_unit(base.skeleton))
+    unit = motion_files.file_unit(base.skeleton)  # the target's file was read as centimetres
+    metres, motion = unit / motion_files.CM, motion_files.in_metres(result.motion, unit)
     data = motion_files.encode(motion, suffix)  # 22 joints: centimetres in BVH; errors before writing
     outputs = [(out, lambda f: f.write(data), True, "output")]
     if npz is not None:  # both files or neither
